@@ -1,0 +1,2 @@
+"""infomarket."""
+__version__ = "0.1.0"
