@@ -1,2 +1,20 @@
-"""infomarket."""
+"""infomarket: a swarm of foraging robots that buy and sell navigation information.
+
+Quick use::
+
+    import infomarket as im
+    cfg = im.load_experiment("fig2B")
+    res = im.simulate(cfg, seed=1)
+    res.robots.groupby("honest").items_collected.median()
+
+New behaviours and payment schemes: ``im.register_behaviour`` / ``im.register_payment`` (docs/extending.md).
+"""
 __version__ = "0.1.0"
+
+from .config import Experiment, load_experiment  # noqa: E402
+from .engine import Result, Simulation, simulate  # noqa: E402
+from .errors import ConfigError, InfomarketError, SimulationError  # noqa: E402
+from .registry import behaviour, payment, register_behaviour, register_payment  # noqa: E402
+
+__all__ = ["ConfigError", "Experiment", "InfomarketError", "Result", "Simulation", "SimulationError",
+           "behaviour", "load_experiment", "payment", "register_behaviour", "register_payment", "simulate"]

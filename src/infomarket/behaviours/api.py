@@ -1,0 +1,162 @@
+"""What a behaviour's rules may call: reading offers, buying, combining, and the pending list.
+
+All helpers are compiled functions over the world tuple ``w`` (fields in ``engine.world``), so a rule
+written with them runs inside the compiled step loop.  Sites are 0 (food) and 1 (nest); vectors are in
+the calling robot's own frame (x axis along its heading).
+
+Timing (MODEL.md §3): during the communication phase sellers sell from the table they had at the start
+of the step (``own_entry``), while a buyer's purchases go into its new table (``current`` / ``install``
+/ ``combine``), which it starts using when it moves.  Stakes and the pending list change at once.
+"""
+from numba import njit
+
+from ..engine.geometry import direction, norm
+from ..engine.kernels import to_frame, to_world
+from ..ledger.kernels import open_transaction, purchase_events
+
+#: ``diff`` of a zero vector (eq. 6 divides by its norm).
+DIFF_OF_ZERO = 1000.0
+
+
+@njit(inline="always")
+def own_entry(w, me, site):
+    """The robot's own table entry as it was at the start of the step: (valid, x, y, age)."""
+    return w.tab_valid[me, site], w.tab_vec[me, site, 0], w.tab_vec[me, site, 1], w.tab_age[me, site]
+
+
+@njit(inline="always")
+def current(w, me, site):
+    """The robot's table entry including this step's purchases: (valid, x, y, age)."""
+    return w.new_valid[me, site], w.new_vec[me, site, 0], w.new_vec[me, site, 1], w.new_age[me, site]
+
+
+@njit(inline="always")
+def offer(w, seller, site):
+    """What a buyer sees of a seller's offer before buying: (valid, age)."""
+    return w.off_valid[seller, site], w.off_age[seller, site]
+
+
+@njit
+def next_candidate(w, nbrs, site, after_age, after_id):
+    """The neighbour with a valid offer that comes next after (after_age, after_id) in (age, id) order,
+    or -1.  Start with (-1, -1) to get the freshest offer; ties go to the lower id."""
+    best = -1
+    best_age = 0
+    for j in range(nbrs.shape[0]):
+        s = nbrs[j]
+        if not w.off_valid[s, site]:
+            continue
+        a = w.off_age[s, site]
+        if a < after_age or (a == after_age and s <= after_id):
+            continue
+        if best < 0 or a < best_age or (a == best_age and s < best):
+            best = s
+            best_age = a
+    return best
+
+
+@njit
+def buy(w, me, seller, site):
+    """Buy the seller's offer for ``site``: (ok, x, y, age), the vector in the buyer's frame.
+
+    The offer is rotated into the buyer's frame and recorded as a transaction (direction before the
+    position offset); under staking the seller locks the stake first and a seller that cannot pay is
+    refused (ok False, nothing recorded).  Robots in communication cooldown cannot trade.  The returned
+    vector is the rotated offer plus the seller's position in the buyer's frame.
+    """
+    if not w.off_valid[seller, site] or w.cool_timer[me] > 0 or w.cool_timer[seller] > 0:
+        return False, 0.0, 0.0, 0
+    gx, gy = to_world(w, seller, w.off_vec[seller, site, 0], w.off_vec[seller, site, 1])
+    rx, ry = to_frame(w, me, gx, gy)
+    d = direction(rx, ry)
+    ox, oy = to_frame(w, me, w.pos[seller, 0] - w.pos[me, 0], w.pos[seller, 1] - w.pos[me, 1])
+    age = w.off_age[seller, site]
+    ok = open_transaction(w, me, seller, site, d)
+    purchase_events(w, ok, me, seller, site, d, rx + ox, ry + oy, age)
+    if not ok:
+        return False, 0.0, 0.0, 0
+    if w.stop_time > 0 or w.cooldown > 0:
+        for r in (me, seller):
+            w.stop_timer[r] = w.stop_time
+            w.cool_timer[r] = w.stop_time + w.cooldown
+    return True, rx + ox, ry + oy, age
+
+
+@njit
+def weighted(ax, ay, a_age, bx, by, b_age):
+    """Age-weighted average of eqs. (4)-(5): the younger information gets the larger weight.
+    Returns (x, y, age) with age floor((a + b) / 2); equal weights when both ages are 0."""
+    total = a_age + b_age
+    if total == 0:
+        return 0.5 * (ax + bx), 0.5 * (ay + by), 0
+    wa = a_age / total  # weight of b (the other's) information is a's age share, and vice versa
+    wb = b_age / total
+    return wa * bx + wb * ax, wa * by + wb * ay, total // 2
+
+
+@njit(inline="always")
+def install(w, me, site, x, y, age):
+    """Make (x, y, age) the robot's valid entry for ``site`` (takes effect when it moves)."""
+    w.new_vec[me, site, 0] = x
+    w.new_vec[me, site, 1] = y
+    w.new_age[me, site] = age
+    w.new_valid[me, site] = True
+
+
+@njit
+def combine(w, me, site, x, y, age):
+    """Combine bought information with the robot's current entry (eqs. 4-5) and install the result;
+    an invalid entry is replaced by the bought vector (its age still averaged, as the original does)."""
+    valid, ox, oy, oage = current(w, me, site)
+    nx, ny, nage = weighted(ox, oy, oage, x, y, age)
+    if not valid:
+        nx, ny = x, y
+    install(w, me, site, nx, ny, nage)
+
+
+@njit
+def diff(ax, ay, bx, by):
+    """Difference score of eq. (6): |a - b| / |a|, and 1000 when |a| = 0."""
+    na = norm(ax, ay)
+    if na == 0.0:
+        return DIFF_OF_ZERO
+    return norm(ax - bx, ay - by) / na
+
+
+@njit(inline="always")
+def pending_count(w, me, site):
+    return w.pend_count[me, site]
+
+
+@njit(inline="always")
+def pending_get(w, me, site, j):
+    """The j-th pending entry (insertion order): (seller, x, y, age)."""
+    return (w.pend_seller[me, site, j], w.pend_vec[me, site, j, 0], w.pend_vec[me, site, j, 1],
+            w.pend_age[me, site, j])
+
+
+@njit(inline="always")
+def pending_has(w, me, site, seller):
+    for j in range(w.pend_count[me, site]):
+        if w.pend_seller[me, site, j] == seller:
+            return True
+    return False
+
+
+@njit
+def pending_add(w, me, site, seller, x, y, age):
+    """Append a purchase to the pending list; the list holds at most one entry per seller."""
+    k = w.pend_count[me, site]
+    if k >= w.pend_seller.shape[2]:
+        return False
+    w.pend_seller[me, site, k] = seller
+    w.pend_vec[me, site, k, 0] = x
+    w.pend_vec[me, site, k, 1] = y
+    w.pend_age[me, site, k] = age
+    w.pend_count[me, site] = k + 1
+    return True
+
+
+@njit(inline="always")
+def pending_clear(w, me, site):
+    w.pend_count[me, site] = 0

@@ -1,0 +1,30 @@
+"""Naive robots: buy the freshest offer younger than their own entry, sell their own entry."""
+from ..registry import register_behaviour
+from .api import buy, combine, current, next_candidate, own_entry
+
+
+def naive_buy(w, me, nbrs):
+    """Per site, candidates in (offered age, id) order: buy from the first whose age is below the
+    robot's own, combine (eqs. 4-5); one purchase per site per step, a refused one moves on."""
+    for site in range(2):
+        age_seen, s = -1, -1
+        while True:
+            s = next_candidate(w, nbrs, site, age_seen, s)
+            if s < 0:
+                break
+            age_seen = w.off_age[s, site]
+            if age_seen >= current(w, me, site)[3]:
+                break
+            ok, x, y, age = buy(w, me, s, site)
+            if ok:
+                combine(w, me, site, x, y, age)
+                break
+
+
+def honest_sell(w, me, site):
+    """Sell the entry as it is."""
+    return own_entry(w, me, site)
+
+
+register_behaviour("naive", buy=naive_buy, sell=honest_sell, honest=True,
+                   description="buys younger information and averages it in; sells its own entry")

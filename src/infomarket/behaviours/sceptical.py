@@ -1,0 +1,45 @@
+"""Sceptical robots: use bought information only when something confirms it (eq. 6, pending list)."""
+from ..registry import register_behaviour
+from .api import (buy, combine, current, diff, install, next_candidate, pending_add, pending_clear,
+                  pending_count, pending_get, pending_has, weighted)
+
+
+def sceptical_buy(w, me, nbrs, threshold=0.25):
+    """Per site, every candidate (in offered-age order) younger than the current entry and not already
+    pending is bought; it is used if it agrees with the own entry (diff < threshold, or the entry is
+    invalid), or with a pending purchase, which it is then averaged with; otherwise it waits, pending."""
+    for site in range(2):
+        age_seen, s = -1, -1
+        while True:
+            s = next_candidate(w, nbrs, site, age_seen, s)
+            if s < 0:
+                break
+            age_seen = w.off_age[s, site]
+            valid, ox, oy, oage = current(w, me, site)
+            if age_seen >= oage:
+                break
+            if pending_has(w, me, site, s):
+                continue
+            ok, x, y, age = buy(w, me, s, site)
+            if not ok:
+                continue
+            if not valid or diff(ox, oy, x, y) < threshold:
+                combine(w, me, site, x, y, age)
+                pending_clear(w, me, site)
+                continue
+            confirmed = False
+            for j in range(pending_count(w, me, site)):
+                _, px, py, page = pending_get(w, me, site, j)
+                if diff(px, py, x, y) < threshold:
+                    cx, cy, cage = weighted(px, py, page, x, y, age)
+                    install(w, me, site, cx, cy, cage)
+                    confirmed = True
+                    break
+            if confirmed:
+                pending_clear(w, me, site)
+            else:
+                pending_add(w, me, site, s, x, y, age)
+
+
+register_behaviour("sceptical", buy=sceptical_buy, sell="naive", honest=True,
+                   description="waits for a second, agreeing piece of information before using it")

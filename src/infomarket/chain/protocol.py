@@ -1,0 +1,189 @@
+"""The off-chain half of a sale: the light contract (paper, Methods, last section; MODEL.md section 9).
+
+1. The seller, having sensed the buyer's relative pose, computes the path information in the buyer's
+   frame (``path_in_buyer_frame``), commits to it with a salted hash, and signs an ``Offer`` (site,
+   age, max block, hash) as EIP-712 typed data. The offer is addressed to one buyer because the hash
+   commits to information in that buyer's frame.
+2. The buyer checks the seller's signature and signs an ``Acceptance`` (the offer, itself, and the
+   seller's position in its own frame). That double-signed pair is the ``LightContract``.
+3. The seller submits ``revealInformation(lightContract, pathInfo)``; the contract checks the buyer's
+   signature against its own EIP-712 domain (name, version, chain id, contract address), so a
+   signature is good for one contract on one chain only.
+
+Signatures are produced by eth-account, which always emits the low-s form the contract requires.
+"""
+from __future__ import annotations
+
+import secrets
+from dataclasses import dataclass, field
+
+from eth_abi import encode as abi_encode
+from eth_account import Account
+from eth_account.messages import encode_typed_data
+from eth_utils import keccak, to_checksum_address
+
+from ..engine.geometry import direction, rotate
+from .errors import ChainError
+from .units import to_micro, to_microdegrees
+
+FOOD, NEST = 0, 1
+#: Order of the secp256k1 group; a signature's twin with s' = N - s recovers to the same signer.
+SECP256K1_N = 0xFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFEBAAEDCE6AF48A03BBFD25E8CD0364141
+
+_OFFER_FIELDS = [
+    {"name": "seller", "type": "address"},
+    {"name": "site", "type": "uint8"},
+    {"name": "age", "type": "uint32"},
+    {"name": "maxBlock", "type": "uint64"},
+    {"name": "pathHash", "type": "bytes32"},
+]
+_ACCEPTANCE_FIELDS = [
+    {"name": "offer", "type": "Offer"},
+    {"name": "buyer", "type": "address"},
+    {"name": "sellerX", "type": "int64"},
+    {"name": "sellerY", "type": "int64"},
+]
+_DOMAIN_FIELDS = [
+    {"name": "name", "type": "string"},
+    {"name": "version", "type": "string"},
+    {"name": "chainId", "type": "uint256"},
+    {"name": "verifyingContract", "type": "address"},
+]
+
+
+class ProtocolError(ChainError, ValueError):
+    """A light contract was malformed or badly signed before it ever reached the chain."""
+
+
+@dataclass(frozen=True)
+class Domain:
+    """The EIP-712 domain of one deployed market (what binds a signature to it)."""
+
+    chain_id: int
+    verifying_contract: str
+    name: str = "InformationMarket"
+    version: str = "1"
+
+    def as_dict(self) -> dict:
+        return {
+            "name": self.name,
+            "version": self.version,
+            "chainId": self.chain_id,
+            "verifyingContract": to_checksum_address(self.verifying_contract),
+        }
+
+
+@dataclass(frozen=True)
+class PathInfo:
+    """Revealed path information in the buyer's frame, fixed point (see ``units``)."""
+
+    x: int
+    y: int
+    direction: int
+    salt: bytes = field(default_factory=lambda: secrets.token_bytes(32))
+
+    @classmethod
+    def from_floats(cls, x: float, y: float, direction_deg: float, salt: bytes | None = None) -> PathInfo:
+        """Encode a purchased vector and the direction of the rotated offer (degrees)."""
+        return cls(to_micro(x), to_micro(y), to_microdegrees(direction_deg), salt or secrets.token_bytes(32))
+
+    def digest(self) -> bytes:
+        """The commitment the offer carries: ``keccak256(abi.encode(x, y, direction, salt))``."""
+        return keccak(abi_encode(["int64", "int64", "uint32", "bytes32"], list(self.as_abi())))
+
+    def as_abi(self) -> tuple:
+        return (self.x, self.y, self.direction, self.salt)
+
+
+@dataclass(frozen=True)
+class Offer:
+    """A seller's signed-to-be offer: the information is hidden behind ``path_hash``."""
+
+    seller: str
+    site: int
+    age: int
+    max_block: int
+    path_hash: bytes
+
+    def as_abi(self) -> tuple:
+        return (to_checksum_address(self.seller), self.site, self.age, self.max_block, self.path_hash)
+
+    def message(self) -> dict:
+        return dict(zip(("seller", "site", "age", "maxBlock", "pathHash"), self.as_abi()))
+
+
+@dataclass(frozen=True)
+class LightContract:
+    """The double-signed agreement; ``v, r, s`` is the buyer's signature over the acceptance."""
+
+    offer: Offer
+    offer_signature: bytes
+    buyer: str
+    seller_x: int
+    seller_y: int
+    v: int
+    r: bytes
+    s: bytes
+
+    def as_abi(self) -> tuple:
+        return (self.offer.as_abi(), to_checksum_address(self.buyer), self.seller_x, self.seller_y,
+                self.v, self.r, self.s)
+
+
+def offer_typed_data(domain: Domain, offer: Offer) -> dict:
+    """EIP-712 message the seller signs."""
+    return {
+        "types": {"EIP712Domain": _DOMAIN_FIELDS, "Offer": _OFFER_FIELDS},
+        "primaryType": "Offer",
+        "domain": domain.as_dict(),
+        "message": offer.message(),
+    }
+
+
+def acceptance_typed_data(domain: Domain, offer: Offer, buyer: str, seller_x: int, seller_y: int) -> dict:
+    """EIP-712 message the buyer signs (the contract's ``acceptanceDigest`` hashes the same thing)."""
+    return {
+        "types": {"EIP712Domain": _DOMAIN_FIELDS, "Offer": _OFFER_FIELDS, "Acceptance": _ACCEPTANCE_FIELDS},
+        "primaryType": "Acceptance",
+        "domain": domain.as_dict(),
+        "message": {"offer": offer.message(), "buyer": to_checksum_address(buyer),
+                    "sellerX": seller_x, "sellerY": seller_y},
+    }
+
+
+def sign_offer(seller_key: bytes, domain: Domain, offer: Offer) -> bytes:
+    """The seller's 65-byte signature over its offer."""
+    if Account.from_key(seller_key).address != to_checksum_address(offer.seller):
+        raise ProtocolError("an offer can only be signed by the seller it names")
+    return bytes(Account.sign_typed_data(seller_key, full_message=offer_typed_data(domain, offer)).signature)
+
+
+def accept_offer(buyer_key: bytes, domain: Domain, offer: Offer, offer_signature: bytes,
+                 seller_position: tuple[float, float]) -> LightContract:
+    """The buyer's side: check who made the offer, then sign the acceptance.
+
+    ``seller_position`` is the seller's position in the buyer's frame, as the buyer senses it; signing
+    it lets anyone audit, after the reveal, that the revealed direction is that of the revealed vector
+    minus this position.
+    """
+    signer = Account.recover_message(encode_typed_data(full_message=offer_typed_data(domain, offer)),
+                                     signature=offer_signature)
+    if signer != to_checksum_address(offer.seller):
+        raise ProtocolError(f"offer claims seller {offer.seller} but is signed by {signer}")
+    buyer = Account.from_key(buyer_key).address
+    sx, sy = to_micro(seller_position[0]), to_micro(seller_position[1])
+    signed = Account.sign_typed_data(buyer_key, full_message=acceptance_typed_data(domain, offer, buyer, sx, sy))
+    return LightContract(offer, offer_signature, buyer, sx, sy, signed.v,
+                         signed.r.to_bytes(32, "big"), signed.s.to_bytes(32, "big"))
+
+
+def path_in_buyer_frame(vector: tuple[float, float], heading_offset_deg: float,
+                        seller_position: tuple[float, float]) -> tuple[float, float, float]:
+    """What the seller reveals (MODEL.md section 4): its vector rotated into the buyer's frame by
+    ``heading_seller - heading_buyer``, plus its own position in the buyer's frame.
+
+    Returns ``(x, y, direction_deg)``; the direction is that of the rotated vector before the offset,
+    which is what the outlier rule compares.
+    """
+    rx, ry = rotate(vector[0], vector[1], heading_offset_deg)
+    return rx + seller_position[0], ry + seller_position[1], direction(rx, ry)

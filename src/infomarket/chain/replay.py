@@ -1,0 +1,167 @@
+"""Replay a simulator's event log through the contract, and compare the two ledgers.
+
+The simulator's ledger and the contract implement the same rules (MODEL.md section 5) in floats and
+in fixed point. Feeding the contract the same events (every purchase as a real light contract
+revealed by its seller, every deposit as the market's ``buyItem``) and comparing every robot's final
+balance is the conformance check between the two backends.
+
+How close must they be? Each share the contract pays is floored to a whole unit (1e-9 token) and the
+remainder stays with the depositing robot, so a robot's on-chain balance may differ from the exact
+value by less than one unit per share it received or paid out; ``ReplayReport.rounding_bound`` counts
+exactly those, per robot. The simulator's float error is below 1e-3 unit for runs of this size, so the
+comparison allows ``FLOAT_SLACK_UNITS`` on top of the bound and nothing more.
+"""
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from statistics import mean
+
+from .errors import ChainError, ContractRevert
+from .market import ChainMarket, MarketParams, connect, derived_account, fund_gas
+from .protocol import PathInfo
+from .units import TOKEN_UNIT, to_units
+
+#: Allowance for the simulator's own floating-point error, in units (1e-9 token).
+FLOAT_SLACK_UNITS = 0.5
+SITE_CODES = {0: 0, 1: 1, "food": 0, "nest": 1}
+
+
+@dataclass(frozen=True)
+class BalanceRow:
+    """One robot's balance on chain against the simulated ledger."""
+
+    robot: int
+    chain_units: int
+    expected: float
+    bound_units: int
+
+    @property
+    def diff_units(self) -> float:
+        return self.chain_units - self.expected * TOKEN_UNIT
+
+    @property
+    def ok(self) -> bool:
+        return abs(self.diff_units) <= self.bound_units + FLOAT_SLACK_UNITS
+
+
+@dataclass
+class ReplayReport:
+    """What the replay cost and the state it left on chain."""
+
+    robots: int
+    reveal_gas: list[int] = field(default_factory=list)
+    buy_gas: list[int] = field(default_factory=list)
+    first_block: int = 0
+    last_block: int = 0
+    refusals_confirmed: int = 0
+    disagreements: list[str] = field(default_factory=list)
+    balances: list[int] = field(default_factory=list)
+    pots: list[int] = field(default_factory=list)
+    rounding_bound: list[int] = field(default_factory=list)
+    total_supply: int = 0
+    minted: int = 0
+
+    @property
+    def items(self) -> int:
+        return len(self.buy_gas)
+
+    @property
+    def blocks_used(self) -> int:
+        return self.last_block - self.first_block
+
+    @property
+    def gas_per_item(self) -> float:
+        """All the gas of the market's activity (reveals and buys) per item delivered."""
+        return (sum(self.reveal_gas) + sum(self.buy_gas)) / self.items if self.items else float("nan")
+
+    def conserved(self) -> bool:
+        """Money on chain is exactly what was granted plus the rewards: nothing created or lost."""
+        return sum(self.balances) + sum(self.pots) == self.total_supply == self.minted
+
+    def compare(self, expected: Sequence[float]) -> list[BalanceRow]:
+        """Each robot's on-chain balance against ``expected`` (the simulated ledger's, in tokens)."""
+        if len(expected) != self.robots:
+            raise ValueError(f"expected {self.robots} balances, got {len(expected)}")
+        return [BalanceRow(i, self.balances[i], float(expected[i]), self.rounding_bound[i])
+                for i in range(self.robots)]
+
+    def summary(self) -> dict[str, float]:
+        def avg(xs: list[int]) -> float:
+            return mean(xs) if xs else float("nan")
+
+        return {"reveals": len(self.reveal_gas), "items": self.items, "gas_per_reveal": avg(self.reveal_gas),
+                "gas_per_buy_item": avg(self.buy_gas), "max_gas_buy_item": max(self.buy_gas, default=0),
+                "gas_per_item": self.gas_per_item, "blocks_used": self.blocks_used,
+                "refusals_confirmed": self.refusals_confirmed}
+
+
+def replay_on_chain(events: Iterable[Mapping] | object, *, robots: int, params: MarketParams,
+                    initial_wealth: float, rpc_url: str | None = None, seed: int = 0,
+                    blocks_valid: int = 8) -> ReplayReport:
+    """Deploy a market, give ``robots`` accounts their initial wealth, and replay ``events``.
+
+    ``events`` are the simulator's event records (a DataFrame or mappings) with ``kind`` in
+    ``purchase | refused | deposit``, ``buyer``, ``seller``, ``site``, ``direction_deg``, ``x``, ``y``,
+    ``age``, and optionally ``seller_x``/``seller_y`` (the seller's position in the buyer's frame,
+    which the buyer signs; (0, 0) when the log does not carry it). A purchase the chain refuses, or a
+    refusal the chain would accept, is recorded in ``disagreements`` rather than stopping the replay.
+    """
+    w3 = connect(rpc_url)
+    market = ChainMarket.deploy(params, w3=w3, seed=seed)
+    accounts = [derived_account("robot", i, seed) for i in range(robots)]
+    fund_gas(w3, [a.address for a in accounts])
+    wealth = to_units(initial_wealth)
+    for a in accounts:
+        market.grant_wealth(a.address, wealth)
+
+    report = ReplayReport(robots, first_block=w3.eth.block_number, rounding_bound=[0] * robots,
+                          minted=wealth * robots)
+    open_sellers: list[list[int]] = [[] for _ in range(robots)]
+    records = events.to_dict("records") if hasattr(events, "to_dict") else events
+    for number, ev in enumerate(records):
+        kind = ev["kind"]
+        if kind == "deposit":
+            buyer = int(ev["buyer"])
+            report.buy_gas.append(market.buy_item(accounts[buyer].address).gas_used)
+            report.minted += params.reward
+            _count_rounding(report.rounding_bound, buyer, open_sellers[buyer])
+            open_sellers[buyer] = []
+            continue
+        if kind not in ("purchase", "refused"):
+            raise ChainError(f"event {number}: unknown kind {kind!r}")
+        buyer, seller = int(ev["buyer"]), int(ev["seller"])
+        info = PathInfo.from_floats(float(ev["x"]), float(ev["y"]), float(ev["direction_deg"]))
+        position = (float(ev.get("seller_x", 0.0)), float(ev.get("seller_y", 0.0)))
+        lc = market.light_contract(accounts[seller], accounts[buyer], SITE_CODES[ev["site"]], int(ev["age"]),
+                                   info, position, blocks_valid)
+        if kind == "purchase":
+            try:
+                report.reveal_gas.append(market.reveal(accounts[seller], lc, info).gas_used)
+            except ContractRevert as err:
+                report.disagreements.append(f"event {number} (step {ev.get('step')}): purchase refused on chain: {err}")
+                continue
+            open_sellers[buyer].append(seller)
+        else:
+            try:
+                market.check_reveal(accounts[seller], lc, info)
+            except ContractRevert as err:
+                if err.name == "InfoMarketInsufficientStake":
+                    report.refusals_confirmed += 1
+                    continue
+                raise
+            report.disagreements.append(f"event {number} (step {ev.get('step')}): refused purchase accepted on chain")
+
+    report.last_block = w3.eth.block_number
+    report.balances = [market.balance_of(a.address) for a in accounts]
+    report.pots = [market.locked_stake(a.address) for a in accounts]
+    report.total_supply = market.total_supply()
+    return report
+
+
+def _count_rounding(bound: list[int], buyer: int, sellers: list[int]) -> None:
+    """A deposit with n records floors n shares: each seller may lose under a unit per share it
+    receives, and the buyer keeps the dust, under a unit per share."""
+    bound[buyer] += len(sellers)
+    for s in sellers:
+        bound[s] += 1

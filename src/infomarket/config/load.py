@@ -1,0 +1,111 @@
+"""Read experiment files (our TOML, or the original JSON format) and turn every problem into one
+``ConfigError`` whose message names the file, the key and what is allowed."""
+from __future__ import annotations
+
+import json
+import tomllib
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from pydantic import ValidationError
+
+from ..errors import ConfigError
+from .legacy import from_legacy, is_legacy
+from .schema import Experiment
+
+SHIPPED = "infomarket.experiments"
+
+
+def shipped_experiments() -> dict[str, Path]:
+    """Experiment files that ship with the package, by name (e.g. ``fig2A``)."""
+    found: dict[str, Path] = {}
+    root = resources.files(SHIPPED)
+    for sub in sorted(p for p in root.iterdir() if p.is_dir() and not p.name.startswith("_")):
+        for f in sorted(sub.iterdir()):
+            if f.name.endswith(".toml"):
+                found[f.name[:-5]] = Path(str(f))
+    return found
+
+
+def _describe(err: dict[str, Any]) -> str:
+    loc = ".".join(str(p) for p in err["loc"] if p not in ("function-after[_coherent()]",))
+    msg = err["msg"]
+    if err["type"] == "extra_forbidden":
+        return f"{loc}: unknown key"
+    if msg.startswith("Value error, "):
+        msg = msg[len("Value error, "):]
+    got = err.get("input")
+    shown = "" if isinstance(got, dict) or err["type"] == "missing" else f" (got {got!r})"
+    return f"{loc + ': ' if loc else ''}{msg}{shown}"
+
+
+def _allowed_keys(model: type, loc: tuple) -> list[str]:
+    """Field names allowed where an unknown key was found."""
+    for part in loc[:-1]:
+        if isinstance(part, int):
+            continue
+        field = model.model_fields.get(part)
+        if field is None:
+            return []
+        ann = field.annotation
+        inner = getattr(ann, "__args__", None)
+        if inner and hasattr(inner[0], "model_fields"):
+            ann = inner[0]
+        if not hasattr(ann, "model_fields"):
+            return []
+        model = ann
+    return sorted(model.model_fields)
+
+
+def validate(data: dict[str, Any], source: str = "configuration") -> Experiment:
+    """Validate a dictionary in our schema; raise ConfigError listing every problem."""
+    try:
+        return Experiment.model_validate(data)
+    except ValidationError as exc:
+        lines = []
+        for err in exc.errors():
+            line = _describe(err)
+            if err["type"] == "extra_forbidden":
+                line += f"; allowed keys here: {', '.join(_allowed_keys(Experiment, err['loc']))}"
+            lines.append(line)
+        raise ConfigError(f"{source}: invalid experiment\n  " + "\n  ".join(lines)) from None
+
+
+def load_experiment(what: str | Path) -> Experiment:
+    """Load an experiment from a ``.toml`` or ``.json`` file, or by the name of a shipped one."""
+    path = Path(what)
+    if not path.exists():
+        shipped = shipped_experiments()
+        if str(what) in shipped:
+            path = shipped[str(what)]
+        else:
+            raise ConfigError(f"no experiment file {str(what)!r} and no shipped experiment of that name; "
+                              f"shipped: {', '.join(shipped)}")
+    if path.is_dir():
+        raise ConfigError(f"{path}: is a directory, not an experiment file (.toml or .json)")
+    try:
+        text = path.read_text()
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ConfigError(f"{path}: cannot read: {exc}") from None
+    if path.suffix == ".toml":
+        try:
+            data = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            raise ConfigError(f"{path}: not valid TOML: {exc}") from None
+    elif path.suffix == ".json":
+        try:
+            data = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise ConfigError(f"{path}: not valid JSON: {exc}") from None
+        if not isinstance(data, dict):
+            raise ConfigError(f"{path}: the top level must be a JSON object")
+        if is_legacy(data):
+            try:
+                data = from_legacy(data, path.stem)
+            except ConfigError as exc:
+                raise ConfigError(f"{path}: {exc}") from None
+    else:
+        raise ConfigError(f"{path}: unknown file type {path.suffix!r}; use .toml (or the original .json)")
+    data.setdefault("name", path.stem)
+    return validate(data, str(path))

@@ -1,0 +1,176 @@
+"""Experiment configuration: a validated, frozen description of one simulated setup.
+
+Validation happens here, before anything runs: unknown keys, wrong types and impossible values are
+all reported with the key's dotted path and what is allowed (see ``config.errors``).  Defaults are the
+values of MODEL.md §1 that produced the paper's figures.
+"""
+from __future__ import annotations
+
+import hashlib
+import importlib
+import json
+from typing import Annotated
+
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
+from ..registry import behaviours, payments
+
+PosFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+NonNegFloat = Annotated[float, Field(ge=0, allow_inf_nan=False)]
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+NonNegInt = Annotated[int, Field(ge=0, strict=True)]
+PosInt = Annotated[int, Field(gt=0, strict=True)]
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class Arena(_Strict):
+    width: PosFloat = 1200.0
+    height: PosFloat = 600.0
+
+
+class Site(_Strict):
+    x: Finite
+    y: Finite
+    radius: PosFloat = 50.0
+
+
+class Robot(_Strict):
+    radius: PosFloat = 8.0
+    speed: PosFloat = 2.5
+    communication_range: NonNegFloat = 50.0
+    bias_mean: Finite = 0.05
+    bias_sd: NonNegFloat = 0.05
+    noise_sd: NonNegFloat = 0.05
+    stop_time: NonNegInt = 0
+    cooldown: NonNegInt = 0
+    fuel_cost: NonNegFloat = 0.0
+
+
+class RandomWalk(_Strict):
+    rho: Annotated[float, Field(gt=0, lt=1)] = 0.9
+    alpha: Annotated[float, Field(gt=0, le=2)] = 1.4
+
+
+class Group(_Strict):
+    behaviour: str
+    count: NonNegInt
+    params: dict[str, Finite] = Field(default_factory=dict)
+
+
+class Swarm(_Strict):
+    robots: PosInt = 25
+    groups: list[Group] = Field(min_length=1)
+
+    @model_validator(mode="after")
+    def _counts(self) -> "Swarm":
+        for k, g in enumerate(self.groups):
+            if g.count > self.robots:
+                raise ValueError(f"groups[{k}].count = {g.count} is more robots of {g.behaviour!r} than "
+                                 f"the swarm has (robots = {self.robots})")
+        total = sum(g.count for g in self.groups)
+        if total != self.robots:
+            raise ValueError(f"the group counts add up to {total} but robots = {self.robots}; they must be equal")
+        return self
+
+
+class Payment(_Strict):
+    scheme: str = "delayed"
+    initial_wealth: NonNegFloat = 1.0
+    reward: NonNegFloat = 1.0
+    information_share: Annotated[float, Field(ge=0, le=1)] = 0.5
+    stake: NonNegFloat = 0.0
+    params: dict[str, Finite] = Field(default_factory=dict)
+
+
+class Experiment(_Strict):
+    """One setup: world, robots, swarm composition, payment scheme, run length, runs and seed."""
+
+    name: str = "experiment"
+    description: str = ""
+    plugins: list[str] = Field(default_factory=list, description="modules to import that register rules")
+    steps: PosInt = 15000
+    transitory: NonNegInt = 0
+    runs: PosInt = 1
+    seed: NonNegInt = 0
+    history_every: NonNegInt = 0
+    arena: Arena = Arena()
+    food: Site = Site(x=200.0, y=300.0)
+    nest: Site = Site(x=1000.0, y=300.0)
+    robot: Robot = Robot()
+    random_walk: RandomWalk = RandomWalk()
+    swarm: Swarm
+    payment: Payment = Payment()
+
+    @field_validator("plugins")
+    @classmethod
+    def _import_plugins(cls, mods: list[str]) -> list[str]:
+        for m in mods:
+            try:
+                importlib.import_module(m)
+            except ImportError as exc:
+                raise ValueError(f"cannot import plugin module {m!r}: {exc}") from None
+        return mods
+
+    @model_validator(mode="after")
+    def _coherent(self) -> "Experiment":
+        if self.transitory >= self.steps:
+            raise ValueError(f"transitory = {self.transitory} must be smaller than steps = {self.steps}")
+        w, h, r = self.arena.width, self.arena.height, self.robot.radius
+        if w - 1 - 2 * r < 0 or h - 1 - 2 * r < 0:
+            raise ValueError(f"the arena ({w} x {h}) is too small for robots of radius {r}")
+        for key in ("food", "nest"):
+            s = getattr(self, key)
+            if s.x - s.radius < 0 or s.x + s.radius > w or s.y - s.radius < 0 or s.y + s.radius > h:
+                raise ValueError(f"{key} site at ({s.x}, {s.y}) with radius {s.radius} lies outside the "
+                                 f"arena [0, {w}] x [0, {h}]")
+        if self.history_every > self.steps:
+            raise ValueError(f"history_every = {self.history_every} must be at most steps = {self.steps}")
+        known = behaviours()
+        for k, g in enumerate(self.swarm.groups):
+            if g.behaviour not in known:
+                raise ValueError(f"swarm.groups[{k}].behaviour: unknown behaviour {g.behaviour!r}; "
+                                 f"allowed: {', '.join(sorted(known))}")
+            allowed = known[g.behaviour].params
+            for p in g.params:
+                if p not in allowed:
+                    raise ValueError(f"swarm.groups[{k}].params: {g.behaviour!r} has no parameter {p!r}; "
+                                     f"allowed: {', '.join(allowed) or 'none'}")
+            missing = [p for p in allowed if p not in g.params and p not in known[g.behaviour].defaults]
+            if missing:
+                raise ValueError(f"swarm.groups[{k}].params: {g.behaviour!r} needs {', '.join(missing)}")
+        schemes = payments()
+        if self.payment.scheme not in schemes:
+            raise ValueError(f"payment.scheme: unknown scheme {self.payment.scheme!r}; "
+                             f"allowed: {', '.join(sorted(schemes))}")
+        spec = schemes[self.payment.scheme]
+        for p in self.payment.params:
+            if p not in spec.params:
+                raise ValueError(f"payment.params: scheme {spec.name!r} has no parameter {p!r}; "
+                                 f"allowed: {', '.join(spec.params) or 'none'}")
+        missing = [p for p in spec.params if p not in self.payment.params and p not in spec.defaults]
+        if missing:
+            raise ValueError(f"payment.params: scheme {spec.name!r} needs {', '.join(missing)}")
+        return self
+
+    # ------------------------------------------------------------------ derived views
+    def behaviour_params(self, group: Group) -> dict[str, float]:
+        spec = behaviours()[group.behaviour]
+        return {p: float(group.params.get(p, spec.defaults.get(p, 0.0))) for p in spec.params}
+
+    def payment_params(self) -> dict[str, float]:
+        spec = payments()[self.payment.scheme]
+        return {p: float(self.payment.params.get(p, spec.defaults.get(p, 0.0))) for p in spec.params}
+
+    def with_overrides(self, **changes) -> "Experiment":
+        """A re-validated copy with top-level fields replaced (e.g. steps, runs, seed)."""
+        data = self.model_dump()
+        data.update(changes)
+        return Experiment.model_validate(data)
+
+    def config_hash(self) -> str:
+        """Hash of everything that determines results (not name, description, runs or seed)."""
+        data = self.model_dump(exclude={"name", "description", "runs", "seed"})
+        return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:16]

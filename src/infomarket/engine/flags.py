@@ -1,0 +1,24 @@
+"""Error bits set by compiled code (which cannot raise) and turned into exceptions by the host."""
+from enum import IntFlag
+
+
+class ErrorFlags(IntFlag):
+    """Bits of ``World.flags[0]``."""
+
+    TX_OVERFLOW = 1  #: a buy rule made more purchases in one step than the per-step reserve allows
+    BAD_WEIGHTS = 2  #: a payment rule returned a negative or non-finite weight
+    EVENT_OVERFLOW = 4  #: the event log reserve was exceeded within one step
+
+    def describe(self) -> str:
+        text = {
+            ErrorFlags.TX_OVERFLOW: "a buy rule made more than 2 x robots purchases in one step",
+            ErrorFlags.BAD_WEIGHTS: "a payment rule returned a negative or non-finite weight",
+            ErrorFlags.EVENT_OVERFLOW: "more events in one step than the event log reserves",
+        }
+        return "; ".join(msg for bit, msg in text.items() if bit in self)
+
+
+# Plain ints for use inside compiled code.
+TX_OVERFLOW = int(ErrorFlags.TX_OVERFLOW)
+BAD_WEIGHTS = int(ErrorFlags.BAD_WEIGHTS)
+EVENT_OVERFLOW = int(ErrorFlags.EVENT_OVERFLOW)

@@ -1,0 +1,84 @@
+"""Compiled ledger operations over the world's arrays (see engine.world for the fields).
+
+Money is conserved by construction: the only operations are transfers between balances and pots,
+the reward issued on a deposit, and (optionally) fuel burned by moving robots.
+"""
+import math
+
+from numba import njit
+
+from ..engine import flags
+from ..engine.world import EV_DEPOSIT, EV_PURCHASE, EV_REFUSED
+
+
+@njit
+def log_event(w, kind, buyer, seller, site, direction, x, y, age, stake):
+    """Append one event to the log when recording; the host keeps enough room for a whole step."""
+    if not w.record:
+        return
+    k = w.ev_count[0]
+    if k >= w.ev_step.shape[0]:
+        w.flags[0] |= flags.EVENT_OVERFLOW
+        return
+    w.ev_step[k] = w.clock[0]
+    w.ev_kind[k] = kind
+    w.ev_buyer[k] = buyer
+    w.ev_seller[k] = seller
+    w.ev_site[k] = site
+    w.ev_dir[k] = direction
+    w.ev_x[k] = x
+    w.ev_y[k] = y
+    w.ev_age[k] = age
+    w.ev_stake[k] = stake
+    w.ev_count[0] = k + 1
+
+
+@njit
+def open_transaction(w, buyer, seller, site, direction):
+    """Lock the seller's stake and record the transaction; False (nothing recorded) when refused."""
+    k = w.tx_count[buyer]
+    if k >= w.tx_seller.shape[1]:
+        w.flags[0] |= flags.TX_OVERFLOW
+        return False
+    if w.stake > 0.0:
+        if w.balance[seller] < w.stake:
+            return False
+        w.balance[seller] -= w.stake
+        w.pot[buyer] += w.stake
+    w.tx_seller[buyer, k] = seller
+    w.tx_site[buyer, k] = site
+    w.tx_dir[buyer, k] = direction
+    w.tx_count[buyer] = k + 1
+    return True
+
+
+@njit
+def purchase_events(w, ok, buyer, seller, site, direction, x, y, age):
+    log_event(w, EV_PURCHASE if ok else EV_REFUSED, buyer, seller, site, direction, x, y, age,
+              w.stake if ok else 0.0)
+
+
+@njit
+def distribute(w, buyer, weights):
+    """Settle a deposit: reward and pot to the buyer, then ``info_share * reward + pot`` from the buyer
+    to the sellers of its open transactions in proportion to ``weights``; clear its transactions."""
+    k = w.tx_count[buyer]
+    w.balance[buyer] += w.reward
+    pot = w.pot[buyer]
+    w.balance[buyer] += pot
+    w.pot[buyer] = 0.0
+    total = 0.0
+    for x in range(k):
+        wx = weights[x]
+        if not (wx >= 0.0) or math.isinf(wx):
+            w.flags[0] |= flags.BAD_WEIGHTS
+            w.tx_count[buyer] = 0
+            return
+        total += wx
+    if k > 0 and total > 0.0:
+        amount = w.info_share * w.reward + pot
+        for x in range(k):
+            w.balance[w.tx_seller[buyer, x]] += amount * (weights[x] / total)
+        w.balance[buyer] -= amount
+    w.tx_count[buyer] = 0
+    log_event(w, EV_DEPOSIT, buyer, -1, -1, 0.0, 0.0, 0.0, 0, 0.0)

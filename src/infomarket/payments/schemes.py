@@ -1,0 +1,31 @@
+"""Built-in payment schemes (MODEL.md §5), registered through the public ``register_payment``.
+
+A scheme only weighs the buyer's transactions; the ledger moves the money (``ledger.kernels.distribute``).
+Staking is a ledger setting (``payment.stake``), so any scheme can be run with or without it.
+"""
+from ..engine.geometry import angular_distance
+from ..registry import register_payment
+
+
+def delayed_weights(buyer, sellers, sites, directions, weights):
+    """Delayed payment: every transaction weighs the same, so sellers are paid per transaction."""
+    for x in range(weights.shape[0]):
+        weights[x] = 1.0
+
+
+def outlier_weights(buyer, sellers, sites, directions, weights, theta=30.0):
+    """Outlier penalisation (eqs. 7-8): a transaction weighs as many same-site transactions (itself
+    included) as point within ``theta`` degrees of it, so isolated directions earn little."""
+    k = weights.shape[0]
+    for x in range(k):
+        c = 0
+        for y in range(k):
+            if sites[y] == sites[x] and angular_distance(directions[x], directions[y]) < theta:
+                c += 1
+        weights[x] = c
+
+
+register_payment("delayed", delayed_weights,
+                 description="sellers share information_share * reward per transaction")
+register_payment("outlier", outlier_weights,
+                 description="sellers share information_share * reward + stakes by similarity weight")

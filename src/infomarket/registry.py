@@ -1,0 +1,198 @@
+"""Registry of market rules: behaviours (a buy rule and a sell rule) and payment schemes.
+
+A rule is a plain Python function over the world tuple, robot ids and numbers, written in the
+numba-compatible subset.  Registering it wraps it in ``numba.njit``; the engine then generates a
+step kernel that calls the configured rules directly (see ``engine.specialise``), so a user's rule
+runs at the same compiled speed as the built-ins, which are registered through this very module.
+
+Rule parameters are the function's arguments after the fixed leading ones; their defaults are the
+defaults of the behaviour or scheme, and an experiment file may override them by name.
+"""
+from __future__ import annotations
+
+import inspect
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numba
+
+from .errors import ConfigError
+
+#: Fixed leading arguments of each kind of rule (everything after them is a parameter).
+BUY_ARGS = ("w", "me", "nbrs")
+SELL_ARGS = ("w", "me", "site")
+PAY_ARGS = ("buyer", "sellers", "sites", "directions", "weights")
+
+
+@dataclass(frozen=True)
+class Rule:
+    """One compiled rule and the numeric parameters it takes, in call order."""
+
+    func: Callable
+    params: tuple[str, ...]
+    defaults: dict[str, float]
+
+    @property
+    def py_func(self) -> Callable:
+        return getattr(self.func, "py_func", self.func)
+
+
+@dataclass(frozen=True)
+class BehaviourSpec:
+    """A robot behaviour: what it buys (and how it uses it) and what it sells."""
+
+    name: str
+    buy: Rule
+    sell: Rule
+    honest: bool
+    description: str = ""
+    params: tuple[str, ...] = field(default=())
+    defaults: dict[str, float] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class PaymentSpec:
+    """A payment scheme: how the shared reward (plus stakes) is split among a round trip's sellers."""
+
+    name: str
+    weights: Rule
+    description: str = ""
+
+    @property
+    def params(self) -> tuple[str, ...]:
+        return self.weights.params
+
+    @property
+    def defaults(self) -> dict[str, float]:
+        return self.weights.defaults
+
+
+_BEHAVIOURS: dict[str, BehaviourSpec] = {}
+_PAYMENTS: dict[str, PaymentSpec] = {}
+
+
+def _jit(func: Callable) -> Callable:
+    if isinstance(func, numba.core.registry.CPUDispatcher):
+        return func
+    if not callable(func):
+        raise TypeError(f"a rule must be a function, got {func!r}")
+    return numba.njit(func)
+
+
+def _rule(func: Callable, fixed: tuple[str, ...], what: str) -> Rule:
+    jitted = _jit(func)
+    py = getattr(jitted, "py_func", jitted)
+    sig = list(inspect.signature(py).parameters.values())
+    if len(sig) < len(fixed):
+        raise TypeError(f"{what} {py.__name__} must take the arguments {', '.join(fixed)} first")
+    extra = sig[len(fixed):]
+    for p in extra:
+        if p.kind not in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD):
+            raise TypeError(f"{what} {py.__name__}: parameter {p.name} must be a plain positional argument")
+    defaults = {p.name: float(p.default) for p in extra if p.default is not p.empty}
+    return Rule(jitted, tuple(p.name for p in extra), defaults)
+
+
+def register_behaviour(name: str, *, buy: Callable | str, sell: Callable | str, honest: bool,
+                       description: str = "", replace: bool = False) -> BehaviourSpec:
+    """Register a behaviour from a buy rule and a sell rule (functions, or names of registered behaviours
+    whose rule to reuse).
+
+    ``buy(w, me, nbrs, *params)`` buys from the neighbours ``nbrs`` (ids, increasing) and installs what it
+    buys; ``sell(w, me, site, *params) -> (valid, x, y, age)`` is the offer for ``site`` (0 food, 1 nest)
+    in the seller's own frame.  ``honest`` says whether robots of this behaviour count as honest in the
+    metrics (Byzantine otherwise).
+    """
+    if name in _BEHAVIOURS and not replace:
+        raise ValueError(f"behaviour {name!r} is already registered (pass replace=True to override)")
+    buy_rule = _BEHAVIOURS[buy].buy if isinstance(buy, str) else _rule(buy, BUY_ARGS, "buy rule")
+    sell_rule = _BEHAVIOURS[sell].sell if isinstance(sell, str) else _rule(sell, SELL_ARGS, "sell rule")
+    params: list[str] = []
+    defaults: dict[str, float] = {}
+    for r in (buy_rule, sell_rule):
+        for p in r.params:
+            if p not in params:
+                params.append(p)
+        for k, v in r.defaults.items():
+            if k in defaults and defaults[k] != v:
+                raise ValueError(f"behaviour {name!r}: rules disagree on the default of {k!r}")
+            defaults[k] = v
+    spec = BehaviourSpec(name, buy_rule, sell_rule, bool(honest), description, tuple(params), defaults)
+    _BEHAVIOURS[name] = spec
+    return spec
+
+
+def behaviour(name: str, *, buy: Callable | str, honest: bool, description: str = "", replace: bool = False):
+    """Decorator form of :func:`register_behaviour` for the sell rule: ``@behaviour("liar", buy="naive",
+    honest=False)`` over ``def sell(w, me, site): ...``."""
+
+    def wrap(sell: Callable) -> Callable:
+        spec = register_behaviour(name, buy=buy, sell=sell, honest=honest, description=description,
+                                  replace=replace)
+        return spec.sell.func
+
+    return wrap
+
+
+def register_payment(name: str, weights: Callable, *, description: str = "",
+                     replace: bool = False) -> PaymentSpec:
+    """Register a payment scheme from its weight rule.
+
+    ``weights(buyer, sellers, sites, directions, weights, *params)`` receives the buyer's transactions
+    since its last deposit (seller id, site, direction in degrees in the buyer's frame) and fills
+    ``weights`` with one non-negative number per transaction.  On a deposit the ledger pays the buyer the
+    reward and its pot of stakes, then moves ``information_share * reward + pot`` from the buyer to the
+    sellers in proportion to those weights, so every scheme conserves money by construction.
+    """
+    if name in _PAYMENTS and not replace:
+        raise ValueError(f"payment scheme {name!r} is already registered (pass replace=True to override)")
+    spec = PaymentSpec(name, _rule(weights, PAY_ARGS, "payment rule"), description)
+    _PAYMENTS[name] = spec
+    return spec
+
+
+def payment(name: str, *, description: str = "", replace: bool = False):
+    """Decorator form of :func:`register_payment`."""
+
+    def wrap(weights: Callable) -> Callable:
+        return register_payment(name, weights, description=description, replace=replace).weights.func
+
+    return wrap
+
+
+def _ensure_builtins() -> None:
+    # Importing the packages registers the built-ins, through the same functions as above.
+    from . import behaviours, payments  # noqa: F401
+
+
+def get_behaviour(name: str) -> BehaviourSpec:
+    _ensure_builtins()
+    try:
+        return _BEHAVIOURS[name]
+    except KeyError:
+        raise ConfigError(f"unknown behaviour {name!r}; registered: {', '.join(sorted(_BEHAVIOURS))}") from None
+
+
+def get_payment(name: str) -> PaymentSpec:
+    _ensure_builtins()
+    try:
+        return _PAYMENTS[name]
+    except KeyError:
+        raise ConfigError(f"unknown payment scheme {name!r}; registered: {', '.join(sorted(_PAYMENTS))}") from None
+
+
+def behaviours() -> dict[str, BehaviourSpec]:
+    _ensure_builtins()
+    return dict(_BEHAVIOURS)
+
+
+def payments() -> dict[str, PaymentSpec]:
+    _ensure_builtins()
+    return dict(_PAYMENTS)
+
+
+def rule_function(kind: str, name: str, role: str) -> Callable:
+    """The compiled function of a registered rule; generated kernels look their rules up here."""
+    if kind == "behaviour":
+        return getattr(get_behaviour(name), role).func
+    return get_payment(name).weights.func

@@ -1,0 +1,1 @@
+"""Tests of infomarket.chain (a package, so its module names cannot clash with tests elsewhere)."""
