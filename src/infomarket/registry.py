@@ -48,6 +48,15 @@ class BehaviourSpec:
     description: str = ""
     params: tuple[str, ...] = field(default=())
     defaults: dict[str, float] = field(default_factory=dict)
+    limits: dict[str, tuple[str, Callable[[float], bool]]] = field(default_factory=dict)
+
+    def check(self, name: str, value: float) -> str | None:
+        """Why ``value`` is not allowed for parameter ``name``, or None."""
+        if name in self.limits:
+            text, ok = self.limits[name]
+            if not ok(value):
+                return f"must be {text}"
+        return None
 
 
 @dataclass(frozen=True)
@@ -57,6 +66,9 @@ class PaymentSpec:
     name: str
     weights: Rule
     description: str = ""
+    limits: dict[str, tuple[str, Callable[[float], bool]]] = field(default_factory=dict)
+
+    check = BehaviourSpec.check
 
     @property
     def params(self) -> tuple[str, ...]:
@@ -94,14 +106,16 @@ def _rule(func: Callable, fixed: tuple[str, ...], what: str) -> Rule:
 
 
 def register_behaviour(name: str, *, buy: Callable | str, sell: Callable | str, honest: bool,
-                       description: str = "", replace: bool = False) -> BehaviourSpec:
+                       description: str = "", limits: dict | None = None,
+                       replace: bool = False) -> BehaviourSpec:
     """Register a behaviour from a buy rule and a sell rule (functions, or names of registered behaviours
     whose rule to reuse).
 
     ``buy(w, me, nbrs, *params)`` buys from the neighbours ``nbrs`` (ids, increasing) and installs what it
     buys; ``sell(w, me, site, *params) -> (valid, x, y, age)`` is the offer for ``site`` (0 food, 1 nest)
     in the seller's own frame.  ``honest`` says whether robots of this behaviour count as honest in the
-    metrics (Byzantine otherwise).
+    metrics (Byzantine otherwise).  ``limits`` maps a parameter to ``(text, predicate)``, e.g.
+    ``{"threshold": ("> 0", lambda v: v > 0)}``: configurations breaking it are rejected with the text.
     """
     if name in _BEHAVIOURS and not replace:
         raise ValueError(f"behaviour {name!r} is already registered (pass replace=True to override)")
@@ -117,7 +131,12 @@ def register_behaviour(name: str, *, buy: Callable | str, sell: Callable | str, 
             if k in defaults and defaults[k] != v:
                 raise ValueError(f"behaviour {name!r}: rules disagree on the default of {k!r}")
             defaults[k] = v
-    spec = BehaviourSpec(name, buy_rule, sell_rule, bool(honest), description, tuple(params), defaults)
+    limits = dict(limits or {})
+    for r in (buy, sell):
+        if isinstance(r, str):  # a reused rule brings its limits along
+            limits = {**_BEHAVIOURS[r].limits, **limits}
+    limits = {k: v for k, v in limits.items() if k in params}
+    spec = BehaviourSpec(name, buy_rule, sell_rule, bool(honest), description, tuple(params), defaults, limits)
     _BEHAVIOURS[name] = spec
     return spec
 
@@ -134,7 +153,7 @@ def behaviour(name: str, *, buy: Callable | str, honest: bool, description: str 
     return wrap
 
 
-def register_payment(name: str, weights: Callable, *, description: str = "",
+def register_payment(name: str, weights: Callable, *, description: str = "", limits: dict | None = None,
                      replace: bool = False) -> PaymentSpec:
     """Register a payment scheme from its weight rule.
 
@@ -146,7 +165,7 @@ def register_payment(name: str, weights: Callable, *, description: str = "",
     """
     if name in _PAYMENTS and not replace:
         raise ValueError(f"payment scheme {name!r} is already registered (pass replace=True to override)")
-    spec = PaymentSpec(name, _rule(weights, PAY_ARGS, "payment rule"), description)
+    spec = PaymentSpec(name, _rule(weights, PAY_ARGS, "payment rule"), description, dict(limits or {}))
     _PAYMENTS[name] = spec
     return spec
 

@@ -42,4 +42,5 @@ def sceptical_buy(w, me, nbrs, threshold=0.25):
 
 
 register_behaviour("sceptical", buy=sceptical_buy, sell="naive", honest=True,
-                   description="waits for a second, agreeing piece of information before using it")
+                   description="waits for a second, agreeing piece of information before using it",
+                   limits={"threshold": ("> 0", lambda v: v > 0)})

@@ -58,10 +58,11 @@ def _allowed_keys(model: type, loc: tuple) -> list[str]:
     return sorted(model.model_fields)
 
 
-def validate(data: dict[str, Any], source: str = "configuration") -> Experiment:
-    """Validate a dictionary in our schema; raise ConfigError listing every problem."""
+def validate(data: dict[str, Any], source: str = "configuration", base: Path | None = None) -> Experiment:
+    """Validate a dictionary in our schema; raise ConfigError listing every problem.  ``base`` is the
+    folder relative plugin paths are resolved against (the experiment file's)."""
     try:
-        return Experiment.model_validate(data)
+        return Experiment.model_validate(data, context={"base": base})
     except ValidationError as exc:
         lines = []
         for err in exc.errors():
@@ -108,4 +109,4 @@ def load_experiment(what: str | Path) -> Experiment:
     else:
         raise ConfigError(f"{path}: unknown file type {path.suffix!r}; use .toml (or the original .json)")
     data.setdefault("name", path.stem)
-    return validate(data, str(path))
+    return validate(data, str(path), base=path.resolve().parent)

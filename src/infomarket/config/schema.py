@@ -7,11 +7,12 @@ values of MODEL.md §1 that produced the paper's figures.
 from __future__ import annotations
 
 import hashlib
-import importlib
 import json
 from typing import Annotated
 
-from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator, model_validator
+
+from .. import plugins
 
 from ..registry import behaviours, payments
 
@@ -106,13 +107,15 @@ class Experiment(_Strict):
 
     @field_validator("plugins")
     @classmethod
-    def _import_plugins(cls, mods: list[str]) -> list[str]:
-        for m in mods:
+    def _import_plugins(cls, entries: list[str], info: ValidationInfo) -> list[str]:
+        base = (info.context or {}).get("base")
+        resolved = [plugins.resolve(e, base) for e in entries]
+        for e in resolved:
             try:
-                importlib.import_module(m)
-            except ImportError as exc:
-                raise ValueError(f"cannot import plugin module {m!r}: {exc}") from None
-        return mods
+                plugins.load(e)
+            except Exception as exc:  # a plugin's own error is the user's to see, in one line
+                raise ValueError(f"cannot load plugin {e!r}: {type(exc).__name__}: {exc}") from None
+        return resolved
 
     @model_validator(mode="after")
     def _coherent(self) -> "Experiment":
@@ -134,10 +137,13 @@ class Experiment(_Strict):
                 raise ValueError(f"swarm.groups[{k}].behaviour: unknown behaviour {g.behaviour!r}; "
                                  f"allowed: {', '.join(sorted(known))}")
             allowed = known[g.behaviour].params
-            for p in g.params:
+            for p, v in g.params.items():
                 if p not in allowed:
                     raise ValueError(f"swarm.groups[{k}].params: {g.behaviour!r} has no parameter {p!r}; "
                                      f"allowed: {', '.join(allowed) or 'none'}")
+                why = known[g.behaviour].check(p, v)
+                if why:
+                    raise ValueError(f"swarm.groups[{k}].params.{p} = {v}: {why}")
             missing = [p for p in allowed if p not in g.params and p not in known[g.behaviour].defaults]
             if missing:
                 raise ValueError(f"swarm.groups[{k}].params: {g.behaviour!r} needs {', '.join(missing)}")
@@ -146,10 +152,13 @@ class Experiment(_Strict):
             raise ValueError(f"payment.scheme: unknown scheme {self.payment.scheme!r}; "
                              f"allowed: {', '.join(sorted(schemes))}")
         spec = schemes[self.payment.scheme]
-        for p in self.payment.params:
+        for p, v in self.payment.params.items():
             if p not in spec.params:
                 raise ValueError(f"payment.params: scheme {spec.name!r} has no parameter {p!r}; "
                                  f"allowed: {', '.join(spec.params) or 'none'}")
+            why = spec.check(p, v)
+            if why:
+                raise ValueError(f"payment.params.{p} = {v}: {why}")
         missing = [p for p in spec.params if p not in self.payment.params and p not in spec.defaults]
         if missing:
             raise ValueError(f"payment.params: scheme {spec.name!r} needs {', '.join(missing)}")
@@ -168,7 +177,7 @@ class Experiment(_Strict):
         """A re-validated copy with top-level fields replaced (e.g. steps, runs, seed)."""
         data = self.model_dump()
         data.update(changes)
-        return Experiment.model_validate(data)
+        return Experiment.model_validate(data)  # plugins are absolute paths or module names by now
 
     def config_hash(self) -> str:
         """Hash of everything that determines results (not name, description, runs or seed)."""

@@ -55,8 +55,8 @@ class Simulation:
         self.world, self.behaviour_names = build_world(config, self.rng, record_events=record_events,
                                                        history_every=hist)
         t0 = time.perf_counter()
-        self._view = kernel_view(self.world)
         self._kernel = specialise.kernel_module(self.kinds, config.payment.scheme)
+        self._view = kernel_view(self.world, self._kernel)
         self._kernel.run_steps(self._view, self.rng, 0)  # compile or load from cache; runs no step
         self.compile_seconds = time.perf_counter() - t0
         self.run_seconds = 0.0
@@ -79,7 +79,7 @@ class Simulation:
             if status == self._kernel.DONE:
                 break
             self.world = grow(self.world)
-            self._view = kernel_view(self.world)
+            self._view = kernel_view(self.world, self._kernel)
         self.run_seconds += time.perf_counter() - t0
 
     def run(self, steps: int | None = None) -> Result:

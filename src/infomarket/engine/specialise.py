@@ -21,6 +21,7 @@ import numba
 
 from .. import __version__
 from ..registry import BehaviourSpec, PaymentSpec, Rule, get_behaviour, get_payment
+from .worldref import constructor_source
 
 _TEMPLATE = Path(__file__).with_name("_loop.py")
 _PACKAGE = Path(__file__).resolve().parents[1]
@@ -28,12 +29,18 @@ _LOADED: dict[str, ModuleType] = {}
 _PACKAGE_DIGEST: list[str] = []
 
 
+#: Subpackages whose code ends up inside compiled kernels.
+_COMPILED_PARTS = ("engine", "behaviours", "payments", "ledger")
+
+
 def _package_digest() -> str:
-    """Hash of the package's own source: the generated kernel inlines engine code from many modules, and
-    numba only checks the generated file itself for staleness, so any change here must change the name."""
+    """Hash of the source that compiled code comes from: the generated kernel inlines engine code from
+    many modules, and numba only checks the generated file itself for staleness, so any change there
+    must change the kernel's name."""
     if not _PACKAGE_DIGEST:
         h = hashlib.sha256()
-        for f in sorted(_PACKAGE.rglob("*.py")):
+        files = [f for part in _COMPILED_PARTS for f in (_PACKAGE / part).rglob("*.py")]
+        for f in sorted(files):
             h.update(str(f.relative_to(_PACKAGE)).encode())
             h.update(f.read_bytes())
         _PACKAGE_DIGEST.append(h.hexdigest())
@@ -83,7 +90,9 @@ def generate_source(behaviours: list[BehaviourSpec], payment: PaymentSpec) -> st
                   f"        _b{k}_buy(w, i, nbrs{_args(b.buy, b.params, 'w.bparams[i]')})"]
     lines += ["", "", "@njit(cache=True)", "def pay_dispatch(w, buyer, sellers, sites, directions, weights):",
               f"    _pay(buyer, sellers, sites, directions, weights{_args(payment.weights, payment.params, 'w.pparams')})",
-              ""]
+              "", "", "from numba.experimental.structref import new as _structref_new",
+              "from infomarket.engine.worldref import world_type as _world_type",
+              "_WORLD_TYPE = _world_type()", "", "", constructor_source()]
     return "\n".join(lines)
 
 

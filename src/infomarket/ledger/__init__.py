@@ -3,6 +3,6 @@
 ``ledger.kernels`` holds the compiled operations the engine calls; ``ledger.replay`` runs the same
 operations over a list of events, for conformance tests and for checking the EVM contract.
 """
-from .replay import replay_events
+from .replay import LedgerEvent, Replayed, replay_events
 
-__all__ = ["replay_events"]
+__all__ = ["LedgerEvent", "Replayed", "replay_events"]

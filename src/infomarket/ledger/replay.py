@@ -20,6 +20,15 @@ from .kernels import open_transaction
 
 
 @dataclass(frozen=True)
+class Replayed:
+    """Balances and pots after a replay, and whether each purchase was accepted (in order)."""
+
+    balances: np.ndarray
+    pots: np.ndarray
+    accepted: list[bool]
+
+
+@dataclass(frozen=True)
 class LedgerEvent:
     """``kind`` is 'purchase' (buyer, seller, site, direction_deg) or 'deposit' (buyer)."""
 
@@ -32,9 +41,9 @@ class LedgerEvent:
 
 def replay_events(events: Iterable, robots: int, *, scheme: str = "delayed", initial_wealth: float = 1.0,
                   reward: float = 1.0, information_share: float = 0.5, stake: float = 0.0,
-                  params: dict | None = None) -> tuple[np.ndarray, list[bool]]:
-    """Apply purchases and deposits in order; return the final balances and, per purchase, whether
-    it was accepted.  Events are LedgerEvent-like objects or mappings with the same fields
+                  params: dict | None = None) -> Replayed:
+    """Apply purchases and deposits in order; return the final balances and pots and, per purchase,
+    whether it was accepted.  Events are LedgerEvent-like objects or mappings with the same fields
     (a DataFrame's ``itertuples()`` works; 'refused' events are replayed as purchases)."""
     cfg = Experiment.model_validate({
         "swarm": {"robots": robots, "groups": [{"behaviour": "naive", "count": robots}]},
@@ -43,7 +52,7 @@ def replay_events(events: Iterable, robots: int, *, scheme: str = "delayed", ini
     })
     world, _ = build_world(cfg, np.random.default_rng(0))
     kernel = specialise.kernel_module(("naive",), scheme)
-    view = kernel_view(world)
+    view = kernel_view(world, kernel)
     accepted: list[bool] = []
     for ev in events:
         get = ev.get if isinstance(ev, dict) else (lambda k, e=ev: getattr(e, k))
@@ -51,7 +60,7 @@ def replay_events(events: Iterable, robots: int, *, scheme: str = "delayed", ini
         if kind in ("purchase", "refused"):
             if int(world.tx_count.max()) + 1 >= world.tx_seller.shape[1]:
                 world = grow(world)
-                view = kernel_view(world)
+                view = kernel_view(world, kernel)
             accepted.append(bool(open_transaction(view, int(get("buyer")), int(get("seller")),
                                                   int(get("site")), float(get("direction_deg")))))
         elif kind == "deposit":
@@ -61,4 +70,4 @@ def replay_events(events: Iterable, robots: int, *, scheme: str = "delayed", ini
         flags = ErrorFlags(int(world.flags[0]))
         if flags:
             raise SimulationError(flags.describe())
-    return world.balance.copy(), accepted
+    return Replayed(world.balance.copy(), world.pot.copy(), accepted)

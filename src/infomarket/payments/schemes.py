@@ -28,4 +28,5 @@ def outlier_weights(buyer, sellers, sites, directions, weights, theta=30.0):
 register_payment("delayed", delayed_weights,
                  description="sellers share information_share * reward per transaction")
 register_payment("outlier", outlier_weights,
-                 description="sellers share information_share * reward + stakes by similarity weight")
+                 description="sellers share information_share * reward + stakes by similarity weight",
+                 limits={"theta": ("in (0, 180]", lambda v: 0 < v <= 180)})

@@ -1,0 +1,235 @@
+"""The ``infomarket`` command line.
+
+Bad input (a malformed experiment, an impossible option) prints one clear message and exits with code
+2, before anything is written; no traceback reaches the user for errors infomarket raises on purpose.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import tempfile
+from pathlib import Path
+
+from . import __version__
+from .errors import ConfigError, InfomarketError
+
+EXIT_USAGE = 2
+
+
+class UsageError(InfomarketError):
+    """A command-line option is wrong."""
+
+
+def _positive(kind):
+    def parse(text: str):
+        try:
+            v = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a {kind.__name__}, got {text!r}") from None
+        if v <= 0:
+            raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
+        return v
+    return parse
+
+
+def _non_negative_int(text: str) -> int:
+    try:
+        v = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+    if v < 0:
+        raise argparse.ArgumentTypeError(f"must be >= 0, got {text}")
+    return v
+
+
+def _writable_dir(path: Path) -> Path:
+    """Check that ``path`` can be created and written to, creating it (and nothing else) if needed."""
+    if path.exists() and not path.is_dir():
+        raise UsageError(f"--out {path}: exists and is not a directory")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=path):
+            pass
+    except OSError as exc:
+        raise UsageError(f"--out {path}: cannot write there ({exc.strerror or exc})") from None
+    return path
+
+
+def _print_summary(robots, title: str) -> None:
+    from rich.console import Console
+    from rich.table import Table
+
+    from .analysis import summarise
+
+    table = Table(title=title)
+    for col in ("behaviour", "robots/run", "honest", "median items", "median wealth share"):
+        table.add_column(col, justify="left" if col == "behaviour" else "right")
+    for row in summarise(robots).itertuples():
+        table.add_row(str(row.behaviour), str(row.robots), "yes" if row.honest else "no",
+                      f"{row.median_items:g}", f"{row.median_wealth_share_pct:.2f} %")
+    Console().print(table)
+
+
+# ---------------------------------------------------------------------------------------------- run
+def cmd_run(args) -> int:
+    from .config import load_experiment
+    from .runner import run_batch
+    from .runner.batch import default_workers
+    from .runner.progress import progress
+    from .store import write_parquet_atomic
+
+    cfg = load_experiment(args.experiment)
+    changes = {}
+    if args.steps is not None:
+        changes["steps"] = args.steps
+    if args.history is not None:
+        changes["history_every"] = args.history
+    if changes:
+        try:
+            cfg = cfg.with_overrides(**changes)
+        except ConfigError as exc:
+            raise UsageError(str(exc).replace("configuration: invalid experiment\n  ", "")) from None
+    runs = args.runs or cfg.runs
+    seed = cfg.seed if args.seed is None else args.seed
+    out = _writable_dir(Path(args.out or Path("results") / cfg.name))
+    workers = args.workers or min(default_workers(), runs)
+    with progress(f"{cfg.name}", runs, enabled=not args.quiet) as bar:
+        res = run_batch(cfg, runs, seed, workers=workers, on_done=bar.advance)
+    write_parquet_atomic(res.robots, out / "robots.parquet")
+    written = ["robots.parquet"]
+    if cfg.history_every:
+        write_parquet_atomic(res.history, out / "wealth_history.parquet")
+        written.append("wealth_history.parquet")
+    _print_summary(res.robots, f"{cfg.name}: {runs} runs x {res.steps} steps, master seed {seed}")
+    print(f"wrote {', '.join(str(out / w) for w in written)}")
+    print(f"{res.env_steps_per_second:,.0f} env-steps/s per core (compile/load {res.compile_seconds:.2f} s)")
+    return 0
+
+
+# -------------------------------------------------------------------------------------------- bench
+BENCH_SETUPS = ("fig2A", "fig2D", "fig4C")
+
+
+def cmd_bench(args) -> int:
+    from .bench import run_bench
+
+    report = run_bench(BENCH_SETUPS, steps=args.steps, repeats=args.repeats)
+    if args.json:
+        print(json.dumps(report, indent=2))
+    else:
+        from rich.console import Console
+        from rich.table import Table
+
+        t = Table(title=f"single-process runs, 25 robots x {args.steps} steps (median of {args.repeats})")
+        for c in ("setup", "env-steps/s", "seconds/run", "compile/load s"):
+            t.add_column(c, justify="right")
+        for name, r in report["setups"].items():
+            t.add_row(name, f"{r['steps_per_second']:,.0f}", f"{r['seconds_per_run']:.3f}",
+                      f"{r['compile_seconds']:.2f}")
+        Console().print(t)
+    return 0
+
+
+# --------------------------------------------------------------------------------------------- demo
+def cmd_demo(args) -> int:
+    from .demo import run_demo
+
+    return run_demo(runs=args.runs, workers=args.workers)
+
+
+# ----------------------------------------------------------------------------------- list / check
+def cmd_list(args) -> int:
+    from .config import shipped_experiments
+    from .registry import behaviours, payments
+
+    print("shipped experiments:")
+    for name, path in shipped_experiments().items():
+        first = path.read_text().splitlines()[0].lstrip("# ")
+        print(f"  {name:8s} {first}")
+    print("behaviours:")
+    for name, b in behaviours().items():
+        params = ", ".join(f"{p}={b.defaults.get(p, '?')}" for p in b.params)
+        print(f"  {name:11s} {'honest   ' if b.honest else 'byzantine'} {b.description}"
+              + (f" [{params}]" if params else ""))
+    print("payment schemes:")
+    for name, p in payments().items():
+        params = ", ".join(f"{k}={p.defaults.get(k, '?')}" for k in p.params)
+        print(f"  {name:11s} {p.description}" + (f" [{params}]" if params else ""))
+    return 0
+
+
+def cmd_check(args) -> int:
+    from .config import load_experiment
+
+    cfg = load_experiment(args.experiment)
+    groups = ", ".join(f"{g.count} {g.behaviour}" for g in cfg.swarm.groups if g.count)
+    print(f"{cfg.name}: valid. {groups}; scheme {cfg.payment.scheme} (stake {cfg.payment.stake}); "
+          f"{cfg.steps} steps, transitory {cfg.transitory}, {cfg.runs} runs, seed {cfg.seed}; "
+          f"config hash {cfg.config_hash()}")
+    return 0
+
+
+# --------------------------------------------------------------------------------------------- main
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="infomarket", description="Information-market robot swarm simulator.")
+    p.add_argument("--version", action="version", version=f"infomarket {__version__}")
+    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
+
+    r = sub.add_parser("run", help="run an experiment N times and write robots.parquet")
+    r.add_argument("experiment", help="a .toml file, an original .json file, or a shipped name (e.g. fig2B)")
+    r.add_argument("--runs", type=_positive(int), help="number of runs (default: the file's)")
+    r.add_argument("--seed", type=_non_negative_int, help="master seed (default: the file's)")
+    r.add_argument("--steps", type=_positive(int), help="steps per run (default: the file's)")
+    r.add_argument("--history", type=_non_negative_int, metavar="K",
+                   help="also write wealth_history.parquet: every robot's wealth every K steps")
+    r.add_argument("--out", help="output folder (default: results/NAME)")
+    r.add_argument("--workers", type=_positive(int), help="processes (default: one per core)")
+    r.add_argument("--quiet", action="store_true", help="no progress output")
+    r.set_defaults(func=cmd_run)
+
+    b = sub.add_parser("bench", help="time single-process runs of the Fig. 2A, 2D and 4C setups")
+    b.add_argument("--json", action="store_true", help="print one JSON object")
+    b.add_argument("--steps", type=_positive(int), default=15000)
+    b.add_argument("--repeats", type=_positive(int), default=7, help="timed runs per setup (median reported)")
+    b.set_defaults(func=cmd_bench)
+
+    d = sub.add_parser("demo", help="a short Fig. 2-like comparison: naive vs sceptical, with and without a saboteur")
+    d.add_argument("--runs", type=_positive(int), default=8, help="runs per setup")
+    d.add_argument("--workers", type=_positive(int), help="processes (default: one per core)")
+    d.set_defaults(func=cmd_demo)
+
+    ls = sub.add_parser("list", help="shipped experiments, behaviours and payment schemes")
+    ls.set_defaults(func=cmd_list)
+
+    c = sub.add_parser("check", help="validate an experiment file and print what it describes")
+    c.add_argument("experiment")
+    c.set_defaults(func=cmd_check)
+
+    for extra in ("infomarket.chain.cli",):
+        try:
+            module = __import__(extra, fromlist=["add_subcommand"])
+        except ImportError:
+            continue
+        module.add_subcommand(sub)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return int(args.func(args) or 0)
+    except (ConfigError, UsageError) as exc:
+        print(f"infomarket: error: {exc}", file=sys.stderr)
+        return EXIT_USAGE
+    except InfomarketError as exc:
+        print(f"infomarket: error: {exc}", file=sys.stderr)
+        return 1
+    except KeyboardInterrupt:
+        print("infomarket: interrupted", file=sys.stderr)
+        return 130
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

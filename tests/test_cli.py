@@ -1,0 +1,75 @@
+"""The command line as a user meets it: run, bench, list, check, determinism of written files."""
+import json
+
+import pandas as pd
+import pytest
+
+from infomarket.cli import main
+from infomarket.engine.seeds import run_seed
+
+COLUMNS = ["run", "seed", "robot", "behaviour", "honest", "drift", "items_collected", "wealth"]
+
+
+def test_run_writes_robots_table_and_summary(tmp_path, capsys):
+    out = tmp_path / "o"
+    assert main(["run", "fig2B", "--runs", "3", "--steps", "600", "--seed", "5", "--out", str(out),
+                 "--workers", "1", "--quiet"]) == 0
+    df = pd.read_parquet(out / "robots.parquet")
+    assert all(c in df.columns for c in COLUMNS)
+    assert len(df) == 3 * 25 and sorted(df.run.unique()) == [0, 1, 2]
+    assert list(df.seed.unique()) == [run_seed(5, i) for i in range(3)]
+    assert df.groupby("run").honest.sum().tolist() == [24, 24, 24]
+    assert df.groupby("run").wealth_share.sum().round(12).tolist() == [1.0, 1.0, 1.0]
+    text = capsys.readouterr().out
+    assert "saboteur" in text and "median items" in text and "robots.parquet" in text
+    assert not (out / "wealth_history.parquet").exists()
+
+
+def test_same_seed_gives_identical_parquet(tmp_path):
+    paths = []
+    for k, workers in enumerate(("1", "2")):
+        out = tmp_path / f"o{k}"
+        assert main(["run", "fig2D", "--runs", "2", "--steps", "2000", "--seed", "11", "--out", str(out),
+                     "--workers", workers, "--quiet"]) == 0
+        paths.append(out / "robots.parquet")
+    assert paths[0].read_bytes() == paths[1].read_bytes()
+    out = tmp_path / "other"
+    main(["run", "fig2D", "--runs", "2", "--steps", "2000", "--seed", "12", "--out", str(out), "--quiet"])
+    assert not pd.read_parquet(out / "robots.parquet").equals(pd.read_parquet(paths[0]))
+
+
+def test_history_every_k_steps(tmp_path):
+    out = tmp_path / "h"
+    assert main(["run", "fig4A", "--runs", "2", "--steps", "1000", "--history", "100", "--out", str(out),
+                 "--workers", "1", "--quiet"]) == 0
+    h = pd.read_parquet(out / "wealth_history.parquet")
+    assert set(h.columns) >= {"run", "seed", "step", "robot", "wealth"}
+    assert sorted(h.step.unique()) == list(range(100, 1001, 100))
+    assert len(h) == 2 * 10 * 25
+    last = h[h.step == 1000].sort_values(["run", "robot"]).wealth.to_numpy()
+    robots = pd.read_parquet(out / "robots.parquet").sort_values(["run", "robot"]).wealth.to_numpy()
+    assert (last == robots).all()
+
+
+def test_bench_json(capsys):
+    assert main(["bench", "--json", "--steps", "300", "--repeats", "2"]) == 0
+    report = json.loads(capsys.readouterr().out)
+    assert set(report["setups"]) == {"fig2A", "fig2D", "fig4C"}
+    for r in report["setups"].values():
+        assert r["steps_per_second"] > 0 and r["compile_seconds"] >= 0
+
+
+def test_list_and_check(capsys):
+    assert main(["list"]) == 0
+    out = capsys.readouterr().out
+    for word in ("fig2A", "sceptical", "scaboteur", "greedy", "free_rider", "outlier", "theta=30.0"):
+        assert word in out
+    assert main(["check", "fig4C"]) == 0
+    assert "20 sceptical, 5 scaboteur" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("argv", [["run"], ["bench", "--repeats", "x"], ["nonsense"]])
+def test_usage_errors_exit_2(argv):
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2

@@ -1,0 +1,63 @@
+"""The two examples of docs/extending.md: they are the files in examples/, and they work."""
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import infomarket as im
+from infomarket import plugins
+from infomarket.ledger import LedgerEvent, replay_events
+
+ROOT = Path(__file__).parents[1]
+
+
+@pytest.fixture(scope="module", autouse=True)
+def examples():
+    for name in ("age_liar.py", "equal_split.py"):
+        plugins.load(str(ROOT / "examples" / name))
+
+
+def test_doc_code_is_the_example_code():
+    doc = (ROOT / "docs" / "extending.md").read_text()
+    blocks = re.findall(r"```python\n(.*?)```", doc, re.S)
+    for name in ("age_liar.py", "equal_split.py"):
+        code = (ROOT / "examples" / name).read_text()
+        assert code in blocks, f"docs/extending.md does not show examples/{name} as it is"
+        assert len(code.strip().splitlines()) <= 20
+
+
+def test_equal_split_pays_each_seller_the_same():
+    events = [LedgerEvent("purchase", 0, 1, 0, 0.0)] * 3 + [LedgerEvent("purchase", 0, 2, 1, 90.0),
+                                                          LedgerEvent("deposit", 0)]
+    res = replay_events(events, 3, scheme="equal_split")
+    assert res.balances == pytest.approx([1.5, 1.25, 1.25])
+
+
+def test_age_liar_sells_far_more_than_an_honest_robot():
+    cfg = im.load_experiment(ROOT / "examples" / "age_liar.toml").with_overrides(steps=3000)
+    res = im.simulate(cfg, seed=3, record_events=True)
+    ev = res.events[res.events.kind == "purchase"]
+    liar = int(res.robots.index[res.robots.behaviour == "age_liar"][0])
+    sales = ev.groupby("seller").size().reindex(range(25), fill_value=0)
+    assert sales[liar] > 3 * np.median(sales.drop(liar))
+    assert set(ev[ev.seller == liar].age) == {0}  # every sale claimed age 0
+    # equal split conserves money like every scheme
+    assert res.totals["wealth"] + res.totals["pots"] == pytest.approx(25 + res.robots.items_collected.sum())
+
+
+def test_plugins_are_checked_by_the_validator(tmp_path):
+    bad = tmp_path / "x.toml"
+    bad.write_text('plugins = ["missing.py"]\n[swarm]\nrobots = 1\n[[swarm.groups]]\nbehaviour = "naive"\ncount = 1\n')
+    with pytest.raises(im.ConfigError, match="missing.py"):
+        im.load_experiment(bad)
+
+
+def test_registering_twice_needs_replace():
+    def sell(w, me, site):
+        return False, 0.0, 0.0, 0
+
+    im.register_behaviour("tmp_silent", buy="naive", sell=sell, honest=False)
+    with pytest.raises(ValueError, match="already registered"):
+        im.register_behaviour("tmp_silent", buy="naive", sell=sell, honest=False)
+    im.register_behaviour("tmp_silent", buy="naive", sell=sell, honest=False, replace=True)
