@@ -6,6 +6,8 @@ Bad input (a malformed experiment, an impossible option) prints one clear messag
 from __future__ import annotations
 
 import argparse
+import importlib
+import importlib.util
 import json
 import sys
 import tempfile
@@ -15,9 +17,11 @@ from . import __version__
 from .errors import ConfigError, InfomarketError
 
 EXIT_USAGE = 2
+SUBCOMMAND_MODULES = ("infomarket.runner.cli", "infomarket.analysis.cli", "infomarket.viewer.cli",
+                      "infomarket.chain.cli")
 
 
-class UsageError(InfomarketError):
+class UsageError(InfomarketError, ValueError):
     """A command-line option is wrong."""
 
 
@@ -206,12 +210,10 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("experiment")
     c.set_defaults(func=cmd_check)
 
-    for extra in ("infomarket.chain.cli",):
-        try:
-            module = __import__(extra, fromlist=["add_subcommand"])
-        except ImportError:
-            continue
-        module.add_subcommand(sub)
+    for extra in SUBCOMMAND_MODULES:  # each subsystem adds its own commands
+        package = extra.rsplit(".", 1)[0]
+        if importlib.util.find_spec(package) is not None and importlib.util.find_spec(extra) is not None:
+            importlib.import_module(extra).add_subcommand(sub)
     return p
 
 
@@ -220,12 +222,10 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         return int(args.func(args) or 0)
-    except (ConfigError, UsageError) as exc:
-        print(f"infomarket: error: {exc}", file=sys.stderr)
-        return EXIT_USAGE
     except InfomarketError as exc:
+        # bad input (configuration, options, store) is a ValueError: exit 2; anything else: 1
         print(f"infomarket: error: {exc}", file=sys.stderr)
-        return 1
+        return EXIT_USAGE if isinstance(exc, ValueError) else 1
     except KeyboardInterrupt:
         print("infomarket: interrupted", file=sys.stderr)
         return 130

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import hashlib
 import json
-from typing import Annotated
+from typing import Annotated, Any
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator, model_validator
 
@@ -86,6 +86,34 @@ class Payment(_Strict):
     params: dict[str, Finite] = Field(default_factory=dict)
 
 
+class AxisValue(_Strict):
+    """One value of a named sweep axis: the label stored in results, and the keys it sets."""
+
+    value: str | int | float
+    set: dict[str, Any] = Field(min_length=1)
+
+
+class Sweep(_Strict):
+    """Conditions to run: the product of ``grid`` (dotted key -> values) and named ``axes``
+    (name -> values, each setting several keys at once, e.g. the number of Byzantines)."""
+
+    runs: PosInt | None = None
+    grid: dict[str, list[Any]] = Field(default_factory=dict)
+    axes: dict[str, list[AxisValue]] = Field(default_factory=dict)
+
+    @model_validator(mode="after")
+    def _not_empty(self) -> "Sweep":
+        if not self.grid and not self.axes:
+            raise ValueError("a sweep needs a grid or axes with at least one key")
+        for key, values in self.grid.items():
+            if not values:
+                raise ValueError(f"grid.{key}: empty list of values")
+        for name, values in self.axes.items():
+            if not values:
+                raise ValueError(f"axes.{name}: empty list of values")
+        return self
+
+
 class Experiment(_Strict):
     """One setup: world, robots, swarm composition, payment scheme, run length, runs and seed."""
 
@@ -104,6 +132,7 @@ class Experiment(_Strict):
     random_walk: RandomWalk = RandomWalk()
     swarm: Swarm
     payment: Payment = Payment()
+    sweep: Sweep | None = None
 
     @field_validator("plugins")
     @classmethod
@@ -181,5 +210,5 @@ class Experiment(_Strict):
 
     def config_hash(self) -> str:
         """Hash of everything that determines results (not name, description, runs or seed)."""
-        data = self.model_dump(exclude={"name", "description", "runs", "seed"})
+        data = self.model_dump(exclude={"name", "description", "runs", "seed", "sweep"})
         return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:16]

@@ -1,4 +1,5 @@
-"""Writing results: Parquet files written atomically (temporary file, then rename)."""
+"""Writing and reading results: atomic Parquet files and the results store of sweeps."""
 from .files import write_parquet_atomic
+from .results import Store, StoreError
 
-__all__ = ["write_parquet_atomic"]
+__all__ = ["Store", "StoreError", "write_parquet_atomic"]

@@ -1,0 +1,134 @@
+"""``infomarket sweep`` and ``infomarket reproduce``: many runs into a resumable results store."""
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..errors import InfomarketError
+
+PAPER = ("fig2A", "fig2B", "fig2C", "fig2D", "fig3A", "fig3B", "fig3C", "fig4A", "fig4B", "fig4C",
+         "fig5", "fig6A", "fig6B", "fig7")
+
+
+class UsageError(InfomarketError, ValueError):
+    pass
+
+
+def _scale(text: str) -> float:
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not 0 < v <= 1:
+        raise argparse.ArgumentTypeError(f"must be in (0, 1], got {text}")
+    return v
+
+
+def _int_at_least(low: int):
+    def parse(text: str) -> int:
+        try:
+            v = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+        if v < low:
+            raise argparse.ArgumentTypeError(f"must be >= {low}, got {text}")
+        return v
+    return parse
+
+
+def _client(args):
+    """A dask.distributed Client when asked for; None for the local process pool."""
+    if not (args.scheduler or args.dask_local):
+        return None, None
+    try:
+        from distributed import Client, LocalCluster
+    except ImportError:
+        raise UsageError("Dask is not installed: pip install 'infomarket[dask]'") from None
+    if args.scheduler:
+        try:
+            return Client(args.scheduler, timeout="5s"), None
+        except (OSError, TimeoutError) as exc:
+            raise UsageError(f"--scheduler {args.scheduler}: no Dask scheduler answers there ({exc})") from None
+    cluster = LocalCluster(n_workers=args.dask_local, threads_per_worker=1, processes=True,
+                           dashboard_address=None)
+    return Client(cluster), cluster
+
+
+def _execute(experiments, args, label: str) -> int:
+    import time
+
+    from ..runner.batch import default_workers
+    from ..runner.progress import progress
+    from ..runner.sweep import plan, run_sweep
+    from ..store import Store
+
+    conds = plan(experiments, runs=getattr(args, "runs", None), seed=getattr(args, "seed", None),
+                 scale=getattr(args, "scale", 1.0))
+    store = Store(args.out)
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise UsageError(f"--out {out}: exists and is not a directory")
+    try:
+        store.create()
+    except OSError as exc:
+        raise UsageError(f"--out {out}: cannot write there ({exc.strerror or exc})") from None
+    client, cluster = _client(args)
+    workers = args.workers or default_workers()
+    t0 = time.perf_counter()
+    try:
+        total = sum(c.runs for c in conds)
+        with progress(label, total, enabled=not args.quiet) as bar:
+            report = run_sweep(conds, store, workers=workers, client=client, on_done=bar.advance,
+                               on_plan=lambda todo: bar.advance(total - todo) if total - todo else None)
+    finally:
+        if client is not None:
+            client.close()
+        if cluster is not None:
+            cluster.close()
+    wall = time.perf_counter() - t0
+    executor = (f"Dask scheduler {args.scheduler}" if args.scheduler else
+                f"local Dask cluster of {args.dask_local}" if args.dask_local else f"{workers} local process(es)")
+    print(f"{label}: {report.done} runs done, {report.skipped} already in the store, "
+          f"{len(conds)} condition(s); {report.env_steps:,} env-steps in {wall:.1f} s wall "
+          f"({report.env_steps / wall if wall > 0 else 0:,.0f} env-steps/s) on {executor}")
+    print(f"store: {out}")
+    return 0
+
+
+def cmd_sweep(args) -> int:
+    from ..config import load_experiment
+
+    return _execute([load_experiment(args.experiment)], args, "sweep")
+
+
+def cmd_reproduce(args) -> int:
+    from ..config import load_experiment
+
+    if args.what != "paper":
+        raise UsageError(f"reproduce: unknown target {args.what!r}; allowed: paper")
+    return _execute([load_experiment(name) for name in PAPER], args, "paper")
+
+
+def _executor_options(p) -> None:
+    p.add_argument("--out", required=True, help="results store folder (created; resumed if it exists)")
+    p.add_argument("--workers", type=_int_at_least(1), help="local processes (default: one per core)")
+    g = p.add_mutually_exclusive_group()
+    g.add_argument("--scheduler", metavar="ADDRESS", help="run on a Dask scheduler, e.g. tcp://host:8786")
+    g.add_argument("--dask-local", type=_int_at_least(1), metavar="N", help="run on a local Dask cluster of N workers")
+    p.add_argument("--quiet", action="store_true", help="no progress output")
+
+
+def add_subcommand(sub) -> None:
+    s = sub.add_parser("sweep", help="run every condition of an experiment into a results store (resumable)")
+    s.add_argument("experiment")
+    s.add_argument("--runs", type=_int_at_least(1), help="runs per condition (default: the file's)")
+    s.add_argument("--seed", type=_int_at_least(0), help="master seed (default: the file's)")
+    _executor_options(s)
+    s.set_defaults(func=cmd_sweep)
+
+    r = sub.add_parser("reproduce", help="rerun every experiment of the paper into one results store")
+    r.add_argument("what", choices=["paper"], help="what to reproduce")
+    r.add_argument("--scale", type=_scale, default=1.0,
+                   help="fraction of the paper's runs per condition (at least 2), e.g. 0.125 for a quick check")
+    _executor_options(r)
+    r.set_defaults(func=cmd_reproduce)

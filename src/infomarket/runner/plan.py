@@ -1,0 +1,120 @@
+"""From experiment files to a plan of runs: sweep conditions, their configurations and seeds.
+
+A condition is one point of a sweep's grid × axes.  Its id (``key=value,...``, sorted) names it in the
+results store, and its seed stream is derived from (master seed, hash of that id, run index) with
+``SeedSequence``: adding values to a grid never changes the seeds of existing conditions, and any run
+can be rerun alone (``simulate(condition_config, seed=run_seed)``) with the numbers it had in the sweep.
+"""
+from __future__ import annotations
+
+import copy
+import hashlib
+import itertools
+import json
+import re
+from dataclasses import dataclass, field
+from typing import Any
+
+from ..config.load import validate
+from ..config.schema import Experiment
+from ..engine.seeds import run_seed
+from ..errors import ConfigError
+
+BASE = "base"
+_PART = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)(?:\[(\d+)\])?$")
+
+
+@dataclass(frozen=True)
+class Condition:
+    """One configuration of an experiment, with the keys that distinguish it."""
+
+    experiment: str
+    id: str
+    keys: dict[str, Any]
+    config: Experiment
+    runs: int
+    master_seed: int
+    number: int = field(default=0)  # the seed stream's condition index
+
+    def seed(self, run: int) -> int:
+        return run_seed(self.master_seed, run, self.number)
+
+
+def condition_number(cid: str) -> int:
+    """Stable integer for a condition id (0 for the base condition, as ``infomarket run`` uses)."""
+    if cid == BASE:
+        return 0
+    return int(hashlib.sha256(cid.encode()).hexdigest()[:15], 16)
+
+
+def _set_path(data: dict, path: str, value: Any, where: str) -> None:
+    """Assign ``value`` at a dotted path like ``swarm.groups[1].params.rotation_angle``."""
+    parts = path.split(".")
+    node: Any = data
+    for k, part in enumerate(parts):
+        m = _PART.match(part)
+        if not m:
+            raise ConfigError(f"{where}: {path!r} is not a key path (like payment.stake or swarm.groups[1].count)")
+        name, index = m.group(1), m.group(2)
+        last = k == len(parts) - 1
+        if not isinstance(node, dict) or (name not in node and not (last and parts[k - 1] == "params")):
+            allowed = ", ".join(sorted(node)) if isinstance(node, dict) else "none"
+            raise ConfigError(f"{where}: unknown condition key {path!r}: no {name!r} here; allowed: {allowed}")
+        if index is not None:
+            seq = node[name]
+            if not isinstance(seq, list) or int(index) >= len(seq):
+                raise ConfigError(f"{where}: {path!r}: index {index} out of range")
+            if last:
+                seq[int(index)] = value
+            else:
+                node = seq[int(index)]
+            continue
+        if last:
+            node[name] = value
+        else:
+            node = node[name]
+
+
+def _label(path: str) -> str:
+    return _PART.match(path.split(".")[-1]).group(1)
+
+
+def conditions(exp: Experiment, *, runs: int | None = None, seed: int | None = None,
+               scale: float = 1.0) -> list[Condition]:
+    """Expand an experiment into its conditions (one, ``base``, when it has no sweep)."""
+    master = exp.seed if seed is None else seed
+
+    def n_runs(default: int) -> int:
+        n = runs or default
+        return max(2, round(n * scale)) if scale != 1.0 else n
+
+    if exp.sweep is None:
+        return [Condition(exp.name, BASE, {}, exp, n_runs(exp.runs), master, 0)]
+    sw = exp.sweep
+    labels = [_label(p) for p in sw.grid] + list(sw.axes)
+    dupes = {x for x in labels if labels.count(x) > 1}
+    if dupes:
+        raise ConfigError(f"{exp.name}: sweep keys {sorted(dupes)} would name two columns the same")
+    base = exp.model_dump(exclude={"sweep"})
+    grid_items = list(sw.grid.items())
+    axis_items = list(sw.axes.items())
+    out = []
+    for combo in itertools.product(*[v for _, v in grid_items], *[v for _, v in axis_items]):
+        data = copy.deepcopy(base)
+        keys: dict[str, Any] = {}
+        for (path, _), value in zip(grid_items, combo[:len(grid_items)]):
+            _set_path(data, path, value, f"{exp.name}: sweep.grid")
+            keys[_label(path)] = value
+        for (name, _), av in zip(axis_items, combo[len(grid_items):]):
+            for path, value in av.set.items():
+                _set_path(data, path, value, f"{exp.name}: sweep.axes.{name}")
+            keys[name] = av.value
+        cid = ",".join(f"{k}={json.dumps(keys[k]) if isinstance(keys[k], str) else keys[k]}"
+                       for k in sorted(keys)).replace('"', "")
+        try:
+            cfg = validate(data, f"{exp.name} [{cid}]")
+        except ConfigError as exc:
+            raise ConfigError(str(exc)) from None
+        out.append(Condition(exp.name, cid, keys, cfg, n_runs(sw.runs or exp.runs), master,
+                             condition_number(cid)))
+    return out
