@@ -32,3 +32,35 @@ def run_bench(setups, *, steps: int = 15000, repeats: int = 7) -> dict:
                      "compile_seconds": compile_seconds, "robots": cfg.swarm.robots, "steps": steps,
                      "repeats": repeats, "min_seconds": min(times), "max_seconds": max(times)}
     return {"version": __version__, "setups": out}
+
+
+def run_scaling(experiment: str = "fig2A", runs: int = 16, steps: int = 15000) -> dict:
+    """Sweep throughput (env-steps/s) with 1 and 2 local workers and a local Dask cluster of 2."""
+    import tempfile
+
+    from .runner.sweep import plan, run_sweep
+    from .store import Store
+
+    cfg = load_experiment(experiment).with_overrides(steps=steps)
+    conds = plan([cfg], runs=runs)
+    out = {}
+    setups = [("local_1", {"workers": 1}), ("local_2", {"workers": 2}), ("dask_local_2", None)]
+    for name, kw in setups:
+        with tempfile.TemporaryDirectory() as tmp:
+            if kw is None:
+                from distributed import Client, LocalCluster
+
+                with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, Client(cluster) as client:
+                    client.run(lambda: None)  # workers up before the clock starts
+                    t0 = time.perf_counter()
+                    run_sweep(conds, Store(tmp), client=client)
+                    wall = time.perf_counter() - t0
+            else:
+                t0 = time.perf_counter()
+                run_sweep(conds, Store(tmp), **kw)
+                wall = time.perf_counter() - t0
+        out[name] = {"env_steps_per_second": runs * steps / wall, "wall_seconds": wall}
+    out["speedup_2_vs_1"] = out["local_2"]["env_steps_per_second"] / out["local_1"]["env_steps_per_second"]
+    out["dask_vs_local_2"] = out["dask_local_2"]["env_steps_per_second"] / out["local_2"]["env_steps_per_second"]
+    return {"experiment": experiment, "runs": runs, "steps": steps, **out}

@@ -116,8 +116,19 @@ BENCH_SETUPS = ("fig2A", "fig2D", "fig4C")
 
 
 def cmd_bench(args) -> int:
-    from .bench import run_bench
+    from .bench import run_bench, run_scaling
 
+    if args.scaling:
+        report = run_scaling(steps=args.steps)
+        if args.json:
+            print(json.dumps(report, indent=2))
+        else:
+            for k in ("local_1", "local_2", "dask_local_2"):
+                print(f"{k:13s} {report[k]['env_steps_per_second']:>12,.0f} env-steps/s "
+                      f"({report[k]['wall_seconds']:.2f} s for {report['runs']} runs)")
+            print(f"2 workers vs 1: {report['speedup_2_vs_1']:.2f}x; Dask (2) vs local pool (2): "
+                  f"{report['dask_vs_local_2']:.2f}")
+        return 0
     report = run_bench(BENCH_SETUPS, steps=args.steps, repeats=args.repeats)
     if args.json:
         print(json.dumps(report, indent=2))
@@ -196,6 +207,8 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--json", action="store_true", help="print one JSON object")
     b.add_argument("--steps", type=_positive(int), default=15000)
     b.add_argument("--repeats", type=_positive(int), default=7, help="timed runs per setup (median reported)")
+    b.add_argument("--scaling", action="store_true",
+                   help="instead: sweep throughput with 1 and 2 local workers and a local Dask cluster of 2")
     b.set_defaults(func=cmd_bench)
 
     d = sub.add_parser("demo", help="a short Fig. 2-like comparison: naive vs sceptical, with and without a saboteur")

@@ -79,6 +79,8 @@ def make_tasks(conds: list[Condition], done: set, workers: int) -> list[Task]:
     for c, runs in todo:
         for k in range(0, len(runs), size):
             tasks.append(Task(c, tuple(runs[k:k + size])))
+    # longest first, so the long runs (Figs. 5-6) do not finish alone at the end on one worker
+    tasks.sort(key=lambda t: -t.condition.config.steps * len(t.runs))
     return tasks
 
 
