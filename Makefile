@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: venv demo test bench clean
+.PHONY: venv demo test bench clean contracts gas
 
 venv: $(STAMP)
 
@@ -25,3 +25,14 @@ bench: venv
 
 clean:
 	rm -rf $(VENV) .pytest_cache build dist
+
+# The Solidity contract: solc-js pinned in tools/solc; the compiled artifact is committed in the package.
+contracts: tools/solc/node_modules
+	node tools/solc/compile.js
+
+tools/solc/node_modules: tools/solc/package.json tools/solc/package-lock.json
+	cd tools/solc && npm ci --no-audit --no-fund
+	touch $@
+
+gas: venv
+	$(BIN)/python -m infomarket.chain.gasreport

@@ -11,10 +11,8 @@ from pathlib import Path
 
 import pytest
 
-pytest.importorskip("web3", reason="the chain extra (web3, eth-tester) is not installed")
-
-from infomarket.chain.market import ChainMarket, MarketParams, connect, derived_account, fund_gas  # noqa: E402
-from infomarket.chain.units import to_units  # noqa: E402
+from infomarket.chain.market import ChainMarket, MarketParams, connect, derived_account, fund_gas
+from infomarket.chain.units import to_units
 
 ROBOTS = 8
 

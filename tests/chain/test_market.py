@@ -90,6 +90,18 @@ def test_shares_follow_the_outlier_weights_and_the_stakes_are_shared(make_market
     assert market.balance_of(buyer.address) == TOKEN_UNIT + TOKEN_UNIT + 160_000_000 - sum(amount * w // 6 for w in (2, 2, 1, 1))
 
 
+def test_similarity_is_strictly_within_theta_and_wraps_around_north(make_market, robots):
+    """MODEL.md: directions differing by *less than* Theta, circularly, are similar."""
+    market = make_market("outlier", stake=0.0)
+    buyer = robots[0]
+    # 0 and 30 are exactly Theta apart (not similar); 330.000001 is 29.999999 from 0 (similar);
+    # 330.000001 and 30 are 59.999999 apart.
+    for seller, direction in ((robots[1], 0.0), (robots[2], 30.0), (robots[3], 330.000001)):
+        sell(market, seller, buyer, FOOD, direction)
+    shares = logs(market, "RewardShared", market.buy_item(buyer.address))
+    assert [e.args.weight for e in shares] == [2, 1, 2]
+
+
 def test_constructor_refuses_stakes_under_delayed_payment(make_market):
     with pytest.raises(ContractRevert) as refused:
         make_market("delayed", stake=0.04)
@@ -97,13 +109,29 @@ def test_constructor_refuses_stakes_under_delayed_payment(make_market):
     assert refused.value.args_by_name == {"parameter": b"stake".ljust(32, b"\0"), "value": 40_000_000}
 
 
+@pytest.fixture(scope="module")
+def vector_markets(w3, robots, make_market):
+    """One market per (scheme, robots, initial wealth, theta) of the cases, deployed once; each case
+    starts from this snapshot of the chain."""
+    markets = {}
+    for case in CASES:
+        key = (case["scheme"], case["robots"], case["initial_wealth"], case["theta_deg"])
+        if key not in markets:
+            scheme, stake = SCHEMES[case["scheme"]]
+            wealth = [case["initial_wealth"]] * case["robots"] + [0.0] * (len(robots) - case["robots"])
+            markets[key] = make_market(scheme, stake=stake, wealth=wealth, theta_deg=case["theta_deg"])
+    tester = w3.provider.ethereum_tester
+    return markets, tester, tester.take_snapshot()
+
+
 @pytest.mark.parametrize("case", CASES, ids=[f"{i}-{c['scheme']}" for i, c in enumerate(CASES)])
-def test_contract_reproduces_the_original_simulators_payments(case, make_market, robots):
+def test_contract_reproduces_the_original_simulators_payments(case, vector_markets, robots):
     scheme, stake = SCHEMES[case["scheme"]]
     assert stake == case["stake"]
     n = case["robots"]
-    wealth = [case["initial_wealth"]] * n + [0.0] * (len(robots) - n)
-    market = make_market(scheme, stake=stake, wealth=wealth, theta_deg=case["theta_deg"])
+    markets, tester, snapshot = vector_markets
+    tester.revert_to_snapshot(snapshot)
+    market = markets[(case["scheme"], n, case["initial_wealth"], case["theta_deg"])]
     exact = ExactLedger(n, scheme, Fraction(case["reward"]), Fraction(str(case["information_share"])),
                         Fraction(str(stake)), Fraction(case["theta_deg"]), Fraction(str(case["initial_wealth"])))
     buyer = robots[case["buyer"]]

@@ -7,11 +7,12 @@ the default: nothing to install or run) or any JSON-RPC node (``rpc_url``), whos
 account pays the robots' gas (a development node such as anvil or ``geth --dev`` has one).
 
 Refusals come back as ``ContractRevert`` with the custom error's name and decoded arguments, on both
-backends: every transaction is estimated first, which surfaces the revert data before anything is
-mined.
+backends: every transaction is dry-run first (``eth_call``), which surfaces the revert data before
+anything is mined.
 """
 from __future__ import annotations
 
+import ast
 import json
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -32,8 +33,8 @@ from .units import share_to_wad, to_microdegrees, to_units
 SCHEMES = {"delayed": 0, "outlier": 1}
 #: Gas money given to every robot and to the market account (wei); far above what a demo spends.
 GAS_ALLOWANCE_WEI = 10**20
-#: Default cap on records per buyer: keeps the O(n^2) outlier weighting of ``buyItem`` well inside a
-#: 30M block (see docs/gas.md for the measured cost per record).
+#: Default cap on records per buyer: keeps the O(n^2) outlier weighting of ``buyItem`` inside a 30M
+#: block (16.3M gas measured at 256 records; docs/gas.md has the curve up to 64).
 DEFAULT_MAX_CONTRIBUTORS = 256
 
 
@@ -251,9 +252,9 @@ def _revert_data(exc: BaseException) -> bytes | None:
     """The raw revert bytes, wherever the backend put them.
 
     A JSON-RPC node's answer reaches us as web3's ``ContractCustomError``/``ContractLogicError`` with a
-    hex ``data``. eth-tester raises ``TransactionFailed`` carrying the bytes, which web3 re-raises with
-    a message (its repr, or a string it guessed out of them), so the original is looked for along the
-    exception's cause/context chain.
+    hex ``data``. eth-tester raises ``TransactionFailed`` whose message is the bytes' repr, and web3
+    re-raises it with a message of its own (sometimes a string it guessed out of the bytes), so the
+    repr is looked for along the exception's cause/context chain.
     """
     pending: list[BaseException | None] = [exc]
     seen: set[int] = set()
@@ -266,9 +267,21 @@ def _revert_data(exc: BaseException) -> bytes | None:
         if isinstance(data, str) and data.startswith("0x"):
             return bytes.fromhex(data[2:])
         first = e.args[0] if e.args else None
+        if isinstance(first, str):
+            first = _bytes_literal(first.removeprefix("execution reverted: "))
         if isinstance(first, bytes):
             return first
         if isinstance(first, BaseException):
             pending.append(first)
         pending += [e.__cause__, e.__context__]
     return None
+
+
+def _bytes_literal(text: str) -> bytes | None:
+    if text[:2] not in ("b'", 'b"'):
+        return None
+    try:
+        value = ast.literal_eval(text)
+    except (ValueError, SyntaxError):
+        return None
+    return value if isinstance(value, bytes) else None

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from statistics import mean
 
 from .errors import ChainError, ContractRevert
-from .market import ChainMarket, MarketParams, connect, derived_account, fund_gas
+from .market import SCHEMES, ChainMarket, MarketParams, connect, derived_account, fund_gas
 from .protocol import PathInfo
 from .units import TOKEN_UNIT, to_units
 
@@ -55,6 +55,7 @@ class ReplayReport:
     first_block: int = 0
     last_block: int = 0
     refusals_confirmed: int = 0
+    boundary_refusals: int = 0
     disagreements: list[str] = field(default_factory=list)
     balances: list[int] = field(default_factory=list)
     pots: list[int] = field(default_factory=list)
@@ -93,7 +94,7 @@ class ReplayReport:
         return {"reveals": len(self.reveal_gas), "items": self.items, "gas_per_reveal": avg(self.reveal_gas),
                 "gas_per_buy_item": avg(self.buy_gas), "max_gas_buy_item": max(self.buy_gas, default=0),
                 "gas_per_item": self.gas_per_item, "blocks_used": self.blocks_used,
-                "refusals_confirmed": self.refusals_confirmed}
+                "refusals_confirmed": self.refusals_confirmed, "boundary_refusals": self.boundary_refusals}
 
 
 def replay_on_chain(events: Iterable[Mapping] | object, *, robots: int, params: MarketParams,
@@ -105,7 +106,9 @@ def replay_on_chain(events: Iterable[Mapping] | object, *, robots: int, params: 
     ``purchase | refused | deposit``, ``buyer``, ``seller``, ``site``, ``direction_deg``, ``x``, ``y``,
     ``age``, and optionally ``seller_x``/``seller_y`` (the seller's position in the buyer's frame,
     which the buyer signs; (0, 0) when the log does not carry it). A purchase the chain refuses, or a
-    refusal the chain would accept, is recorded in ``disagreements`` rather than stopping the replay.
+    refusal the chain would accept, is recorded in ``disagreements`` rather than stopping the replay;
+    except a refusal whose seller's exact balance equals the stake to within the comparison's
+    precision, which only float rounding in the simulator refused (counted in ``boundary_refusals``).
     """
     w3 = connect(rpc_url)
     market = ChainMarket.deploy(params, w3=w3, seed=seed)
@@ -150,13 +153,48 @@ def replay_on_chain(events: Iterable[Mapping] | object, *, robots: int, params: 
                     report.refusals_confirmed += 1
                     continue
                 raise
-            report.disagreements.append(f"event {number} (step {ev.get('step')}): refused purchase accepted on chain")
+            # The contract would accept: fine only if the seller's balance *is* the stake, within the
+            # precision of the comparison (the simulator's float balance, e.g. 1 - 24 * 0.04, can land
+            # a hair under a stake that the exact balance equals).
+            margin = market.balance_of(accounts[seller].address) - params.stake
+            if margin <= report.rounding_bound[seller] + FLOAT_SLACK_UNITS:
+                report.boundary_refusals += 1
+            else:
+                report.disagreements.append(f"event {number} (step {ev.get('step')}): refused purchase "
+                                            f"accepted on chain (seller {seller} has {margin} units above the stake)")
 
     report.last_block = w3.eth.block_number
     report.balances = [market.balance_of(a.address) for a in accounts]
     report.pots = [market.locked_stake(a.address) for a in accounts]
     report.total_supply = market.total_supply()
     return report
+
+
+def market_params(config) -> MarketParams:
+    """The contract's parameters for an experiment's payment section (``config.payment``).
+
+    The contract implements the two built-in schemes; a plugin scheme, or a fuel cost (money the
+    simulation burns, which the contract has no notion of), cannot be replayed on chain.
+    """
+    payment = config.payment
+    if payment.scheme not in SCHEMES:
+        raise ChainError(f"the contract implements the {' and '.join(SCHEMES)} schemes, not {payment.scheme!r}")
+    if config.robot.fuel_cost:
+        raise ChainError("the contract has no fuel cost: replay a configuration with robot.fuel_cost = 0")
+    theta = config.payment_params().get("theta", 30.0) if payment.scheme == "outlier" else 30.0
+    return MarketParams.from_floats(payment.scheme, reward=payment.reward,
+                                    information_share=payment.information_share, stake=payment.stake,
+                                    theta_deg=theta)
+
+
+def replay_result(result, *, rpc_url: str | None = None) -> tuple[ReplayReport, list[BalanceRow]]:
+    """Replay a simulation's events (``simulate(..., record_events=True)``) on a fresh market and
+    compare every robot's on-chain balance with its final wealth in the simulation."""
+    config = result.config
+    report = replay_on_chain(result.events, robots=config.swarm.robots, params=market_params(config),
+                             initial_wealth=config.payment.initial_wealth, rpc_url=rpc_url, seed=result.seed)
+    wealth = result.robots.sort_values("robot")["wealth"].to_numpy()
+    return report, report.compare(wealth)
 
 
 def _count_rounding(bound: list[int], buyer: int, sellers: list[int]) -> None:

@@ -1,0 +1,151 @@
+"""``infomarket chain demo``: a small swarm whose every sale and deposit goes through the contract.
+
+The simulator runs first and records its ledger events; each purchase then becomes a real light
+contract (the seller's offer and the buyer's acceptance signed with their own keys) revealed on chain
+by its seller, each refused purchase is checked to be refused by the contract too, and each deposit
+is a ``buyItem`` by the market account. The command prints the gas and blocks this took and compares
+every robot's on-chain balance with its wealth in the simulation (exit status 1 if any differs by more
+than the fixed-point rounding allows, see ``replay``).
+
+``add_subcommand(subparsers)`` hangs ``chain demo`` under the main ``infomarket`` parser; the chosen
+handler is stored as ``func`` (``args.func(args)`` returns the exit status). Heavy imports (the
+simulator, web3) happen only when the command runs.
+"""
+from __future__ import annotations
+
+import argparse
+import sys
+import time
+
+DEMO_SCHEMES = {"delayed": ("delayed", 0.0), "outlier": ("outlier", 0.0), "staking": ("outlier", 0.04)}
+
+
+def _count(lowest: int):
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be a whole number, not {text!r}") from None
+        if value < lowest:
+            raise argparse.ArgumentTypeError(f"must be at least {lowest}, not {value}")
+        return value
+
+    return parse
+
+
+def _rpc_url(text: str) -> str:
+    if not text.startswith(("http://", "https://")):
+        raise argparse.ArgumentTypeError(f"must be an http(s):// JSON-RPC URL, not {text!r}")
+    return text
+
+
+def add_subcommand(subparsers) -> None:
+    """Add ``chain`` (with its ``demo`` subcommand) to an argparse subparsers object."""
+    chain = subparsers.add_parser("chain", help="run the information market on an Ethereum chain",
+                                  description="The information market as a Solidity contract (docs/chain.md).")
+    commands = chain.add_subparsers(dest="chain_command", metavar="COMMAND", required=True)
+    demo = commands.add_parser(
+        "demo", help="replay a small simulated swarm through the contract and compare the balances",
+        description=__doc__.split("\n\n")[1].replace("\n", " "))
+    demo.add_argument("--robots", type=_count(1), default=10, help="swarm size (default 10)")
+    demo.add_argument("--steps", type=_count(1), default=3000, help="simulation steps (default 3000)")
+    demo.add_argument("--scheme", choices=sorted(DEMO_SCHEMES), default="staking",
+                      help="payment scheme: delayed, outlier (no stake) or staking (outlier, stake 0.04); "
+                           "default staking")
+    demo.add_argument("--experiment", default="fig4C",
+                      help="experiment whose swarm composition is scaled down (default fig4C)")
+    demo.add_argument("--seed", type=_count(0), default=0, help="simulation seed (default 0)")
+    demo.add_argument("--rpc", type=_rpc_url, metavar="URL",
+                      help="JSON-RPC node to use instead of the in-process EVM (needs an unlocked funded account)")
+    demo.set_defaults(func=run_demo)
+
+
+def demo_config(base, robots: int, steps: int, scheme: str):
+    """``base`` with its swarm scaled to ``robots`` (every group keeps at least one robot when there
+    is room), run for ``steps``, paying with ``scheme`` (a key of ``DEMO_SCHEMES``)."""
+    groups = base.swarm.groups
+    counts = [max(1, round(g.count * robots / base.swarm.robots)) if g.count else 0 for g in groups]
+    largest = max(range(len(groups)), key=lambda k: counts[k])
+    counts[largest] += robots - sum(counts)
+    if counts[largest] < 0:  # more groups than robots: keep the first ones
+        counts = [1 if k < robots else 0 for k in range(len(groups))]
+    name, stake = DEMO_SCHEMES[scheme]
+    payment = base.payment.model_dump()
+    payment.update(scheme=name, stake=stake, params=payment["params"] if base.payment.scheme == name else {})
+    return base.with_overrides(
+        steps=steps, transitory=0,
+        swarm={"robots": robots, "groups": [dict(g.model_dump(), count=c) for g, c in zip(groups, counts)]},
+        payment=payment)
+
+
+def run_demo(args: argparse.Namespace) -> int:
+    """Handler of ``infomarket chain demo``; returns the exit status."""
+    try:
+        from .. import load_experiment, simulate
+        from ..errors import ConfigError
+        from .errors import ChainError
+        from .market import connect
+        from .replay import replay_result
+    except ImportError as exc:
+        print(f"error: infomarket chain needs the chain extra (pip install 'infomarket[chain]'): {exc}",
+              file=sys.stderr)
+        return 1
+    try:
+        config = demo_config(load_experiment(args.experiment), args.robots, args.steps, args.scheme)
+        if args.rpc:
+            connect(args.rpc)  # fail before simulating if the node is not there
+    except (ConfigError, ValueError, ChainError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    composition = ", ".join(f"{g.count} {g.behaviour}" for g in config.swarm.groups if g.count)
+    print(f"chain demo: {args.robots} robots ({composition}), {args.steps} steps, scheme {args.scheme} "
+          f"(stake {config.payment.stake:g}), seed {args.seed}")
+    t0 = time.perf_counter()
+    result = simulate(config, seed=args.seed, record_events=True)
+    kinds = result.events["kind"].value_counts()
+    print(f"simulated in {time.perf_counter() - t0:.1f} s: {kinds.get('purchase', 0)} purchases, "
+          f"{kinds.get('refused', 0)} refused, {kinds.get('deposit', 0)} deposits")
+    t0 = time.perf_counter()
+    try:
+        report, rows = replay_result(result, rpc_url=args.rpc)
+    except ChainError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 1
+    print(f"replayed on {args.rpc or 'the in-process EVM (py-evm)'} in {time.perf_counter() - t0:.1f} s")
+    print(_report_text(report, rows))
+    good = all(r.ok for r in rows) and report.conserved() and not report.disagreements
+    print("on-chain balances equal the simulated ledger up to the fixed-point unit per share: "
+          + ("yes" if good else "NO"))
+    return 0 if good else 1
+
+
+def _report_text(report, rows) -> str:
+    s = report.summary()
+    lines = [
+        f"  reveals                 {s['reveals']}",
+        f"  gas per reveal          {s['gas_per_reveal']:,.0f} (mean)",
+        f"  gas per buyItem         {s['gas_per_buy_item']:,.0f} (mean), {s['max_gas_buy_item']:,} (max)",
+        f"  gas per item delivered  {s['gas_per_item']:,.0f}  ({s['items']} items)",
+        f"  blocks used             {s['blocks_used']}",
+        f"  refusals confirmed      {s['refusals_confirmed']} (and {s['boundary_refusals']} where the seller's "
+        "balance equals the stake exactly, refused by the simulator's float rounding)",
+        f"  money conserved         {'yes' if report.conserved() else 'NO'} "
+        f"(supply {report.total_supply / 1e9:.9f} = balances + locked stakes)",
+        "  robot   on chain        simulated       diff (units)  bound",
+    ]
+    lines += [f"  {r.robot:5d}   {r.chain_units / 1e9:13.9f}   {r.expected:13.9f}   {r.diff_units:11.3f}  "
+              f"{r.bound_units:5d}{'' if r.ok else '  <- differs'}" for r in rows]
+    lines += [f"  disagreement: {d}" for d in report.disagreements]
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Stand-alone entry (``python -m infomarket.chain.cli chain demo ...``), same as the main CLI's."""
+    parser = argparse.ArgumentParser(prog="infomarket")
+    add_subcommand(parser.add_subparsers(dest="command", required=True))
+    args = parser.parse_args(argv)
+    return args.func(args)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,44 @@
+"""The committed ABI + bytecode (src/infomarket/chain/artifacts) is what the pinned compiler makes of
+the committed contract, so the Python side can run without Node and still never run stale code."""
+from __future__ import annotations
+
+import hashlib
+import json
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+from infomarket.chain.market import load_artifact
+
+ROOT = Path(__file__).resolve().parents[2]
+SOURCE = ROOT / "contracts" / "InformationMarket.sol"
+TOOLS = ROOT / "tools" / "solc"
+
+
+def test_artifact_records_the_source_it_was_built_from():
+    """Cheap staleness check that needs no compiler: the source's hash is stored in the artifact."""
+    artifact = load_artifact()
+    assert artifact["sourceSha256"] == hashlib.sha256(SOURCE.read_bytes()).hexdigest(), (
+        "contracts/InformationMarket.sol changed since the artifact was built: run `make contracts`")
+
+
+def test_compiler_is_pinned_to_one_exact_version():
+    wanted = json.loads((TOOLS / "package.json").read_text())["dependencies"]["solc"]
+    assert wanted.replace(".", "").isdigit(), f"solc must be pinned exactly, not {wanted!r}"
+    locked = json.loads((TOOLS / "package-lock.json").read_text())["packages"]["node_modules/solc"]["version"]
+    assert locked == wanted
+    assert load_artifact()["compiler"]["version"].startswith(f"{wanted}+commit.")
+
+
+def test_recompiling_reproduces_the_committed_artifact(tmp_path):
+    node, npm = shutil.which("node"), shutil.which("npm")
+    if node is None or npm is None:
+        pytest.skip("node and npm are not installed: cannot recompile the contract to check the artifact")
+    if not (TOOLS / "node_modules" / "solc").is_dir():
+        subprocess.run([npm, "ci", "--no-audit", "--no-fund"], cwd=TOOLS, check=True, capture_output=True)
+    fresh = tmp_path / "InformationMarket.json"
+    subprocess.run([node, str(TOOLS / "compile.js"), "--out", str(fresh)], check=True, capture_output=True)
+    assert json.loads(fresh.read_text()) == load_artifact(), (
+        "the committed artifact is stale: run `make contracts` and commit src/infomarket/chain/artifacts")

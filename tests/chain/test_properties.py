@@ -1,0 +1,79 @@
+"""Property: any sequence of reveals and buys keeps the token supply exact and the ledger sound.
+
+For random sequences (random buyers, sellers, sites, directions, schemes, and initial wealth small
+enough that stakes get refused), after every operation:
+- every token is accounted for: balances + locked stakes == totalSupply == wealth granted + rewards;
+- the contract accepts exactly the sales the model accepts (a refused one fails with
+  InfoMarketInsufficientStake, never with an arithmetic panic), so no balance is ever driven below 0;
+- every balance is within its rounding bound of the exact rational model (tests/chain/exact_ledger.py).
+"""
+from __future__ import annotations
+
+from fractions import Fraction
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from infomarket.chain.errors import ContractRevert
+from infomarket.chain.protocol import PathInfo
+from infomarket.chain.units import MICRO, TOKEN_UNIT, to_units
+
+from .exact_ledger import ExactLedger
+
+N = 4
+SCHEMES = [("delayed", 0.0), ("outlier", 0.0), ("outlier", 0.04)]
+WEALTHS = [0.05, 0.1, 1.0]
+
+directions = st.one_of(st.sampled_from([0.0, 10.0, 25.0, 29.999999, 30.0, 45.5, 180.0, 330.0, 359.9]),
+                       st.floats(0.0, 359.999, allow_nan=False))
+sale = st.tuples(st.just("sell"), st.integers(0, N - 1), st.integers(0, N - 1), st.integers(0, 1), directions)
+buy = st.tuples(st.just("buy"), st.integers(0, N - 1))
+sequences = st.lists(st.one_of(sale, sale, buy), min_size=1, max_size=12)
+
+
+@pytest.fixture(scope="module")
+def deployed(w3, make_market):
+    """One market per (scheme, wealth), deployed once; each example starts from this snapshot."""
+    markets = {(s, stake, wealth): make_market(s, stake=stake, wealth=[wealth] * N + [0.0] * 4)
+               for s, stake in SCHEMES for wealth in WEALTHS}
+    tester = w3.provider.ethereum_tester
+    return markets, tester, tester.take_snapshot()
+
+
+@settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(scheme=st.sampled_from(SCHEMES), wealth=st.sampled_from(WEALTHS), ops=sequences)
+def test_random_sequences_conserve_supply_and_never_go_negative(deployed, robots, scheme, wealth, ops):
+    markets, tester, snapshot = deployed
+    tester.revert_to_snapshot(snapshot)
+    name, stake = scheme
+    market = markets[(name, stake, wealth)]
+    exact = ExactLedger(N, name, Fraction(1), Fraction(1, 2), Fraction(str(stake)), Fraction(30),
+                        Fraction(str(wealth)))
+    minted = to_units(wealth) * N
+    for op in ops:
+        if op[0] == "buy":
+            market.buy_item(robots[op[1]].address)
+            exact.deposit(op[1])
+            minted += TOKEN_UNIT
+        else:
+            _, buyer, seller, site, direction = op
+            if buyer == seller:
+                continue
+            info = PathInfo.from_floats(1.0, 2.0, direction)
+            accepted = exact.purchase(buyer, seller, site, Fraction(info.direction, MICRO))
+            lc = market.light_contract(robots[seller], robots[buyer], site, len(exact.open[buyer]), info)
+            if accepted:
+                market.reveal(robots[seller], lc, info)
+            else:
+                with pytest.raises(ContractRevert) as refused:
+                    market.reveal(robots[seller], lc, info)
+                assert refused.value.name == "InfoMarketInsufficientStake"
+
+        balances = [market.balance_of(r.address) for r in robots[:N]]
+        pots = [market.locked_stake(r.address) for r in robots[:N]]
+        assert sum(balances) + sum(pots) == market.total_supply() == minted
+        assert pots == [to_units(float(p)) for p in exact.pot]
+        for i in range(N):
+            assert exact.balance[i] >= 0
+            assert abs(balances[i] - exact.balance[i] * TOKEN_UNIT) < max(exact.bound[i], 1)
