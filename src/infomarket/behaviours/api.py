@@ -72,7 +72,7 @@ def buy(w, me, seller, site):
     ox, oy = to_frame(w, me, w.pos[seller, 0] - w.pos[me, 0], w.pos[seller, 1] - w.pos[me, 1])
     age = w.off_age[seller, site]
     ok = open_transaction(w, me, seller, site, d)
-    purchase_events(w, ok, me, seller, site, d, rx + ox, ry + oy, age)
+    purchase_events(w, ok, me, seller, site, d, rx + ox, ry + oy, age, ox, oy)
     if not ok:
         return False, 0.0, 0.0, 0
     if w.stop_time > 0 or w.cooldown > 0:

@@ -101,7 +101,7 @@ def build_world(cfg: Experiment, rng: np.random.Generator, *, record_events: boo
         stop_timer=z(n, np.int64), cool_timer=z(n, np.int64),
         ev_step=z(ecap, np.int64), ev_kind=z(ecap, np.int64), ev_buyer=z(ecap, np.int64),
         ev_seller=z(ecap, np.int64), ev_site=z(ecap, np.int64), ev_dir=z(ecap), ev_x=z(ecap), ev_y=z(ecap),
-        ev_age=z(ecap, np.int64), ev_stake=z(ecap), ev_count=z(1, np.int64),
+        ev_age=z(ecap, np.int64), ev_stake=z(ecap), ev_sx=z(ecap), ev_sy=z(ecap), ev_count=z(1, np.int64),
         hist=z((hist_rows, n)), flags=z(1, np.int64),
     )
     return world, names
@@ -122,8 +122,7 @@ def grow(world: World) -> World:
     ecap = world.ev_step.shape[0]
     if world.record and int(world.ev_count[0]) + 2 * n * n + n > ecap:
         new = max(2 * ecap, int(world.ev_count[0]) + 4 * n * n + 2 * n)
-        for f in ("ev_step", "ev_kind", "ev_buyer", "ev_seller", "ev_site", "ev_dir", "ev_x", "ev_y",
-                  "ev_age", "ev_stake"):
+        for f in [f for f in world._fields if f.startswith("ev_") and f != "ev_count"]:
             old = getattr(world, f)
             arr = np.zeros(new, old.dtype)
             arr[:ecap] = old

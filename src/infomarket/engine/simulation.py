@@ -116,7 +116,7 @@ class Simulation:
             "step": w.ev_step[:k], "kind": pd.Categorical.from_codes(w.ev_kind[:k], EVENT_NAMES),
             "buyer": w.ev_buyer[:k], "seller": w.ev_seller[:k], "site": w.ev_site[:k],
             "direction_deg": w.ev_dir[:k], "x": w.ev_x[:k], "y": w.ev_y[:k], "age": w.ev_age[:k],
-            "stake": w.ev_stake[:k],
+            "stake": w.ev_stake[:k], "seller_x": w.ev_sx[:k], "seller_y": w.ev_sy[:k],
         })
         totals = {"wealth": total, "pots": float(w.pot.sum()), "burned": float(w.burned[0]),
                   "items": int(w.items.sum())}

@@ -32,7 +32,8 @@ State:
         each buyer's transactions since its last deposit
     nbr [n, n] int64, nbr_count [n] int64: neighbours, increasing id order
     stop_timer [n], cool_timer [n] int64: communication stop and cooldown
-    ev_* [ecap] and ev_count [1]: event log (purchase / refused / deposit), when ``record``
+    ev_* [ecap] and ev_count [1]: event log (purchase / refused / deposit), when ``record``; ev_sx, ev_sy
+        are the seller's position in the buyer's frame (what the on-chain light contract signs)
     hist [m, n] float64: wealth every ``hist_every`` steps;  flags [1] int64: error bits (engine.flags)
 """
 from __future__ import annotations
@@ -53,7 +54,7 @@ STATE_FIELDS = (
     "tx_seller", "tx_site", "tx_dir", "tx_count",
     "nbr", "nbr_count", "stop_timer", "cool_timer",
     "ev_step", "ev_kind", "ev_buyer", "ev_seller", "ev_site", "ev_dir", "ev_x", "ev_y", "ev_age",
-    "ev_stake", "ev_count", "hist", "flags",
+    "ev_stake", "ev_sx", "ev_sy", "ev_count", "hist", "flags",
 )
 
 World = namedtuple("World", PARAM_FIELDS + STATE_FIELDS)

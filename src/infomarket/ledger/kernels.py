@@ -11,8 +11,13 @@ from ..engine import flags
 from ..engine.world import EV_DEPOSIT, EV_PURCHASE, EV_REFUSED
 
 
+#: A seller whose balance falls short of the stake by less than this (float rounding of sums of
+#: stakes, e.g. 1 - 24 x 0.04) can still lock it: the exact on-chain ledger would accept it.
+STAKE_TOLERANCE = 1e-9
+
+
 @njit
-def log_event(w, kind, buyer, seller, site, direction, x, y, age, stake):
+def log_event(w, kind, buyer, seller, site, direction, x, y, age, stake, sx=0.0, sy=0.0):
     """Append one event to the log when recording; the host keeps enough room for a whole step."""
     if not w.record:
         return
@@ -30,6 +35,8 @@ def log_event(w, kind, buyer, seller, site, direction, x, y, age, stake):
     w.ev_y[k] = y
     w.ev_age[k] = age
     w.ev_stake[k] = stake
+    w.ev_sx[k] = sx
+    w.ev_sy[k] = sy
     w.ev_count[0] = k + 1
 
 
@@ -41,10 +48,11 @@ def open_transaction(w, buyer, seller, site, direction):
         w.flags[0] |= flags.TX_OVERFLOW
         return False
     if w.stake > 0.0:
-        if w.balance[seller] < w.stake:
+        if w.balance[seller] < w.stake - STAKE_TOLERANCE:
             return False
-        w.balance[seller] -= w.stake
-        w.pot[buyer] += w.stake
+        lock = min(w.stake, w.balance[seller])  # never below zero, even within the tolerance
+        w.balance[seller] -= lock
+        w.pot[buyer] += lock
     w.tx_seller[buyer, k] = seller
     w.tx_site[buyer, k] = site
     w.tx_dir[buyer, k] = direction
@@ -53,9 +61,9 @@ def open_transaction(w, buyer, seller, site, direction):
 
 
 @njit
-def purchase_events(w, ok, buyer, seller, site, direction, x, y, age):
+def purchase_events(w, ok, buyer, seller, site, direction, x, y, age, sx, sy):
     log_event(w, EV_PURCHASE if ok else EV_REFUSED, buyer, seller, site, direction, x, y, age,
-              w.stake if ok else 0.0)
+              w.stake if ok else 0.0, sx, sy)
 
 
 @njit
@@ -81,4 +89,4 @@ def distribute(w, buyer, weights):
             w.balance[w.tx_seller[buyer, x]] += amount * (weights[x] / total)
         w.balance[buyer] -= amount
     w.tx_count[buyer] = 0
-    log_event(w, EV_DEPOSIT, buyer, -1, -1, 0.0, 0.0, 0.0, 0, 0.0)
+    log_event(w, EV_DEPOSIT, buyer, -1, -1, 0.0, 0.0, 0.0, 0, 0.0, 0.0, 0.0)
