@@ -1,0 +1,38 @@
+"""``infomarket figures STORE --out DIR``: the paper's figures, the paper-vs-store table and a report."""
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from ..errors import ConfigError
+
+
+def add_subcommand(subparsers) -> None:
+    p = subparsers.add_parser(
+        "figures", help="draw the paper's Figs. 2-7 from a results store and write report.md/html",
+        description="Draw every figure of the paper that the store has data for (PNG and SVG/PDF), compare "
+                    "the headline numbers with the paper, and write report.md and report.html in DIR.")
+    p.add_argument("store", metavar="STORE", help="a results store (folder with store.json)")
+    p.add_argument("--out", required=True, metavar="DIR", help="folder for the figures and the report")
+    p.add_argument("--vector", choices=("svg", "pdf"), default="svg", help="vector format besides PNG")
+    p.set_defaults(func=cmd_figures)
+
+
+def cmd_figures(args: argparse.Namespace) -> int:
+    """Exit 0 when the report is written, whatever the verdicts: a failed row is a finding, not an error."""
+    from ..store import Store
+    from .frames import Frames
+    from .report import build_report
+
+    out = Path(args.out)
+    if out.exists() and not out.is_dir():
+        raise ConfigError(f"--out {out}: exists and is not a directory")
+    frames = Frames.of(Store(args.store))  # raises StoreError for a missing or foreign folder
+    if frames.robots.empty and frames.history.empty:
+        print(f"{args.store}: the store holds no completed runs; writing an empty report")
+    try:
+        out.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ConfigError(f"--out {out}: cannot create it ({exc.strerror or exc})") from None
+    build_report(frames, out, vector=args.vector, echo=print, label=str(args.store))
+    return 0

@@ -1,0 +1,234 @@
+"""The paper's Figs. 2-7, each a function from DataFrames to a matplotlib ``Figure``.
+
+Figures are built with ``matplotlib.figure.Figure`` rather than pyplot, so nothing here changes the
+global backend: a notebook shows the returned figure inline, and ``save`` renders with Agg.  A panel
+without data shows "no data in the store"; a figure without any data raises ``MissingDataError``.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import matplotlib
+import numpy as np
+import pandas as pd
+from matplotlib.axes import Axes
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+
+from . import metrics, stats
+from .boxplots import BYZANTINE, HONEST, draw_boxes, honest_vs_byzantine, legend_handles
+from .frames import Frames, MissingDataError, composition, experiment
+
+EQUAL_SHARE_PCT = 100.0 / 25  # every robot's wealth share when wealth is equal (MODEL.md §7)
+THETA_DEG = 30.0              # outlier threshold of the smart contract (paper, Fig. 7)
+STAKING, NO_STAKING = "#2ca02c", "#ff7f0e"
+
+
+def _figure(ncols: int, width: float = 3.6, height: float = 4.2, sharey: bool = True) -> tuple[Figure, list[Axes]]:
+    fig = Figure(figsize=(width * ncols, height), layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(1, ncols, sharey=sharey, squeeze=False)[0]
+    return fig, list(axes)
+
+
+def _panel_title(ax: Axes, letter: str, text: str = "") -> None:
+    ax.set_title(f"({letter}) {text}".rstrip(), loc="left", fontsize=10)
+
+
+def _no_data(ax: Axes, name: str) -> None:
+    ax.text(0.5, 0.5, f"no {name} data\nin the store", ha="center", va="center", transform=ax.transAxes,
+            color="grey")
+    ax.set_xticks([])
+
+
+def _box_panels(robots: pd.DataFrame, names: list[str], column: str, scale: float, ylabel: str,
+                annotate: Callable[[Axes, pd.DataFrame], None] | None = None) -> Figure:
+    """One honest-vs-Byzantine box plot per experiment of ``names``, labelled with its swarm."""
+    if all(experiment(robots, n).empty for n in names):
+        raise MissingDataError(f"none of {', '.join(names)} is in the store")
+    fig, axes = _figure(len(names))
+    for ax, name in zip(axes, names):
+        rows = experiment(robots, name)
+        _panel_title(ax, name[-1])
+        if rows.empty:
+            _no_data(ax, name)
+            continue
+        honest_vs_byzantine(ax, rows[column].to_numpy() * scale, rows["honest"].to_numpy())
+        ax.set_xlim(-0.7, 0.7)
+        ax.set_xticks([])
+        ax.set_xlabel(composition(rows).replace(" + ", "\n+ "), fontsize=9)
+        if annotate:
+            annotate(ax, rows)
+    axes[0].set_ylabel(ylabel)
+    fig.legend(handles=legend_handles(), loc="outside lower center", ncols=2, frameon=False)
+    return fig
+
+
+# ------------------------------------------------------------------------------------------- Fig. 2
+def fig2(robots: pd.DataFrame) -> Figure:
+    """Items collected per robot after the transitory period: (A) naive, (B) naive + saboteur,
+    (C) sceptical, (D) sceptical + scaboteur."""
+    fig = _box_panels(robots, ["fig2A", "fig2B", "fig2C", "fig2D"], "items_collected", 1.0,
+                      "items collected per robot")
+    fig.suptitle("Fig. 2: items collected per robot", fontsize=11)
+    return fig
+
+
+# ---------------------------------------------------------------------------------------- Figs. 3-4
+def _annotate_mann_whitney(ax: Axes, rows: pd.DataFrame) -> None:
+    ax.axhline(EQUAL_SHARE_PCT, color="grey", linestyle="--", linewidth=0.8, zorder=0)
+    honest = rows["honest"].to_numpy(bool)
+    if honest.all() or not honest.any():
+        return
+    mw = stats.mann_whitney(rows.loc[honest, "wealth_share"], rows.loc[~honest, "wealth_share"])
+    ax.text(0.03, 0.97, f"Mann-Whitney U, one-sided\np = {mw.pvalue:.2g}", transform=ax.transAxes, ha="left",
+            va="top", fontsize=8, bbox=dict(facecolor="white", edgecolor="none", alpha=0.8))
+
+
+def _wealth_share_figure(robots: pd.DataFrame, number: int, title: str) -> Figure:
+    names = [f"fig{number}{p}" for p in "ABC"]
+    fig = _box_panels(robots, names, "wealth_share", 100.0, "wealth share (%)", _annotate_mann_whitney)
+    fig.suptitle(f"Fig. {number}: {title}", fontsize=11)
+    return fig
+
+
+def fig3(robots: pd.DataFrame) -> Figure:
+    """Wealth share per robot under outlier penalisation, 1, 3 and 5 scaboteurs; one-sided Mann-Whitney
+    U p-value (honest > Byzantine) on each panel; dashed line = equal share (4 %)."""
+    return _wealth_share_figure(robots, 3, "wealth share, outlier penalisation")
+
+
+def fig4(robots: pd.DataFrame) -> Figure:
+    """As Fig. 3, with staking (0.04 per sale)."""
+    return _wealth_share_figure(robots, 4, "wealth share, outlier penalisation with staking")
+
+
+# ------------------------------------------------------------------------------------------- Fig. 5
+def fig5(history: pd.DataFrame, robots: pd.DataFrame | None = None) -> Figure:
+    """Average wealth over time of honest robots and scaboteurs, (A) absolute and (B) as a share of the
+    swarm's wealth, with 95 % bootstrap bands over runs.  ``robots`` is needed only when the history
+    has no ``honest`` column."""
+    curves = metrics.wealth_curves(history, robots)
+    rows = experiment(history, "fig5")
+    if "behaviour" not in rows.columns and robots is not None:
+        rows = experiment(robots, "fig5")
+    fig, axes = _figure(2, width=5.2, sharey=False)
+    for ax, (key, letter, ylabel, scale) in zip(axes, [("wealth", "A", "mean wealth per robot", 1.0),
+                                                       ("share", "B", "mean wealth share (%)", 100.0)]):
+        for honest, colour in ((True, HONEST), (False, BYZANTINE)):
+            if honest not in curves[key]:
+                continue
+            table = curves[key][honest]
+            band = stats.mean_band(table.to_numpy())
+            steps = table.columns.to_numpy()
+            label = metrics.behaviour_label(rows, honest)
+            ax.plot(steps, band.centre * scale, color=colour, label=f"{label} ({len(table)} runs)")
+            ax.fill_between(steps, band.low * scale, band.high * scale, color=colour, alpha=0.25,
+                            linewidth=0)
+        if key == "share":
+            ax.axhline(EQUAL_SHARE_PCT, color="grey", linestyle="--", linewidth=0.8, zorder=0)
+        _panel_title(ax, letter)
+        ax.set_xlabel("step")
+        ax.set_ylabel(ylabel)
+        ax.legend(fontsize=8, frameon=False)
+    fig.suptitle("Fig. 5: average wealth over time (shades: 95 % CI over runs)", fontsize=11)
+    return fig
+
+
+# ------------------------------------------------------------------------------------------- Fig. 6
+def fig6(robots: pd.DataFrame) -> Figure:
+    """|odometry drift| against wealth share of honest robots, (A) no Byzantines and (B) five
+    scaboteurs; least-squares line with a 95 % bootstrap band, and Pearson r with its 95 % CI."""
+    names = ["fig6A", "fig6B"]
+    if all(experiment(robots, n).empty for n in names):
+        raise MissingDataError("neither fig6A nor fig6B is in the store")
+    fig, axes = _figure(2, width=4.6)
+    for ax, name in zip(axes, names):
+        rows = experiment(robots, name)
+        _panel_title(ax, name[-1])
+        honest = rows[rows["honest"]] if len(rows) else rows
+        if len(honest) < 3:
+            _no_data(ax, name)
+            continue
+        x = honest["drift"].abs().to_numpy()
+        y = honest["wealth_share"].to_numpy() * 100.0
+        ax.scatter(x, y, s=6, color=HONEST, alpha=0.35, linewidths=0)
+        grid = np.linspace(x.min(), x.max(), 100)
+        band = stats.regression_band(x, y, grid)
+        ax.plot(grid, band.centre, color="black", linewidth=1.5)
+        ax.fill_between(grid, band.low, band.high, color="black", alpha=0.2, linewidth=0)
+        c = stats.pearson(x, y)
+        ax.text(0.97, 0.97, f"Pearson r = {c.r:.2f}\n95 % CI [{c.low:.2f}, {c.high:.2f}]\nn = {c.n}",
+                transform=ax.transAxes, ha="right", va="top", fontsize=8,
+                bbox=dict(facecolor="white", edgecolor="none", alpha=0.8))
+        ax.set_xlabel(f"|odometry drift| (deg/step)\n{composition(rows)}", fontsize=9)
+    axes[0].set_ylabel("wealth share (%), honest robots")
+    fig.suptitle("Fig. 6: odometry drift vs wealth share", fontsize=11)
+    return fig
+
+
+# ------------------------------------------------------------------------------------------- Fig. 7
+def fig7(robots: pd.DataFrame) -> Figure:
+    """Items collected by the swarm after the transitory period against the Byzantines' rotation angle,
+    with and without staking, (A) one and (B) three Byzantines; dotted line at Theta = 30 deg."""
+    runs = metrics.swarm_throughput(robots)
+    fig, axes = _figure(2, width=6.0, height=4.6)
+    for ax, (letter, byz) in zip(axes, [("A", 1), ("B", 3)]):
+        panel = runs[runs["byzantines"] == byz]
+        _panel_title(ax, letter, f"{byz} Byzantine{'s' if byz > 1 else ''}")
+        if panel.empty:
+            _no_data(ax, f"fig7 ({byz} Byzantine)")
+            continue
+        angles = np.sort(panel["rotation_angle"].unique())
+        for market, colour, offset in (("no_staking", NO_STAKING, -2.2), ("staking", STAKING, 2.2)):
+            sel = panel[panel["market"] == market]
+            data = [sel.loc[sel["rotation_angle"] == a, "throughput"].to_numpy() for a in angles]
+            draw_boxes(ax, data, angles + offset, colour, width=3.8)
+        ax.axvline(THETA_DEG, color="grey", linestyle=":", linewidth=1)
+        ax.set_xticks(angles, [f"{a:g}" for a in angles])
+        ax.set_xlabel("rotation angle of the Byzantine robots (deg)")
+        ax.set_xlim(angles.min() - 6, angles.max() + 6)
+    axes[0].set_ylabel("items collected by the swarm\n(after the transitory period)")
+    fig.legend(handles=legend_handles({NO_STAKING: "without staking (delayed payment)",
+                                       STAKING: "with staking (outlier penalisation, 0.04)"})
+               + [Line2D([], [], color="grey", linestyle=":", label="Theta = 30 deg")],
+               loc="outside lower center", ncols=3, frameon=False)
+    fig.suptitle("Fig. 7: collective performance vs rotation angle", fontsize=11)
+    return fig
+
+
+# ------------------------------------------------------------------------------------------ registry
+@dataclass(frozen=True)
+class FigureSpec:
+    name: str
+    caption: str
+    draw: Callable[[Frames], Figure]
+
+
+FIGURES: tuple[FigureSpec, ...] = (
+    FigureSpec("fig2", "Items collected per robot: (A) 25 naive, (B) 24 naive + 1 saboteur, (C) 25 sceptical, "
+               "(D) 24 sceptical + 1 scaboteur. Blue honest, red Byzantine.", lambda f: fig2(f.robots)),
+    FigureSpec("fig3", "Wealth share per robot with outlier penalisation, 1, 3 and 5 scaboteurs; one-sided "
+               "Mann-Whitney U p-value (honest > Byzantine) per panel; dashed line = 4 %.", lambda f: fig3(f.robots)),
+    FigureSpec("fig4", "As Fig. 3, with staking (0.04 per sale).", lambda f: fig4(f.robots)),
+    FigureSpec("fig5", "Average wealth of honest robots and scaboteurs (20 + 5, staking) over time, (A) absolute, "
+               "(B) share; shades: 95 % bootstrap CI over runs.", lambda f: fig5(f.history, f.robots)),
+    FigureSpec("fig6", "|Odometry drift| vs wealth share of honest robots, (A) 25 sceptical, (B) 20 sceptical + "
+               "5 scaboteurs; least-squares line with 95 % bootstrap band, Pearson r with 95 % CI.",
+               lambda f: fig6(f.robots)),
+    FigureSpec("fig7", "Items collected by the swarm after the transitory period vs rotation angle, with and "
+               "without staking, (A) 1 and (B) 3 Byzantines.", lambda f: fig7(f.robots)),
+)
+
+
+def save(fig: Figure, out: Path, name: str, vector: str = "svg") -> list[Path]:
+    """Write ``name.png`` and ``name.svg`` (or ``.pdf``) under ``out``, without timestamps or random ids,
+    so the same data give the same files."""
+    paths = [out / f"{name}.png", out / f"{name}.{vector}"]
+    with matplotlib.rc_context({"svg.hashsalt": "infomarket"}):
+        fig.savefig(paths[0], dpi=150, metadata={"Software": None})
+        fig.savefig(paths[1], metadata={"svg": {"Date": None}, "pdf": {"CreationDate": None}}[vector])
+    return paths

@@ -1,0 +1,169 @@
+"""``report.md`` and ``report.html``: every figure, the "paper vs this store" table, and provenance.
+
+``build_report`` draws and saves each figure (skipping, with a one-line note, those whose data the
+store lacks), computes the headline table and provenance once, and writes both documents from the
+same ``Report`` so they never disagree.
+"""
+from __future__ import annotations
+
+import html
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pandas as pd
+
+from ..store import Store
+from .figures import FIGURES, save
+from .frames import Frames, MissingDataError
+from .headline import FAIL, NO_DATA, PASS, headline_table
+from .provenance import Provenance, collect_provenance
+
+TABLE_COLUMNS = {"figure": "figure", "claim": "claim", "paper": "paper", "store": "this store",
+                 "tolerance": "tolerance", "verdict": "verdict"}
+
+
+@dataclass
+class FigureResult:
+    name: str
+    caption: str
+    files: list[Path] = field(default_factory=list)  # empty when skipped
+    note: str = ""                                    # why it was skipped
+
+
+@dataclass
+class Report:
+    source: str
+    figures: list[FigureResult]
+    table: pd.DataFrame
+    provenance: Provenance
+    files: list[Path] = field(default_factory=list)
+
+    def counts(self) -> dict[str, int]:
+        return {v: int((self.table["verdict"] == v).sum()) for v in (PASS, FAIL, NO_DATA)}
+
+
+def build_report(source, out: str | Path, *, vector: str = "svg", label: str | None = None,
+                 echo: Callable[[str], None] = lambda line: None) -> Report:
+    """Write the figures, ``report.md`` and ``report.html`` under ``out``; ``echo`` gets one line per step.
+
+    ``source`` is anything ``Frames.of`` reads; ``label`` names it in the report (default: its path)."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    label = label or _label(source)
+    frames = Frames.of(source)
+    results = []
+    for spec in FIGURES:
+        try:
+            fig = spec.draw(frames)
+        except MissingDataError as exc:
+            results.append(FigureResult(spec.name, spec.caption, note=str(exc)))
+            echo(f"{spec.name}: skipped ({exc})")
+            continue
+        files = save(fig, out, spec.name, vector)
+        results.append(FigureResult(spec.name, spec.caption, files))
+        echo(f"{spec.name}: wrote {', '.join(p.name for p in files)}")
+    table = headline_table(frames)
+    report = Report(label, results, table, collect_provenance(frames, label))
+    c = report.counts()
+    echo(f"paper vs this store: {c[PASS]} pass, {c[FAIL]} fail, {c[NO_DATA]} no data")
+    for name, text in (("report.md", to_markdown(report)), ("report.html", to_html(report))):
+        (out / name).write_text(text, encoding="utf-8")
+        report.files.append(out / name)
+    echo(f"wrote {', '.join(str(p) for p in report.files)}")
+    return report
+
+
+def _label(source) -> str:
+    """How the report names its data: the store's path, or "tables" for DataFrames."""
+    if isinstance(source, Store):
+        return str(source.root)
+    return str(source) if isinstance(source, (str, Path)) else "tables"
+
+
+# ------------------------------------------------------------------------------------------ markdown
+def _md_cell(text) -> str:
+    return str(text).replace("|", "\\|").replace("\n", " ")
+
+
+def _md_table(df: pd.DataFrame) -> str:
+    lines = ["| " + " | ".join(_md_cell(c) for c in df.columns) + " |",
+             "|" + "---|" * len(df.columns)]
+    lines += ["| " + " | ".join(_md_cell(v) for v in row) + " |" for row in df.itertuples(index=False)]
+    return "\n".join(lines)
+
+
+def _summary(report: Report) -> str:
+    c = report.counts()
+    return f"{c[PASS]} pass, {c[FAIL]} fail, {c[NO_DATA]} without data, of {len(report.table)} rows."
+
+
+def to_markdown(report: Report) -> str:
+    md = [f"# Paper figures from {report.source}", "",
+          "Figures and headline numbers of *An Information Market for Social Navigation in Robots*, "
+          "recomputed from this results store. Tolerances: `src/infomarket/analysis/tolerances.toml` "
+          "(declared before any result was seen).", "", "## Figures", ""]
+    for r in report.figures:
+        md.append(f"### {r.name.replace('fig', 'Fig. ')}")
+        md.append("")
+        md.append(r.caption)
+        md.append("")
+        if r.files:
+            md.append(f"![{r.name}]({r.files[0].name})")
+            md.append("")
+            md.append(f"Vector: [{r.files[1].name}]({r.files[1].name})")
+        else:
+            md.append(f"*Skipped: {r.note}.*")
+        md.append("")
+    md += ["## Paper vs this store", "", _summary(report), "",
+           _md_table(report.table[list(TABLE_COLUMNS)].rename(columns=TABLE_COLUMNS)), "",
+           "## Provenance", ""]
+    md += [f"- {k}: {v}" for k, v in report.provenance.facts.items()]
+    if not report.provenance.experiments.empty:
+        md += ["", _md_table(report.provenance.experiments)]
+    return "\n".join(md) + "\n"
+
+
+# ---------------------------------------------------------------------------------------------- html
+CSS = """body{font-family:system-ui,sans-serif;max-width:1200px;margin:2em auto;padding:0 1em;color:#222}
+img{max-width:100%;border:1px solid #ddd}table{border-collapse:collapse;font-size:90%;margin:1em 0}
+td,th{border:1px solid #ccc;padding:4px 8px;text-align:left;vertical-align:top}th{background:#f3f3f3}
+.pass{background:#e3f5e1}.fail{background:#fbe0e0}.nodata{background:#f0f0f0;color:#666}
+.note{color:#666;font-style:italic}"""
+
+
+def _html_table(df: pd.DataFrame, verdicts: bool = False) -> str:
+    head = "".join(f"<th>{html.escape(str(c))}</th>" for c in df.columns)
+    body = []
+    for row in df.itertuples(index=False):
+        cls = ""
+        if verdicts:
+            cls = f' class="{str(row[-1]).replace(" ", "")}"'
+        body.append(f"<tr{cls}>" + "".join(f"<td>{html.escape(str(v))}</td>" for v in row) + "</tr>")
+    return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
+
+
+def to_html(report: Report) -> str:
+    e = html.escape
+    parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>Paper figures from {e(report.source)}"
+             f"</title><style>{CSS}</style></head><body>",
+             f"<h1>Paper figures from {e(report.source)}</h1>",
+             "<p>Figures and headline numbers of <i>An Information Market for Social Navigation in Robots</i>, "
+             "recomputed from this results store. Tolerances: <code>src/infomarket/analysis/tolerances.toml"
+             "</code> (declared before any result was seen).</p>", "<h2>Figures</h2>"]
+    for r in report.figures:
+        parts.append(f"<h3>{e(r.name.replace('fig', 'Fig. '))}</h3><p>{e(r.caption)}</p>")
+        if r.files:
+            png, vec = (p.name for p in r.files)
+            parts.append(f"<p><a href='{e(vec)}'><img src='{e(png)}' alt='{e(r.name)}'></a></p>")
+        else:
+            parts.append(f"<p class='note'>Skipped: {e(r.note)}.</p>")
+    parts += ["<h2>Paper vs this store</h2>", f"<p>{e(_summary(report))}</p>",
+              _html_table(report.table[list(TABLE_COLUMNS)].rename(columns=TABLE_COLUMNS), verdicts=True),
+              "<h2>Provenance</h2><ul>"]
+    parts += [f"<li>{e(k)}: {e(v)}</li>" for k, v in report.provenance.facts.items()]
+    parts.append("</ul>")
+    if not report.provenance.experiments.empty:
+        parts.append(_html_table(report.provenance.experiments))
+    parts.append("</body></html>")
+    return "\n".join(parts) + "\n"

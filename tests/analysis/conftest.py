@@ -1,0 +1,24 @@
+"""Synthetic stores shared by the analysis tests (built once per session: they are read-only)."""
+from __future__ import annotations
+
+import pytest
+
+from infomarket.analysis.frames import Frames
+
+from .synthetic import paper_like, write_store
+
+
+@pytest.fixture(scope="session")
+def paper_store(tmp_path_factory):
+    return write_store(tmp_path_factory.mktemp("paper") / "store", paper_like())
+
+
+@pytest.fixture(scope="session")
+def paper_frames(paper_store):
+    return Frames.of(paper_store)
+
+
+@pytest.fixture(scope="session")
+def equal_wealth_store(tmp_path_factory):
+    """Honest and Byzantine robots share one wealth distribution in Figs. 3-4."""
+    return write_store(tmp_path_factory.mktemp("equal") / "store", paper_like(honest_richer=False))

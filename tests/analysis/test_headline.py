@@ -1,0 +1,108 @@
+import math
+
+import pytest
+
+from infomarket.analysis import headline
+from infomarket.analysis.headline import FAIL, NO_DATA, PASS, Rule, headline_table, load_rules
+
+from .synthetic import paper_like, write_store
+
+
+def verdicts(table) -> dict[str, str]:
+    return dict(zip(table["id"], table["verdict"]))
+
+
+def test_every_rule_has_a_metric_and_every_metric_a_rule():
+    assert set(load_rules()) == set(headline.METRICS)
+
+
+def test_the_declared_tolerances_are_no_wider_than_the_issue_allows():
+    """Guards against widening a rule until it passes (values from the issue and the paper)."""
+    r = load_rules()
+    assert (r["fig2A_median"].min, r["fig2A_median"].max) == (18, 22)
+    assert r["fig2B_halves"].max <= 0.65
+    assert r["fig2D_vs_2B"].min >= 1.5
+    assert (r["fig2D_vs_2C"].min, r["fig2D_vs_2C"].max) == (-3, 3)
+    assert r["fig3A_scaboteur_share"].max <= 3.6
+    assert r["fig3A_honest_share"].above >= 4.0
+    for rid in [f"fig{n}{p}_mannwhitney" for n in (3, 4) for p in "ABC"]:
+        assert r[rid].below <= 0.001
+    assert r["fig6A_pearson"].min >= -0.54 - 0.15 and r["fig6A_pearson"].max <= -0.54 + 0.15
+    assert r["fig6B_pearson"].min >= -0.64 - 0.15 and r["fig6B_pearson"].max <= -0.64 + 0.15
+    assert r["fig7B_staking_helps"].min == 1.0
+
+
+def test_every_rule_states_the_paper_value_and_the_reason_for_its_bounds():
+    text = headline.TOLERANCES.read_text()
+    for rid, rule in load_rules().items():
+        assert rule.paper and rule.claim and rule.figure, rid
+        block = text.split(f"[rows.{rid}]\n")[1].split("\n[rows.")[0]
+        assert any(line.startswith("# ") for line in block.splitlines()), f"rows.{rid}: no reasoning comment"
+
+
+@pytest.mark.parametrize("rule, value, ok", [
+    (Rule("r", "f", "c", "p", min=18, max=22), 18, True),
+    (Rule("r", "f", "c", "p", min=18, max=22), 22.5, False),
+    (Rule("r", "f", "c", "p", above=4.0), 4.0, False),
+    (Rule("r", "f", "c", "p", above=4.0), 4.01, True),
+    (Rule("r", "f", "c", "p", below=0.001), 0.0009, True),
+    (Rule("r", "f", "c", "p", below=0.001), 0.001, False),
+    (Rule("r", "f", "c", "p", max=3.6), math.nan, False),
+])
+def test_rule_bounds_are_inclusive_or_strict_as_declared(rule, value, ok):
+    assert rule.passes(value) is ok
+
+
+def test_rule_describes_its_bounds():
+    assert Rule("r", "f", "c", "p", min=-0.69, max=-0.39).describe() == "[-0.69, -0.39]"
+    assert Rule("r", "f", "c", "p", below=0.001).describe() == "< 0.001"
+
+
+def test_a_store_like_the_paper_passes_every_row(paper_store):
+    table = headline_table(paper_store)
+    assert list(table["verdict"]) == [PASS] * len(load_rules()), table[table.verdict != PASS]
+    assert list(table.columns) == headline.COLUMNS
+
+
+def test_honest_robots_clearly_richer_give_p_below_0001(paper_store):
+    table = headline_table(paper_store).set_index("id")
+    for rid in [f"fig{n}{p}_mannwhitney" for n in (3, 4) for p in "ABC"]:
+        assert table.loc[rid, "value"] < 0.001
+        assert table.loc[rid, "verdict"] == PASS
+
+
+def test_honest_robots_not_richer_fail_the_wealth_rows(equal_wealth_store):
+    v = verdicts(headline_table(equal_wealth_store))
+    for rid in [f"fig{n}{p}_mannwhitney" for n in (3, 4) for p in "ABC"]:
+        assert v[rid] == FAIL, rid
+    assert v["fig3A_scaboteur_share"] == FAIL
+    assert v["fig2A_median"] == PASS  # rows about items are untouched
+
+
+def test_missing_experiments_give_no_data_rows_not_errors(tmp_path):
+    store = write_store(tmp_path / "s", paper_like(), only=("fig2",))
+    v = verdicts(headline_table(store))
+    assert v["fig2A_median"] == PASS
+    assert all(v[rid] == NO_DATA for rid in v if not rid.startswith("fig2"))
+
+
+def test_weaker_correlation_than_the_paper_fails(paper_frames):
+    robots = paper_frames.robots.copy()
+    sel = robots.experiment == "fig6A"
+    robots.loc[sel, "drift"] = robots.loc[sel, "drift"].sample(frac=1, random_state=0).to_numpy()  # r ~ 0
+    v = verdicts(headline_table({"robots": robots, "history": paper_frames.history}))
+    assert v["fig6A_pearson"] == FAIL and v["fig6B_pearson"] == PASS
+
+
+def test_staking_that_does_not_help_three_byzantines_fails(paper_frames):
+    robots = paper_frames.robots.copy()
+    byz3 = (robots.experiment == "fig7") & (robots.byzantines == 3) & (robots.market == "no_staking")
+    robots.loc[byz3, "items_collected"] += 5  # no staking now does better at every angle
+    v = verdicts(headline_table(robots))
+    assert v["fig7B_staking_helps"] == FAIL and v["fig7A_no_difference"] == PASS
+
+
+def test_headline_table_takes_frames_dicts_and_paths(paper_store, paper_frames):
+    a = headline_table(paper_store.root)
+    b = headline_table({"robots": paper_frames.robots, "history": paper_frames.history})
+    assert list(a["verdict"]) == list(b["verdict"])
