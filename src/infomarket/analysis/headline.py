@@ -207,11 +207,11 @@ def _fig5_grows(f: Frames) -> Measurement:
 # --------------------------------------------------------------------------------------- Fig. 6
 def _pearson(name: str) -> Callable[[Frames], Measurement]:
     def measure(f: Frames) -> Measurement:
-        rows = require(f.robots, name, ("drift", "wealth_share", "honest")).query("honest")
+        rows, when = metrics.drift_and_share(f.robots, f.history, name)
         if len(rows) < 3:
             raise MissingDataError(f"{name}: fewer than 3 honest robots")
-        c = stats.pearson(rows["drift"].abs(), rows["wealth_share"])
-        return Measurement(c.r, f"r = {c.r:.2f}, 95 % CI [{c.low:.2f}, {c.high:.2f}], n = {c.n}")
+        c = stats.pearson(rows["abs_drift"], rows["wealth_share"])
+        return Measurement(c.r, f"r = {c.r:.2f}, 95 % CI [{c.low:.2f}, {c.high:.2f}], n = {c.n}, {when}")
     return measure
 
 

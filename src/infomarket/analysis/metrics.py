@@ -68,6 +68,31 @@ def wealth_curves(history: pd.DataFrame, robots: pd.DataFrame | None = None,
     return out
 
 
+#: Fig. 6's caption: drift against wealth "after 15 000 timesteps" (the runs themselves last 100 000).
+FIG6_STEP = 15000
+
+
+def drift_and_share(robots: pd.DataFrame, history: pd.DataFrame, name: str,
+                    step: int = FIG6_STEP) -> tuple[pd.DataFrame, str]:
+    """Honest robots' |drift| and wealth share for Fig. 6: at ``step`` when the history recorded it
+    (the paper's caption), else at the end of the runs.  Returns the rows and a label saying which."""
+    rows = robots[robots["experiment"] == name] if "experiment" in robots.columns else robots
+    rows = require(rows, name, ("drift", "wealth_share", "honest"))
+    h = history[history["experiment"] == name] if len(history) and "experiment" in history.columns else history
+    if len(h) and step in set(h["step"].unique()):
+        at = h[h["step"] == step][[*RUN, "robot", "wealth"]]
+        total = at.groupby(RUN, observed=True)["wealth"].transform("sum")
+        at = at.assign(share_at=at["wealth"] / total.where(total > 0, 1.0))
+        rows = rows.merge(at[[*RUN, "robot", "share_at"]], on=[*RUN, "robot"], how="inner")
+        rows = rows.assign(wealth_share=rows["share_at"]).drop(columns="share_at")
+        label = f"after {step:,} steps".replace(",", " ")
+    else:
+        steps = int(rows["steps"].iloc[0]) if "steps" in rows.columns else None
+        label = "at the end of the runs" if steps is None else f"after {steps:,} steps".replace(",", " ")
+    honest = rows[rows["honest"]]
+    return honest.assign(abs_drift=honest["drift"].abs()), label
+
+
 def behaviour_label(rows: pd.DataFrame, honest: bool) -> str:
     """The behaviours of the honest (or Byzantine) robots of a panel, e.g. ``sceptical``."""
     names = []
