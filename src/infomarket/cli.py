@@ -14,37 +14,12 @@ import tempfile
 from pathlib import Path
 
 from . import __version__
+from .cliargs import UsageError, at_least
 from .errors import ConfigError, InfomarketError
 
 EXIT_USAGE = 2
 SUBCOMMAND_MODULES = ("infomarket.runner.cli", "infomarket.analysis.cli", "infomarket.viewer.cli",
                       "infomarket.chain.cli")
-
-
-class UsageError(InfomarketError, ValueError):
-    """A command-line option is wrong."""
-
-
-def _positive(kind):
-    def parse(text: str):
-        try:
-            v = kind(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected a {kind.__name__}, got {text!r}") from None
-        if v <= 0:
-            raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
-        return v
-    return parse
-
-
-def _non_negative_int(text: str) -> int:
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
-    if v < 0:
-        raise argparse.ArgumentTypeError(f"must be >= 0, got {text}")
-    return v
 
 
 def _writable_dir(path: Path) -> Path:
@@ -193,27 +168,27 @@ def build_parser() -> argparse.ArgumentParser:
 
     r = sub.add_parser("run", help="run an experiment N times and write robots.parquet")
     r.add_argument("experiment", help="a .toml file, an original .json file, or a shipped name (e.g. fig2B)")
-    r.add_argument("--runs", type=_positive(int), help="number of runs (default: the file's)")
-    r.add_argument("--seed", type=_non_negative_int, help="master seed (default: the file's)")
-    r.add_argument("--steps", type=_positive(int), help="steps per run (default: the file's)")
-    r.add_argument("--history", type=_non_negative_int, metavar="K",
+    r.add_argument("--runs", type=at_least(1), help="number of runs (default: the file's)")
+    r.add_argument("--seed", type=at_least(0), help="master seed (default: the file's)")
+    r.add_argument("--steps", type=at_least(1), help="steps per run (default: the file's)")
+    r.add_argument("--history", type=at_least(0), metavar="K",
                    help="also write wealth_history.parquet: every robot's wealth every K steps")
     r.add_argument("--out", help="output folder (default: results/NAME)")
-    r.add_argument("--workers", type=_positive(int), help="processes (default: one per core)")
+    r.add_argument("--workers", type=at_least(1), help="processes (default: one per core)")
     r.add_argument("--quiet", action="store_true", help="no progress output")
     r.set_defaults(func=cmd_run)
 
     b = sub.add_parser("bench", help="time single-process runs of the Fig. 2A, 2D and 4C setups")
     b.add_argument("--json", action="store_true", help="print one JSON object")
-    b.add_argument("--steps", type=_positive(int), default=15000)
-    b.add_argument("--repeats", type=_positive(int), default=7, help="timed runs per setup (median reported)")
+    b.add_argument("--steps", type=at_least(1), default=15000)
+    b.add_argument("--repeats", type=at_least(1), default=7, help="timed runs per setup (median reported)")
     b.add_argument("--scaling", action="store_true",
                    help="instead: sweep throughput with 1 and 2 local workers and a local Dask cluster of 2")
     b.set_defaults(func=cmd_bench)
 
     d = sub.add_parser("demo", help="a short Fig. 2-like comparison: naive vs sceptical, with and without a saboteur")
-    d.add_argument("--runs", type=_positive(int), default=8, help="runs per setup")
-    d.add_argument("--workers", type=_positive(int), help="processes (default: one per core)")
+    d.add_argument("--runs", type=at_least(1), default=8, help="runs per setup")
+    d.add_argument("--workers", type=at_least(1), help="processes (default: one per core)")
     d.set_defaults(func=cmd_demo)
 
     ls = sub.add_parser("list", help="shipped experiments, behaviours and payment schemes")

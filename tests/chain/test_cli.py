@@ -8,7 +8,7 @@ from infomarket.chain.cli import demo_config, main
 
 
 @pytest.mark.parametrize("argv, message", [
-    (["--robots", "0"], "argument --robots: must be at least 1, not 0"),
+    (["--robots", "0"], "argument --robots: must be >= 1, got 0"),
     (["--steps", "many"], "argument --steps: must be a whole number, not 'many'"),
     (["--scheme", "barter"], "invalid choice: 'barter'"),
     (["--rpc", "localhost:8545"], "argument --rpc: must be an http(s):// JSON-RPC URL"),

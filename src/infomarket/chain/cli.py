@@ -17,20 +17,9 @@ import argparse
 import sys
 import time
 
+from ..cliargs import at_least
+
 DEMO_SCHEMES = {"delayed": ("delayed", 0.0), "outlier": ("outlier", 0.0), "staking": ("outlier", 0.04)}
-
-
-def _count(lowest: int):
-    def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"must be a whole number, not {text!r}") from None
-        if value < lowest:
-            raise argparse.ArgumentTypeError(f"must be at least {lowest}, not {value}")
-        return value
-
-    return parse
 
 
 def _rpc_url(text: str) -> str:
@@ -47,14 +36,14 @@ def add_subcommand(subparsers) -> None:
     demo = commands.add_parser(
         "demo", help="replay a small simulated swarm through the contract and compare the balances",
         description=__doc__.split("\n\n")[1].replace("\n", " "))
-    demo.add_argument("--robots", type=_count(1), default=10, help="swarm size (default 10)")
-    demo.add_argument("--steps", type=_count(1), default=3000, help="simulation steps (default 3000)")
+    demo.add_argument("--robots", type=at_least(1), default=10, help="swarm size (default 10)")
+    demo.add_argument("--steps", type=at_least(1), default=3000, help="simulation steps (default 3000)")
     demo.add_argument("--scheme", choices=sorted(DEMO_SCHEMES), default="staking",
                       help="payment scheme: delayed, outlier (no stake) or staking (outlier, stake 0.04); "
                            "default staking")
     demo.add_argument("--experiment", default="fig4C",
                       help="experiment whose swarm composition is scaled down (default fig4C)")
-    demo.add_argument("--seed", type=_count(0), default=0, help="simulation seed (default 0)")
+    demo.add_argument("--seed", type=at_least(0), default=0, help="simulation seed (default 0)")
     demo.add_argument("--rpc", type=_rpc_url, metavar="URL",
                       help="JSON-RPC node to use instead of the in-process EVM (needs an unlocked funded account)")
     demo.set_defaults(func=run_demo)

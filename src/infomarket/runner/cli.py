@@ -1,39 +1,12 @@
 """``infomarket sweep`` and ``infomarket reproduce``: many runs into a resumable results store."""
 from __future__ import annotations
 
-import argparse
 from pathlib import Path
 
-from ..errors import InfomarketError
+from ..cliargs import UsageError, at_least, fraction
 
 PAPER = ("fig2A", "fig2B", "fig2C", "fig2D", "fig3A", "fig3B", "fig3C", "fig4A", "fig4B", "fig4C",
          "fig5", "fig6A", "fig6B", "fig7")
-
-
-class UsageError(InfomarketError, ValueError):
-    pass
-
-
-def _scale(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
-    if not 0 < v <= 1:
-        raise argparse.ArgumentTypeError(f"must be in (0, 1], got {text}")
-    return v
-
-
-def _int_at_least(low: int):
-    def parse(text: str) -> int:
-        try:
-            v = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
-        if v < low:
-            raise argparse.ArgumentTypeError(f"must be >= {low}, got {text}")
-        return v
-    return parse
 
 
 def _client(args):
@@ -111,24 +84,24 @@ def cmd_reproduce(args) -> int:
 
 def _executor_options(p) -> None:
     p.add_argument("--out", required=True, help="results store folder (created; resumed if it exists)")
-    p.add_argument("--workers", type=_int_at_least(1), help="local processes (default: one per core)")
+    p.add_argument("--workers", type=at_least(1), help="local processes (default: one per core)")
     g = p.add_mutually_exclusive_group()
     g.add_argument("--scheduler", metavar="ADDRESS", help="run on a Dask scheduler, e.g. tcp://host:8786")
-    g.add_argument("--dask-local", type=_int_at_least(1), metavar="N", help="run on a local Dask cluster of N workers")
+    g.add_argument("--dask-local", type=at_least(1), metavar="N", help="run on a local Dask cluster of N workers")
     p.add_argument("--quiet", action="store_true", help="no progress output")
 
 
 def add_subcommand(sub) -> None:
     s = sub.add_parser("sweep", help="run every condition of an experiment into a results store (resumable)")
     s.add_argument("experiment")
-    s.add_argument("--runs", type=_int_at_least(1), help="runs per condition (default: the file's)")
-    s.add_argument("--seed", type=_int_at_least(0), help="master seed (default: the file's)")
+    s.add_argument("--runs", type=at_least(1), help="runs per condition (default: the file's)")
+    s.add_argument("--seed", type=at_least(0), help="master seed (default: the file's)")
     _executor_options(s)
     s.set_defaults(func=cmd_sweep)
 
     r = sub.add_parser("reproduce", help="rerun every experiment of the paper into one results store")
     r.add_argument("what", choices=["paper"], help="what to reproduce")
-    r.add_argument("--scale", type=_scale, default=1.0,
+    r.add_argument("--scale", type=fraction, default=1.0,
                    help="fraction of the paper's runs per condition (at least 2), e.g. 0.125 for a quick check")
     _executor_options(r)
     r.set_defaults(func=cmd_reproduce)
