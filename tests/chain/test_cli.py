@@ -9,10 +9,10 @@ from infomarket.chain.cli import demo_config, main
 
 @pytest.mark.parametrize("argv, message", [
     (["--robots", "0"], "argument --robots: must be >= 1, got 0"),
-    (["--steps", "many"], "argument --steps: must be a whole number, not 'many'"),
+    (["--steps", "many"], "argument --steps: expected an integer, got 'many'"),
     (["--scheme", "barter"], "invalid choice: 'barter'"),
     (["--rpc", "localhost:8545"], "argument --rpc: must be an http(s):// JSON-RPC URL"),
-    (["--seed", "-1"], "argument --seed: must be at least 0"),
+    (["--seed", "-1"], "argument --seed: must be >= 0, got -1"),
 ])
 def test_bad_arguments_give_one_message_and_exit_status_2(capsys, argv, message):
     with pytest.raises(SystemExit) as stopped:

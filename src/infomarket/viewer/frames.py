@@ -1,0 +1,181 @@
+"""Frames: one snapshot of the swarm, encoded so the browser reads it without parsing.
+
+A frame is a header of float64 numbers followed by one contiguous little-endian array per robot
+attribute (``COLUMNS``), float32 columns first, then uint8 ones, so every column starts on an aligned
+offset and the page wraps each in a typed-array view (no copy, no JSON): 1 000 robots cost 50 kB.
+The live server, the self-contained replay and the movie all draw from these same bytes, so the three
+show exactly the same thing.
+
+What does not change during a run (arena, sites, behaviours, odometry biases, the column layout) is
+sent once as the *scene*, a JSON object.  Details only the side panel needs (pending purchases, open
+transactions, the last events of one robot) travel as JSON on request (``robot_detail``).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..engine.world import EVENT_NAMES, SITE_NAMES, STATE_NAMES
+from ..registry import behaviours
+
+#: Header fields, float64 each, in order.
+HEADER = ("step", "items_honest", "items_byzantine", "wealth_honest", "wealth_byzantine")
+
+#: Per-robot columns (name, numpy dtype).  food_x/y and nest_x/y are where the robot *believes* each
+#: site is: its navigation-table vector taken out of its own frame into the world's.
+COLUMNS = (
+    ("x", "<f4"), ("y", "<f4"), ("heading", "<f4"), ("wealth", "<f4"), ("items", "<f4"),
+    ("food_x", "<f4"), ("food_y", "<f4"), ("nest_x", "<f4"), ("nest_y", "<f4"),
+    ("food_age", "<f4"), ("nest_age", "<f4"),
+    ("state", "u1"), ("flags", "u1"), ("pending_food", "u1"), ("pending_nest", "u1"),
+)
+
+#: Bits of the ``flags`` column.
+CARRYING, FOOD_VALID, NEST_VALID, LAST_FOOD, LAST_NEST = 1, 2, 4, 8, 16
+
+#: How many of a robot's most recent events the side panel lists.
+LAST_EVENTS = 8
+
+
+def frame_size(n: int) -> int:
+    """Bytes in one frame of ``n`` robots."""
+    return 8 * len(HEADER) + n * sum(np.dtype(t).itemsize for _, t in COLUMNS)
+
+
+def honest_mask(sim) -> np.ndarray:
+    """[n] bool: which robots run an honest behaviour."""
+    specs = behaviours()
+    return np.array([specs[b].honest for b in sim.behaviour_names], dtype=bool)
+
+
+def scene(sim) -> dict:
+    """Everything about a run that stays fixed while it plays, as a JSON-ready dict."""
+    cfg = sim.config
+    names = list(dict.fromkeys(sim.behaviour_names))
+    specs = behaviours()
+    return {
+        "name": cfg.name,
+        "description": cfg.description,
+        "seed": sim.seed,
+        "steps": cfg.steps,
+        "scheme": cfg.payment.scheme,
+        "arena": {"width": cfg.arena.width, "height": cfg.arena.height},
+        "sites": [{"name": SITE_NAMES[k], "x": s.x, "y": s.y, "radius": s.radius}
+                  for k, s in enumerate((cfg.food, cfg.nest))],
+        "robot": {"radius": cfg.robot.radius, "comm_range": cfg.robot.communication_range},
+        "n": len(sim.behaviour_names),
+        "behaviours": [{"name": b, "honest": specs[b].honest} for b in names],
+        "kind": [names.index(b) for b in sim.behaviour_names],
+        "bias": [round(float(b), 5) for b in sim.world.bias],
+        "states": list(STATE_NAMES),
+        "events": list(EVENT_NAMES),
+        "header": list(HEADER),
+        "columns": [[c, np.dtype(t).str] for c, t in COLUMNS],
+    }
+
+
+def _believed(w, site: int) -> tuple[np.ndarray, np.ndarray]:
+    """World position each robot's table points at for ``site`` (robot frame: x axis = heading)."""
+    v = w.tab_vec[:, site]
+    c, s = w.hdir[:, 0], w.hdir[:, 1]
+    return w.pos[:, 0] + c * v[:, 0] - s * v[:, 1], w.pos[:, 1] + s * v[:, 0] + c * v[:, 1]
+
+
+def encode(sim, honest: np.ndarray | None = None) -> bytes:
+    """The current state of ``sim`` as one binary frame (see ``COLUMNS``)."""
+    w = sim.world  # re-read every time: the engine may replace arrays between steps
+    honest = honest_mask(sim) if honest is None else honest
+    items = w.items.astype(np.float64)
+    header = np.array([sim.clock, items[honest].sum(), items[~honest].sum(),
+                       w.balance[honest].sum(), w.balance[~honest].sum()], dtype="<f8")
+    fx, fy = _believed(w, 0)
+    nx, ny = _believed(w, 1)
+    flags = (w.carrying.astype(np.uint8) * CARRYING
+             | w.tab_valid[:, 0].astype(np.uint8) * FOOD_VALID
+             | w.tab_valid[:, 1].astype(np.uint8) * NEST_VALID
+             | (w.last_site == 0).astype(np.uint8) * LAST_FOOD
+             | (w.last_site == 1).astype(np.uint8) * LAST_NEST)
+    pend = np.minimum(w.pend_count, 255)
+    values = {
+        "x": w.pos[:, 0], "y": w.pos[:, 1], "heading": w.heading, "wealth": w.balance, "items": items,
+        "food_x": fx, "food_y": fy, "nest_x": nx, "nest_y": ny,
+        "food_age": w.tab_age[:, 0], "nest_age": w.tab_age[:, 1],
+        "state": w.state, "flags": flags, "pending_food": pend[:, 0], "pending_nest": pend[:, 1],
+    }
+    return header.tobytes() + b"".join(np.ascontiguousarray(values[c], dtype=t).tobytes()
+                                       for c, t in COLUMNS)
+
+
+@dataclass(frozen=True)
+class Frame:
+    """A decoded frame: ``header`` numbers by name and ``columns`` arrays by name."""
+
+    header: dict[str, float]
+    columns: dict[str, np.ndarray]
+
+    @property
+    def step(self) -> int:
+        return int(self.header["step"])
+
+
+def decode(data: bytes, n: int) -> Frame:
+    """Inverse of ``encode`` for a swarm of ``n`` robots (what the page does, in Python)."""
+    if len(data) != frame_size(n):
+        raise ValueError(f"a frame of {n} robots has {frame_size(n)} bytes, got {len(data)}")
+    head = np.frombuffer(data, "<f8", len(HEADER))
+    offset, cols = 8 * len(HEADER), {}
+    for c, t in COLUMNS:
+        cols[c] = np.frombuffer(data, t, n, offset)
+        offset += n * np.dtype(t).itemsize
+    return Frame(dict(zip(HEADER, head.tolist(), strict=True)), cols)
+
+
+def event_columns(sim, start: int = 0) -> dict[str, np.ndarray]:
+    """The event log from entry ``start`` on, as int32 columns (step, kind, buyer, seller, site)."""
+    w = sim.world
+    k = int(w.ev_count[0])
+    return {c: getattr(w, f"ev_{c}")[start:k].astype("<i4") for c in ("step", "kind", "buyer", "seller", "site")}
+
+
+def _last_events(w, i: int, last: int) -> list[dict]:
+    """The ``last`` most recent events in which robot ``i`` took part, newest first.  Scans the log
+    backwards in growing chunks, so a long log does not cost a full pass per frame."""
+    k = int(w.ev_count[0])
+    found: list[int] = []
+    end, chunk = k, 4096
+    while end > 0 and len(found) < last:
+        start = max(0, end - chunk)
+        hit = np.nonzero((w.ev_buyer[start:end] == i) | (w.ev_seller[start:end] == i))[0]
+        found.extend((start + hit[::-1]).tolist())
+        end, chunk = start, chunk * 4
+    out = []
+    for e in found[:last]:
+        site = int(w.ev_site[e])
+        out.append({"step": int(w.ev_step[e]), "kind": EVENT_NAMES[int(w.ev_kind[e])],
+                    "buyer": int(w.ev_buyer[e]), "seller": int(w.ev_seller[e]),
+                    "site": SITE_NAMES[site] if site >= 0 else None,
+                    "stake": round(float(w.ev_stake[e]), 6)})
+    return out
+
+
+def robot_detail(sim, i: int, last: int = LAST_EVENTS) -> dict:
+    """What the side panel shows about robot ``i`` beyond the frame's columns: its pending (unconfirmed)
+    purchases with the world position each points at, its open transactions as buyer since its last
+    deposit, and its last events."""
+    w = sim.world
+    c, s = w.hdir[i]
+    pending = []
+    for site in (0, 1):
+        for k in range(int(w.pend_count[i, site])):
+            vx, vy = w.pend_vec[i, site, k]
+            pending.append({"site": SITE_NAMES[site], "seller": int(w.pend_seller[i, site, k]),
+                            "age": int(w.pend_age[i, site, k]),
+                            "x": round(float(w.pos[i, 0] + c * vx - s * vy), 2),
+                            "y": round(float(w.pos[i, 1] + s * vx + c * vy), 2)})
+    m = int(w.tx_count[i])
+    open_tx = [{"seller": int(w.tx_seller[i, k]), "site": SITE_NAMES[int(w.tx_site[i, k])],
+                "direction": round(float(w.tx_dir[i, k]), 1)} for k in range(m)]
+    return {"type": "robot", "id": i, "step": sim.clock, "behaviour": sim.behaviour_names[i],
+            "state": STATE_NAMES[int(w.state[i])], "pot": round(float(w.pot[i]), 6),
+            "pending": pending, "open_transactions": open_tx, "events": _last_events(w, i, last)}

@@ -1,0 +1,533 @@
+/* infomarket viewer: draws frames that the Python engine computed; it simulates nothing itself.
+ *
+ * Two sources feed the same drawing code: a live server (WebSocket at ./ws, see viewer/server.py) and
+ * a replay whose frames are embedded in the page (<script id="infomarket-replay">, see viewer/replay.py).
+ * A frame is binary: float64 header numbers, then one little-endian column per robot attribute, laid
+ * out as the scene's "columns" say (viewer/frames.py); we wrap each column in a typed-array view.
+ * Tests and curious users read the page's state through window.infomarketViewer.
+ */
+"use strict";
+(() => {
+  const COLOUR = { honest: "#2f6fd6", byzantine: "#d62f2f", food: "#2ca02c", nest: "#e8b100",
+                   none: "#666666", heading: "#ffffff", comm: "rgba(110,110,110,0.35)" };
+  const FLAG = { carrying: 1, foodValid: 2, nestValid: 4, lastFood: 8, lastNest: 16 };
+  const TYPED = { "<f8": Float64Array, "<f4": Float32Array, "|u1": Uint8Array, "<i4": Int32Array };
+  const MAX_HISTORY = 4000;
+  const $ = (id) => document.getElementById(id);
+  const esc = (s) => String(s).replace(/[&<>"]/g, (c) => ({ "&": "&amp;", "<": "&lt;", ">": "&gt;", '"': "&quot;" }[c]));
+
+  const V = {
+    mode: "live", scene: null, layout: null, frame: null, selected: null, detail: null,
+    showComm: false, playing: false, dirty: true, panelDirty: true, chartsDirty: true, ready: false,
+    history: null, robotsDrawn: 0, view: null,
+    fps: 0, rafFps: 0, drawn: 0, totalDrawn: 0, rafs: 0, fpsSince: performance.now(),
+    source: null,
+  };
+
+  // ------------------------------------------------------------------------------------ frames
+  function makeLayout(scene) {
+    const n = scene.n;
+    let offset = 8 * scene.header.length;
+    const columns = scene.columns.map(([name, dtype]) => {
+      const Typed = TYPED[dtype];
+      const col = { name, Typed, offset };
+      offset += n * Typed.BYTES_PER_ELEMENT;
+      return col;
+    });
+    return { n, columns, size: offset, header: scene.header };
+  }
+
+  function decodeFrame(buffer, base, L) {
+    const head = new Float64Array(buffer, base, L.header.length);
+    const header = {};
+    L.header.forEach((h, k) => { header[h] = head[k]; });
+    const c = {};
+    for (const col of L.columns) c[col.name] = new col.Typed(buffer, base + col.offset, L.n);
+    return { step: header.step, header, c };
+  }
+
+  function newHistory() { return { step: [], itemsH: [], itemsB: [], shareH: [], shareB: [] }; }
+
+  function groupCounts() {
+    const s = V.scene;
+    let honest = 0;
+    for (let i = 0; i < s.n; i++) if (s.behaviours[s.kind[i]].honest) honest++;
+    return { honest, byzantine: s.n - honest };
+  }
+
+  function pushHistory(h, header) {
+    const g = V.groups;
+    const total = header.wealth_honest + header.wealth_byzantine;
+    h.step.push(header.step);
+    h.itemsH.push(g.honest ? header.items_honest / g.honest : NaN);
+    h.itemsB.push(g.byzantine ? header.items_byzantine / g.byzantine : NaN);
+    h.shareH.push(g.honest && total > 0 ? 100 * header.wealth_honest / total / g.honest : NaN);
+    h.shareB.push(g.byzantine && total > 0 ? 100 * header.wealth_byzantine / total / g.byzantine : NaN);
+    if (h.step.length > MAX_HISTORY) for (const k in h) h[k] = h[k].filter((_, j) => j % 2 === 0);
+  }
+
+  function setScene(scene) {
+    V.scene = scene;
+    V.layout = makeLayout(scene);
+    V.groups = groupCounts();
+    V.history = newHistory();
+    V.frame = null;
+    V.detail = null;
+    if (V.selected !== null && V.selected >= scene.n) V.selected = null;
+    $("title").textContent = `infomarket · ${scene.name}`;
+    const groups = scene.behaviours.map((b, k) => `${scene.kind.filter((x) => x === k).length} ${b.name}`).join(" + ");
+    $("subtitle").textContent = `${groups} · ${scene.scheme} payment · seed ${scene.seed}`;
+    if (V.mode === "live") $("seed").placeholder = `random (now ${scene.seed})`;
+    fit();
+  }
+
+  function showFrame(frame, record = true) {
+    V.frame = frame;
+    if (record) pushHistory(V.history, frame.header);
+    $("step").textContent = frame.step;
+    V.dirty = V.panelDirty = V.chartsDirty = true;
+    if (!V.ready) V.ready = true;
+  }
+
+  // ------------------------------------------------------------------------------------- arena
+  const arena = $("arena");
+  const ctx = arena.getContext("2d");
+
+  function fit() {
+    if (!V.scene) return;
+    const dpr = window.devicePixelRatio || 1;
+    const { width, height } = V.scene.arena;
+    const cssW = arena.clientWidth || 900;
+    const cssH = Math.round(cssW * height / width);
+    arena.style.height = `${cssH}px`;
+    arena.width = Math.round(cssW * dpr);
+    arena.height = Math.round(cssH * dpr);
+    V.view = { scale: cssW / width, dpr };
+    V.dirty = true;
+  }
+
+  function arrow(x0, y0, x1, y1, colour, dashed, s) {
+    const len = Math.hypot(x1 - x0, y1 - y0);
+    if (len < 1e-6) return;
+    const ux = (x1 - x0) / len, uy = (y1 - y0) / len, head = 9 / s;
+    ctx.strokeStyle = colour;
+    ctx.fillStyle = colour;
+    ctx.lineWidth = 2 / s;
+    ctx.setLineDash(dashed ? [6 / s, 4 / s] : []);
+    ctx.beginPath(); ctx.moveTo(x0, y0); ctx.lineTo(x1 - ux * head, y1 - uy * head); ctx.stroke();
+    ctx.setLineDash([]);
+    ctx.beginPath();
+    ctx.moveTo(x1, y1);
+    ctx.lineTo(x1 - ux * head - uy * head * 0.5, y1 - uy * head + ux * head * 0.5);
+    ctx.lineTo(x1 - ux * head + uy * head * 0.5, y1 - uy * head - ux * head * 0.5);
+    ctx.closePath(); ctx.fill();
+  }
+
+  function drawArena() {
+    const s = V.scene, f = V.frame;
+    if (!s || !f || !V.view) return;
+    const { scale, dpr } = V.view;
+    ctx.setTransform(1, 0, 0, 1, 0, 0);
+    ctx.clearRect(0, 0, arena.width, arena.height);
+    ctx.setTransform(scale * dpr, 0, 0, scale * dpr, 0, 0); // world units from here on
+    const px = 1 / scale; // one CSS pixel in world units
+    ctx.fillStyle = "#f4f4f1";
+    ctx.fillRect(0, 0, s.arena.width, s.arena.height);
+    for (const site of s.sites) {
+      const colour = COLOUR[site.name];
+      ctx.beginPath(); ctx.arc(site.x, site.y, site.radius, 0, 2 * Math.PI);
+      ctx.globalAlpha = 0.35; ctx.fillStyle = colour; ctx.fill();
+      ctx.globalAlpha = 1; ctx.lineWidth = 2 * px; ctx.strokeStyle = colour; ctx.stroke();
+    }
+    const { x, y, heading, flags } = f.c;
+    const n = s.n, r = Math.max(s.robot.radius, 2.5 * px);
+    if (V.showComm) {
+      ctx.beginPath();
+      for (let i = 0; i < n; i++) { ctx.moveTo(x[i] + s.robot.comm_range, y[i]); ctx.arc(x[i], y[i], s.robot.comm_range, 0, 2 * Math.PI); }
+      ctx.lineWidth = px; ctx.strokeStyle = COLOUR.comm; ctx.stroke();
+    }
+    // Discs, batched by fill colour; outlines batched by last visited site.
+    const honest = s.behaviours.map((b) => b.honest);
+    for (const [want, colour] of [[true, COLOUR.honest], [false, COLOUR.byzantine]]) {
+      ctx.beginPath();
+      for (let i = 0; i < n; i++) {
+        if (honest[s.kind[i]] !== want) continue;
+        ctx.moveTo(x[i] + r, y[i]); ctx.arc(x[i], y[i], r, 0, 2 * Math.PI);
+      }
+      ctx.fillStyle = colour; ctx.fill();
+    }
+    ctx.lineWidth = Math.max(r * 0.35, 1.5 * px);
+    for (const [bit, colour] of [[FLAG.lastFood, COLOUR.food], [FLAG.lastNest, COLOUR.nest], [0, COLOUR.none]]) {
+      ctx.beginPath();
+      for (let i = 0; i < n; i++) {
+        const last = flags[i] & (FLAG.lastFood | FLAG.lastNest);
+        if (bit ? !(last & bit) : last) continue;
+        ctx.moveTo(x[i] + r, y[i]); ctx.arc(x[i], y[i], r, 0, 2 * Math.PI);
+      }
+      ctx.strokeStyle = colour; ctx.stroke();
+    }
+    ctx.beginPath(); // headings
+    for (let i = 0; i < n; i++) {
+      const a = heading[i] * Math.PI / 180;
+      ctx.moveTo(x[i], y[i]); ctx.lineTo(x[i] + Math.cos(a) * r, y[i] + Math.sin(a) * r);
+    }
+    ctx.lineWidth = Math.max(r * 0.25, px); ctx.strokeStyle = COLOUR.heading; ctx.stroke();
+    ctx.beginPath(); // a carried item: a dark dot
+    for (let i = 0; i < n; i++) {
+      if (!(flags[i] & FLAG.carrying)) continue;
+      ctx.moveTo(x[i] + r * 0.3, y[i]); ctx.arc(x[i], y[i], r * 0.3, 0, 2 * Math.PI);
+    }
+    ctx.fillStyle = "#222"; ctx.fill();
+    V.robotsDrawn = n;
+    if (V.selected !== null) drawSelected(V.selected, px, r);
+  }
+
+  function drawSelected(i, px, r) {
+    const s = V.scene, c = V.frame.c;
+    ctx.beginPath(); ctx.arc(c.x[i], c.y[i], r + 4 * px, 0, 2 * Math.PI);
+    ctx.lineWidth = 2 * px; ctx.strokeStyle = "#000"; ctx.stroke();
+    s.sites.forEach((site, k) => {
+      // the true site: thin dashed grey arrow; where the robot believes it is: solid arrow in its colour
+      arrow(c.x[i], c.y[i], site.x, site.y, "rgba(80,80,80,0.55)", true, 1 / px);
+      const valid = c.flags[i] & (k === 0 ? FLAG.foodValid : FLAG.nestValid);
+      if (!valid) return;
+      const bx = c[`${site.name}_x`][i], by = c[`${site.name}_y`][i];
+      arrow(c.x[i], c.y[i], bx, by, COLOUR[site.name], false, 1 / px);
+      ctx.beginPath(); ctx.arc(bx, by, 5 * px, 0, 2 * Math.PI); ctx.lineWidth = 2 * px; ctx.strokeStyle = "#000"; ctx.stroke();
+    });
+    if (V.detail && V.detail.id === i) {
+      for (const p of V.detail.pending) {
+        ctx.beginPath(); ctx.arc(p.x, p.y, 4 * px, 0, 2 * Math.PI);
+        ctx.setLineDash([3 * px, 3 * px]); ctx.lineWidth = 1.5 * px; ctx.strokeStyle = COLOUR[p.site]; ctx.stroke(); ctx.setLineDash([]);
+      }
+    }
+  }
+
+  function robotAt(cssX, cssY) {
+    if (!V.frame || !V.view) return null;
+    const wx = cssX / V.view.scale, wy = cssY / V.view.scale;
+    const reach = Math.max(V.scene.robot.radius * 1.6, 8 / V.view.scale);
+    let best = null, bestD = reach;
+    const { x, y } = V.frame.c;
+    for (let i = 0; i < V.scene.n; i++) {
+      const d = Math.hypot(x[i] - wx, y[i] - wy);
+      if (d <= bestD) { best = i; bestD = d; }
+    }
+    return best;
+  }
+
+  // ------------------------------------------------------------------------------------ charts
+  function drawChart(canvas, xs, series, ref) {
+    const dpr = window.devicePixelRatio || 1, w = canvas.clientWidth, h = canvas.clientHeight;
+    if (canvas.width !== Math.round(w * dpr) || canvas.height !== Math.round(h * dpr)) {
+      canvas.width = Math.round(w * dpr); canvas.height = Math.round(h * dpr);
+    }
+    const g = canvas.getContext("2d");
+    g.setTransform(dpr, 0, 0, dpr, 0, 0);
+    g.clearRect(0, 0, w, h);
+    const m = { l: 40, r: 10, t: 8, b: 18 };
+    const x0 = xs.length ? xs[0] : 0, x1 = Math.max(xs.length ? xs[xs.length - 1] : 1, x0 + 1);
+    let ymax = ref ? ref * 1.5 : 0;
+    for (const sr of series) for (const v of sr.values) if (v > ymax) ymax = v;
+    ymax = ymax > 0 ? ymax * 1.08 : 1;
+    const X = (v) => m.l + (v - x0) / (x1 - x0) * (w - m.l - m.r);
+    const Y = (v) => h - m.b - v / ymax * (h - m.t - m.b);
+    g.strokeStyle = "#999"; g.lineWidth = 1;
+    g.beginPath(); g.moveTo(m.l, m.t); g.lineTo(m.l, h - m.b); g.lineTo(w - m.r, h - m.b); g.stroke();
+    g.fillStyle = "#555"; g.font = "11px system-ui, sans-serif";
+    g.textAlign = "right"; g.fillText(ymax.toPrecision(3), m.l - 3, m.t + 9); g.fillText("0", m.l - 3, h - m.b);
+    g.textAlign = "left"; g.fillText(`${Math.round(x0)}`, m.l, h - 4);
+    g.textAlign = "right"; g.fillText(`step ${Math.round(x1)}`, w - m.r, h - 4);
+    if (ref) {
+      g.setLineDash([4, 4]); g.strokeStyle = "#888";
+      g.beginPath(); g.moveTo(m.l, Y(ref)); g.lineTo(w - m.r, Y(ref)); g.stroke(); g.setLineDash([]);
+    }
+    for (const sr of series) {
+      g.strokeStyle = sr.colour; g.lineWidth = 1.8; g.beginPath();
+      let pen = false;
+      sr.values.forEach((v, k) => {
+        if (!Number.isFinite(v)) { pen = false; return; }
+        if (pen) g.lineTo(X(xs[k]), Y(v)); else { g.moveTo(X(xs[k]), Y(v)); pen = true; }
+      });
+      g.stroke();
+    }
+  }
+
+  function drawCharts() {
+    const h = V.history, f = V.frame;
+    if (!h || !f) return;
+    let end = 0, hi = h.step.length; // points up to the frame shown (a replay holds the whole run)
+    while (end < hi) { const mid = (end + hi) >> 1; if (h.step[mid] <= f.step) end = mid + 1; else hi = mid; }
+    const cut = (a) => a.slice(0, end);
+    const xs = cut(h.step);
+    const series = (a, b) => [{ values: cut(a), colour: COLOUR.honest }]
+      .concat(V.groups.byzantine ? [{ values: cut(b), colour: COLOUR.byzantine }] : []);
+    drawChart($("chart-items"), xs, series(h.itemsH, h.itemsB), 0);
+    drawChart($("chart-wealth"), xs, series(h.shareH, h.shareB), 100 / V.scene.n);
+    const hd = f.header, total = hd.items_honest + hd.items_byzantine;
+    const byz = V.groups.byzantine;
+    $("cap-items").textContent = `items collected per robot — total ${total}` +
+      (byz ? ` (honest ${hd.items_honest}, Byzantine ${hd.items_byzantine})` : "");
+    const wsum = hd.wealth_honest + hd.wealth_byzantine;
+    const pct = (v) => (wsum > 0 ? (100 * v / wsum).toFixed(1) : "0.0");
+    $("cap-wealth").textContent = `wealth share per robot, % (dashed: equal share) — groups: honest ${pct(hd.wealth_honest)} %` +
+      (byz ? `, Byzantine ${pct(hd.wealth_byzantine)} %` : "");
+  }
+
+  // ------------------------------------------------------------------------------------- panel
+  function eventText(e, i) {
+    const site = e.site ?? "";
+    if (e.kind === "deposit") return "deposited an item";
+    if (e.kind === "purchase") return e.buyer === i ? `bought ${site} info from #${e.seller}` : `sold ${site} info to #${e.buyer}`;
+    return e.buyer === i ? `#${e.seller} could not stake for ${site} info` : `could not stake to sell ${site} info to #${e.buyer}`;
+  }
+
+  function renderPanel() {
+    const panel = $("panel"), i = V.selected, s = V.scene, f = V.frame;
+    if (i === null || !s || !f) {
+      delete panel.dataset.robot;
+      delete panel.dataset.detail;
+      panel.innerHTML = '<p class="muted">Click a robot to see its navigation table, wealth and trades.</p>';
+      return;
+    }
+    const c = f.c, b = s.behaviours[s.kind[i]];
+    const flags = c.flags[i];
+    const last = flags & FLAG.lastFood ? "food" : flags & FLAG.lastNest ? "nest" : "none yet";
+    const total = f.header.wealth_honest + f.header.wealth_byzantine;
+    const rows = [
+      ["behaviour", `${esc(b.name)} (${b.honest ? "honest" : "Byzantine"})`],
+      ["state", esc(s.states[c.state[i]].replace("_", " "))],
+      ["carrying an item", flags & FLAG.carrying ? "yes" : "no"],
+      ["odometry bias", `${s.bias[i] >= 0 ? "+" : ""}${s.bias[i].toFixed(4)} °/step`],
+      ["wealth", `${c.wealth[i].toFixed(3)} (${total > 0 ? (100 * c.wealth[i] / total).toFixed(2) : "0"} % of all)`],
+      ["items collected", `${c.items[i]}`],
+      ["last site visited", last],
+    ];
+    let html = `<h2>robot #${i}</h2><table>${rows.map(([k, v]) => `<tr><th>${k}</th><td>${v}</td></tr>`).join("")}</table>`;
+    html += "<h3>navigation table</h3><table><tr><th>site</th><th>believed at</th><th>age</th><th>off by</th></tr>";
+    s.sites.forEach((site, k) => {
+      const valid = flags & (k === 0 ? FLAG.foodValid : FLAG.nestValid);
+      const bx = c[`${site.name}_x`][i], by = c[`${site.name}_y`][i];
+      html += `<tr><td>${site.name}</td>` + (valid
+        ? `<td>(${bx.toFixed(0)}, ${by.toFixed(0)})</td><td>${c[`${site.name}_age`][i]}</td><td>${Math.hypot(bx - site.x, by - site.y).toFixed(0)}</td>`
+        : `<td colspan="3" class="muted">unknown (age ${c[`${site.name}_age`][i]})</td>`) + "</tr>";
+    });
+    html += "</table>";
+    const pf = c.pending_food[i], pn = c.pending_nest[i];
+    const d = V.detail && V.detail.id === i ? V.detail : null;
+    if (pf || pn || (d && d.pending.length)) {
+      html += `<h3>pending information (unconfirmed): food ${pf}, nest ${pn}</h3>`;
+      if (d) html += "<ul>" + d.pending.map((p) => `<li>${p.site} from #${p.seller}, age ${p.age}, points at (${p.x.toFixed(0)}, ${p.y.toFixed(0)})</li>`).join("") + "</ul>";
+    }
+    if (d) {
+      html += `<h3>open purchases since last deposit (${d.open_transactions.length})</h3>`;
+      html += d.open_transactions.length
+        ? "<ul>" + d.open_transactions.slice(-8).map((t) => `<li>${t.site} from #${t.seller}, direction ${t.direction}°</li>`).join("") + "</ul>"
+        : '<p class="muted">none</p>';
+    }
+    const events = d ? d.events : V.mode === "replay" ? replayEvents(i, f.step) : [];
+    html += "<h3>last transactions</h3>";
+    html += events.length
+      ? "<ul>" + events.map((e) => `<li>step ${e.step}: ${eventText(e, i)}</li>`).join("") + "</ul>"
+      : '<p class="muted">none yet</p>';
+    panel.innerHTML = html;
+    panel.dataset.robot = String(i);
+    panel.dataset.detail = d ? String(i) : ""; // the server's details (live only) are shown
+  }
+
+  function select(i) {
+    V.selected = i;
+    V.detail = null;
+    V.dirty = V.panelDirty = true;
+    if (V.source.select) V.source.select(i);
+  }
+
+  // ------------------------------------------------------------------------------------- loop
+  let lastPanel = 0, lastCharts = 0;
+  function tick(now) {
+    V.rafs++;
+    if (V.source && V.source.tick) V.source.tick(now);
+    if (V.dirty) { drawArena(); V.dirty = false; V.drawn++; V.totalDrawn++; }
+    if (V.panelDirty && now - lastPanel > 150) { renderPanel(); V.panelDirty = false; lastPanel = now; }
+    if (V.chartsDirty && now - lastCharts > 250) { drawCharts(); V.chartsDirty = false; lastCharts = now; }
+    if (now - V.fpsSince >= 1000) {
+      const dt = (now - V.fpsSince) / 1000;
+      V.fps = V.drawn / dt; V.rafFps = V.rafs / dt;
+      V.drawn = 0; V.rafs = 0; V.fpsSince = now;
+      $("fps").textContent = V.playing ? V.fps.toFixed(0) : "–";
+    }
+    requestAnimationFrame(tick);
+  }
+
+  function error(message) {
+    const el = $("error");
+    el.textContent = message; el.hidden = false;
+    clearTimeout(error.timer);
+    error.timer = setTimeout(() => { el.hidden = true; }, 6000);
+  }
+
+  function setPlaying(on) {
+    V.playing = on;
+    $("play").textContent = on ? "❚❚ pause" : "▶ play";
+  }
+
+  function fillSpeeds(values, chosen) {
+    const sel = $("speed");
+    sel.innerHTML = values.map((v) => `<option value="${v}"${v === chosen ? " selected" : ""}>${v}</option>`).join("");
+  }
+
+  // -------------------------------------------------------------------------------- live source
+  function liveSource() {
+    const url = new URL("ws", window.location.href);
+    url.protocol = url.protocol === "https:" ? "wss:" : "ws:";
+    const seed = new URLSearchParams(window.location.search).get("seed");
+    if (seed !== null) url.search = `?seed=${encodeURIComponent(seed)}`;
+    const ws = new WebSocket(url);
+    ws.binaryType = "arraybuffer";
+    const send = (msg) => { if (ws.readyState === WebSocket.OPEN) ws.send(JSON.stringify(msg)); };
+    ws.onopen = () => { $("connection").textContent = "live"; };
+    ws.onclose = () => { $("connection").textContent = "disconnected (server stopped?)"; setPlaying(false); };
+    ws.onmessage = (ev) => {
+      if (typeof ev.data !== "string") {
+        if (V.layout && ev.data.byteLength === V.layout.size) showFrame(decodeFrame(ev.data, 0, V.layout));
+        send({ cmd: "ack" });
+        return;
+      }
+      const msg = JSON.parse(ev.data);
+      if (msg.type === "scene") { setScene(msg); if (V.selected !== null) send({ cmd: "select", robot: V.selected }); }
+      else if (msg.type === "status") { setPlaying(msg.playing); $("speed").value = String(msg.speed); }
+      else if (msg.type === "robot") { V.detail = msg; V.panelDirty = V.dirty = true; }
+      else if (msg.type === "error") error(msg.message);
+    };
+    fillSpeeds([1, 2, 5, 10, 20, 50, 100, 200, 500, 1000], 10);
+    return {
+      ws,
+      play: () => send({ cmd: V.playing ? "pause" : "play" }),
+      step: () => send({ cmd: "step", n: 1 }),
+      speed: (v) => send({ cmd: "speed", value: v }),
+      restart: (seed) => send(seed === null ? { cmd: "restart" } : { cmd: "restart", seed }),
+      select: (i) => send({ cmd: "select", robot: i }),
+    };
+  }
+
+  // ------------------------------------------------------------------------------ replay source
+  async function gunzipBase64(text) {
+    const bin = atob(text);
+    const bytes = new Uint8Array(bin.length);
+    for (let k = 0; k < bin.length; k++) bytes[k] = bin.charCodeAt(k);
+    const stream = new Blob([bytes]).stream().pipeThrough(new DecompressionStream("gzip"));
+    return new Response(stream).arrayBuffer();
+  }
+
+  let replayLog = null;
+  function replayEvents(i, step) {
+    if (!replayLog) return [];
+    const { steps, kind, buyer, seller, site } = replayLog;
+    let lo = 0, hi = steps.length; // first event after `step`
+    while (lo < hi) { const mid = (lo + hi) >> 1; if (steps[mid] <= step) lo = mid + 1; else hi = mid; }
+    const out = [];
+    for (let e = lo - 1; e >= 0 && out.length < 8; e--) {
+      if (buyer[e] !== i && seller[e] !== i) continue;
+      out.push({ step: steps[e], kind: V.scene.events[kind[e]], buyer: buyer[e], seller: seller[e],
+                 site: site[e] >= 0 ? V.scene.sites[site[e]].name : null });
+    }
+    return out;
+  }
+
+  async function replaySource(data) {
+    $("restart-box").hidden = true;
+    $("scrub-label").hidden = false;
+    $("connection").textContent = `replay · ${data.frame_count} frames, one every ${data.every} steps`;
+    setScene(data.scene);
+    const buffer = await gunzipBase64(data.frames);
+    const L = V.layout;
+    const count = data.frame_count;
+    const ev = new Int32Array(await gunzipBase64(data.events));
+    const e = data.event_count;
+    replayLog = { steps: ev.subarray(0, e), kind: ev.subarray(e, 2 * e), buyer: ev.subarray(2 * e, 3 * e),
+                  seller: ev.subarray(3 * e, 4 * e), site: ev.subarray(4 * e, 5 * e) };
+    const frames = [];
+    for (let k = 0; k < count; k++) {
+      frames.push(decodeFrame(buffer, k * L.size, L));
+      pushHistory(V.history, frames[k].header);
+    }
+    const scrub = $("scrub");
+    scrub.max = String(count - 1);
+    const src = { index: 0, perTick: 1, last: 0 };
+    const show = (k) => {
+      src.index = Math.max(0, Math.min(count - 1, k));
+      scrub.value = String(src.index);
+      showFrame(frames[src.index], false);
+    };
+    scrub.oninput = () => show(Number(scrub.value));
+    const speeds = [1, 2, 5, 10, 20, 50].map((m) => m * data.every);
+    fillSpeeds(speeds, speeds[0]);
+    Object.assign(src, {
+      play: () => { if (!V.playing && src.index >= count - 1) show(0); setPlaying(!V.playing); },
+      step: () => { setPlaying(false); show(src.index + 1); },
+      speed: (v) => { src.perTick = Math.max(1, Math.round(v / data.every)); },
+      tick: (now) => {
+        if (!V.playing || now - src.last < 1000 / 30) return;
+        src.last = now;
+        show(src.index + src.perTick);
+        if (src.index >= count - 1) setPlaying(false);
+      },
+    });
+    V.source = src;
+    show(0);
+    return src;
+  }
+
+  // ---------------------------------------------------------------------------------- wiring
+  function wire() {
+    $("play").onclick = () => V.source && V.source.play();
+    $("stepbtn").onclick = () => V.source && V.source.step();
+    $("speed").onchange = () => V.source && V.source.speed(Number($("speed").value));
+    $("restart").onclick = () => {
+      const text = $("seed").value.trim();
+      if (V.source && V.source.restart) V.source.restart(text === "" ? null : Number(text));
+    };
+    $("comm").onchange = () => { V.showComm = $("comm").checked; V.dirty = true; };
+    arena.addEventListener("click", (ev) => {
+      const rect = arena.getBoundingClientRect();
+      select(robotAt(ev.clientX - rect.left, ev.clientY - rect.top));
+    });
+    window.addEventListener("resize", () => { fit(); V.chartsDirty = true; });
+    window.addEventListener("keydown", (ev) => {
+      if (["INPUT", "SELECT", "BUTTON"].includes(ev.target.tagName)) return; // their own keys
+      if (ev.code === "Space") { ev.preventDefault(); $("play").click(); }
+      else if (ev.code === "ArrowRight") $("stepbtn").click();
+    });
+  }
+
+  window.infomarketViewer = {
+    get ready() { return V.ready; },
+    get mode() { return V.mode; },
+    get step() { return V.frame ? V.frame.step : -1; },
+    get fps() { return V.fps; },
+    get rafFps() { return V.rafFps; },
+    /** Arena redraws since the page opened (a new frame, a selection, a resize). */
+    get framesDrawn() { return V.totalDrawn; },
+    get playing() { return V.playing; },
+    get robots() { return V.scene ? V.scene.n : 0; },
+    get robotsDrawn() { return V.robotsDrawn; },
+    get selected() { return V.selected; },
+    get seed() { return V.scene ? V.scene.seed : null; },
+    /** CSS pixel position of robot i relative to the arena canvas's top-left corner. */
+    robotScreenPosition(i) {
+      if (!V.frame || !V.view) return null;
+      return { x: V.frame.c.x[i] * V.view.scale, y: V.frame.c.y[i] * V.view.scale };
+    },
+    select,
+  };
+
+  wire();
+  const embedded = document.getElementById("infomarket-replay");
+  if (embedded) {
+    V.mode = "replay";
+    replaySource(JSON.parse(embedded.textContent)).catch((exc) => error(`cannot read the replay: ${exc}`));
+  } else {
+    V.source = liveSource();
+  }
+  requestAnimationFrame(tick);
+})();

@@ -1,0 +1,188 @@
+"""The viewer in a real browser: headless Chromium from Debian's packages, driven by Selenium.
+
+Loads the live page and the disk replay, checks pixels of the drawn robots, plays, steps, restarts,
+clicks a robot and reads its panel, measures frames per second with 25 and 1 000 robots, and saves a
+screenshot in the test's tmp dir.  Skips (with the reason) only when chromium or chromedriver is not
+installed; ``tools/ci/install-browser.sh`` installs both.
+"""
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+import time
+
+import pytest
+from selenium import webdriver
+from selenium.webdriver.chrome.options import Options
+from selenium.webdriver.chrome.service import Service
+from selenium.webdriver.common.action_chains import ActionChains
+from selenium.webdriver.common.by import By
+
+from infomarket.viewer.replay import record, write_html
+
+from .conftest import ServerThread, thousand_robots
+
+CHROMIUM = next(filter(None, (shutil.which(b) for b in ("chromium", "chromium-browser"))), None)
+CHROMEDRIVER = "/usr/bin/chromedriver" if os.path.exists("/usr/bin/chromedriver") else shutil.which("chromedriver")
+
+pytestmark = pytest.mark.skipif(
+    not (CHROMIUM and CHROMEDRIVER),
+    reason=f"headless Chromium not installed (chromium: {CHROMIUM}, chromedriver: {CHROMEDRIVER}); "
+           "run tools/ci/install-browser.sh (Debian packages chromium, chromium-driver)")
+
+# Flags for a closed network and a root user: no sandbox, no background traffic, a fresh profile.
+FLAGS = ("--headless=new", "--no-sandbox", "--disable-gpu", "--disable-dev-shm-usage", "--disable-quic",
+         "--no-first-run", "--disable-background-networking", "--disable-component-update", "--disable-sync",
+         "--disable-extensions", "--window-size=1400,1000", "--force-device-scale-factor=1")
+
+COUNT_COLOURS = """
+const c = document.getElementById('arena'), d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+const near = (k, r, g, b) =>
+  Math.abs(d[k] - r) < 30 && Math.abs(d[k + 1] - g) < 30 && Math.abs(d[k + 2] - b) < 30;
+let blue = 0, red = 0;
+for (let k = 0; k < d.length; k += 4) {
+  if (near(k, 0x2f, 0x6f, 0xd6)) blue++; else if (near(k, 0xd6, 0x2f, 0x2f)) red++;
+}
+return [blue, red];
+"""
+
+
+@pytest.fixture(scope="module")
+def driver():
+    options = Options()
+    options.binary_location = CHROMIUM
+    profile = tempfile.mkdtemp(prefix="infomarket-chromium-")
+    for flag in FLAGS + (f"--user-data-dir={profile}",):
+        options.add_argument(flag)
+    d = webdriver.Chrome(service=Service(CHROMEDRIVER), options=options)
+    d.set_page_load_timeout(30)
+    yield d
+    d.quit()
+    shutil.rmtree(profile, ignore_errors=True)
+
+
+def wait_for(driver, script, timeout=20.0, what=None):
+    """Poll a JS expression until it is truthy; return its value."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        value = driver.execute_script(f"return {script}")
+        if value:
+            return value
+        time.sleep(0.05)
+    raise AssertionError(f"timed out waiting for {what or script}")
+
+
+def open_page(driver, url):
+    driver.get(url)
+    wait_for(driver, "window.infomarketViewer && infomarketViewer.ready", what="the first frame")
+
+
+def settle(driver):
+    """After pause: wait until frames already on the wire have arrived and the step stands still."""
+    last = None
+    while True:
+        time.sleep(0.3)
+        now = driver.execute_script("return infomarketViewer.step")
+        if now == last:
+            return now
+        last = now
+
+
+def click_robot(driver, i, live):
+    canvas = driver.find_element(By.ID, "arena")
+    p = driver.execute_script(f"return infomarketViewer.robotScreenPosition({i})")
+    w, h = driver.execute_script("const r = arguments[0].getBoundingClientRect(); return [r.width, r.height]", canvas)
+    ActionChains(driver).move_to_element_with_offset(canvas, p["x"] - w / 2, p["y"] - h / 2).click().perform()
+    key = "detail" if live else "robot"  # live: wait for the server's details too
+    wait_for(driver, f"document.getElementById('panel').dataset.{key} === '{i}'", what=f"the panel of robot {i}")
+    return driver.find_element(By.ID, "panel").text
+
+
+def js_errors(driver):
+    return [e["message"] for e in driver.get_log("browser") if e["level"] == "SEVERE"]
+
+
+def measure_fps(driver, seconds=3.0):
+    """New frames drawn per second (and requestAnimationFrame callbacks per second), measured in the page."""
+    probe = "return [performance.now(), infomarketViewer.framesDrawn, infomarketViewer.step]"
+    t0, f0, s0 = driver.execute_script(probe)
+    time.sleep(seconds)
+    t1, f1, s1 = driver.execute_script(probe)
+    seconds = (t1 - t0) / 1000
+    return (f1 - f0) / seconds, (s1 - s0) / seconds, driver.execute_script("return infomarketViewer.rafFps")
+
+
+def test_live_page_draws_plays_steps_and_inspects_a_robot(driver, server_2b, tmp_path):
+    open_page(driver, server_2b.url)
+    view = "infomarketViewer"
+    assert driver.execute_script(f"return [{view}.mode, {view}.robots, {view}.step]") == ["live", 25, 0]
+    blue, red = driver.execute_script(COUNT_COLOURS)
+    assert blue > 24 * 15 and red > 10, f"robot discs on the canvas: {blue} blue, {red} red pixels"
+    assert "24 naive + 1 saboteur" in driver.find_element(By.ID, "subtitle").text
+
+    driver.find_element(By.ID, "play").click()
+    wait_for(driver, f"{view}.step >= 300", what="the step counter to advance")
+    assert int(driver.find_element(By.ID, "step").text) >= 300
+    driver.find_element(By.ID, "play").click()
+    before = settle(driver)
+    driver.find_element(By.ID, "stepbtn").click()
+    wait_for(driver, f"{view}.step === {before + 1}", what="a single step")
+
+    text = click_robot(driver, 24, live=True)
+    for needle in ("robot #24", "saboteur (Byzantine)", "odometry bias", "wealth", "items collected",
+                   "navigation table", "open purchases", "last transactions"):
+        assert needle in text, f"{needle!r} not in panel:\n{text}"
+    shot = tmp_path / "viewer-live.png"
+    driver.save_screenshot(str(shot))
+    assert shot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and shot.stat().st_size > 20_000
+
+    plain = driver.execute_script("return document.getElementById('arena').toDataURL()")
+    driver.find_element(By.ID, "comm").click()
+    wait_for(driver, f"document.getElementById('arena').toDataURL() !== {plain!r}", what="communication circles")
+
+    driver.find_element(By.ID, "seed").send_keys("7")
+    driver.find_element(By.ID, "restart").click()
+    wait_for(driver, f"{view}.seed === 7 && {view}.step === 0", what="a restart with seed 7")
+    assert "seed 7" in driver.find_element(By.ID, "subtitle").text
+    assert not js_errors(driver)
+
+
+@pytest.mark.parametrize("robots, least", [(25, 30), (1000, 10)])
+def test_frame_rate(driver, fig2b, robots, least, record_property):
+    server = ServerThread(fig2b if robots == 25 else thousand_robots(), seed=1)
+    try:
+        open_page(driver, server.url)
+        assert driver.execute_script("return infomarketViewer.robots") == robots
+        driver.find_element(By.ID, "play").click()
+        wait_for(driver, "infomarketViewer.step > 50", what="playing")
+        fps, steps_per_s, raf = measure_fps(driver)
+        driver.find_element(By.ID, "play").click()
+    finally:
+        server.stop()
+    wait_for(driver, "document.getElementById('connection').textContent.startsWith('disconnected')",
+             what="the page to see the server stop")
+    assert not js_errors(driver), "the server closes the socket cleanly"
+    record_property(f"fps_{robots}", round(fps, 1))
+    print(f"\n{robots} robots: {fps:.1f} frames/s drawn, {steps_per_s:.0f} steps/s, rAF {raf:.0f}/s")
+    assert fps >= least, f"{robots} robots: {fps:.1f} frames per second, want at least {least}"
+
+
+def test_replay_opens_from_disk_and_plays(driver, fig2b, tmp_path):
+    path = write_html(record(fig2b, 2, steps=400, every=4), tmp_path / "replay.html")
+    open_page(driver, path.as_uri())
+    view = "infomarketViewer"
+    assert driver.execute_script(f"return [{view}.mode, {view}.robots, {view}.step]") == ["replay", 25, 0]
+    assert not driver.find_element(By.ID, "restart").is_displayed()
+    blue, red = driver.execute_script(COUNT_COLOURS)
+    assert blue > 24 * 15 and red > 10
+    driver.find_element(By.ID, "play").click()
+    wait_for(driver, f"{view}.step >= 200", what="the replay to play")
+    driver.find_element(By.ID, "play").click()
+    step = settle(driver)
+    text = click_robot(driver, 24, live=False)
+    assert "saboteur (Byzantine)" in text and "last transactions" in text
+    driver.find_element(By.ID, "stepbtn").click()
+    wait_for(driver, f"{view}.step === {step + 4}", what="one recorded frame further")
+    driver.save_screenshot(str(tmp_path / "viewer-replay.png"))
+    assert not js_errors(driver)

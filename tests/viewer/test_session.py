@@ -1,0 +1,51 @@
+"""A page's session: command validation, stepping, restarting, selection."""
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from infomarket.viewer.frames import decode
+from infomarket.viewer.session import MAX_SPEED, Command, CommandError, Session, parse_command
+
+
+@pytest.mark.parametrize("msg, want", [
+    ({"cmd": "play"}, Command("play")),
+    ({"cmd": "pause"}, Command("pause")),
+    ({"cmd": "ack"}, Command("ack")),
+    ({"cmd": "step"}, Command("step", 1)),
+    ({"cmd": "step", "n": 40}, Command("step", 40)),
+    ({"cmd": "speed", "value": MAX_SPEED}, Command("speed", MAX_SPEED)),
+    ({"cmd": "restart"}, Command("restart", None)),
+    ({"cmd": "restart", "seed": 9}, Command("restart", 9)),
+    ({"cmd": "select", "robot": 0}, Command("select", 0)),
+    ({"cmd": "select", "robot": None}, Command("select", None)),
+])
+def test_valid_commands(msg, want):
+    assert parse_command(json.dumps(msg), robots=25) == want
+
+
+@pytest.mark.parametrize("text", [
+    "{", "3", '{"cmd": 1}', '{"cmd": "jump"}', '{"cmd": "step", "n": 0}', '{"cmd": "step", "n": 1.5}',
+    f'{{"cmd": "speed", "value": {MAX_SPEED + 1}}}', '{"cmd": "speed"}', '{"cmd": "select", "robot": -1}',
+    '{"cmd": "select", "robot": "3"}', '{"cmd": "restart", "seed": false}',
+])
+def test_invalid_commands_say_why(text):
+    with pytest.raises(CommandError) as err:
+        parse_command(text, robots=25)
+    assert str(err.value)
+
+
+def test_session_steps_restarts_and_reports(fig2b):
+    s = Session(fig2b, seed=4)
+    assert s.status() == {"type": "status", "playing": False, "speed": 10, "step": 0, "seed": 4,
+                          "selected": None}
+    frame, detail = s.advance(12)
+    assert decode(frame, s.robots).step == 12 and detail is None
+    s.selected = 3
+    _, detail = s.advance(1)
+    assert detail["id"] == 3 and detail["step"] == 13
+    s.restart()
+    assert s.sim.clock == 0 and s.seed != 4 and s.scene()["seed"] == s.seed
+    s.restart(4)
+    assert s.seed == 4
