@@ -44,5 +44,5 @@ def run_demo(runs: int = 8, workers: int | None = None) -> int:
     console.print(table)
     console.print(f"{len(SETUPS) * runs} runs, {steps:,} env-steps in {wall:.1f} s wall "
                   f"({steps / wall:,.0f} env-steps/s on {workers} worker(s), compilation included).")
-    console.print("Next: infomarket run fig2B --runs 16   |   infomarket list   |   docs/extending.md")
+    console.print("Next: .venv/bin/infomarket run fig2B --runs 16  |  .venv/bin/infomarket list  |  docs/extending.md")
     return 0

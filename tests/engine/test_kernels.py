@@ -6,7 +6,7 @@ import pytest
 from scipy import stats
 
 from infomarket.engine import kernels as K
-from infomarket.engine.build import cauchy_cdf, levy_cdf
+from infomarket.engine.build import cauchy_cdf, guide_table, levy_cdf
 from infomarket.engine.world import EXPLORING, FOOD, NEST, SEEKING_FOOD
 
 from ..conftest import Handle, make_config
@@ -126,7 +126,8 @@ def test_wrapped_cauchy_table_by_sampling():
     rho = 0.9
     cdf = cauchy_cdf(rho)
     u = np.random.default_rng(3).random(200_000)
-    draws = np.array([K.draw_index(cdf, x) for x in u[:20_000]])
+    guide = guide_table(cdf)
+    draws = np.array([K.draw_index(cdf, guide, x) for x in u[:20_000]])
     assert np.array_equal(draws, np.searchsorted(cdf, u[:20_000], side="right"))
     draws = np.searchsorted(cdf, u, side="right")
     phi = np.radians(np.arange(360))
@@ -164,3 +165,12 @@ def test_random_walk_turns_only_when_the_counter_runs_out():
     assert K.intended_move(h.view, 0, h.rng) == (2.5, 0.0)  # 2 -> 1
     K.intended_move(h.view, 0, h.rng)  # counter 1: turn drawn, then 0 -> redrawn (>= 1)
     assert w.levy[0] >= 1
+
+
+def test_guided_sampling_equals_the_inverse_cdf_everywhere():
+    cdf = levy_cdf(1.4, 15000)
+    guide = guide_table(cdf)
+    u = np.concatenate([np.random.default_rng(5).random(20_000), cdf[:50], np.nextafter(cdf[:50], 0), [0.0]])
+    u = u[u < 1.0]
+    got = np.array([K.draw_index(cdf, guide, x) for x in u])
+    assert np.array_equal(got, np.searchsorted(cdf, u, side="right"))

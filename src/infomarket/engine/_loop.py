@@ -20,10 +20,11 @@ NEED_ROOM = 1
 @njit(cache=True)
 def has_room(w):
     """Enough transaction and event capacity for one more step (the host grows the arrays if not)."""
-    n = w.pos.shape[0]
-    reserve = 2 * n
+    tx_count = w.tx_count
+    n = tx_count.shape[0]
+    limit = w.tx_seller.shape[1] - 2 * n
     for i in range(n):
-        if w.tx_count[i] + reserve > w.tx_seller.shape[1]:
+        if tx_count[i] > limit:
             return False
     if w.record and w.ev_count[0] + 2 * n * n + n > w.ev_step.shape[0]:
         return False
@@ -40,42 +41,50 @@ def settle(w, i):
 
 @njit(cache=True)
 def run_steps(w, rng, t_end):
-    """Advance the world until step ``t_end`` (or until the host must grow the logs): DONE or NEED_ROOM."""
+    """Advance the world until step ``t_end`` (or until the host must grow the logs): DONE or NEED_ROOM.
+
+    Arrays are read out of ``w`` once, here: every access to a field of the world handle costs an
+    atomic reference-count increment and decrement, which dominated the step when done per robot."""
     n = w.pos.shape[0]
-    while w.clock[0] < t_end:
+    clock, kind, balance = w.clock, w.kind, w.balance
+    cool, stop = w.cool_timer, w.stop_timer
+    off_valid, off_vec, off_age = w.off_valid, w.off_vec, w.off_age
+    nbr, nbr_count = w.nbr, w.nbr_count
+    fuel = w.fuel_cost
+    while clock[0] < t_end:
         if not has_room(w):
             return NEED_ROOM
-        w.clock[0] += 1
+        clock[0] += 1
         find_neighbours(w)
         begin_communication(w)
         for i in range(n):
             for site in range(2):
-                if w.cool_timer[i] == 0:
-                    valid, x, y, age = sell_dispatch(w.kind[i], w, i, site)  # noqa: F821
-                    w.off_valid[i, site] = valid
-                    w.off_vec[i, site, 0] = x
-                    w.off_vec[i, site, 1] = y
-                    w.off_age[i, site] = age
+                if cool[i] == 0:
+                    valid, x, y, age = sell_dispatch(kind[i], w, i, site)  # noqa: F821
+                    off_valid[i, site] = valid
+                    off_vec[i, site, 0] = x
+                    off_vec[i, site, 1] = y
+                    off_age[i, site] = age
                 else:
-                    w.off_valid[i, site] = False
+                    off_valid[i, site] = False
         for i in range(n):
-            if w.cool_timer[i] == 0:
-                buy_dispatch(w.kind[i], w, i, w.nbr[i, :w.nbr_count[i]])  # noqa: F821
+            if cool[i] == 0:
+                buy_dispatch(kind[i], w, i, nbr[i, :nbr_count[i]])  # noqa: F821
         for i in range(n):
             if forage(w, i, rng):
                 settle(w, i)
             install_table(w, i)
-            if w.stop_timer[i] > 0:
-                w.stop_timer[i] -= 1
-            elif w.fuel_cost > 0.0 and w.balance[i] < w.fuel_cost:
+            if stop[i] > 0:
+                stop[i] -= 1
+            elif fuel > 0.0 and balance[i] < fuel:
                 pass
             else:
-                if w.fuel_cost > 0.0:
-                    w.balance[i] -= w.fuel_cost
-                    w.burned[0] += w.fuel_cost
+                if fuel > 0.0:
+                    balance[i] -= fuel
+                    w.burned[0] += fuel
                 dx, dy = behaviour_step(w, i, rng)
                 move(w, i, dx, dy, rng)
-            if w.cool_timer[i] > 0:
-                w.cool_timer[i] -= 1
+            if cool[i] > 0:
+                cool[i] -= 1
         record_history(w)
     return DONE

@@ -31,6 +31,13 @@ def levy_cdf(alpha: float, steps: int) -> np.ndarray:
     return cdf
 
 
+def guide_table(cdf: np.ndarray) -> np.ndarray:
+    """For u in [j/M, (j+1)/M): the answer of inverse-CDF sampling is at least ``guide[j]`` (M = len(cdf)),
+    the first index whose cumulative probability exceeds j/M."""
+    m = len(cdf)
+    return np.searchsorted(cdf, np.arange(m) / m, side="right").astype(np.int64)
+
+
 def behaviour_kinds(cfg: Experiment) -> tuple[str, ...]:
     """Distinct behaviours in order of first appearance: a robot's ``kind`` indexes this tuple."""
     names: list[str] = []
@@ -71,6 +78,8 @@ def build_world(cfg: Experiment, rng: np.random.Generator, *, record_events: boo
     bias = rng.normal(cfg.robot.bias_mean, cfg.robot.bias_sd, size=n)
     bias *= np.where(rng.random(n) < 0.5, -1.0, 1.0)
 
+    cauchy = cauchy_cdf(cfg.random_walk.rho)
+    levy = levy_cdf(cfg.random_walk.alpha, cfg.steps)
     hist_rows = cfg.steps // history_every if history_every else 0
     ecap = EVENT_CAPACITY if record_events else 0
     z = np.zeros
@@ -82,7 +91,7 @@ def build_world(cfg: Experiment, rng: np.random.Generator, *, record_events: boo
         reward=float(cfg.payment.reward), info_share=float(cfg.payment.information_share),
         stake=float(cfg.payment.stake), fuel_cost=float(cfg.robot.fuel_cost),
         transitory=int(cfg.transitory), stop_time=int(cfg.robot.stop_time), cooldown=int(cfg.robot.cooldown),
-        cauchy_cdf=cauchy_cdf(cfg.random_walk.rho), levy_cdf=levy_cdf(cfg.random_walk.alpha, cfg.steps),
+        cauchy_cdf=cauchy, cauchy_guide=guide_table(cauchy), levy_cdf=levy, levy_guide=guide_table(levy),
         bparams=bparams, pparams=pparams, record=bool(record_events), hist_every=int(history_every),
         clock=z(1, np.int64), pos=pos, heading=heading,
         hdir=np.stack([np.cos(np.radians(heading)), np.sin(np.radians(heading))], axis=1), bias=bias, kind=kind,

@@ -34,7 +34,9 @@ def norm(x, y):
 @njit(inline="always")
 def angular_distance(a, b):
     """Smallest absolute difference between two directions in degrees, in [0, 180]."""
-    d = abs(a - b) % 360.0
+    d = abs(a - b)
+    if d >= 360.0:  # only for directions outside [0, 360): fmod is a library call, keep it off the hot path
+        d = d % 360.0
     if d > 180.0:
         d = 360.0 - d
     return d

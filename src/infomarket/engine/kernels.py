@@ -172,17 +172,16 @@ def update_state(w, i, front):
 
 
 @njit(inline="always")
-def draw_index(cdf, u):
-    """Inverse-CDF sampling on a table: the first index whose cumulative probability exceeds u."""
-    lo = 0
-    hi = cdf.shape[0] - 1
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if cdf[mid] > u:
-            hi = mid
-        else:
-            lo = mid + 1
-    return lo
+def draw_index(cdf, guide, u):
+    """Inverse-CDF sampling on a table: the first index whose cumulative probability exceeds u.
+
+    ``guide[j]`` is that index for u = j / len(guide) (see ``build.guide_table``), so the search starts
+    next to the answer and takes about one step on average instead of a binary search's ~14."""
+    k = guide[int(u * guide.shape[0])]
+    last = cdf.shape[0] - 1
+    while k < last and cdf[k] <= u:
+        k += 1
+    return k
 
 
 @njit
@@ -200,10 +199,10 @@ def intended_move(w, i, rng):
         return x, y
     turn = 0.0
     if w.levy[i] <= 1:
-        turn = float(draw_index(w.cauchy_cdf, rng.random()))
+        turn = float(draw_index(w.cauchy_cdf, w.cauchy_guide, rng.random()))
     w.levy[i] -= 1
     if w.levy[i] <= 0:
-        w.levy[i] = draw_index(w.levy_cdf, rng.random()) + 1
+        w.levy[i] = draw_index(w.levy_cdf, w.levy_guide, rng.random()) + 1
     if turn == 0.0:
         return w.speed, 0.0
     a = turn * DEG

@@ -10,6 +10,7 @@ Parameters (scalars and lookup tables, never written):
     site_pos: [2, 2] float64 site centres;  site_r: [2] float64 site radii
     reward, info_share, stake, fuel_cost: float;  transitory, stop_time, cooldown: int
     cauchy_cdf: [360] float64 turn-angle CDF (whole degrees);  levy_cdf: [steps + 1] float64 step-length CDF
+    cauchy_guide, levy_guide: int64 guide tables that make sampling those CDFs O(1) (build.guide_table)
     bparams: [n, P] float64 per-robot behaviour parameters;  pparams: [Q] float64 payment parameters
     record: bool, whether to log events;  hist_every: int, wealth-history interval (0 = off)
 
@@ -43,7 +44,7 @@ from collections import namedtuple
 PARAM_FIELDS = (
     "width", "height", "radius", "speed", "comm_range", "noise_sd", "site_pos", "site_r",
     "reward", "info_share", "stake", "fuel_cost", "transitory", "stop_time", "cooldown",
-    "cauchy_cdf", "levy_cdf", "bparams", "pparams", "record", "hist_every",
+    "cauchy_cdf", "cauchy_guide", "levy_cdf", "levy_guide", "bparams", "pparams", "record", "hist_every",
 )
 STATE_FIELDS = (
     "clock", "pos", "heading", "hdir", "bias", "kind", "state", "carrying", "levy",
