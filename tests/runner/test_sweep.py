@@ -149,6 +149,7 @@ def test_bad_targets_exit_2(tmp_path, capsys):
     assert main(["sweep", str(path), "--out", str(tmp_path / "d"), "--scheduler", "tcp://127.0.0.1:9", "--quiet"]) == 2
     assert "no Dask scheduler answers" in capsys.readouterr().err
     assert time.monotonic() - t0 < 60
+    assert not (tmp_path / "d").exists()  # nothing written
 
 
 def test_killed_sweep_resumes_with_every_run_exactly_once(tmp_path):

@@ -41,14 +41,14 @@ def _execute(experiments, args, label: str) -> int:
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {out}: exists and is not a directory")
-    try:
-        store.create()
-    except OSError as exc:
-        raise UsageError(f"--out {out}: cannot write there ({exc.strerror or exc})") from None
-    client, cluster = _client(args)
+    client, cluster = _client(args)  # before creating anything: a scheduler that does not answer writes nothing
     workers = args.workers or default_workers()
     t0 = time.perf_counter()
     try:
+        try:
+            store.create()
+        except OSError as exc:
+            raise UsageError(f"--out {out}: cannot write there ({exc.strerror or exc})") from None
         total = sum(c.runs for c in conds)
         with progress(label, total, enabled=not args.quiet) as bar:
             report = run_sweep(conds, store, workers=workers, client=client, on_done=bar.advance,

@@ -113,8 +113,8 @@ def run_sweep(conds: list[Condition], store: Store, *, workers: int = 1, client=
     """Run every missing run of ``conds`` into ``store``.  ``client``: a dask.distributed Client
     (never created here); otherwise a local pool of ``workers`` processes (inline when 1)."""
     store.create()
+    check_compatible(store, conds)  # first: a refused store is left exactly as it was
     store.remove_orphans()
-    check_compatible(store, conds)
     done = store.completed_runs()
     tasks = make_tasks(conds, done, workers)
     planned = sum(c.runs for c in conds)
