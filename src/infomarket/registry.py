@@ -179,9 +179,20 @@ def payment(name: str, *, description: str = "", replace: bool = False):
     return wrap
 
 
+_ENTRY_POINTS_LOADED: list[bool] = []
+
+
 def _ensure_builtins() -> None:
-    # Importing the packages registers the built-ins, through the same functions as above.
+    # Importing the packages registers the built-ins, through the same functions as above; installed
+    # third-party packages register theirs through the "infomarket.plugins" entry-point group.
     from . import behaviours, payments  # noqa: F401
+
+    if not _ENTRY_POINTS_LOADED:
+        _ENTRY_POINTS_LOADED.append(True)
+        from importlib.metadata import entry_points
+
+        for ep in entry_points(group="infomarket.plugins"):
+            ep.load()
 
 
 def get_behaviour(name: str) -> BehaviourSpec:
