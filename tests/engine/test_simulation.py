@@ -81,3 +81,12 @@ def test_plain_python_path_runs_the_same_code():
 def test_seed_derivation_is_stable():
     assert run_seed(1, 0) == run_seed(1, 0) != run_seed(1, 1) != run_seed(2, 1)
     assert 0 <= run_seed(2**40, 99, 3) < 2**63
+
+
+def test_snapshot_is_plain_python_of_the_current_state():
+    sim = im.Simulation(im.load_experiment("fig2B").with_overrides(steps=200), seed=1)
+    sim.step(200)
+    snap = sim.snapshot()
+    assert snap["step"] == 200 and len(snap["pos"]) == 25 and len(snap["pos"][0]) == 2
+    assert snap["wealth"] == sim.world.balance.tolist() and snap["items"] == sim.world.items.tolist()
+    assert set(snap["state"]) <= {0, 1, 2} and snap["sites"] == ("food", "nest")
