@@ -34,3 +34,15 @@ def test_a_nondeterministic_seller_is_caught():
     im.register_behaviour("tmp_noisy", buy="naive", sell=noisy_sell, honest=False, replace=True)
     with pytest.raises(checks.CheckFailed, match="same seed"):
         checks.check_behaviour("tmp_noisy", steps=300)
+
+
+def test_a_random_rule_gets_the_runs_generator_and_stays_reproducible():
+    def random_liar(w, me, site, rng, lie_probability=0.5):
+        valid, x, y, age = w.tab_valid[me, site], w.tab_vec[me, site, 0], w.tab_vec[me, site, 1], w.tab_age[me, site]
+        if rng.random() < lie_probability:
+            return valid, -x, -y, age
+        return valid, x, y, age
+
+    spec = im.register_behaviour("tmp_random_liar", buy="naive", sell=random_liar, honest=False, replace=True)
+    assert spec.sell.wants_rng and spec.params == ("lie_probability",)
+    checks.check_behaviour("tmp_random_liar", steps=800)  # reproducible from the seed, money conserved

@@ -31,6 +31,7 @@ class Rule:
     func: Callable
     params: tuple[str, ...]
     defaults: dict[str, float]
+    wants_rng: bool = False  #: the rule takes the run's numpy Generator as ``rng`` after the fixed arguments
 
     @property
     def py_func(self) -> Callable:
@@ -98,11 +99,14 @@ def _rule(func: Callable, fixed: tuple[str, ...], what: str) -> Rule:
     if len(sig) < len(fixed):
         raise TypeError(f"{what} {py.__name__} must take the arguments {', '.join(fixed)} first")
     extra = sig[len(fixed):]
+    wants_rng = bool(extra) and extra[0].name == "rng"
+    if wants_rng:
+        extra = extra[1:]
     for p in extra:
         if p.kind not in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD):
             raise TypeError(f"{what} {py.__name__}: parameter {p.name} must be a plain positional argument")
     defaults = {p.name: float(p.default) for p in extra if p.default is not p.empty}
-    return Rule(jitted, tuple(p.name for p in extra), defaults)
+    return Rule(jitted, tuple(p.name for p in extra), defaults, wants_rng)
 
 
 def register_behaviour(name: str, *, buy: Callable | str, sell: Callable | str, honest: bool,
@@ -113,7 +117,8 @@ def register_behaviour(name: str, *, buy: Callable | str, sell: Callable | str, 
 
     ``buy(w, me, nbrs, *params)`` buys from the neighbours ``nbrs`` (ids, increasing) and installs what it
     buys; ``sell(w, me, site, *params) -> (valid, x, y, age)`` is the offer for ``site`` (0 food, 1 nest)
-    in the seller's own frame.  ``honest`` says whether robots of this behaviour count as honest in the
+    in the seller's own frame.  A rule whose first argument after the fixed ones is named ``rng`` gets
+    the run's numpy Generator there (so a random rule stays reproducible from the run's seed).  ``honest`` says whether robots of this behaviour count as honest in the
     metrics (Byzantine otherwise).  ``limits`` maps a parameter to ``(text, predicate)``, e.g.
     ``{"threshold": ("> 0", lambda v: v > 0)}``: configurations breaking it are rejected with the text.
     """

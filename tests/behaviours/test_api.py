@@ -69,7 +69,7 @@ def test_naive_buys_the_freshest_younger_offer_once_per_site():
     w.new_age[0, FOOD] = 50
     h.offer(1, FOOD, 20.0, 0.0, 30)
     h.offer(2, FOOD, 20.0, 0.0, 10)
-    h.kernel.buy_dispatch(0, h.view, 0, np.array([1, 2]))
+    h.kernel.buy_dispatch(0, h.view, 0, np.array([1, 2]), h.rng)
     assert w.tx_count[0] == 1 and w.tx_seller[0, 0] == 2  # only the freshest, one purchase
     assert w.new_valid[0, FOOD] and w.new_age[0, FOOD] == 30
 
@@ -84,12 +84,12 @@ def test_sceptic_waits_for_confirmation():
     w.new_vec[0, FOOD] = (100.0, 0.0)
     w.new_age[0, FOOD] = 100
     h.offer(1, FOOD, 0.0, 100.0, 10)  # disagrees with the own entry (diff = 1.41 > 0.25)
-    h.kernel.buy_dispatch(0, h.view, 0, np.array([1]))
+    h.kernel.buy_dispatch(0, h.view, 0, np.array([1]), h.rng)
     assert w.tx_count[0] == 1 and w.pend_count[0, FOOD] == 1
     assert tuple(w.new_vec[0, FOOD]) == (100.0, 0.0)  # not used yet
     w.tab_age[0] = w.new_age[0]
     h.offer(2, FOOD, 5.0, 101.0, 20)  # confirms the pending one (diff ~ 0.05)
-    h.kernel.buy_dispatch(0, h.view, 0, np.array([1, 2]))  # 1 is pending already: not bought again
+    h.kernel.buy_dispatch(0, h.view, 0, np.array([1, 2]), h.rng)  # 1 is pending already: not bought again
     assert w.tx_count[0] == 2 and w.tx_seller[0, 1] == 2
     assert w.pend_count[0, FOOD] == 0
     # pending (0, 100) age 10 averaged with bought (5, 101) age 20: 10/30 * bought + 20/30 * pending
@@ -106,7 +106,7 @@ def test_sceptic_uses_information_that_agrees_with_its_own():
     w.new_vec[0, NEST] = (100.0, 0.0)
     w.new_age[0, NEST] = 30
     h.offer(1, NEST, 110.0, 0.0, 10)  # diff = 0.1 < 0.25
-    h.kernel.buy_dispatch(0, h.view, 0, np.array([1]))
+    h.kernel.buy_dispatch(0, h.view, 0, np.array([1]), h.rng)
     assert w.new_vec[0, NEST] == pytest.approx([107.5, 0.0]) and w.new_age[0, NEST] == 20
 
 
@@ -116,6 +116,6 @@ def test_saboteur_sells_rotated_and_keeps_the_truth():
     w.tab_valid[1, FOOD] = True
     w.tab_vec[1, FOOD] = (10.0, 0.0)
     w.tab_age[1, FOOD] = 4
-    valid, x, y, age = h.kernel.sell_dispatch(0, h.view, 1, FOOD)
+    valid, x, y, age = h.kernel.sell_dispatch(0, h.view, 1, FOOD, h.rng)
     assert valid and age == 4 and (x, y) == pytest.approx((0.0, 10.0), abs=1e-12)
     assert tuple(w.tab_vec[1, FOOD]) == (10.0, 0.0)

@@ -32,10 +32,10 @@ def has_room(w):
 
 
 @njit(cache=True)
-def settle(w, i):
+def settle(w, i, rng):
     k = w.tx_count[i]
     weights = np.zeros(k)
-    pay_dispatch(w, i, w.tx_seller[i, :k], w.tx_site[i, :k], w.tx_dir[i, :k], weights)  # noqa: F821
+    pay_dispatch(w, i, w.tx_seller[i, :k], w.tx_site[i, :k], w.tx_dir[i, :k], weights, rng)  # noqa: F821
     distribute(w, i, weights)
 
 
@@ -60,7 +60,7 @@ def run_steps(w, rng, t_end):
         for i in range(n):
             for site in range(2):
                 if cool[i] == 0:
-                    valid, x, y, age = sell_dispatch(kind[i], w, i, site)  # noqa: F821
+                    valid, x, y, age = sell_dispatch(kind[i], w, i, site, rng)  # noqa: F821
                     off_valid[i, site] = valid
                     off_vec[i, site, 0] = x
                     off_vec[i, site, 1] = y
@@ -69,10 +69,10 @@ def run_steps(w, rng, t_end):
                     off_valid[i, site] = False
         for i in range(n):
             if cool[i] == 0:
-                buy_dispatch(kind[i], w, i, nbr[i, :nbr_count[i]])  # noqa: F821
+                buy_dispatch(kind[i], w, i, nbr[i, :nbr_count[i]], rng)  # noqa: F821
         for i in range(n):
             if forage(w, i, rng):
-                settle(w, i)
+                settle(w, i, rng)
             install_table(w, i)
             if stop[i] > 0:
                 stop[i] -= 1

@@ -66,7 +66,8 @@ def _rule_source(rule: Rule) -> str | None:
 
 
 def _args(rule: Rule, spec_params: tuple[str, ...], row: str) -> str:
-    return "".join(f", {row}[{spec_params.index(p)}]" for p in rule.params)
+    rng = ", rng" if rule.wants_rng else ""
+    return rng + "".join(f", {row}[{spec_params.index(p)}]" for p in rule.params)
 
 
 def generate_source(behaviours: list[BehaviourSpec], payment: PaymentSpec) -> str:
@@ -77,18 +78,18 @@ def generate_source(behaviours: list[BehaviourSpec], payment: PaymentSpec) -> st
         lines.append(f"_b{k}_buy = _rule_function('behaviour', {b.name!r}, 'buy')")
         lines.append(f"_b{k}_sell = _rule_function('behaviour', {b.name!r}, 'sell')")
     lines.append(f"_pay = _rule_function('payment', {payment.name!r}, 'weights')")
-    lines += ["", "", "@njit(cache=True)", "def sell_dispatch(kind, w, i, site):"]
+    lines += ["", "", "@njit(cache=True)", "def sell_dispatch(kind, w, i, site, rng):"]
     for k, b in enumerate(behaviours):
         call = f"return _b{k}_sell(w, i, site{_args(b.sell, b.params, 'w.bparams[i]')})"
         if k == len(behaviours) - 1:
             lines.append(f"    {call}")
         else:
             lines += [f"    if kind == {k}:", f"        {call}"]
-    lines += ["", "", "@njit(cache=True)", "def buy_dispatch(kind, w, i, nbrs):"]
+    lines += ["", "", "@njit(cache=True)", "def buy_dispatch(kind, w, i, nbrs, rng):"]
     for k, b in enumerate(behaviours):
         lines += [f"    {'if' if k == 0 else 'elif'} kind == {k}:",
                   f"        _b{k}_buy(w, i, nbrs{_args(b.buy, b.params, 'w.bparams[i]')})"]
-    lines += ["", "", "@njit(cache=True)", "def pay_dispatch(w, buyer, sellers, sites, directions, weights):",
+    lines += ["", "", "@njit(cache=True)", "def pay_dispatch(w, buyer, sellers, sites, directions, weights, rng):",
               f"    _pay(buyer, sellers, sites, directions, weights{_args(payment.weights, payment.params, 'w.pparams')})",
               "", "", "from numba.experimental.structref import new as _structref_new",
               "from infomarket.engine.worldref import world_type as _world_type",

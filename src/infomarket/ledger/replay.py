@@ -50,7 +50,8 @@ def replay_events(events: Iterable, robots: int, *, scheme: str = "delayed", ini
         "payment": {"scheme": scheme, "initial_wealth": initial_wealth, "reward": reward,
                     "information_share": information_share, "stake": stake, "params": params or {}},
     })
-    world, _ = build_world(cfg, np.random.default_rng(0))
+    rng = np.random.default_rng(0)  # only a rule that asks for one uses it
+    world, _ = build_world(cfg, rng)
     kernel = specialise.kernel_module(("naive",), scheme)
     view = kernel_view(world, kernel)
     accepted: list[bool] = []
@@ -64,7 +65,7 @@ def replay_events(events: Iterable, robots: int, *, scheme: str = "delayed", ini
             accepted.append(bool(open_transaction(view, int(get("buyer")), int(get("seller")),
                                                   int(get("site")), float(get("direction_deg")))))
         elif kind == "deposit":
-            kernel.settle(view, int(get("buyer")))
+            kernel.settle(view, int(get("buyer")), rng)
         else:
             raise ValueError(f"unknown ledger event kind {kind!r}")
         flags = ErrorFlags(int(world.flags[0]))
