@@ -1,50 +1,69 @@
-"""Template of the compiled step loop.  Never called from here: ``engine.specialise`` writes a module
-made of this source plus ``sell_dispatch``, ``buy_dispatch`` and ``pay_dispatch`` for the configured
-rules, so each rule call is a direct, inlinable call and the whole kernel is cached on disk.
+"""Template of the compiled step loop.  Never imported as is: ``engine.specialise`` writes a module made of
+this source plus the three dispatch functions for the configured rules (below, declared and left to
+the generator), so each rule call is a direct, inlinable call and the whole kernel is cached on disk.
 
 Order of operations per step (MODEL.md §3): neighbours; communication (offers from start-of-step
 tables, then every robot buys in id order); move (foraging and payment, install the new table,
 behaviour step, noisy motion), robots in id order.
+
+Before a step changes anything, ``has_room`` checks that the step cannot outgrow a capacity (neighbour
+lists, pending lists, the transaction pool, the event log); if it could, the loop returns NEED_ROOM
+with the step not begun, the host grows the arrays (``build.make_room``) and calls again.
 """
 import numpy as np
 from numba import njit
 
-from infomarket.engine.kernels import (begin_communication, behaviour_step, find_neighbours, forage,
-                                       install_table, move, record_history)
-from infomarket.ledger.kernels import distribute
+from infomarket.engine.kernels import (begin_communication, behaviour_step, forage, install_table, move,
+                                       record_history)
+from infomarket.engine.neighbours import find_neighbours
+from infomarket.ledger.kernels import distribute, reserve, settlement
 
 DONE = 0
 NEED_ROOM = 1
 
+# ---- provided by the generator (engine.specialise), one branch per configured rule -----------------
+#: sell_dispatch(kind, w, i, site, rng) -> (valid, x, y, age): robot i's offer for ``site``
+#: buy_dispatch(kind, w, i, nbrs, rng): robot i buys from its neighbours
+#: pay_dispatch(w, buyer, sellers, sites, directions, weights, rng): the scheme's weights
+sell_dispatch = buy_dispatch = pay_dispatch = None
+
 
 @njit(cache=True)
 def has_room(w):
-    """Enough transaction and event capacity for one more step (the host grows the arrays if not)."""
-    tx_count = w.tx_count
-    n = tx_count.shape[0]
-    limit = w.tx_seller.shape[1] - 2 * n
+    """Can this step fit?  Per robot and site a buy rule may make one purchase per neighbour, and add
+    one pending entry per neighbour; the log gets at most one event per purchase plus a deposit.
+    Transaction blocks that could overflow are moved to bigger ones while the pool has space."""
+    nbr_count = w.nbr_count
+    n = nbr_count.shape[0]
+    kn = w.nbr.shape[1]
+    kp = w.pend_seller.shape[2]
+    events = n
     for i in range(n):
-        if tx_count[i] > limit:
+        c = nbr_count[i]
+        if c > kn:
             return False
-    if w.record and w.ev_count[0] + 2 * n * n + n > w.ev_step.shape[0]:
+        if w.pend_count[i, 0] + c > kp or w.pend_count[i, 1] + c > kp:
+            return False
+        if not reserve(w, i, w.tx_count[i] + 2 * c):
+            return False
+        events += 2 * c
+    if w.record and w.ev_count[0] + events > w.ev_step.shape[0]:
         return False
     return True
 
 
 @njit(cache=True)
 def settle(w, i, rng):
-    k = w.tx_count[i]
-    weights = np.zeros(k)
-    pay_dispatch(w, i, w.tx_seller[i, :k], w.tx_site[i, :k], w.tx_dir[i, :k], weights, rng)  # noqa: F821
+    """Robot i deposited: weigh its open transactions with the scheme, then pay (ledger.kernels)."""
+    sellers, sites, directions = settlement(w, i)
+    weights = np.zeros(sellers.shape[0])
+    pay_dispatch(w, i, sellers, sites, directions, weights, rng)
     distribute(w, i, weights)
 
 
 @njit(cache=True)
 def run_steps(w, rng, t_end):
-    """Advance the world until step ``t_end`` (or until the host must grow the logs): DONE or NEED_ROOM.
-
-    Arrays are read out of ``w`` once, here: every access to a field of the world handle costs an
-    atomic reference-count increment and decrement, which dominated the step when done per robot."""
+    """Advance the world until step ``t_end`` (or until the host must grow an array): DONE or NEED_ROOM."""
     n = w.pos.shape[0]
     clock, kind, balance = w.clock, w.kind, w.balance
     cool, stop = w.cool_timer, w.stop_timer
@@ -52,15 +71,15 @@ def run_steps(w, rng, t_end):
     nbr, nbr_count = w.nbr, w.nbr_count
     fuel = w.fuel_cost
     while clock[0] < t_end:
+        find_neighbours(w)
         if not has_room(w):
             return NEED_ROOM
         clock[0] += 1
-        find_neighbours(w)
         begin_communication(w)
         for i in range(n):
             for site in range(2):
                 if cool[i] == 0:
-                    valid, x, y, age = sell_dispatch(kind[i], w, i, site, rng)  # noqa: F821
+                    valid, x, y, age = sell_dispatch(kind[i], w, i, site, rng)
                     off_valid[i, site] = valid
                     off_vec[i, site, 0] = x
                     off_vec[i, site, 1] = y
@@ -69,7 +88,7 @@ def run_steps(w, rng, t_end):
                     off_valid[i, site] = False
         for i in range(n):
             if cool[i] == 0:
-                buy_dispatch(kind[i], w, i, nbr[i, :nbr_count[i]], rng)  # noqa: F821
+                buy_dispatch(kind[i], w, i, nbr[i, :nbr_count[i]], rng)
         for i in range(n):
             if forage(w, i, rng):
                 settle(w, i, rng)

@@ -7,9 +7,14 @@ import numpy as np
 
 from ..config.schema import Experiment
 from ..registry import behaviours
-from .world import World
+from .kernels import turn_tables
+from .neighbours import grid_shape
+from .world import LOG, World
 
-TX_CAPACITY = 64
+#: First capacities; the host grows each when the kernel asks for room (``make_room``).
+NEIGHBOUR_CAPACITY = 8
+PENDING_CAPACITY = 4
+TX_CAPACITY = 16
 EVENT_CAPACITY = 4096
 
 
@@ -80,34 +85,41 @@ def build_world(cfg: Experiment, rng: np.random.Generator, *, record_events: boo
 
     cauchy = cauchy_cdf(cfg.random_walk.rho)
     levy = levy_cdf(cfg.random_walk.alpha, cfg.steps)
+    turn_cos, turn_sin = turn_tables()
+    rc = float(cfg.robot.communication_range)
+    cell, nx, ny = grid_shape(float(w_), float(h_), rc, n)
     hist_rows = cfg.steps // history_every if history_every else 0
     ecap = EVENT_CAPACITY if record_events else 0
+    kn, kp, kt = NEIGHBOUR_CAPACITY, PENDING_CAPACITY, TX_CAPACITY
     z = np.zeros
     world = World(
         width=float(w_), height=float(h_), radius=float(r), speed=float(cfg.robot.speed),
-        comm_range=float(cfg.robot.communication_range), noise_sd=float(cfg.robot.noise_sd),
+        comm_range=rc, noise_sd=float(cfg.robot.noise_sd),
         site_pos=np.array([[cfg.food.x, cfg.food.y], [cfg.nest.x, cfg.nest.y]], dtype=np.float64),
         site_r=np.array([cfg.food.radius, cfg.nest.radius], dtype=np.float64),
         reward=float(cfg.payment.reward), info_share=float(cfg.payment.information_share),
         stake=float(cfg.payment.stake), fuel_cost=float(cfg.robot.fuel_cost),
         transitory=int(cfg.transitory), stop_time=int(cfg.robot.stop_time), cooldown=int(cfg.robot.cooldown),
         cauchy_cdf=cauchy, cauchy_guide=guide_table(cauchy), levy_cdf=levy, levy_guide=guide_table(levy),
+        turn_cos=turn_cos, turn_sin=turn_sin,
         bparams=bparams, pparams=pparams, record=bool(record_events), hist_every=int(history_every),
-        clock=z(1, np.int64), pos=pos, heading=heading,
+        grid_cell=cell, grid_nx=nx, grid_ny=ny,
+        clock=z(1, np.int64), pos=pos,
         hdir=np.stack([np.cos(np.radians(heading)), np.sin(np.radians(heading))], axis=1), bias=bias, kind=kind,
         state=z(n, np.int64), carrying=z(n, np.bool_), levy=np.ones(n, np.int64),
         tab_vec=z((n, 2, 2)), tab_age=z((n, 2), np.int64), tab_valid=z((n, 2), np.bool_),
         new_vec=z((n, 2, 2)), new_age=z((n, 2), np.int64), new_valid=z((n, 2), np.bool_),
         off_vec=z((n, 2, 2)), off_age=z((n, 2), np.int64), off_valid=z((n, 2), np.bool_),
-        pend_vec=z((n, 2, n, 2)), pend_age=z((n, 2, n), np.int64), pend_seller=z((n, 2, n), np.int64),
+        pend_vec=z((n, 2, kp, 2)), pend_age=z((n, 2, kp), np.int64), pend_seller=z((n, 2, kp), np.int64),
         pend_count=z((n, 2), np.int64),
         spot=z((n, 2, 2)), has_spot=z((n, 2), np.bool_), last_site=np.full(n, -1, np.int64),
-        items=z(n, np.int64), balance=np.full(n, float(cfg.payment.initial_wealth)), pot=z(n),
-        burned=z(1),
-        tx_seller=z((n, TX_CAPACITY), np.int64), tx_site=z((n, TX_CAPACITY), np.int64),
-        tx_dir=z((n, TX_CAPACITY)), tx_count=z(n, np.int64),
-        nbr=z((n, n), np.int64), nbr_count=z(n, np.int64),
-        stop_timer=z(n, np.int64), cool_timer=z(n, np.int64),
+        items=z(n, np.int64), stop_timer=z(n, np.int64), cool_timer=z(n, np.int64),
+        nbr=z((n, kn), np.int64), nbr_count=z(n, np.int64),
+        cell_start=z(nx * ny + 1, np.int64), cell_items=z(n, np.int64),
+        balance=np.full(n, float(cfg.payment.initial_wealth)), pot=z(n), burned=z(1),
+        tx_off=np.arange(n, dtype=np.int64) * kt, tx_cap=np.full(n, kt, np.int64), tx_count=z(n, np.int64),
+        tx_seller=z(n * kt, np.int64), tx_site=z(n * kt, np.int64), tx_dir=z(n * kt),
+        tx_step=z(n * kt, np.int64), pool_top=np.array([n * kt], np.int64),
         ev_step=z(ecap, np.int64), ev_kind=z(ecap, np.int64), ev_buyer=z(ecap, np.int64),
         ev_seller=z(ecap, np.int64), ev_site=z(ecap, np.int64), ev_dir=z(ecap), ev_x=z(ecap), ev_y=z(ecap),
         ev_age=z(ecap, np.int64), ev_stake=z(ecap), ev_sx=z(ecap), ev_sy=z(ecap), ev_count=z(1, np.int64),
@@ -116,24 +128,60 @@ def build_world(cfg: Experiment, rng: np.random.Generator, *, record_events: boo
     return world, names
 
 
-def grow(world: World) -> World:
-    """Double the per-buyer transaction capacity and the event log where a step might not fit."""
+def _grown(old: np.ndarray, axis: int, size: int) -> np.ndarray:
+    shape = list(old.shape)
+    shape[axis] = size
+    new = np.zeros(shape, old.dtype)
+    new[tuple(slice(0, k) for k in old.shape)] = old
+    return new
+
+
+def make_room(world: World, tx_need: np.ndarray | None = None) -> World:
+    """Grow whatever the next step might outgrow (the kernel's ``has_room`` said something would):
+    neighbour and pending capacities to the largest need with headroom, the transaction pool (its live
+    blocks compacted to the front), the event log; capacities at least double, so growth is amortised.
+    ``tx_need`` overrides each buyer's transaction need (default: open ones + 2 per neighbour)."""
     n = world.pos.shape[0]
+    nbr = world.nbr_count
+    need_n = int(nbr.max(initial=0))
     changes = {}
-    cap = world.tx_seller.shape[1]
-    if int(world.tx_count.max(initial=0)) + 2 * n > cap:
-        new = max(2 * cap, int(world.tx_count.max()) + 4 * n)
-        for f in ("tx_seller", "tx_site", "tx_dir"):
+    kn = world.nbr.shape[1]
+    if need_n > kn:
+        changes["nbr"] = np.zeros((n, max(2 * kn, need_n + 4)), np.int64)
+    kp = world.pend_seller.shape[2]
+    need_p = int((world.pend_count + nbr[:, None]).max(initial=0))
+    if need_p > kp:
+        size = max(2 * kp, need_p + 4)
+        for f in ("pend_vec", "pend_age", "pend_seller"):
+            changes[f] = _grown(getattr(world, f), 2, size)
+    need_t = world.tx_count + 2 * nbr if tx_need is None else tx_need
+    needy = need_t > world.tx_cap
+    if needy.any():
+        caps = world.tx_cap.copy()
+        caps[needy] = np.maximum(2 * caps[needy], need_t[needy] + 8)
+        starts = np.concatenate([[0], np.cumsum(caps)[:-1]]).astype(np.int64)
+        size = 2 * int(caps.sum())
+        src = _ranges(world.tx_off, world.tx_count)
+        dst = _ranges(starts, world.tx_count)
+        for f in ("tx_seller", "tx_site", "tx_dir", "tx_step"):
             old = getattr(world, f)
-            arr = np.zeros((n, new), old.dtype)
-            arr[:, :cap] = old
-            changes[f] = arr
-    ecap = world.ev_step.shape[0]
-    if world.record and int(world.ev_count[0]) + 2 * n * n + n > ecap:
-        new = max(2 * ecap, int(world.ev_count[0]) + 4 * n * n + 2 * n)
-        for f in [f for f in world._fields if f.startswith("ev_") and f != "ev_count"]:
-            old = getattr(world, f)
-            arr = np.zeros(new, old.dtype)
-            arr[:ecap] = old
-            changes[f] = arr
+            new = np.zeros(size, old.dtype)
+            new[dst] = old[src]
+            changes[f] = new
+        changes.update(tx_off=starts, tx_cap=caps, pool_top=np.array([int(caps.sum())], np.int64))
+    if world.record:
+        ecap = world.ev_step.shape[0]
+        need_e = int(world.ev_count[0]) + n + 2 * int(nbr.sum())
+        if need_e > ecap:
+            for f in [f for f in LOG if f.startswith("ev_") and f != "ev_count"]:
+                changes[f] = _grown(getattr(world, f), 0, max(2 * ecap, need_e))
     return world._replace(**changes)
+
+
+def _ranges(starts: np.ndarray, counts: np.ndarray) -> np.ndarray:
+    """Concatenated index ranges starts[i] .. starts[i] + counts[i] - 1."""
+    total = int(counts.sum())
+    if total == 0:
+        return np.zeros(0, np.int64)
+    offsets = np.repeat(starts - np.concatenate([[0], np.cumsum(counts)[:-1]]), counts)
+    return np.arange(total, dtype=np.int64) + offsets

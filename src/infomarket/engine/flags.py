@@ -11,7 +11,7 @@ class ErrorFlags(IntFlag):
 
     def describe(self) -> str:
         text = {
-            ErrorFlags.TX_OVERFLOW: "a buy rule made more than 2 x robots purchases in one step",
+            ErrorFlags.TX_OVERFLOW: "a buy rule made more than 2 purchases per neighbour in one step",
             ErrorFlags.BAD_WEIGHTS: "a payment rule returned a negative or non-finite weight",
             ErrorFlags.EVENT_OVERFLOW: "more events in one step than the event log reserves",
         }

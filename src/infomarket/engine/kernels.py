@@ -7,28 +7,8 @@ import math
 
 from numba import njit
 
-from .geometry import DEG, direction, norm, rotate
+from .geometry import DEG, norm, rotate
 from .world import EXPLORING, FOOD, NEST, SEEKING_FOOD, SEEKING_NEST
-
-
-@njit
-def find_neighbours(w):
-    """Neighbour lists: pairs strictly closer than the communication range, increasing id order."""
-    n = w.pos.shape[0]
-    rc2 = w.comm_range * w.comm_range
-    for i in range(n):
-        w.nbr_count[i] = 0
-    for i in range(n):
-        xi = w.pos[i, 0]
-        yi = w.pos[i, 1]
-        for j in range(i + 1, n):
-            dx = w.pos[j, 0] - xi
-            dy = w.pos[j, 1] - yi
-            if dx * dx + dy * dy < rc2:
-                w.nbr[i, w.nbr_count[i]] = j
-                w.nbr_count[i] += 1
-                w.nbr[j, w.nbr_count[j]] = i
-                w.nbr_count[j] += 1
 
 
 @njit
@@ -205,8 +185,8 @@ def intended_move(w, i, rng):
         w.levy[i] = draw_index(w.levy_cdf, w.levy_guide, rng.random()) + 1
     if turn == 0.0:
         return w.speed, 0.0
-    a = turn * DEG
-    return w.speed * math.cos(a), w.speed * math.sin(a)
+    k = int(turn)
+    return w.speed * w.turn_cos[k], w.speed * w.turn_sin[k]
 
 
 @njit
@@ -259,7 +239,6 @@ def move(w, i, dx, dy, rng):
     length = norm(mx, my)
     w.hdir[i, 0] = mx / length
     w.hdir[i, 1] = my / length
-    w.heading[i] = direction(mx, my)
     r = w.radius
     w.pos[i, 0] = min(max(w.pos[i, 0] + mx, r), w.width - r)
     w.pos[i, 1] = min(max(w.pos[i, 1] + my, r), w.height - r)
@@ -273,3 +252,22 @@ def record_history(w):
         if 0 <= k < w.hist.shape[0]:
             for i in range(w.pos.shape[0]):
                 w.hist[k, i] = w.balance[i]
+
+
+@njit
+def _turn_tables(cos_out, sin_out):
+    for k in range(cos_out.shape[0]):
+        a = float(k) * DEG
+        cos_out[k] = math.cos(a)
+        sin_out[k] = math.sin(a)
+
+
+def turn_tables():
+    """cos and sin of every whole-degree turn, computed by compiled code (the same libm calls the
+    kernel made before it looked them up), so a turn costs a table read instead of two calls."""
+    import numpy as np
+
+    c = np.empty(360)
+    s = np.empty(360)
+    _turn_tables(c, s)
+    return c, s

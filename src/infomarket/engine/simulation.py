@@ -16,9 +16,9 @@ from ..config.schema import Experiment
 from ..errors import SimulationError
 from ..registry import behaviours
 from . import specialise
-from .build import behaviour_kinds, build_world, grow
+from .build import behaviour_kinds, build_world, make_room
 from .flags import ErrorFlags
-from .world import EVENT_NAMES, SITE_NAMES
+from .world import EVENT_NAMES, SITE_NAMES, headings
 from .worldref import kernel_view
 
 
@@ -78,7 +78,7 @@ class Simulation:
                 raise SimulationError(f"step {self.clock}: {flags.describe()}")
             if status == self._kernel.DONE:
                 break
-            self.world = grow(self.world)
+            self.world = make_room(self.world)
             self._view = kernel_view(self.world, self._kernel)
         self.run_seconds += time.perf_counter() - t0
 
@@ -126,7 +126,7 @@ class Simulation:
     def snapshot(self) -> dict:
         """Plain-Python view of the current state, for viewers and inspection."""
         w = self.world
-        return {"step": self.clock, "pos": w.pos.tolist(), "heading": w.heading.tolist(),
+        return {"step": self.clock, "pos": w.pos.tolist(), "heading": headings(w).tolist(),
                 "state": w.state.tolist(), "carrying": w.carrying.tolist(), "last_site": w.last_site.tolist(),
                 "items": w.items.tolist(), "wealth": w.balance.tolist(),
                 "sites": SITE_NAMES}

@@ -1,64 +1,93 @@
 """The world: every piece of simulation state as arrays (struct of arrays), in one named tuple.
 
-One ``World`` is what every compiled function receives (``w``).  Rules read it and write the few
-arrays that are theirs to write (the buyer's new table, the pending lists).  Shapes use ``n`` for the
-number of robots, ``2`` sites (0 = food, 1 = nest), ``cap`` for the transaction capacity per buyer and
-``ecap`` for the event-log capacity (both grown by the host between steps, see ``engine.simulation``).
+One ``World`` is what every compiled function receives (``w``).  Its fields come in four groups, and
+the group says who may write a field:
 
-Parameters (scalars and lookup tables, never written):
+``PARAMS``  never change during a run (scalars, site geometry, sampling tables, rule parameters).  In
+            compiled code their arrays are typed read-only, so a rule that writes one does not compile.
+``ROBOTS``  the robots' state, written by the engine's step; a buy rule writes only its own robot's
+            ``new_*`` table and pending list, through ``behaviours.api``.
+``LEDGER``  the simulated blockchain: balances, pots and each buyer's open transactions, written only
+            by ``ledger.kernels`` (a rule reaches it through ``api.buy``; payment rules only weigh).
+``LOG``     output: the event log, the wealth history and the error flags.
+
+Shapes use ``n`` robots, 2 sites (0 = food, 1 = nest) and small capacities that the host grows between
+steps when the kernel asks for room (``build.make_room``): ``kn`` neighbours, ``kp`` pending entries
+per site, the transaction pool ``P`` and the event log ``E``.  Nothing is [n, n]: memory is O(n·k).
+
+PARAMS:
     width, height, radius, speed, comm_range, noise_sd: float
-    site_pos: [2, 2] float64 site centres;  site_r: [2] float64 site radii
+    site_pos [2, 2] float64 site centres;  site_r [2] float64 site radii
     reward, info_share, stake, fuel_cost: float;  transitory, stop_time, cooldown: int
-    cauchy_cdf: [360] float64 turn-angle CDF (whole degrees);  levy_cdf: [steps + 1] float64 step-length CDF
+    cauchy_cdf [360] turn-angle CDF (whole degrees);  levy_cdf [steps + 1] step-length CDF
     cauchy_guide, levy_guide: int64 guide tables that make sampling those CDFs O(1) (build.guide_table)
-    bparams: [n, P] float64 per-robot behaviour parameters;  pparams: [Q] float64 payment parameters
+    turn_cos, turn_sin [360]: cos and sin of each whole-degree turn (computed with the kernel's libm)
+    bparams [n, P] per-robot behaviour parameters;  pparams [Q] payment parameters
     record: bool, whether to log events;  hist_every: int, wealth-history interval (0 = off)
+    grid_cell: float cell side of the neighbour grid (>= comm_range);  grid_nx, grid_ny: int cells
 
-State:
-    clock: [1] int64, the last completed step (the first step is 1)
-    pos: [n, 2] float64 true positions;  heading: [n] float64 true heading, degrees
-    hdir: [n, 2] float64 unit vector of the heading (kept so the hot loop needs no trigonometry)
-    bias: [n] float64 odometry bias mu_i (degrees per step);  kind: [n] int64 behaviour index
-    state: [n] int64 EXPLORING / SEEKING_FOOD / SEEKING_NEST;  carrying: [n] bool;  levy: [n] int64
-    tab_vec [n, 2, 2], tab_age [n, 2] int64, tab_valid [n, 2] bool: navigation table (robot frame),
-        as it was at the start of the step (what sellers sell)
+ROBOTS:
+    clock [1] int64 the last completed step (the first step is 1)
+    pos [n, 2] true positions;  hdir [n, 2] unit vector of the true heading (no angle is kept: the
+        hot loop needs no trigonometry for it; ``headings(world)`` gives degrees)
+    bias [n] odometry bias mu_i (degrees per step);  kind [n] behaviour index;  levy [n] steps left
+    state [n] EXPLORING / SEEKING_FOOD / SEEKING_NEST;  carrying [n] bool
+    tab_vec [n, 2, 2], tab_age [n, 2], tab_valid [n, 2]: navigation table (robot frame) as it was at
+        the start of the step (what sellers sell)
     new_vec, new_age, new_valid: the table being bought into during the communication phase
     off_vec [n, 2, 2], off_age [n, 2], off_valid [n, 2]: this step's offers (seller frame)
-    pend_vec [n, 2, n, 2], pend_age [n, 2, n], pend_seller [n, 2, n], pend_count [n, 2]: pending
+    pend_vec [n, 2, kp, 2], pend_age [n, 2, kp], pend_seller [n, 2, kp], pend_count [n, 2]: pending
         (unconfirmed) purchases, per site, in the robot's frame, aged like table entries
     spot [n, 2, 2], has_spot [n, 2]: pick-up / drop spot per site
-    last_site [n] int64 (-1 none);  items [n] int64 items counted after the transitory period
-    balance [n] float64, pot [n] float64 stakes locked by the robot's open purchases, burned [1] float64
-    tx_seller [n, cap] int64, tx_site [n, cap] int64, tx_dir [n, cap] float64, tx_count [n] int64:
-        each buyer's transactions since its last deposit
-    nbr [n, n] int64, nbr_count [n] int64: neighbours, increasing id order
-    stop_timer [n], cool_timer [n] int64: communication stop and cooldown
-    ev_* [ecap] and ev_count [1]: event log (purchase / refused / deposit), when ``record``; ev_sx, ev_sy
-        are the seller's position in the buyer's frame (what the on-chain light contract signs)
-    hist [m, n] float64: wealth every ``hist_every`` steps;  flags [1] int64: error bits (engine.flags)
+    last_site [n] (-1 none);  items [n] items counted after the transitory period
+    stop_timer [n], cool_timer [n]: communication stop and cooldown
+    nbr [n, kn], nbr_count [n]: neighbours in increasing id order (a count above kn asks for room)
+    cell_start [grid_nx * grid_ny + 1], cell_items [n]: the neighbour grid, rebuilt every step
+
+LEDGER:
+    balance [n], pot [n] stakes locked by the robot's open purchases, burned [1] fuel burned
+    tx_off [n], tx_cap [n], tx_count [n]: buyer i's open transactions (since its last deposit) are
+        pool entries tx_off[i] .. tx_off[i] + tx_count[i] - 1, in purchase order
+    tx_seller [P], tx_site [P], tx_dir [P] float64 degrees, tx_step [P]: the transaction pool;
+        pool_top [1] the first unused pool entry
+
+LOG:
+    ev_* [E] and ev_count [1]: event log (purchase / refused / deposit) when ``record``; ev_sx, ev_sy are
+        the seller's position in the buyer's frame (what the on-chain light contract signs)
+    hist [m, n] wealth every ``hist_every`` steps;  flags [1] error bits (engine.flags)
 """
 from __future__ import annotations
 
 from collections import namedtuple
 
-PARAM_FIELDS = (
+import numpy as np
+
+PARAMS = (
     "width", "height", "radius", "speed", "comm_range", "noise_sd", "site_pos", "site_r",
     "reward", "info_share", "stake", "fuel_cost", "transitory", "stop_time", "cooldown",
-    "cauchy_cdf", "cauchy_guide", "levy_cdf", "levy_guide", "bparams", "pparams", "record", "hist_every",
+    "cauchy_cdf", "cauchy_guide", "levy_cdf", "levy_guide", "turn_cos", "turn_sin",
+    "bparams", "pparams", "record", "hist_every", "grid_cell", "grid_nx", "grid_ny",
 )
-STATE_FIELDS = (
-    "clock", "pos", "heading", "hdir", "bias", "kind", "state", "carrying", "levy",
+ROBOTS = (
+    "clock", "pos", "hdir", "bias", "kind", "state", "carrying", "levy",
     "tab_vec", "tab_age", "tab_valid", "new_vec", "new_age", "new_valid",
     "off_vec", "off_age", "off_valid",
     "pend_vec", "pend_age", "pend_seller", "pend_count",
-    "spot", "has_spot", "last_site", "items", "balance", "pot", "burned",
-    "tx_seller", "tx_site", "tx_dir", "tx_count",
-    "nbr", "nbr_count", "stop_timer", "cool_timer",
+    "spot", "has_spot", "last_site", "items", "stop_timer", "cool_timer",
+    "nbr", "nbr_count", "cell_start", "cell_items",
+)
+LEDGER = (
+    "balance", "pot", "burned", "tx_off", "tx_cap", "tx_count",
+    "tx_seller", "tx_site", "tx_dir", "tx_step", "pool_top",
+)
+LOG = (
     "ev_step", "ev_kind", "ev_buyer", "ev_seller", "ev_site", "ev_dir", "ev_x", "ev_y", "ev_age",
     "ev_stake", "ev_sx", "ev_sy", "ev_count", "hist", "flags",
 )
+#: Everything but the parameters changes during a run.
+STATE = ROBOTS + LEDGER + LOG
 
-World = namedtuple("World", PARAM_FIELDS + STATE_FIELDS)
+World = namedtuple("World", PARAMS + STATE)
 
 # Robot states.
 EXPLORING = 0
@@ -76,3 +105,15 @@ EV_PURCHASE = 0
 EV_REFUSED = 1
 EV_DEPOSIT = 2
 EVENT_NAMES = ("purchase", "refused", "deposit")
+
+
+def headings(world: World) -> np.ndarray:
+    """Each robot's true heading in degrees, [0, 360) (the state keeps only its unit vector)."""
+    return np.degrees(np.arctan2(world.hdir[:, 1], world.hdir[:, 0])) % 360.0
+
+
+def open_transactions(world: World, buyer: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Buyer's open transactions (sellers, sites, directions in degrees), oldest first (copies)."""
+    a = int(world.tx_off[buyer])
+    b = a + int(world.tx_count[buyer])
+    return world.tx_seller[a:b].copy(), world.tx_site[a:b].copy(), world.tx_dir[a:b].copy()

@@ -41,10 +41,33 @@ def log_event(w, kind, buyer, seller, site, direction, x, y, age, stake, sx=0.0,
 
 
 @njit
+def reserve(w, buyer, need):
+    """Make the buyer's block of the transaction pool hold at least ``need`` transactions, moving it to
+    a bigger block at the top of the pool if needed; False when the pool is full (the host grows it)."""
+    cap = w.tx_cap[buyer]
+    if need <= cap:
+        return True
+    cap = max(2 * cap, need + 8)
+    top = w.pool_top[0]
+    if top + cap > w.tx_seller.shape[0]:
+        return False
+    a = w.tx_off[buyer]
+    for x in range(w.tx_count[buyer]):
+        w.tx_seller[top + x] = w.tx_seller[a + x]
+        w.tx_site[top + x] = w.tx_site[a + x]
+        w.tx_dir[top + x] = w.tx_dir[a + x]
+        w.tx_step[top + x] = w.tx_step[a + x]
+    w.tx_off[buyer] = top
+    w.tx_cap[buyer] = cap
+    w.pool_top[0] = top + cap
+    return True
+
+
+@njit
 def open_transaction(w, buyer, seller, site, direction):
     """Lock the seller's stake and record the transaction; False (nothing recorded) when refused."""
     k = w.tx_count[buyer]
-    if k >= w.tx_seller.shape[1]:
+    if k >= w.tx_cap[buyer]:
         w.flags[0] |= flags.TX_OVERFLOW
         return False
     if w.stake > 0.0:
@@ -53,11 +76,21 @@ def open_transaction(w, buyer, seller, site, direction):
         lock = min(w.stake, w.balance[seller])  # never below zero, even within the tolerance
         w.balance[seller] -= lock
         w.pot[buyer] += lock
-    w.tx_seller[buyer, k] = seller
-    w.tx_site[buyer, k] = site
-    w.tx_dir[buyer, k] = direction
+    x = w.tx_off[buyer] + k
+    w.tx_seller[x] = seller
+    w.tx_site[x] = site
+    w.tx_dir[x] = direction
+    w.tx_step[x] = w.clock[0]
     w.tx_count[buyer] = k + 1
     return True
+
+
+@njit
+def settlement(w, buyer):
+    """The buyer's open transactions as (sellers, sites, directions): views of its pool block."""
+    a = w.tx_off[buyer]
+    b = a + w.tx_count[buyer]
+    return w.tx_seller[a:b], w.tx_site[a:b], w.tx_dir[a:b]
 
 
 @njit
@@ -85,8 +118,9 @@ def distribute(w, buyer, weights):
         total += wx
     if k > 0 and total > 0.0:
         amount = w.info_share * w.reward + pot
+        a = w.tx_off[buyer]
         for x in range(k):
-            w.balance[w.tx_seller[buyer, x]] += amount * (weights[x] / total)
+            w.balance[w.tx_seller[a + x]] += amount * (weights[x] / total)
         w.balance[buyer] -= amount
     w.tx_count[buyer] = 0
     log_event(w, EV_DEPOSIT, buyer, -1, -1, 0.0, 0.0, 0.0, 0, 0.0, 0.0, 0.0)

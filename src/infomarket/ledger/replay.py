@@ -12,11 +12,11 @@ import numpy as np
 
 from ..config.schema import Experiment
 from ..engine import specialise
-from ..engine.build import build_world, grow
+from ..engine.build import build_world, make_room
 from ..engine.flags import ErrorFlags
 from ..errors import SimulationError
 from ..engine.worldref import kernel_view
-from .kernels import open_transaction
+from .kernels import open_transaction, reserve
 
 
 @dataclass(frozen=True)
@@ -59,8 +59,9 @@ def replay_events(events: Iterable, robots: int, *, scheme: str = "delayed", ini
         get = ev.get if isinstance(ev, dict) else (lambda k, e=ev: getattr(e, k))
         kind = str(get("kind"))
         if kind in ("purchase", "refused"):
-            if int(world.tx_count.max()) + 1 >= world.tx_seller.shape[1]:
-                world = grow(world)
+            buyer = int(get("buyer"))
+            while not reserve(view, buyer, int(world.tx_count[buyer]) + 1):
+                world = make_room(world, tx_need=world.tx_count + 1)
                 view = kernel_view(world, kernel)
             accepted.append(bool(open_transaction(view, int(get("buyer")), int(get("seller")),
                                                   int(get("site")), float(get("direction_deg")))))

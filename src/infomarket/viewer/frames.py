@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..engine.world import EVENT_NAMES, SITE_NAMES, STATE_NAMES
+from ..engine.world import EVENT_NAMES, SITE_NAMES, STATE_NAMES, headings, open_transactions
 from ..registry import behaviours
 
 #: Header fields, float64 each, in order.
@@ -98,7 +98,7 @@ def encode(sim, honest: np.ndarray | None = None) -> bytes:
              | (w.last_site == 1).astype(np.uint8) * LAST_NEST)
     pend = np.minimum(w.pend_count, 255)
     values = {
-        "x": w.pos[:, 0], "y": w.pos[:, 1], "heading": w.heading, "wealth": w.balance, "items": items,
+        "x": w.pos[:, 0], "y": w.pos[:, 1], "heading": headings(w), "wealth": w.balance, "items": items,
         "food_x": fx, "food_y": fy, "nest_x": nx, "nest_y": ny,
         "food_age": w.tab_age[:, 0], "nest_age": w.tab_age[:, 1],
         "state": w.state, "flags": flags, "pending_food": pend[:, 0], "pending_nest": pend[:, 1],
@@ -173,9 +173,9 @@ def robot_detail(sim, i: int, last: int = LAST_EVENTS) -> dict:
                             "age": int(w.pend_age[i, site, k]),
                             "x": round(float(w.pos[i, 0] + c * vx - s * vy), 2),
                             "y": round(float(w.pos[i, 1] + s * vx + c * vy), 2)})
-    m = int(w.tx_count[i])
-    open_tx = [{"seller": int(w.tx_seller[i, k]), "site": SITE_NAMES[int(w.tx_site[i, k])],
-                "direction": round(float(w.tx_dir[i, k]), 1)} for k in range(m)]
+    sellers, sites, directions = open_transactions(w, i)
+    open_tx = [{"seller": int(a), "site": SITE_NAMES[int(b)], "direction": round(float(d), 1)}
+               for a, b, d in zip(sellers, sites, directions)]
     return {"type": "robot", "id": i, "step": sim.clock, "behaviour": sim.behaviour_names[i],
             "state": STATE_NAMES[int(w.state[i])], "pot": round(float(w.pot[i]), 6),
             "pending": pending, "open_transactions": open_tx, "events": _last_events(w, i, last)}
