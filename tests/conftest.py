@@ -34,7 +34,6 @@ class Handle:
     def place(self, i: int, x: float, y: float, heading: float) -> None:
         w = self.world
         w.pos[i] = (x, y)
-        w.heading[i] = heading
         a = np.radians(heading)
         w.hdir[i] = (np.cos(a), np.sin(a))
 

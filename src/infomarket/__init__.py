@@ -15,6 +15,7 @@ from .config import Experiment, load_experiment  # noqa: E402
 from .engine import Result, Simulation, simulate  # noqa: E402
 from .errors import ConfigError, InfomarketError, SimulationError  # noqa: E402
 from .registry import behaviour, payment, register_behaviour, register_payment  # noqa: E402
+from . import builtins as _builtins  # noqa: E402, F401  (registers the built-in rules)
 
 __all__ = ["ConfigError", "Experiment", "InfomarketError", "Result", "Simulation", "SimulationError",
            "behaviour", "load_experiment", "payment", "register_behaviour", "register_payment", "simulate"]

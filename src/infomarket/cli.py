@@ -15,6 +15,7 @@ import tempfile
 from pathlib import Path
 
 from . import __version__
+from .bench import cli as bench_cli
 from .cliargs import UsageError, at_least
 from .errors import ConfigError, InfomarketError
 
@@ -87,41 +88,6 @@ def cmd_run(args) -> int:
     return 0
 
 
-# -------------------------------------------------------------------------------------------- bench
-BENCH_SETUPS = ("fig2A", "fig2D", "fig4C")
-
-
-def cmd_bench(args) -> int:
-    from .bench import run_bench, run_scaling
-
-    if args.scaling:
-        report = run_scaling(steps=args.steps)
-        if args.json:
-            print(json.dumps(report, indent=2))
-        else:
-            for k in ("local_1", "local_2", "dask_local_2"):
-                print(f"{k:13s} {report[k]['env_steps_per_second']:>12,.0f} env-steps/s "
-                      f"({report[k]['wall_seconds']:.2f} s for {report['runs']} runs)")
-            print(f"2 workers vs 1: {report['speedup_2_vs_1']:.2f}x; Dask (2) vs local pool (2): "
-                  f"{report['dask_vs_local_2']:.2f}")
-        return 0
-    report = run_bench(BENCH_SETUPS, steps=args.steps, repeats=args.repeats)
-    if args.json:
-        print(json.dumps(report, indent=2))
-    else:
-        from rich.console import Console
-        from rich.table import Table
-
-        t = Table(title=f"single-process runs, 25 robots x {args.steps} steps (median of {args.repeats})")
-        for c in ("setup", "env-steps/s", "seconds/run", "compile/load s"):
-            t.add_column(c, justify="right")
-        for name, r in report["setups"].items():
-            t.add_row(name, f"{r['steps_per_second']:,.0f}", f"{r['seconds_per_run']:.3f}",
-                      f"{r['compile_seconds']:.2f}")
-        Console().print(t)
-    return 0
-
-
 # --------------------------------------------------------------------------------------------- demo
 def cmd_demo(args) -> int:
     from .demo import run_demo
@@ -179,13 +145,7 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--quiet", action="store_true", help="no progress output")
     r.set_defaults(func=cmd_run)
 
-    b = sub.add_parser("bench", help="time single-process runs of the Fig. 2A, 2D and 4C setups")
-    b.add_argument("--json", action="store_true", help="print one JSON object")
-    b.add_argument("--steps", type=at_least(1), default=15000)
-    b.add_argument("--repeats", type=at_least(1), default=7, help="timed runs per setup (median reported)")
-    b.add_argument("--scaling", action="store_true",
-                   help="instead: sweep throughput with 1 and 2 local workers and a local Dask cluster of 2")
-    b.set_defaults(func=cmd_bench)
+    bench_cli.add_subcommand(sub)
 
     d = sub.add_parser("demo", help="a short Fig. 2-like comparison: naive vs sceptical, with and without a saboteur")
     d.add_argument("--runs", type=at_least(1), default=8, help="runs per setup")

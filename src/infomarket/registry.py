@@ -188,10 +188,8 @@ _ENTRY_POINTS_LOADED: list[bool] = []
 
 
 def _ensure_builtins() -> None:
-    # Importing the packages registers the built-ins, through the same functions as above; installed
-    # third-party packages register theirs through the "infomarket.plugins" entry-point group.
-    from . import behaviours, payments  # noqa: F401
-
+    """Load third-party rules from the "infomarket.plugins" entry-point group, once.  (The built-ins
+    are registered by ``infomarket.builtins``, which the package imports; this module never does.)"""
     if not _ENTRY_POINTS_LOADED:
         _ENTRY_POINTS_LOADED.append(True)
         from importlib.metadata import entry_points

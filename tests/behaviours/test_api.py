@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from infomarket.behaviours import api
-from infomarket.engine.world import FOOD, NEST
+from infomarket.engine.world import FOOD, NEST, open_transactions
 
 from ..conftest import Handle, make_config
 
@@ -18,8 +18,9 @@ def test_purchase_rotates_into_buyer_frame_and_adds_seller_offset(world2):
     # offer (10, 0) world -> buyer frame (0, -10); seller at (30, 0) world -> (0, -30) in buyer frame
     assert (x, y) == pytest.approx((0.0, -40.0), abs=1e-9)
     w = h.world
-    assert w.tx_count[0] == 1 and w.tx_seller[0, 0] == 1 and w.tx_site[0, 0] == FOOD
-    assert w.tx_dir[0, 0] == pytest.approx(270.0)  # direction of the rotated vector, before the offset
+    sellers, sites, directions = open_transactions(w, 0)
+    assert list(sellers) == [1] and list(sites) == [FOOD]
+    assert directions[0] == pytest.approx(270.0)  # direction of the rotated vector, before the offset
     assert w.ev_count[0] == 1 and w.ev_kind[0] == 0
 
 
@@ -70,7 +71,7 @@ def test_naive_buys_the_freshest_younger_offer_once_per_site():
     h.offer(1, FOOD, 20.0, 0.0, 30)
     h.offer(2, FOOD, 20.0, 0.0, 10)
     h.kernel.buy_dispatch(0, h.view, 0, np.array([1, 2]), h.rng)
-    assert w.tx_count[0] == 1 and w.tx_seller[0, 0] == 2  # only the freshest, one purchase
+    assert list(open_transactions(w, 0)[0]) == [2]  # only the freshest, one purchase
     assert w.new_valid[0, FOOD] and w.new_age[0, FOOD] == 30
 
 
@@ -90,7 +91,7 @@ def test_sceptic_waits_for_confirmation():
     w.tab_age[0] = w.new_age[0]
     h.offer(2, FOOD, 5.0, 101.0, 20)  # confirms the pending one (diff ~ 0.05)
     h.kernel.buy_dispatch(0, h.view, 0, np.array([1, 2]), h.rng)  # 1 is pending already: not bought again
-    assert w.tx_count[0] == 2 and w.tx_seller[0, 1] == 2
+    assert w.tx_count[0] == 2 and open_transactions(w, 0)[0][1] == 2
     assert w.pend_count[0, FOOD] == 0
     # pending (0, 100) age 10 averaged with bought (5, 101) age 20: 10/30 * bought + 20/30 * pending
     assert w.new_vec[0, FOOD] == pytest.approx([5 / 3, 100 + 1 / 3])

@@ -7,7 +7,8 @@ from scipy import stats
 
 from infomarket.engine import kernels as K
 from infomarket.engine.build import cauchy_cdf, guide_table, levy_cdf
-from infomarket.engine.world import EXPLORING, FOOD, NEST, SEEKING_FOOD
+from infomarket.engine.neighbours import find_neighbours
+from infomarket.engine.world import EXPLORING, FOOD, NEST, SEEKING_FOOD, headings
 
 from ..conftest import Handle, make_config
 
@@ -15,7 +16,7 @@ from ..conftest import Handle, make_config
 def test_neighbours_strict_range_and_id_order():
     h = Handle(make_config(4))
     h.world.pos[:] = [[100, 100], [149.999, 100], [150, 100], [120, 110]]
-    K.find_neighbours(h.view)
+    find_neighbours(h.view)
     w = h.world
     assert list(w.nbr[0, :w.nbr_count[0]]) == [1, 3]  # robot 2 is exactly 50 away: not a neighbour
     assert list(w.nbr[3, :w.nbr_count[3]]) == [0, 1, 2]
@@ -38,7 +39,7 @@ def test_wall_sensors_and_reflection_use_the_reflected_move():
     w.bias[0] = 0.0
     K.move(h.view, 0, dx, dy, np.random.default_rng(1))
     assert w.pos[0, 0] < 1200 - 8 - 1.0  # it moved away from the wall
-    assert abs(w.heading[0] - 180.0) < 1.0
+    assert abs(headings(w)[0] - 180.0) < 1.0
 
 
 def test_walls_report_each_side():

@@ -10,6 +10,7 @@ import pytest
 
 import infomarket as im
 from infomarket.engine.seeds import run_seed
+from infomarket.engine.world import open_transactions
 
 
 def test_same_seed_same_numbers_bit_for_bit():
@@ -45,21 +46,42 @@ def test_money_is_conserved_in_a_run(name):
 def test_event_log_and_transaction_storage_grow_as_needed():
     cfg = im.load_experiment("fig2A").with_overrides(steps=5000)
     sim = im.Simulation(cfg, seed=4, record_events=True)
-    cap0, tx0 = sim.world.ev_step.shape[0], sim.world.tx_seller.shape[1]
+    cap0, tx0 = sim.world.ev_step.shape[0], int(sim.world.tx_cap.max())
     most_open = 0
     for _ in range(50):
         sim.step(100)
         most_open = max(most_open, int(sim.world.tx_count.max()))
     r = sim.result()
     assert len(r.events) > cap0  # the log outgrew its first allocation without losing events
-    assert most_open > tx0  # a buyer held more open transactions than the first allocation
-    # nothing lost: each buyer's open transactions are exactly its purchases since its last deposit
+    assert most_open > tx0  # a buyer held more open transactions than its first block of the pool
+    # nothing lost or mixed up when blocks moved: each buyer's open transactions are exactly its
+    # purchases since its last deposit, in order
     ev = r.events.reset_index(drop=True)
     for buyer in range(25):
         mine = ev[ev.buyer == buyer]
         deposits = mine.index[mine.kind == "deposit"]
-        since = mine[mine.index > (deposits.max() if len(deposits) else -1)]
-        assert (since.kind == "purchase").sum() == sim.world.tx_count[buyer]
+        since = mine[(mine.index > (deposits.max() if len(deposits) else -1)) & (mine.kind == "purchase")]
+        sellers, sites, directions = open_transactions(sim.world, buyer)
+        assert list(sellers) == since.seller.tolist() and list(sites) == since.site.tolist()
+        assert list(directions) == since.direction_deg.tolist()
+
+
+def test_memory_is_linear_in_the_swarm():
+    """No array of the world grows with the square of the swarm: at 400 robots every array is at most
+    a few hundred entries per robot (the paper's density, arena scaled with the swarm)."""
+    n = 400
+    scale = (n / 25) ** 0.5
+    cfg = im.load_experiment("fig2A").model_dump()
+    cfg.update(steps=2000, arena={"width": 1200 * scale, "height": 600 * scale},
+               swarm={"robots": n, "groups": [{"behaviour": "naive", "count": n}]})
+    cfg["food"] = {**cfg["food"], "x": cfg["food"]["x"] * scale, "y": cfg["food"]["y"] * scale}
+    cfg["nest"] = {**cfg["nest"], "x": cfg["nest"]["x"] * scale, "y": cfg["nest"]["y"] * scale}
+    sim = im.Simulation(im.Experiment.model_validate(cfg), seed=1)
+    sim.step(2000)
+    w = sim.world
+    biggest = max((f, np.asarray(getattr(w, f)).size) for f in w._fields if f != "levy_cdf" and f != "levy_guide")
+    assert biggest[1] <= 300 * n, biggest
+    assert w.nbr.shape[1] < n // 4 and w.pend_seller.shape[2] < n // 4
 
 
 def test_plain_python_path_runs_the_same_code():

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 import infomarket as im
+from infomarket.engine.world import headings
 from infomarket.viewer import frames as fr
 
 
@@ -37,7 +38,7 @@ def test_round_trip_matches_the_world(running):
     f = fr.decode(fr.encode(running), 25)
     assert f.step == running.clock == 1500
     np.testing.assert_allclose(f.columns["x"], w.pos[:, 0], rtol=1e-6)
-    np.testing.assert_allclose(f.columns["heading"], w.heading, rtol=1e-6)
+    np.testing.assert_allclose(f.columns["heading"], headings(w), rtol=1e-6)
     np.testing.assert_allclose(f.columns["wealth"], w.balance, rtol=1e-6)
     np.testing.assert_array_equal(f.columns["items"], w.items)
     np.testing.assert_array_equal(f.columns["state"], w.state)

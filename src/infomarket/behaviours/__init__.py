@@ -1,6 +1,6 @@
-"""Robot behaviours.  Each is a buy rule and a sell rule registered with ``infomarket.register_behaviour``;
-the built-ins below use exactly that public API.  Helpers for writing rules are in ``behaviours.api``."""
-from . import naive, sceptical, byzantine  # noqa: F401, I001  (registration order: byzantine reuses rules)
+"""Robot behaviours: buy rules and sell rules, plain functions over the world (``behaviours.api`` has the
+helpers they call).  Nothing is registered on import: ``infomarket.builtins`` registers the built-ins
+through the same public ``register_behaviour`` that users call."""
 from . import api
 
 __all__ = ["api"]

@@ -42,11 +42,12 @@ def next_candidate(w, nbrs, site, after_age, after_id):
     or -1.  Start with (-1, -1) to get the freshest offer; ties go to the lower id."""
     best = -1
     best_age = 0
+    off_valid, off_age = w.off_valid, w.off_age
     for j in range(nbrs.shape[0]):
         s = nbrs[j]
-        if not w.off_valid[s, site]:
+        if not off_valid[s, site]:
             continue
-        a = w.off_age[s, site]
+        a = off_age[s, site]
         if a < after_age or (a == after_age and s <= after_id):
             continue
         if best < 0 or a < best_age or (a == best_age and s < best):

@@ -1,6 +1,5 @@
 """Byzantine behaviours: saboteurs sell rotated vectors; greedy robots oversell; free riders never sell."""
 from ..engine.geometry import rotate
-from ..registry import register_behaviour
 from .api import own_entry
 
 
@@ -21,12 +20,3 @@ def free_rider_sell(w, me, site):
     """Offer nothing."""
     return False, 0.0, 0.0, 0
 
-
-register_behaviour("saboteur", buy="naive", sell=rotated_sell, honest=False,
-                   description="naive buyer that sells vectors rotated by rotation_angle")
-register_behaviour("scaboteur", buy="sceptical", sell=rotated_sell, honest=False,
-                   description="sceptical buyer that sells vectors rotated by rotation_angle")
-register_behaviour("greedy", buy="naive", sell=greedy_sell, honest=False,
-                   description="naive buyer that sells its entry claiming age 1")
-register_behaviour("free_rider", buy="naive", sell=free_rider_sell, honest=False,
-                   description="naive buyer that never sells")

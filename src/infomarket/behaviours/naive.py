@@ -1,5 +1,5 @@
-"""Naive robots: buy the freshest offer younger than their own entry, sell their own entry."""
-from ..registry import register_behaviour
+"""Naive robots: buy the freshest offer younger than their own entry, sell their own entry.
+(Registered as ``naive`` by ``infomarket.builtins``.)"""
 from .api import buy, combine, current, next_candidate, own_entry
 
 
@@ -25,6 +25,3 @@ def honest_sell(w, me, site):
     """Sell the entry as it is."""
     return own_entry(w, me, site)
 
-
-register_behaviour("naive", buy=naive_buy, sell=honest_sell, honest=True,
-                   description="buys younger information and averages it in; sells its own entry")

@@ -1,5 +1,5 @@
-"""Sceptical robots: use bought information only when something confirms it (eq. 6, pending list)."""
-from ..registry import register_behaviour
+"""Sceptical robots: use bought information only when something confirms it (eq. 6, pending list).
+(Registered as ``sceptical`` by ``infomarket.builtins``.)"""
 from .api import (buy, combine, current, diff, install, next_candidate, pending_add, pending_clear,
                   pending_count, pending_get, pending_has, weighted)
 
@@ -40,7 +40,3 @@ def sceptical_buy(w, me, nbrs, threshold=0.25):
             else:
                 pending_add(w, me, site, s, x, y, age)
 
-
-register_behaviour("sceptical", buy=sceptical_buy, sell="naive", honest=True,
-                   description="waits for a second, agreeing piece of information before using it",
-                   limits={"threshold": ("> 0", lambda v: v > 0)})

@@ -40,6 +40,7 @@ def _package_digest() -> str:
     if not _PACKAGE_DIGEST:
         h = hashlib.sha256()
         files = [f for part in _COMPILED_PARTS for f in (_PACKAGE / part).rglob("*.py")]
+        files.append(_PACKAGE / "builtins.py")
         for f in sorted(files):
             h.update(str(f.relative_to(_PACKAGE)).encode())
             h.update(f.read_bytes())

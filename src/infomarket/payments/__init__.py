@@ -1,2 +1,2 @@
-"""Payment schemes, registered with ``infomarket.register_payment`` (the built-ins use the same API)."""
-from . import schemes  # noqa: F401  (registration)
+"""Payment schemes: weight rules over a buyer's open transactions (registered by ``infomarket.builtins``
+through the public ``register_payment``)."""

@@ -4,7 +4,6 @@ A scheme only weighs the buyer's transactions; the ledger moves the money (``led
 Staking is a ledger setting (``payment.stake``), so any scheme can be run with or without it.
 """
 from ..engine.geometry import angular_distance
-from ..registry import register_payment
 
 
 def delayed_weights(buyer, sellers, sites, directions, weights):
@@ -24,9 +23,3 @@ def outlier_weights(buyer, sellers, sites, directions, weights, theta=30.0):
                 c += 1
         weights[x] = c
 
-
-register_payment("delayed", delayed_weights,
-                 description="sellers share information_share * reward per transaction")
-register_payment("outlier", outlier_weights,
-                 description="sellers share information_share * reward + stakes by similarity weight",
-                 limits={"theta": ("in (0, 180]", lambda v: 0 < v <= 180)})

@@ -1,41 +1,9 @@
-"""Benchmark: single-process runs after compilation; medians of several runs per setup.
-
-Performance is measured here (``infomarket bench``, ``make bench``), never asserted in tests.
-"""
+"""Sweep throughput: the same runs on 1 and 2 local workers and on a local Dask cluster of 2."""
 from __future__ import annotations
 
-import statistics
 import time
 
-from . import __version__
-from .config import load_experiment
-from .engine.seeds import run_seed
-from .engine.simulation import Simulation
-
-
-def run_bench(setups, *, steps: int = 15000, repeats: int = 7) -> dict:
-    """Per setup: env-steps per second (median over ``repeats`` runs) and the time to get the compiled
-    kernel ready in this process: a compilation, or a load from numba's disk cache (then
-    ``kernel_from_disk_cache`` is true; a kernel already loaded in this process counts as cached)."""
-    out = {}
-    for name in setups:
-        cfg = load_experiment(name).with_overrides(steps=steps)
-        t0 = time.perf_counter()
-        first = Simulation(cfg, run_seed(cfg.seed, 0))
-        compile_seconds = time.perf_counter() - t0
-        loaded_from_disk = bool(sum(first._kernel.run_steps.stats.cache_hits.values()))
-        del first
-        times = []
-        for i in range(repeats):
-            sim = Simulation(cfg, run_seed(cfg.seed, i))
-            sim.run()
-            times.append(sim.run_seconds)
-        med = statistics.median(times)
-        out[name] = {"steps_per_second": steps / med, "seconds_per_run": med,
-                     "compile_seconds": compile_seconds, "kernel_from_disk_cache": loaded_from_disk,
-                     "robots": cfg.swarm.robots, "steps": steps,
-                     "repeats": repeats, "min_seconds": min(times), "max_seconds": max(times)}
-    return {"version": __version__, "setups": out}
+from ..config import load_experiment
 
 
 def run_scaling(experiment: str = "fig2A", runs: int = 32, steps: int = 15000) -> dict:
@@ -44,9 +12,9 @@ def run_scaling(experiment: str = "fig2A", runs: int = 32, steps: int = 15000) -
     local pool's forked workers inherit it from the parent; Dask workers load it from the disk cache)."""
     import tempfile
 
-    from .runner.batch import warm
-    from .runner.sweep import plan, run_sweep
-    from .store import Store
+    from ..runner.batch import warm
+    from ..runner.sweep import plan, run_sweep
+    from ..store import Store
 
     cfg = load_experiment(experiment).with_overrides(steps=steps)
     conds = plan([cfg], runs=runs)

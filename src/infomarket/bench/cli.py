@@ -1,0 +1,85 @@
+"""``infomarket bench``: the paper's setups against this machine's floor, swarm sizes, or sweep scaling."""
+from __future__ import annotations
+
+import argparse
+import json
+
+from ..cliargs import at_least
+
+SETUPS = ("fig2A", "fig2D", "fig4C")
+
+
+def _sizes(text: str) -> list[int]:
+    try:
+        sizes = [int(x) for x in text.split(",") if x.strip()]
+    except ValueError:
+        sizes = []
+    if not sizes or min(sizes) < 1:
+        raise argparse.ArgumentTypeError(f"must be robot counts separated by commas, like 25,100,1000; got {text!r}")
+    return sizes
+
+
+def add_subcommand(sub) -> None:
+    b = sub.add_parser("bench", help="time the Fig. 2A, 2D and 4C setups against this machine's floor",
+                       description="Single-process runs after compilation (medians), each beside a floor kernel "
+                                   "measured in the same run; or, with --robots, robot-steps/s and peak memory "
+                                   "by swarm size at the paper's density; or, with --scaling, sweep throughput.")
+    b.add_argument("--json", action="store_true", help="print one JSON object")
+    b.add_argument("--steps", type=at_least(1), default=15000, help="steps per run (default 15000)")
+    b.add_argument("--repeats", type=at_least(1), default=7, help="timed runs per setup (median reported)")
+    mode = b.add_mutually_exclusive_group()
+    mode.add_argument("--robots", type=_sizes, metavar="N,N,...",
+                      help="instead: robot-steps/s and peak memory for these swarm sizes (one process each)")
+    mode.add_argument("--scaling", action="store_true",
+                      help="instead: sweep throughput with 1 and 2 local workers and a local Dask cluster of 2")
+    b.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from . import run_bench, run_scaling, run_swarm_sizes
+
+    if args.scaling:
+        report = run_scaling(steps=args.steps)
+        if args.json:
+            print(json.dumps(report, indent=2))
+        else:
+            for k in ("local_1", "local_2", "dask_local_2"):
+                print(f"{k:13s} {report[k]['env_steps_per_second']:>12,.0f} env-steps/s "
+                      f"({report[k]['wall_seconds']:.2f} s for {report['runs']} runs)")
+            print(f"2 workers vs 1: {report['speedup_2_vs_1']:.2f}x; Dask (2) vs local pool (2): "
+                  f"{report['dask_vs_local_2']:.2f}")
+        return 0
+    if args.robots:
+        def shout(n, r):
+            if not args.json:
+                print(f"{n:>7,} robots  {r['robot_steps_per_second']:>12,.0f} robot-steps/s  "
+                      f"peak {r['peak_rss_mb']:8.1f} MB  ({r['seconds']:.1f} s for {r['steps']} steps)", flush=True)
+
+        report = {"steps": args.steps, "robots": run_swarm_sizes(args.robots, args.steps, on_done=shout)}
+        first, last = report["robots"][args.robots[0]], report["robots"][args.robots[-1]]
+        report["largest_vs_smallest"] = last["robot_steps_per_second"] / first["robot_steps_per_second"]
+        if args.json:
+            print(json.dumps(report, indent=2))
+        else:
+            print(f"{args.robots[-1]:,} robots run at {report['largest_vs_smallest']:.0%} of the robot-steps/s "
+                  f"of {args.robots[0]:,}")
+        return 0
+    report = run_bench(SETUPS, steps=args.steps, repeats=args.repeats)
+    if args.json:
+        print(json.dumps(report, indent=2))
+        return 0
+    from rich.console import Console
+    from rich.table import Table
+
+    t = Table(title=f"single-process runs, 25 robots x {args.steps} steps (median of {args.repeats})")
+    for c in ("setup", "env-steps/s", "seconds/run", "x floor", "compile/load s"):
+        t.add_column(c, justify="right")
+    for name, r in report["setups"].items():
+        t.add_row(name, f"{r['steps_per_second']:,.0f}", f"{r['seconds_per_run']:.3f}",
+                  f"{r['ratio_to_floor']:.2f}", f"{r['compile_seconds']:.2f}")
+    f = report["floor"]
+    t.add_row("floor", f"{f['steps_per_second']:,.0f}", f"{f['seconds_per_run']:.3f}", "1.00", "")
+    Console().print(t)
+    print("x floor: how many times the floor kernel's time per step (neighbour search, one Gaussian draw, "
+          "the rotation and dead reckoning per robot) each setup takes, measured in this run")
+    return 0

@@ -1,0 +1,40 @@
+"""The paper's setups in one process after compilation: medians of several runs per setup, each set
+beside this machine's floor (``bench.floor``) measured in the same run."""
+from __future__ import annotations
+
+import statistics
+import time
+
+from .. import __version__
+from ..config import load_experiment
+from ..engine.seeds import run_seed
+from ..engine.simulation import Simulation
+from .floor import floor_steps_per_second
+
+
+def run_bench(setups, *, steps: int = 15000, repeats: int = 7) -> dict:
+    """Per setup: env-steps per second (median over ``repeats`` runs) and the time to get the compiled
+    kernel ready in this process: a compilation, or a load from numba's disk cache (then
+    ``kernel_from_disk_cache`` is true; a kernel already loaded in this process counts as cached)."""
+    out = {}
+    for name in setups:
+        cfg = load_experiment(name).with_overrides(steps=steps)
+        t0 = time.perf_counter()
+        first = Simulation(cfg, run_seed(cfg.seed, 0))
+        compile_seconds = time.perf_counter() - t0
+        loaded_from_disk = bool(sum(first._kernel.run_steps.stats.cache_hits.values()))
+        del first
+        times = []
+        for i in range(repeats):
+            sim = Simulation(cfg, run_seed(cfg.seed, i))
+            sim.run()
+            times.append(sim.run_seconds)
+        med = statistics.median(times)
+        out[name] = {"steps_per_second": steps / med, "seconds_per_run": med,
+                     "compile_seconds": compile_seconds, "kernel_from_disk_cache": loaded_from_disk,
+                     "robots": cfg.swarm.robots, "steps": steps,
+                     "repeats": repeats, "min_seconds": min(times), "max_seconds": max(times)}
+    floor = floor_steps_per_second(robots=25, steps=steps, repeats=repeats)
+    for r in out.values():
+        r["ratio_to_floor"] = floor["steps_per_second"] / r["steps_per_second"]
+    return {"version": __version__, "setups": out, "floor": floor}

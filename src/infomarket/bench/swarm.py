@@ -1,0 +1,66 @@
+"""Swarm size: robot-steps/s and peak memory from 25 robots up, at the paper's density.
+
+Each size runs in a fresh process, so its peak resident memory (``ru_maxrss``) is its own: the arena
+and both sites (centres and radii) are scaled by √(N/25), which keeps robots per unit area, and site
+area per robot, as in the paper.  The behaviour is Fig. 2A's (naive robots, delayed payment).
+"""
+from __future__ import annotations
+
+import json
+import math
+import resource
+import subprocess
+import sys
+
+from ..config import load_experiment
+from ..config.schema import Experiment
+
+
+def scaled_config(robots: int, steps: int, base: str = "fig2A") -> Experiment:
+    """``base`` with ``robots`` robots at the paper's density (every group scaled, the largest absorbs
+    rounding), run for ``steps`` steps."""
+    cfg = load_experiment(base)
+    k = math.sqrt(robots / cfg.swarm.robots)
+    data = cfg.model_dump(exclude={"sweep"})
+    data["steps"] = steps
+    data["transitory"] = min(data["transitory"], steps - 1)
+    data["arena"] = {"width": cfg.arena.width * k, "height": cfg.arena.height * k}
+    for site in ("food", "nest"):
+        s = getattr(cfg, site)
+        data[site] = {"x": s.x * k, "y": s.y * k, "radius": s.radius * k}
+    groups = data["swarm"]["groups"]
+    counts = [round(g["count"] * robots / cfg.swarm.robots) for g in groups]
+    counts[counts.index(max(counts))] += robots - sum(counts)
+    for g, c in zip(groups, counts):
+        g["count"] = c
+    data["swarm"]["robots"] = robots
+    return Experiment.model_validate(data)
+
+
+def measure(robots: int, steps: int, seed: int = 1) -> dict:
+    """One run in this process: robot-steps/s (after the kernel is loaded) and peak RSS so far."""
+    from ..engine.simulation import Simulation
+
+    sim = Simulation(scaled_config(robots, steps), seed)
+    sim.run()
+    rss_kb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return {"robot_steps_per_second": robots * steps / sim.run_seconds, "seconds": sim.run_seconds,
+            "steps": steps, "peak_rss_mb": rss_kb / 1024.0, "items": int(sim.world.items.sum())}
+
+
+def run_swarm_sizes(sizes: list[int], steps: int, on_done=None) -> dict:
+    """``measure`` for each size, each in a fresh interpreter (peak memory must not carry over)."""
+    out = {}
+    for n in sizes:
+        proc = subprocess.run([sys.executable, "-m", "infomarket.bench.swarm", str(n), str(steps)],
+                              capture_output=True, text=True)
+        if proc.returncode != 0:
+            raise RuntimeError(f"bench of {n} robots failed:\n{proc.stderr.strip()[-2000:]}")
+        out[n] = json.loads(proc.stdout.strip().splitlines()[-1])
+        if on_done:
+            on_done(n, out[n])
+    return out
+
+
+if __name__ == "__main__":
+    print(json.dumps(measure(int(sys.argv[1]), int(sys.argv[2]))))
