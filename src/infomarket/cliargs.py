@@ -43,7 +43,7 @@ def writable_file(path: str | Path, option: str = "--out") -> Path:
         raise UsageError(f"{option} {path}: is a directory; give a file name")
     folder = path.parent
     if not folder.is_dir():
-        raise UsageError(f"{option} {path}: the folder {folder} does not exist")
+        raise UsageError(f"{option} {path}: the folder {folder} does not exist; give a file name in an existing folder")
     try:
         with tempfile.TemporaryFile(dir=folder):
             pass
