@@ -72,6 +72,7 @@ def check_compatible(store: Store, conds: list[Condition]) -> None:
     for c in conds:
         if seeds.setdefault(c.experiment, c.master_seed) != c.master_seed:
             raise StoreError(f"{c.experiment}: conditions with two master seeds in one sweep")
+    store.claim_seeds(seeds, record=False)  # the recorded seeds first: the clearest message
     existing = store.runs()
     if not existing.empty:
         first = existing.groupby(["experiment", "condition"]).first()

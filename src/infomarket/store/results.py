@@ -163,9 +163,9 @@ class Store:
         """``with store.lock(): ...`` while writing; a second writer gets StoreError at once."""
         return StoreLock(self.root)
 
-    def claim_seeds(self, seeds: dict[str, int]) -> None:
-        """Record each experiment's master seed; refuse one the store already holds with another seed.
-        Call with the lock held."""
+    def claim_seeds(self, seeds: dict[str, int], record: bool = True) -> None:
+        """Record each experiment's master seed (unless ``record`` is false); refuse one the store already
+        holds with another seed.  Call with the lock held."""
         meta = self.meta()
         known = meta.setdefault("seeds", {})
         for name, seed in seeds.items():
@@ -175,7 +175,7 @@ class Store:
                     f"for seed {seed}. Runs of two seeds would mix in one condition: start a new store "
                     f"(another --out) for seed {seed}, or leave --seed out to resume this one")
         new = {n: int(s) for n, s in seeds.items() if n not in known}
-        if new:
+        if new and record:
             known.update(new)
             self._write_meta(meta)
 
