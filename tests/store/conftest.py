@@ -5,7 +5,7 @@ import pytest
 
 TINY = """
 name = "tiny"
-steps = 300
+steps = {steps}
 runs = {runs}
 seed = {seed}
 
@@ -27,11 +27,11 @@ count = 1
 
 @pytest.fixture
 def tiny(tmp_path) -> "callable":
-    """tiny(runs=3, seed=1) -> path of the experiment file (rewritten in place)."""
+    """tiny(runs=3, seed=1, steps=300) -> path of the experiment file (rewritten in place)."""
 
-    def make(runs: int = 3, seed: int = 1) -> Path:
+    def make(runs: int = 3, seed: int = 1, steps: int = 300) -> Path:
         p = tmp_path / "tiny.toml"
-        p.write_text(TINY.format(runs=runs, seed=seed))
+        p.write_text(TINY.format(runs=runs, seed=seed, steps=steps))
         return p
 
     return make

@@ -96,7 +96,7 @@ def _refusal(what: str, need: int, parts: dict[str, int] | None, fix: str) -> st
     if parts:
         top = sorted(((v, k) for k, v in parts.items() if v), reverse=True)[:3]
         detail = " (" + ", ".join(f"{k} {human(v)}" for v, k in top) + ")"
-    return (f"{what} needs about {human(need)} of memory{detail}, more than the limit of {human(cap)} "
+    return (f"{what} would need about {human(need)} of memory{detail}, more than the limit of {human(cap)} "
             f"({source}); {fix}, or raise the limit deliberately: {ENV}={human(need * 1.25).replace(' ', '')}")
 
 
