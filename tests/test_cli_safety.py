@@ -47,7 +47,13 @@ def test_too_many_robots_or_steps_are_refused_by_check_with_the_estimate(tmp_pat
     assert main(["check", str(write(tmp_path, steps=10**12))]) == 0
 
 
-def test_run_and_sweep_refuse_too_many_runs_at_once_and_write_nothing(tmp_path, capsys):
+def test_run_and_sweep_refuse_too_many_runs_at_once_and_write_nothing(tmp_path, capsys, monkeypatch):
+    import infomarket.runner
+    import infomarket.runner.sweep
+
+    never = lambda *a, **k: pytest.fail("started running instead of refusing")  # noqa: E731
+    monkeypatch.setattr(infomarket.runner, "run_batch", never)
+    monkeypatch.setattr(infomarket.runner.sweep, "run_sweep", never)
     exp = write(tmp_path)
     out = tmp_path / "o"
     assert main(["run", str(exp), "--runs", "1000000000", "--out", str(out), "--quiet"]) == 2
