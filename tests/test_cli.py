@@ -13,7 +13,7 @@ COLUMNS = ["run", "seed", "robot", "behaviour", "honest", "drift", "items_collec
 def test_run_writes_robots_table_and_summary(tmp_path, capsys):
     out = tmp_path / "o"
     assert main(["run", "fig2B", "--runs", "3", "--steps", "600", "--seed", "5", "--out", str(out),
-                 "--workers", "1", "--quiet"]) == 0
+                 "--workers", "1"]) == 0
     df = pd.read_parquet(out / "robots.parquet")
     assert all(c in df.columns for c in COLUMNS)
     assert len(df) == 3 * 25 and sorted(df.run.unique()) == [0, 1, 2]

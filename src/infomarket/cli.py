@@ -5,36 +5,21 @@ Bad input (a malformed experiment, an impossible option) prints one clear messag
 """
 from __future__ import annotations
 
-import argparse
 import importlib
 import importlib.util
 import json
 import os
 import sys
-import tempfile
 from pathlib import Path
 
 from . import __version__
 from .bench import cli as bench_cli
-from .cliargs import UsageError, at_least
-from .errors import ConfigError, InfomarketError
+from .cliargs import Parser, UsageError, at_least, writable_dir
+from .errors import ConfigError, InfomarketError, report
 
-EXIT_USAGE = 2
 SUBCOMMAND_MODULES = ("infomarket.runner.cli", "infomarket.analysis.cli", "infomarket.viewer.cli",
                       "infomarket.chain.cli")
-
-
-def _writable_dir(path: Path) -> Path:
-    """Check that ``path`` can be created and written to, creating it (and nothing else) if needed."""
-    if path.exists() and not path.is_dir():
-        raise UsageError(f"--out {path}: exists and is not a directory")
-    try:
-        path.mkdir(parents=True, exist_ok=True)
-        with tempfile.TemporaryFile(dir=path):
-            pass
-    except OSError as exc:
-        raise UsageError(f"--out {path}: cannot write there ({exc.strerror or exc})") from None
-    return path
+EXIT_INTERRUPTED = 130
 
 
 def _print_summary(robots, title: str) -> None:
@@ -54,11 +39,10 @@ def _print_summary(robots, title: str) -> None:
 
 # ---------------------------------------------------------------------------------------------- run
 def cmd_run(args) -> int:
-    from .config import load_experiment
+    from .config import load_experiment, sizes
     from .runner import run_batch
-    from .runner.batch import default_workers
+    from .runner.batch import BatchInterrupted, default_workers
     from .runner.progress import progress
-    from .store import write_parquet_atomic
 
     cfg = load_experiment(args.experiment)
     changes = {}
@@ -72,20 +56,43 @@ def cmd_run(args) -> int:
         except ConfigError as exc:
             raise UsageError(str(exc).replace("configuration: invalid experiment\n  ", "")) from None
     runs = args.runs or cfg.runs
+    too_big = sizes.runs_too_big(cfg, runs)
+    if too_big:
+        raise UsageError(f"--runs {runs}: {too_big}")
     seed = cfg.seed if args.seed is None else args.seed
-    out = _writable_dir(Path(args.out or Path("results") / cfg.name))
+    out = Path(args.out or Path("results") / cfg.name)
+    names = ["robots.parquet"] + (["wealth_history.parquet"] if cfg.history_every else [])
+    existing = [n for n in names if (out / n).exists()]
+    if existing and not args.force:
+        raise UsageError(f"--out {out}: {existing[0]} exists (an earlier run's results); --force replaces it, "
+                         f"or choose another --out")
+    out = writable_dir(out)
     workers = args.workers or min(default_workers(), runs)
-    with progress(f"{cfg.name}", runs, enabled=not args.quiet) as bar:
-        res = run_batch(cfg, runs, seed, workers=workers, on_done=bar.advance)
-    write_parquet_atomic(res.robots, out / "robots.parquet")
-    written = ["robots.parquet"]
-    if cfg.history_every:
-        write_parquet_atomic(res.history, out / "wealth_history.parquet")
-        written.append("wealth_history.parquet")
-    _print_summary(res.robots, f"{cfg.name}: {runs} runs x {res.steps} steps, master seed {seed}")
-    print(f"wrote {', '.join(str(out / w) for w in written)}")
-    print(f"{res.env_steps_per_second:,.0f} env-steps/s per core (compile/load {res.compile_seconds:.2f} s)")
+    try:
+        with progress(f"{cfg.name}", runs, enabled=not args.quiet) as bar:
+            res = run_batch(cfg, runs, seed, workers=workers, on_done=bar.advance)
+    except BatchInterrupted as stop:
+        if stop.result is None:
+            report(f"interrupted before any of the {runs} runs finished; nothing written", EXIT_INTERRUPTED)
+        else:
+            done = stop.result.robots["run"].nunique()
+            written = _write_run_tables(stop.result, out, names)
+            report(f"interrupted: kept the {done} of {runs} runs that had finished (their run numbers are in "
+                   f"the run column): wrote {', '.join(map(str, written))}", EXIT_INTERRUPTED)
+        return EXIT_INTERRUPTED
+    written = _write_run_tables(res, out, names)
+    if not args.quiet:
+        _print_summary(res.robots, f"{cfg.name}: {runs} runs x {res.steps} steps, master seed {seed}")
+        print(f"wrote {', '.join(map(str, written))}")
+        print(f"{res.env_steps_per_second:,.0f} env-steps/s per core (compile/load {res.compile_seconds:.2f} s)")
     return 0
+
+
+def _write_run_tables(res, out: Path, names: list[str]) -> list[Path]:
+    from .store import write_parquet_atomic
+
+    tables = {"robots.parquet": res.robots, "wealth_history.parquet": res.history}
+    return [write_parquet_atomic(tables[n], out / n) for n in names]
 
 
 # --------------------------------------------------------------------------------------------- demo
@@ -128,8 +135,8 @@ def cmd_check(args) -> int:
 
 
 # --------------------------------------------------------------------------------------------- main
-def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="infomarket", description="Information-market robot swarm simulator.")
+def build_parser() -> Parser:
+    p = Parser(prog="infomarket", description="Information-market robot swarm simulator.")
     p.add_argument("--version", action="version", version=f"infomarket {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
@@ -142,7 +149,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="also write wealth_history.parquet: every robot's wealth every K steps")
     r.add_argument("--out", help="output folder (default: results/NAME)")
     r.add_argument("--workers", type=at_least(1), help="processes (default: one per core)")
-    r.add_argument("--quiet", action="store_true", help="no progress output")
+    r.add_argument("--force", action="store_true", help="replace the results of an earlier run in --out")
+    r.add_argument("--quiet", action="store_true", help="print nothing but errors")
     r.set_defaults(func=cmd_run)
 
     bench_cli.add_subcommand(sub)
@@ -173,11 +181,9 @@ def main(argv: list[str] | None = None) -> int:
         return int(args.func(args) or 0)
     except InfomarketError as exc:
         # bad input (configuration, options, store) is a ValueError: exit 2; anything else: 1
-        print(f"infomarket: error: {exc}", file=sys.stderr)
-        return EXIT_USAGE if isinstance(exc, ValueError) else 1
+        return report(exc)
     except KeyboardInterrupt:
-        print("infomarket: interrupted", file=sys.stderr)
-        return 130
+        return report("interrupted", EXIT_INTERRUPTED)
     except BrokenPipeError:  # output piped into e.g. `head`: stop quietly, like other Unix tools
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0

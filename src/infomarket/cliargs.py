@@ -2,12 +2,56 @@
 from __future__ import annotations
 
 import argparse
+import os
+import sys
+import tempfile
+from pathlib import Path
 
-from .errors import InfomarketError
+from .errors import UsageError, report
+
+__all__ = ["Parser", "UsageError", "at_least", "fraction", "writable_dir", "writable_file"]
 
 
-class UsageError(InfomarketError, ValueError):
-    """A command-line option is wrong (the CLI prints it and exits with code 2)."""
+class Parser(argparse.ArgumentParser):
+    """argparse, with its errors (unknown option, bad value) reported like every other CLI error."""
+
+    def error(self, message: str):
+        self.print_usage(sys.stderr)
+        raise SystemExit(report(f"{self.prog}: {message}"))
+
+
+def writable_dir(path: str | Path, option: str = "--out") -> Path:
+    """Check that folder ``path`` can be created and written to, before any work; creates it (and its
+    parents) if needed, so call it after validating everything else."""
+    path = Path(path)
+    if path.exists() and not path.is_dir():
+        raise UsageError(f"{option} {path}: exists and is not a directory")
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+        with tempfile.TemporaryFile(dir=path):
+            pass
+    except OSError as exc:
+        raise UsageError(f"{option} {path}: cannot write there ({exc.strerror or exc})") from None
+    return path
+
+
+def writable_file(path: str | Path, option: str = "--out") -> Path:
+    """Check that file ``path`` can be written (its folder exists and takes new files; an existing file is
+    writable), before any work; creates nothing."""
+    path = Path(path)
+    if path.is_dir():
+        raise UsageError(f"{option} {path}: is a directory; give a file name")
+    folder = path.parent
+    if not folder.is_dir():
+        raise UsageError(f"{option} {path}: the folder {folder} does not exist; give a file name in an existing folder")
+    try:
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+        if path.exists() and not os.access(path, os.W_OK):
+            raise PermissionError(13, "Permission denied")
+    except OSError as exc:
+        raise UsageError(f"{option} {path}: cannot write there ({exc.strerror or exc})") from None
+    return path
 
 
 def at_least(low: int):

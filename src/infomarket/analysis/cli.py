@@ -4,7 +4,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from ..errors import ConfigError
+from ..cliargs import UsageError, writable_dir
 
 
 def add_subcommand(subparsers) -> None:
@@ -26,13 +26,11 @@ def cmd_figures(args: argparse.Namespace) -> int:
 
     out = Path(args.out)
     if out.exists() and not out.is_dir():
-        raise ConfigError(f"--out {out}: exists and is not a directory")
-    frames = Frames.of(Store(args.store))  # raises StoreError for a missing or foreign folder
+        raise UsageError(f"--out {out}: exists and is not a directory")
+    # raises StoreError for a missing or foreign folder, StoreDamaged (naming the repair) for a damaged one
+    frames = Frames.of(Store(args.store))
     if frames.robots.empty and frames.history.empty:
         print(f"{args.store}: the store holds no completed runs; writing an empty report")
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise ConfigError(f"--out {out}: cannot create it ({exc.strerror or exc})") from None
+    writable_dir(out)
     build_report(frames, out, vector=args.vector, echo=print, label=str(args.store))
     return 0

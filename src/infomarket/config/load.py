@@ -28,8 +28,18 @@ def shipped_experiments() -> dict[str, Path]:
     return found
 
 
+def key_path(loc: tuple) -> str:
+    """A validation location as users write keys: ``swarm.groups[0].count`` (as in sweep grids)."""
+    out = ""
+    for part in loc:
+        if part in ("function-after[_coherent()]",):
+            continue
+        out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else str(part))
+    return out
+
+
 def _describe(err: dict[str, Any]) -> str:
-    loc = ".".join(str(p) for p in err["loc"] if p not in ("function-after[_coherent()]",))
+    loc = key_path(err["loc"])
     msg = err["msg"]
     if err["type"] == "extra_forbidden":
         return f"{loc}: unknown key"

@@ -1,8 +1,10 @@
 """Experiment configuration: a validated, frozen description of one simulated setup.
 
 Validation happens here, before anything runs: unknown keys, wrong types and impossible values are
-all reported with the key's dotted path and what is allowed (see ``config.errors``).  Defaults are the
-values of MODEL.md §1 that produced the paper's figures.
+all reported with the key's path (``swarm.groups[0].count``) and what is allowed (``config.load`` turns
+them into one ``errors.ConfigError``), and so is a configuration whose memory need exceeds the limit
+(``config.sizes``).  Defaults are the values of MODEL.md §1 that produced the paper's figures; ``swarm``
+has none and is required.
 """
 from __future__ import annotations
 
@@ -13,8 +15,8 @@ from typing import Annotated, Any
 from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator, model_validator
 
 from .. import plugins
-
 from ..registry import behaviours, payments
+from . import sizes
 
 PosFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 NonNegFloat = Annotated[float, Field(ge=0, allow_inf_nan=False)]
@@ -191,6 +193,9 @@ class Experiment(_Strict):
         missing = [p for p in spec.params if p not in self.payment.params and p not in spec.defaults]
         if missing:
             raise ValueError(f"payment.params: scheme {spec.name!r} needs {', '.join(missing)}")
+        too_big = sizes.run_too_big(self)
+        if too_big:
+            raise ValueError(too_big)
         return self
 
     # ------------------------------------------------------------------ derived views

@@ -9,6 +9,7 @@ import multiprocessing
 import os
 import sys
 import time
+import traceback
 from concurrent.futures import Executor, ProcessPoolExecutor
 from dataclasses import dataclass
 
@@ -35,21 +36,72 @@ class BatchResult:
         return runs * self.steps / self.run_seconds if self.run_seconds > 0 else float("inf")
 
 
-def _one(cfg: Experiment, run: int, seed: int, steps: int | None, history_every: int | None):
-    r = simulate(cfg, seed, steps=steps, history_every=history_every)
+class BatchInterrupted(KeyboardInterrupt):
+    """Ctrl-C during ``run_batch``: ``result`` holds the runs that had finished (None if none had)."""
+
+    def __init__(self, result: "BatchResult | None", planned: int):
+        super().__init__()
+        self.result, self.planned = result, planned
+
+
+@dataclass
+class RunOutput:
+    """What one run of a batch produced; ``error`` (a traceback's text) when it raised instead."""
+
+    run: int
+    seed: int
+    robots: pd.DataFrame
+    history: pd.DataFrame
+    events: pd.DataFrame
+    compile_seconds: float = 0.0
+    run_seconds: float = 0.0
+    steps: int = 0
+    error: str | None = None
+
+
+MAX_ERROR_CHARS = 4000
+
+
+def _one(cfg: Experiment, run: int, seed: int, steps: int | None, history_every: int | None,
+         record_events: bool = False) -> RunOutput:
+    r = simulate(cfg, seed, steps=steps, history_every=history_every, record_events=record_events)
     robots = r.robots
     robots.insert(0, "run", np.int64(run))
-    hist = r.history
-    if len(hist):
-        hist.insert(0, "run", np.int64(run))
-        hist.insert(1, "seed", np.uint64(seed))
-    return robots, hist, r.compile_seconds, r.run_seconds, r.steps
+    hist, events = r.history, r.events
+    for table in (hist, events):
+        if len(table):
+            table.insert(0, "run", np.int64(run))
+            table.insert(1, "seed", np.uint64(seed))
+    return RunOutput(run, seed, robots, hist, events if record_events else pd.DataFrame(),
+                     r.compile_seconds, r.run_seconds, r.steps)
 
 
-def _chunk(cfg: Experiment, items: list[tuple[int, int]], steps, history_every):
-    for entry in cfg.plugins:  # rules registered by plugins must exist in this worker too
-        plugins.load(entry)
-    return [_one(cfg, run, seed, steps, history_every) for run, seed in items]
+def _failed(run: int, seed: int, exc: BaseException) -> RunOutput:
+    text = "".join(traceback.format_exception(exc))[-MAX_ERROR_CHARS:]
+    empty = pd.DataFrame()
+    return RunOutput(run, seed, empty, empty, empty, error=text)
+
+
+def _chunk(cfg: Experiment, items: list[tuple[int, int]], steps, history_every, record_events=False,
+           isolate=False) -> list[RunOutput]:
+    """Run ``items`` (run, seed) in this process.  ``isolate``: a run that raises becomes a RunOutput
+    with its error text, and the others still run (sweeps); otherwise the exception propagates."""
+    try:
+        for entry in cfg.plugins:  # rules registered by plugins must exist in this worker too
+            plugins.load(entry)
+    except Exception as exc:
+        if not isolate:
+            raise
+        return [_failed(run, seed, exc) for run, seed in items]
+    out = []
+    for run, seed in items:
+        try:
+            out.append(_one(cfg, run, seed, steps, history_every, record_events))
+        except Exception as exc:
+            if not isolate:
+                raise
+            out.append(_failed(run, seed, exc))
+    return out
 
 
 def default_workers() -> int:
@@ -73,33 +125,40 @@ def run_batch(cfg: Experiment, runs: int, master_seed: int, *, steps: int | None
     """Run ``runs`` independent runs; ``on_done(k)`` is called as runs complete (for progress).
     ``executor`` (any concurrent.futures Executor) is used if given, else a local pool of ``workers``."""
     items = [(i, run_seed(master_seed, i, condition)) for i in range(runs)]
-    outputs = []
+    outputs: list[RunOutput] = []
     warm_seconds = 0.0
-    if executor is None and (workers <= 1 or runs == 1):
-        for it in items:
-            outputs.append(_one(cfg, *it, steps, history_every))
-            if on_done:
-                on_done(1)
-    else:
-        t0 = time.perf_counter()
-        warm(cfg)
-        warm_seconds = time.perf_counter() - t0
-        n_workers = workers if executor is None else max(workers, 1)
-        size = max(1, min(8, runs // (n_workers * 4) or 1))  # batch runs per task: little overhead
-        chunks = [items[k:k + size] for k in range(0, runs, size)]
-        pool = executor or process_pool(workers)
-        try:
-            futures = [pool.submit(_chunk, cfg, c, steps, history_every) for c in chunks]
-            for f in futures:
-                res = f.result()
-                outputs.extend(res)
+    try:
+        if executor is None and (workers <= 1 or runs == 1):
+            for it in items:
+                outputs.append(_one(cfg, *it, steps, history_every))
                 if on_done:
-                    on_done(len(res))
-        finally:
-            if executor is None:
-                pool.shutdown(cancel_futures=True)
-    robots = pd.concat([o[0] for o in outputs], ignore_index=True)
-    hists = [o[1] for o in outputs if len(o[1])]
+                    on_done(1)
+        else:
+            t0 = time.perf_counter()
+            warm(cfg)
+            warm_seconds = time.perf_counter() - t0
+            n_workers = workers if executor is None else max(workers, 1)
+            size = max(1, min(8, runs // (n_workers * 4) or 1))  # batch runs per task: little overhead
+            chunks = [items[k:k + size] for k in range(0, runs, size)]
+            pool = executor or process_pool(workers)
+            try:
+                futures = [pool.submit(_chunk, cfg, c, steps, history_every) for c in chunks]
+                for f in futures:
+                    res = f.result()
+                    outputs.extend(res)
+                    if on_done:
+                        on_done(len(res))
+            finally:
+                if executor is None:
+                    pool.shutdown(cancel_futures=True)
+    except KeyboardInterrupt:
+        raise BatchInterrupted(_collect(outputs, warm_seconds) if outputs else None, runs) from None
+    return _collect(outputs, warm_seconds)
+
+
+def _collect(outputs: list[RunOutput], warm_seconds: float) -> BatchResult:
+    robots = pd.concat([o.robots for o in outputs], ignore_index=True)
+    hists = [o.history for o in outputs if len(o.history)]
     history = pd.concat(hists, ignore_index=True) if hists else pd.DataFrame()
-    compile_seconds = max([warm_seconds] + [o[2] for o in outputs])
-    return BatchResult(robots, history, compile_seconds, sum(o[3] for o in outputs), outputs[0][4])
+    compile_seconds = max([warm_seconds] + [o.compile_seconds for o in outputs])
+    return BatchResult(robots, history, compile_seconds, sum(o.run_seconds for o in outputs), outputs[0].steps)

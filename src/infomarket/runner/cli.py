@@ -4,6 +4,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..cliargs import UsageError, at_least, fraction
+from ..errors import EXIT_FAILED, report
 
 PAPER = ("fig2A", "fig2B", "fig2C", "fig2D", "fig3A", "fig3B", "fig3C", "fig4A", "fig4B", "fig4C",
          "fig5", "fig6A", "fig6B", "fig7")
@@ -35,8 +36,21 @@ def _execute(experiments, args, label: str) -> int:
     from ..runner.sweep import plan, run_sweep
     from ..store import Store
 
+    from ..config import sizes
+
     conds = plan(experiments, runs=getattr(args, "runs", None), seed=getattr(args, "seed", None),
                  scale=getattr(args, "scale", 1.0))
+    need = sum(sizes.results_bytes(c.config, c.runs) for c in conds)
+    if need > sizes.limit()[0]:  # the store, read whole by `figures`, and the sweep's plan must fit
+        biggest = max(conds, key=lambda c: sizes.results_bytes(c.config, c.runs))
+        why = sizes.runs_too_big(biggest.config, sum(c.runs for c in conds))
+        raise UsageError(f"{label}: {sum(c.runs for c in conds):,} runs in {len(conds)} condition(s): "
+                         f"{why or 'too many runs for memory'}")
+    if args.events:
+        for c in conds:
+            why = sizes.run_too_big(c.config, record_events=True)
+            if why:
+                raise UsageError(f"--events: {c.experiment} [{c.id}]: {why}")
     store = Store(args.out)
     out = Path(args.out)
     if out.exists() and not out.is_dir():
@@ -51,8 +65,9 @@ def _execute(experiments, args, label: str) -> int:
             raise UsageError(f"--out {out}: cannot write there ({exc.strerror or exc})") from None
         total = sum(c.runs for c in conds)
         with progress(label, total, enabled=not args.quiet) as bar:
-            report = run_sweep(conds, store, workers=workers, client=client, on_done=bar.advance,
-                               on_plan=lambda todo: bar.advance(total - todo) if total - todo else None)
+            done = run_sweep(conds, store, workers=workers, client=client, on_done=bar.advance,
+                             on_plan=lambda todo: bar.advance(total - todo) if total - todo else None,
+                             record_events=args.events, retry_failed=args.retry_failed)
     finally:
         if client is not None:
             client.close()
@@ -61,10 +76,15 @@ def _execute(experiments, args, label: str) -> int:
     wall = time.perf_counter() - t0
     executor = (f"Dask scheduler {args.scheduler}" if args.scheduler else
                 f"local Dask cluster of {args.dask_local}" if args.dask_local else f"{workers} local process(es)")
-    print(f"{label}: {report.done} runs done, {report.skipped} already in the store, "
-          f"{len(conds)} condition(s); {report.env_steps:,} env-steps in {wall:.1f} s wall "
-          f"({report.env_steps / wall if wall > 0 else 0:,.0f} env-steps/s) on {executor}")
-    print(f"store: {out}")
+    if not args.quiet:
+        print(f"{label}: {done.done} runs done, {done.skipped} already in the store, "
+              f"{len(conds)} condition(s); {done.env_steps:,} env-steps in {wall:.1f} s wall "
+              f"({done.env_steps / wall if wall > 0 else 0:,.0f} env-steps/s) on {executor}")
+        print(f"store: {out}")
+    if done.failed:
+        return report(f"{done.failed} of {done.done} runs failed (the first: {done.first_error}); every error "
+                      f"is listed by `infomarket store failed {out}`; `--retry-failed` reruns them",
+                      EXIT_FAILED)
     return 0
 
 
@@ -88,7 +108,10 @@ def _executor_options(p) -> None:
     g = p.add_mutually_exclusive_group()
     g.add_argument("--scheduler", metavar="ADDRESS", help="run on a Dask scheduler, e.g. tcp://host:8786")
     g.add_argument("--dask-local", type=at_least(1), metavar="N", help="run on a local Dask cluster of N workers")
-    p.add_argument("--quiet", action="store_true", help="no progress output")
+    p.add_argument("--events", action="store_true",
+                   help="also store every run's event log (purchases, refusals, deposits) as the events table")
+    p.add_argument("--retry-failed", action="store_true", help="rerun the runs that failed in an earlier sweep")
+    p.add_argument("--quiet", action="store_true", help="print nothing but errors")
 
 
 def add_subcommand(sub) -> None:
@@ -105,3 +128,62 @@ def add_subcommand(sub) -> None:
                    help="fraction of the paper's runs per condition (at least 2), e.g. 0.125 for a quick check")
     _executor_options(r)
     r.set_defaults(func=cmd_reproduce)
+
+    st = sub.add_parser("store", help="check, repair or inspect a results store")
+    ss = st.add_subparsers(dest="store_command", required=True, metavar="ACTION")
+    for name, func, text in (
+            ("verify", cmd_store_verify, "check every part against its commit record; list damaged and orphan parts"),
+            ("repair", cmd_store_repair, "move damaged parts aside (into STORE/damaged/) so the next sweep reruns "
+                                         "their runs"),
+            ("failed", cmd_store_failed, "list the runs that failed, with their errors")):
+        a = ss.add_parser(name, help=text, description=text)
+        a.add_argument("store", metavar="STORE")
+        a.set_defaults(func=func)
+
+
+def _open(path: str):
+    from ..store import Store, StoreError
+
+    store = Store(path)
+    if not store.exists():
+        raise StoreError(f"{path}: not an infomarket results store (no store.json)")
+    return store
+
+
+def cmd_store_verify(args) -> int:
+    store = _open(args.store)
+    found = store.verify()
+    for p in found.damaged:
+        print(f"damaged: {p.path}: {p.why}")
+    for o in found.orphans:
+        print(f"orphan:  {o} (no commit record: left by an interrupted sweep; ignored by readers)")
+    print(f"{args.store}: {found.parts} committed part(s), {len(found.damaged)} damaged, "
+          f"{len(found.orphans)} orphan(s)")
+    if found.damaged:
+        return report(f"{args.store} is damaged; `infomarket store repair {args.store}` moves the damaged parts "
+                      f"aside, and the next sweep reruns their runs")
+    return 0
+
+
+def cmd_store_repair(args) -> int:
+    store = _open(args.store)
+    with store.lock():
+        found, moved = store.repair()
+    for m in moved:
+        print(f"moved aside: {m}")
+    if not moved:
+        print(f"{args.store}: nothing to repair ({found.parts} committed part(s), all intact)")
+    else:
+        print(f"{args.store}: {len({p.part for p in found.damaged})} damaged part(s) and {len(found.orphans)} "
+              f"orphan(s) moved into {store.root / 'damaged'}; the next `sweep`/`reproduce` with the same "
+              f"--out reruns exactly their runs")
+    return 0
+
+
+def cmd_store_failed(args) -> int:
+    failed = _open(args.store).failed()
+    for row in failed.itertuples():
+        print(f"{row.experiment} [{row.condition}] run {row.run} (seed {row.seed}):")
+        print("  " + row.error.strip().replace("\n", "\n  "))
+    print(f"{args.store}: {len(failed)} failed run(s)")
+    return 0

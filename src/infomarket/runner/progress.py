@@ -40,12 +40,17 @@ class _Bar:
         self.progress.update(self.task, advance=k, rate=f"{rate:.1f} runs/s")
 
 
+class _Silent:
+    def advance(self, k: int = 1) -> None:
+        pass
+
+
 @contextmanager
 def progress(label: str, total: int, *, enabled: bool = True, stream=None):
-    """Context manager yielding an object with ``advance(k)``."""
+    """Context manager yielding an object with ``advance(k)``; prints nothing when not ``enabled``."""
     stream = stream or sys.stderr
     if not enabled:
-        yield _Lines(label, total, stream, every=float("inf"))
+        yield _Silent()
         return
     if stream.isatty():
         columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),

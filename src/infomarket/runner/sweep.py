@@ -4,6 +4,11 @@ Runs are batched into tasks (several runs of one condition) so scheduling overhe
 parent process writes each finished task to the store as one part, so the store has a single writer
 whichever executor computed the runs (a local process pool, or ``dask.distributed``).  Resuming is the
 default: runs already committed in the store are skipped, orphan parts of a crash are removed first.
+
+Before anything runs, the sweep takes the store's lock (one writer at a time), checks every committed part
+against its checksum (a damaged store is refused until ``infomarket store repair``), and checks that the
+store holds nothing made with another configuration or another master seed.  A run that raises is
+committed as ``failed`` with its error text; the others go on (``retry_failed`` reruns those).
 """
 from __future__ import annotations
 
@@ -20,7 +25,8 @@ from .. import __version__
 from ..config.schema import Experiment
 from ..engine.build import behaviour_kinds
 from ..store import Store, StoreError
-from .batch import _chunk, process_pool, warm
+from ..store.results import FAILED, OK
+from .batch import RunOutput, _chunk, process_pool, warm
 from .plan import Condition, conditions
 
 
@@ -43,6 +49,9 @@ class SweepReport:
     done: int
     env_steps: int
     wall_seconds: float
+    failed: int = 0
+    first_error: str = ""
+    retried: int = 0
 
     @property
     def env_steps_per_second(self) -> float:
@@ -58,16 +67,28 @@ def plan(experiments: Iterable[Experiment], *, runs: int | None = None, seed: in
 
 
 def check_compatible(store: Store, conds: list[Condition]) -> None:
-    """Refuse to mix runs of different configurations under the same experiment and condition."""
-    existing = store.runs()
-    if existing.empty:
-        return
-    known = existing.groupby(["experiment", "condition"]).config_hash.first().to_dict()
+    """Refuse to mix runs of different configurations or master seeds under one experiment and condition."""
+    seeds: dict[str, int] = {}
     for c in conds:
-        h = known.get((c.experiment, c.id))
-        if h is not None and h != c.config.config_hash():
-            raise StoreError(f"{store.root}: holds runs of {c.experiment} [{c.id}] made with another "
-                             f"configuration (hash {h}, now {c.config.config_hash()}); use another --out")
+        if seeds.setdefault(c.experiment, c.master_seed) != c.master_seed:
+            raise StoreError(f"{c.experiment}: conditions with two master seeds in one sweep")
+    store.claim_seeds(seeds, record=False)  # the recorded seeds first: the clearest message
+    existing = store.runs()
+    if not existing.empty:
+        first = existing.groupby(["experiment", "condition"]).first()
+        for c in conds:
+            if (c.experiment, c.id) not in first.index:
+                continue
+            row = first.loc[(c.experiment, c.id)]
+            if row.config_hash != c.config.config_hash():
+                raise StoreError(f"{store.root}: holds runs of {c.experiment} [{c.id}] made with another "
+                                 f"configuration (hash {row.config_hash}, now {c.config.config_hash()}); "
+                                 f"use another --out")
+            if int(row.seed) != c.seed(int(row.run)):  # also stores made before seeds were recorded
+                raise StoreError(f"{store.root}: holds runs of {c.experiment} [{c.id}] made with another master "
+                                 f"seed than {c.master_seed}; runs of two seeds would mix in one condition: start "
+                                 f"a new store (another --out), or leave --seed out to resume this one")
+    store.claim_seeds(seeds)
 
 
 def make_tasks(conds: list[Condition], done: set, workers: int) -> list[Task]:
@@ -84,37 +105,59 @@ def make_tasks(conds: list[Condition], done: set, workers: int) -> list[Task]:
     return tasks
 
 
-def _frames(task: Task, outputs) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
+def _concat(frames: list[pd.DataFrame]) -> pd.DataFrame | None:
+    frames = [f for f in frames if len(f)]
+    return pd.concat(frames, ignore_index=True) if frames else None
+
+
+def _frames(task: Task, outputs: list[RunOutput]) -> dict[str, pd.DataFrame | None]:
+    """The part's tables: robots, history, events (None when empty) and the runs record."""
     c = task.condition
-    robots, hists, rows = [], [], []
-    for (rob, hist, _compile, run_s, steps), run in zip(outputs, task.runs):
-        rob.insert(0, "experiment", c.experiment)
-        rob.insert(1, "condition", c.id)
-        for k, v in c.keys.items():
-            rob[k] = v
-        robots.append(rob)
-        if len(hist):
-            meta = rob[["robot", "honest", "behaviour"]]
-            hist = hist.merge(meta, on="robot", how="left")
-            hist.insert(0, "experiment", c.experiment)
-            hist.insert(1, "condition", c.id)
-            hists.append(hist)
+
+    def label(df: pd.DataFrame, keys: bool) -> pd.DataFrame:
+        df.insert(0, "experiment", c.experiment)
+        df.insert(1, "condition", c.id)
+        if keys:
+            for k, v in c.keys.items():
+                df[k] = v
+        return df
+
+    robots, hists, events, rows = [], [], [], []
+    for o, run in zip(outputs, task.runs):
+        if o.error is None:
+            robots.append(label(o.robots, True))
+            if len(o.history):
+                meta = o.robots[["robot", "honest", "behaviour"]]
+                hists.append(label(o.history.merge(meta, on="robot", how="left"), False))
+            if len(o.events):
+                events.append(label(o.events, True))
         rows.append({"experiment": c.experiment, "condition": c.id, "run": np.int64(run),
-                     "seed": np.uint64(c.seed(run)), "config_hash": c.config.config_hash(),
-                     "package_version": __version__, "duration_s": run_s, "steps": steps,
-                     "transitory": c.config.transitory, "status": "ok", **c.keys})
-    history = pd.concat(hists, ignore_index=True) if hists else pd.DataFrame()
-    return pd.concat(robots, ignore_index=True), pd.DataFrame(rows), history
+                     "seed": np.uint64(c.seed(run)), "master_seed": np.int64(c.master_seed),
+                     "config_hash": c.config.config_hash(), "package_version": __version__,
+                     "duration_s": o.run_seconds, "steps": o.steps, "transitory": c.config.transitory,
+                     "status": OK if o.error is None else FAILED, "error": o.error or "", **c.keys})
+    return {"robots": _concat(robots), "history": _concat(hists), "events": _concat(events),
+            "runs": pd.DataFrame(rows)}
 
 
 def run_sweep(conds: list[Condition], store: Store, *, workers: int = 1, client=None,
-              on_done: Callable[[int], None] | None = None, on_plan: Callable[[int], None] | None = None
-              ) -> SweepReport:
+              on_done: Callable[[int], None] | None = None, on_plan: Callable[[int], None] | None = None,
+              record_events: bool = False, retry_failed: bool = False) -> SweepReport:
     """Run every missing run of ``conds`` into ``store``.  ``client``: a dask.distributed Client
-    (never created here); otherwise a local pool of ``workers`` processes (inline when 1)."""
+    (never created here); otherwise a local pool of ``workers`` processes (inline when 1).
+    ``record_events``: also store each run's event log; ``retry_failed``: rerun the failed runs."""
     store.create()
-    check_compatible(store, conds)  # first: a refused store is left exactly as it was
-    store.remove_orphans()
+    with store.lock():
+        store.check()  # a damaged store is refused until repaired
+        check_compatible(store, conds)  # first: a refused store is left exactly as it was
+        retried = store.uncommit_failed() if retry_failed else 0
+        store.remove_orphans()
+        report = _run(conds, store, workers, client, on_done, on_plan, record_events)
+    report.retried = retried
+    return report
+
+
+def _run(conds, store, workers, client, on_done, on_plan, record_events) -> SweepReport:
     done = store.completed_runs()
     tasks = make_tasks(conds, done, workers)
     planned = sum(c.runs for c in conds)
@@ -123,17 +166,19 @@ def run_sweep(conds: list[Condition], store: Store, *, workers: int = 1, client=
         on_plan(todo)
     t0 = time.perf_counter()
     env_steps = 0
+    failed: list[RunOutput] = []
 
-    def finished(task: Task, outputs) -> None:
+    def finished(task: Task, outputs: list[RunOutput]) -> None:
         nonlocal env_steps
-        robots, runs, history = _frames(task, outputs)
-        store.write_part(task.part_id, robots, runs, history)
-        env_steps += int(runs.steps.sum())
+        tables = _frames(task, outputs)
+        store.write_part(task.part_id, **tables)
+        env_steps += int(tables["runs"].steps.sum())
+        failed.extend(o for o in outputs if o.error is not None)
         if on_done:
             on_done(len(task.runs))
 
     def args(t: Task):
-        return (t.condition.config, [(r, t.condition.seed(r)) for r in t.runs], None, None)
+        return (t.condition.config, [(r, t.condition.seed(r)) for r in t.runs], None, None, record_events, True)
 
     if tasks and client is None and workers > 1:
         seen = set()
@@ -166,4 +211,5 @@ def run_sweep(conds: list[Condition], store: Store, *, workers: int = 1, client=
                 for f in futures:
                     f.cancel()
                 raise
-    return SweepReport(planned, planned - todo, todo, env_steps, time.perf_counter() - t0)
+    first = failed[0].error.strip().splitlines()[-1] if failed else ""
+    return SweepReport(planned, planned - todo, todo, env_steps, time.perf_counter() - t0, len(failed), first)

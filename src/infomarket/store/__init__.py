@@ -1,5 +1,5 @@
 """Writing and reading results: atomic Parquet files and the results store of sweeps."""
 from .files import write_parquet_atomic
-from .results import Store, StoreError
+from .results import Store, StoreDamaged, StoreError
 
-__all__ = ["Store", "StoreError", "write_parquet_atomic"]
+__all__ = ["Store", "StoreDamaged", "StoreError", "write_parquet_atomic"]

@@ -1,22 +1,47 @@
-"""Atomic file writes: a crash or a kill never leaves a half-written results file behind."""
+"""Atomic file writes: a crash or a kill never leaves a half-written results file behind.
+
+Files are created with mode 0666 minus the umask, like any other file a user's program writes (the
+temporary-file helpers of the standard library create 0600 files, which other users of a shared machine
+cannot read).  ``sha256_file`` is the checksum the results store records for every part it commits.
+"""
 from __future__ import annotations
 
+import hashlib
 import os
-import tempfile
+import secrets
+from collections.abc import Callable
 from pathlib import Path
 
 import pandas as pd
 
 
-def write_parquet_atomic(df: pd.DataFrame, path: str | Path) -> Path:
-    """Write ``df`` to ``path`` through a temporary file in the same folder and an atomic rename."""
+def write_atomic(path: str | Path, write: Callable[[Path], None]) -> Path:
+    """Call ``write(tmp)`` on a fresh temporary file next to ``path``, then rename it to ``path``.
+
+    The temporary file is created (empty) with the umask's permissions before ``write`` replaces its
+    contents, so the result has them too; on any error the temporary file is removed."""
     path = Path(path)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    os.close(fd)
+    tmp = path.parent / f".{path.name}.{secrets.token_hex(6)}.tmp"
+    os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
     try:
-        df.to_parquet(tmp, index=False)
+        write(tmp)
         os.replace(tmp, path)
     except BaseException:
-        Path(tmp).unlink(missing_ok=True)
+        tmp.unlink(missing_ok=True)
         raise
     return path
+
+
+def write_parquet_atomic(df: pd.DataFrame, path: str | Path) -> Path:
+    """Write ``df`` to ``path`` through a temporary file in the same folder and an atomic rename."""
+    return write_atomic(path, lambda tmp: df.to_parquet(tmp, index=False))
+
+
+def write_text_atomic(text: str, path: str | Path) -> Path:
+    return write_atomic(path, lambda tmp: tmp.write_text(text))
+
+
+def sha256_file(path: str | Path) -> str:
+    """Hex SHA-256 of a file's bytes."""
+    with open(path, "rb") as f:
+        return hashlib.file_digest(f, "sha256").hexdigest()

@@ -2,38 +2,121 @@
 
 Layout (each part file written atomically, see ``files``)::
 
-    STORE/store.json               format version, package version, creation time
+    STORE/store.json               format version, package version, creation time, master seed per experiment
+    STORE/store.lock               held (an OS lock) by the one sweep writing the store
     STORE/robots/part-ID.parquet   one row per robot per run
     STORE/history/part-ID.parquet  wealth of every robot every K steps (when asked)
+    STORE/events/part-ID.parquet   the ledger's event log: purchases, refusals, deposits (``--events``)
     STORE/runs/part-ID.parquet     one row per run: the commit record of its part
+    STORE/damaged/...              parts that ``repair`` moved aside
 
-Columns common to the three tables: ``experiment`` (e.g. ``fig2A``), ``condition`` (a stable id such as
+Columns common to the tables: ``experiment`` (e.g. ``fig2A``), ``condition`` (a stable id such as
 ``byzantines=3,market=staking,rotation_angle=40``; ``base`` without a sweep), ``run``, ``seed``, and one
 column per condition key (e.g. ``rotation_angle``).  A part counts only once its ``runs`` part exists:
-the runs part is written last, so a crash leaves at most an orphan robots/history part, which readers
-ignore and the next sweep deletes.  Query with pandas (``Store(path).robots()``) or DuckDB::
+the runs part is written last, so a crash leaves at most an orphan robots/history/events part, which
+readers ignore and the next sweep deletes.
+
+**Integrity.**  The runs part records, for each other table, the SHA-256 and the row count of the part
+it commits (columns ``robots_sha256``, ``robots_rows``, ...); the runs part itself is written with
+Parquet page checksums.  Every read checks them and raises ``StoreDamaged`` naming the part and the
+repair command; ``verify`` lists every damaged and orphan part, ``repair`` moves damaged parts aside
+(into ``damaged/``) so that their runs count as not done and the next sweep reruns exactly those.
+
+Query with pandas (``Store(path).robots()``) or DuckDB::
 
     SELECT r.* FROM 'STORE/robots/*.parquet' r JOIN 'STORE/runs/*.parquet' USING (experiment, condition, run)
 """
 from __future__ import annotations
 
+import fcntl
 import json
+import os
+import shutil
 import time
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import pandas as pd
+import pyarrow.parquet as pq
 
 from .. import __version__
 from ..errors import InfomarketError
-from .files import write_parquet_atomic
+from .files import sha256_file, write_atomic, write_text_atomic
 
 FORMAT = 1
-TABLES = ("robots", "history", "runs")
+DATA_TABLES = ("robots", "history", "events")
+TABLES = DATA_TABLES + ("runs",)
 KEY = ["experiment", "condition", "run"]
+OK, FAILED = "ok", "failed"
 
 
 class StoreError(InfomarketError, ValueError):
-    """The folder is not a usable results store (wrong format, incompatible contents)."""
+    """The folder is not a usable results store (wrong format, incompatible contents, locked)."""
+
+
+class StoreDamaged(StoreError):
+    """A committed part does not match its commit record (truncated, altered, missing, unreadable)."""
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One damaged part: ``path`` (relative to the store), and why."""
+
+    part: str
+    path: str
+    why: str
+
+
+@dataclass
+class Inspection:
+    """What ``Store.verify`` found."""
+
+    parts: int = 0
+    damaged: list[Problem] = field(default_factory=list)
+    orphans: list[str] = field(default_factory=list)
+
+    @property
+    def ok(self) -> bool:
+        return not self.damaged
+
+
+_HELD: set[Path] = set()  # stores locked by this process (POSIX locks do not conflict within one)
+
+
+class StoreLock:
+    """An exclusive OS lock (``fcntl.lockf``) on ``STORE/store.lock``, refused at once if held.
+
+    POSIX record locks belong to the process: the kernel drops them when it dies, even by SIGKILL (no
+    stale lock), and forked workers do not inherit them."""
+
+    def __init__(self, root: Path):
+        self.path = root / "store.lock"
+        self.fd: int | None = None
+
+    def __enter__(self) -> "StoreLock":
+        key = self.path.resolve()
+        if key in _HELD:
+            raise StoreError(f"{self.path.parent}: this process is already writing this store")
+        fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o666)
+        try:
+            fcntl.lockf(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except OSError:
+            os.close(fd)
+            raise StoreError(f"{self.path.parent}: another infomarket process is writing this store (it holds "
+                             f"{self.path.name}); wait for it to finish, or use another --out") from None
+        self.fd = fd
+        _HELD.add(key)
+        return self
+
+    def __exit__(self, *exc) -> None:
+        _HELD.discard(self.path.resolve())
+        if self.fd is not None:
+            os.close(self.fd)  # closing drops the lock
+            self.fd = None
+
+
+def _rel(root: Path, path: Path) -> str:
+    return str(path.relative_to(root))
 
 
 class Store:
@@ -50,22 +133,54 @@ class Store:
     def exists(self) -> bool:
         return self.meta_path.exists()
 
+    def meta(self) -> dict:
+        try:
+            return json.loads(self.meta_path.read_text())
+        except (OSError, ValueError) as exc:
+            raise StoreError(f"{self.meta_path}: unreadable ({exc})") from None
+
     def create(self) -> "Store":
         """Create the folder layout (idempotent); refuse a folder that holds something else."""
         if self.exists():
-            meta = json.loads(self.meta_path.read_text())
+            meta = self.meta()
             if meta.get("format") != FORMAT:
                 raise StoreError(f"{self.root}: store format {meta.get('format')} is not {FORMAT}")
+            for t in TABLES:
+                (self.root / t).mkdir(exist_ok=True)
             return self
         if self.root.exists() and any(self.root.iterdir()):
             raise StoreError(f"{self.root}: exists, is not empty and is not an infomarket results store")
         for t in TABLES:
             (self.root / t).mkdir(parents=True, exist_ok=True)
-        tmp = self.meta_path.with_suffix(".tmp")
-        tmp.write_text(json.dumps({"format": FORMAT, "package_version": __version__,
-                                   "created": time.strftime("%Y-%m-%dT%H:%M:%S%z")}, indent=2))
-        tmp.replace(self.meta_path)
+        self._write_meta({"format": FORMAT, "package_version": __version__,
+                          "created": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "seeds": {}})
         return self
+
+    def _write_meta(self, meta: dict) -> None:
+        write_text_atomic(json.dumps(meta, indent=2) + "\n", self.meta_path)
+
+    def lock(self) -> StoreLock:
+        """``with store.lock(): ...`` while writing; a second writer gets StoreError at once."""
+        return StoreLock(self.root)
+
+    def claim_seeds(self, seeds: dict[str, int], record: bool = True) -> None:
+        """Record each experiment's master seed (unless ``record`` is false); refuse one the store already
+        holds with another seed.  Call with the lock held."""
+        meta = self.meta()
+        known = meta.setdefault("seeds", {})
+        for name, seed in seeds.items():
+            if name in known and int(known[name]) != int(seed):
+                raise StoreError(
+                    f"{self.root}: holds runs of {name} made with master seed {known[name]}; this sweep asks "
+                    f"for seed {seed}. Runs of two seeds would mix in one condition: start a new store "
+                    f"(another --out) for seed {seed}, or leave --seed out to resume this one")
+        new = {n: int(s) for n, s in seeds.items() if n not in known}
+        if new and record:
+            known.update(new)
+            self._write_meta(meta)
+
+    def seeds(self) -> dict[str, int]:
+        return {k: int(v) for k, v in self.meta().get("seeds", {}).items()} if self.exists() else {}
 
     def _parts(self, table: str) -> dict[str, Path]:
         folder = self.root / table
@@ -73,14 +188,17 @@ class Store:
             return {}
         return {p.stem.removeprefix("part-"): p for p in folder.glob("part-*.parquet")}
 
+    def part_path(self, table: str, part_id: str) -> Path:
+        return self.root / table / f"part-{part_id}.parquet"
+
     def committed(self) -> list[str]:
         return sorted(self._parts("runs"))
 
     def remove_orphans(self) -> int:
-        """Delete robots/history parts without a runs part (left by a crash); returns how many."""
+        """Delete robots/history/events parts without a runs part (left by a crash); returns how many."""
         done = set(self._parts("runs"))
         removed = 0
-        for t in ("robots", "history"):
+        for t in DATA_TABLES:
             for pid, path in self._parts(t).items():
                 if pid not in done:
                     path.unlink(missing_ok=True)
@@ -90,26 +208,148 @@ class Store:
         return removed
 
     # ------------------------------------------------------------------ writing
-    def write_part(self, part_id: str, robots: pd.DataFrame, runs: pd.DataFrame,
-                   history: pd.DataFrame | None = None) -> None:
-        """Write one part: robots (and history) first, the runs record last."""
-        write_parquet_atomic(robots, self.root / "robots" / f"part-{part_id}.parquet")
-        if history is not None and len(history):
-            write_parquet_atomic(history, self.root / "history" / f"part-{part_id}.parquet")
-        write_parquet_atomic(runs, self.root / "runs" / f"part-{part_id}.parquet")
+    def write_part(self, part_id: str, robots: pd.DataFrame | None, runs: pd.DataFrame,
+                   history: pd.DataFrame | None = None, events: pd.DataFrame | None = None) -> None:
+        """Write one part: the data tables (robots, history, events) first, then the runs record with
+        their checksums and row counts, last."""
+        if self.part_path("runs", part_id).exists():
+            raise StoreError(f"{self.root}: part {part_id} is already committed")
+        runs = runs.copy()
+        tables = {"robots": robots, "history": history, "events": events}
+        for t in DATA_TABLES:
+            df = tables[t]
+            sha, rows = "", 0
+            if df is not None and len(df):
+                path = self.part_path(t, part_id)
+                write_atomic(path, lambda tmp, df=df: df.to_parquet(tmp, index=False))
+                sha, rows = sha256_file(path), len(df)
+            runs[f"{t}_sha256"] = sha
+            runs[f"{t}_rows"] = rows
+        self._write_runs(part_id, runs)
+
+    def _write_runs(self, part_id: str, runs: pd.DataFrame) -> None:
+        write_atomic(self.part_path("runs", part_id),
+                     lambda tmp: runs.to_parquet(tmp, index=False, write_page_checksum=True))
+
+    # ------------------------------------------------------------------ integrity
+    def _repair_hint(self) -> str:
+        return f"run `infomarket store repair {self.root}` to move damaged parts aside (their runs are then rerun)"
+
+    def _read_runs_part(self, path: Path) -> pd.DataFrame:
+        return pq.read_table(path, page_checksum_verification=True).to_pandas()
+
+    def _check_data_part(self, table: str, part_id: str, record: pd.DataFrame) -> str | None:
+        """Why the ``table`` part of ``part_id`` does not match its commit record, or None."""
+        path = self.part_path(table, part_id)
+        sha_col, rows_col = f"{table}_sha256", f"{table}_rows"
+        if sha_col not in record.columns:  # a store written before checksums: readable is all we know
+            if not path.exists():
+                return None
+            try:
+                pq.read_metadata(path)
+            except Exception as exc:  # noqa: BLE001 - any reader error means damage
+                return f"unreadable ({type(exc).__name__}: {exc})"
+            return None
+        sha, rows = str(record[sha_col].iloc[0]), int(record[rows_col].iloc[0])
+        if not sha:
+            return "exists but its commit record says it has no rows" if path.exists() else None
+        if not path.exists():
+            return f"missing (the commit record says {rows} rows)"
+        if sha256_file(path) != sha:
+            return f"checksum mismatch: truncated or altered (the commit record says {rows} rows)"
+        return None
+
+    def verify(self) -> Inspection:
+        """Check every committed part against its commit record; list damaged and orphan parts."""
+        found = Inspection()
+        runs_parts = self._parts("runs")
+        for pid, path in sorted(runs_parts.items()):
+            found.parts += 1
+            try:
+                record = self._read_runs_part(path)
+            except Exception as exc:  # noqa: BLE001 - any reader error means damage
+                found.damaged.append(Problem(pid, _rel(self.root, path),
+                                             f"unreadable commit record ({type(exc).__name__}: {exc})"))
+                continue
+            for t in DATA_TABLES:
+                why = self._check_data_part(t, pid, record)
+                if why:
+                    found.damaged.append(Problem(pid, _rel(self.root, self.part_path(t, pid)), why))
+        for t in DATA_TABLES:
+            found.orphans += [_rel(self.root, p) for pid, p in sorted(self._parts(t).items())
+                              if pid not in runs_parts]
+        found.orphans += sorted(_rel(self.root, p) for p in self.root.glob("*/.part-*.tmp"))
+        return found
+
+    def check(self) -> None:
+        """Raise StoreDamaged naming the first damaged part (and how many more) and the repair command."""
+        found = self.verify()
+        if found.damaged:
+            first = found.damaged[0]
+            more = f" (and {len(found.damaged) - 1} more damaged part(s))" if len(found.damaged) > 1 else ""
+            raise StoreDamaged(f"{self.root}: part {first.path} is damaged: {first.why}{more}; "
+                               f"{self._repair_hint()}")
+
+    def repair(self) -> tuple[Inspection, list[str]]:
+        """Move every damaged part (all its files, the commit record included) and every orphan into
+        ``damaged/``; returns the inspection and the paths moved (relative to the store).  Call with the
+        lock held.  Nothing is deleted."""
+        found = self.verify()
+        moved = []
+        stamp = time.strftime("%Y%m%dT%H%M%S")
+        aside = self.root / "damaged" / stamp
+
+        def move(path: Path) -> None:
+            dest = aside / _rel(self.root, path)
+            dest.parent.mkdir(parents=True, exist_ok=True)
+            shutil.move(path, dest)
+            moved.append(_rel(self.root, path))
+
+        for pid in sorted({p.part for p in found.damaged}):
+            for t in ("runs",) + DATA_TABLES:  # the commit record first: its runs are then not done
+                path = self.part_path(t, pid)
+                if path.exists():
+                    move(path)
+        for rel in found.orphans:
+            if (self.root / rel).exists():
+                move(self.root / rel)
+        return found, moved
 
     # ------------------------------------------------------------------ reading
+    def _records(self) -> dict[str, pd.DataFrame]:
+        """Every commit record by part id; StoreDamaged if one cannot be read."""
+        out = {}
+        for pid, path in sorted(self._parts("runs").items()):
+            try:
+                out[pid] = self._read_runs_part(path)
+            except Exception as exc:  # noqa: BLE001
+                raise StoreDamaged(f"{self.root}: part {_rel(self.root, path)} is damaged: unreadable commit "
+                                   f"record ({type(exc).__name__}); {self._repair_hint()}") from None
+        return out
+
     def _read(self, table: str) -> pd.DataFrame:
-        done = set(self._parts("runs"))
-        paths = [p for pid, p in sorted(self._parts(table).items()) if pid in done]
-        if not paths:
+        records = self._records()
+        frames = []
+        for pid, record in records.items():
+            if table == "runs":
+                frames.append(record)
+                continue
+            why = self._check_data_part(table, pid, record)
+            if why:
+                raise StoreDamaged(f"{self.root}: part {_rel(self.root, self.part_path(table, pid))} is damaged: "
+                                   f"{why}; {self._repair_hint()}")
+            path = self.part_path(table, pid)
+            if path.exists():
+                frames.append(pd.read_parquet(path))
+        frames = [f for f in frames if len(f)]
+        if not frames:
             return pd.DataFrame()
-        df = pd.concat([pd.read_parquet(p) for p in paths], ignore_index=True)
+        df = pd.concat(frames, ignore_index=True)
         sort = [c for c in KEY + ["step", "robot"] if c in df.columns]
         return df.sort_values(sort, kind="stable").reset_index(drop=True)
 
     def runs(self) -> pd.DataFrame:
-        """One row per completed run."""
+        """One row per committed run, ``status`` ``ok`` or ``failed`` (then ``error`` says why)."""
         return self._read("runs")
 
     def robots(self) -> pd.DataFrame:
@@ -120,8 +360,35 @@ class Store:
         """Wealth every K steps, for the runs that recorded it."""
         return self._read("history")
 
+    def events(self) -> pd.DataFrame:
+        """The ledger's event log of the runs swept with ``--events``."""
+        return self._read("events")
+
+    def failed(self) -> pd.DataFrame:
+        """The committed runs that raised, with their error text."""
+        runs = self.runs()
+        if runs.empty or "status" not in runs.columns:
+            return runs.iloc[0:0]
+        return runs[runs.status == FAILED].reset_index(drop=True)
+
     def completed_runs(self) -> set[tuple[str, str, int]]:
+        """Keys of every committed run, failed ones included (a sweep does not rerun them unasked)."""
         runs = self.runs()
         if runs.empty:
             return set()
         return set(zip(runs.experiment, runs.condition, runs.run.astype(int)))
+
+    def uncommit_failed(self) -> int:
+        """Remove failed runs from their commit records (their parts hold no rows of them), so the next
+        sweep reruns them; returns how many.  Call with the lock held."""
+        n = 0
+        for pid, record in self._records().items():
+            if "status" not in record.columns or not (record.status == FAILED).any():
+                continue
+            keep = record[record.status != FAILED]
+            n += len(record) - len(keep)
+            if len(keep):
+                self._write_runs(pid, keep.reset_index(drop=True))
+            else:  # nothing of this part succeeded: no data part exists, drop the record
+                self.part_path("runs", pid).unlink()
+        return n

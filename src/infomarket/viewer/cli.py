@@ -1,6 +1,6 @@
 """The ``view`` and ``replay`` commands (added to ``infomarket`` by the main CLI).
 
-Bad input raises ``ConfigError`` before anything runs or is written; the main CLI prints it in one line
+Bad input raises ``UsageError`` or ``ConfigError`` before anything runs or is written; the main CLI prints it in one line
 and exits 2.  Heavy imports (aiohttp, matplotlib) wait until a command actually needs them.
 """
 from __future__ import annotations
@@ -10,8 +10,8 @@ import sys
 import time
 from pathlib import Path
 
-from ..cliargs import at_least
-from ..errors import ConfigError, InfomarketError
+from ..cliargs import UsageError, at_least, writable_file
+from ..errors import InfomarketError
 from . import DEFAULT_PORT
 
 
@@ -82,14 +82,13 @@ def cmd_replay(args) -> int:
     from .replay import record, write_html
 
     if not args.out and not args.movie:
-        raise ConfigError("replay: say what to write: --out FILE.html, --movie FILE.mp4 (or .gif), or both")
-    out = Path(args.out) if args.out else None
-    if out is not None and (out.is_dir() or not out.parent.is_dir()):
-        raise ConfigError(f"--out {out}: must be a file name in an existing folder")
+        raise UsageError("replay: say what to write: --out FILE.html, --movie FILE.mp4 (or .gif), or both")
+    out = writable_file(args.out) if args.out else None  # before simulating: fail fast
     if args.movie:
         from .movie import check_movie_path
 
         check_movie_path(args.movie)
+        writable_file(args.movie, "--movie")
     cfg = _load(args.experiment, args.steps)
     steps = cfg.steps
     rec = record(cfg, args.seed, steps=steps, every=args.every, on_progress=_Ticker("steps"))

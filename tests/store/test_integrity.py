@@ -1,0 +1,106 @@
+"""A damaged store (a part truncated as a full disk or a crashed file system would leave it) is detected on
+every read, refused by every command that reads it, listed by `store verify`, and repaired by `store
+repair` so that the next sweep reruns exactly the lost runs."""
+import os
+import stat
+
+import pandas as pd
+import pytest
+
+from infomarket.cli import main
+from infomarket.store import Store, StoreDamaged
+
+SWEEP = ["--workers", "1", "--quiet"]
+VOLATILE = ["duration_s", "robots_sha256", "history_sha256", "events_sha256",
+            "robots_rows", "history_rows", "events_rows"]
+
+
+def truncate(path, keep=0.5):
+    data = path.read_bytes()
+    path.write_bytes(data[: int(len(data) * keep)])
+
+
+def sweep(exp, out, *extra):
+    return main(["sweep", str(exp), "--out", str(out), *SWEEP, *extra])
+
+
+@pytest.fixture
+def store(tiny, tmp_path):
+    out = tmp_path / "s"
+    assert sweep(tiny(), out) == 0
+    return Store(out)
+
+
+def first_part(store, table):
+    return sorted((store.root / table).glob("part-*.parquet"))[0]
+
+
+def test_commit_records_hold_each_parts_checksum_and_rows(store):
+    import hashlib
+
+    runs = store.runs()
+    assert len(runs) == 6 and (runs.status == "ok").all()
+    part = store.root / "robots" / f"part-{store.committed()[0]}.parquet"
+    rec = pd.read_parquet(store.root / "runs" / part.name)
+    assert rec.robots_sha256.iloc[0] == hashlib.sha256(part.read_bytes()).hexdigest()
+    assert rec.robots_rows.iloc[0] == 6 * len(rec)  # six robots per run
+
+
+def test_truncated_robots_part_is_refused_by_every_reader(store, tiny, tmp_path, capsys):
+    part = first_part(store, "robots")
+    truncate(part)
+    with pytest.raises(StoreDamaged, match=f"robots/{part.name}"):
+        store.robots()
+    capsys.readouterr()
+    assert main(["figures", str(store.root), "--out", str(tmp_path / "fig")]) == 2
+    err = capsys.readouterr().err
+    assert f"robots/{part.name} is damaged" in err and f"infomarket store repair {store.root}" in err
+    assert "Traceback" not in err and not (tmp_path / "fig").exists()
+    assert sweep(tiny(), store.root) == 2
+    assert "infomarket store repair" in capsys.readouterr().err
+    assert main(["store", "verify", str(store.root)]) == 2
+    out = capsys.readouterr().out
+    assert f"damaged: robots/{part.name}: checksum mismatch" in out
+
+
+def test_truncated_commit_record_is_refused_not_a_crash(store, tiny, capsys):
+    part = first_part(store, "runs")
+    truncate(part)
+    assert sweep(tiny(), store.root) == 2
+    err = capsys.readouterr().err
+    assert f"runs/{part.name} is damaged" in err and "Traceback" not in err
+
+
+def test_verify_repair_sweep_ends_like_an_undamaged_store(store, tiny, tmp_path, capsys):
+    reference = {t: getattr(store, t)() for t in ("robots", "runs")}
+    robots_part, runs_part = first_part(store, "robots"), sorted((store.root / "runs").glob("*.parquet"))[-1]
+    truncate(robots_part)
+    truncate(runs_part, 0.9)
+    orphan = store.root / "robots" / "part-orphan.parquet"
+    orphan.write_bytes(b"left by a crash")
+    assert main(["store", "verify", str(store.root)]) == 2
+    out = capsys.readouterr().out
+    assert out.count("damaged:") == 2 and "orphan:  robots/part-orphan.parquet" in out
+    damaged_bytes = robots_part.read_bytes()
+    assert main(["store", "repair", str(store.root)]) == 0
+    moved = list((store.root / "damaged").rglob("*.parquet"))
+    assert damaged_bytes in [m.read_bytes() for m in moved]  # moved aside, never deleted
+    assert main(["store", "verify", str(store.root)]) == 0
+    assert len(store.runs()) < 6  # the damaged parts' runs are no longer committed
+    assert sweep(tiny(), store.root) == 0
+    for t, ref in reference.items():
+        now = getattr(store, t)()
+        pd.testing.assert_frame_equal(now.drop(columns=[c for c in VOLATILE if c in now]),
+                                      ref.drop(columns=[c for c in VOLATILE if c in ref]), check_exact=True)
+
+
+def test_parts_get_the_umasks_permissions(tiny, tmp_path):
+    old = os.umask(0o022)
+    try:
+        out = tmp_path / "s"
+        assert sweep(tiny(), out) == 0
+        assert main(["run", str(tiny()), "--runs", "1", "--out", str(tmp_path / "r"), "--quiet"]) == 0
+    finally:
+        os.umask(old)
+    files = list(out.rglob("*.parquet")) + [out / "store.json", tmp_path / "r" / "robots.parquet"]
+    assert files and {stat.S_IMODE(f.stat().st_mode) for f in files} == {0o644}
