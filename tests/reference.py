@@ -259,7 +259,7 @@ class Reference:
             r.carrying = True
             return
         r.carrying = False
-        if self.clock > p.transitory:
+        if self.clock >= p.transitory:  # the original counts from the step equal to the transitory period
             r.items += 1
         self.pay(i)
 

@@ -85,7 +85,7 @@ def test_deposit_in_transitory_period_pays_but_does_not_count():
     w.has_spot[0, NEST] = True
     w.spot[0, NEST] = (1000, 300)
     h.place(0, 1000, 300, 0.0)
-    w.clock[0] = 10
+    w.clock[0] = 9  # the last step of the transitory period (the step equal to it counts in the original)
     assert K.forage(h.view, 0, h.rng)
     assert w.items[0] == 0
 
