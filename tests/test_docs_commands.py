@@ -28,7 +28,7 @@ NOT_RUN = {
     "infomarket run path/to/original/fig4C.json": "a placeholder path; the format is tested in tests/config",
     "infomarket bench --json": "a timing of 21 full runs; bench --json is tested with --steps 300",
     "infomarket reproduce paper --out results/paper": "the whole paper (2 656 runs)",
-    "infomarket reproduce paper --out /tmp/quick --scale 0.125": "332 runs; --scale is tested in tests/test_commands.py",
+    "infomarket reproduce paper --out /tmp/quick --scale 0.125": "332 runs; --scale: tests/test_commands.py",
     "infomarket reproduce paper --out results/paper --scale 0.125": "332 runs, as above",
     "infomarket figures results/paper --out results/figures": "needs the paper's results store",
     "infomarket figures results/paper --out results/paper-report": "needs the paper's results store",

@@ -9,19 +9,12 @@ import pytest
 import infomarket as im
 from infomarket.engine.world import FOOD
 
-SITES = ((200.0, 300.0, 50.0), (1000.0, 300.0, 50.0))
-
-
 def config(groups, **top):
     data = {"steps": 100, "swarm": {"robots": sum(c for _, c in groups),
                                     "groups": [{"behaviour": b, "count": c} for b, c in groups]}}
     for k, v in top.items():
         data[k] = v
     return im.Experiment.model_validate(data)
-
-
-def in_a_site(x, y):
-    return any(math.hypot(x - cx, y - cy) < r for cx, cy, r in SITES)
 
 
 def place(sim, i, x, y, heading):

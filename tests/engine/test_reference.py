@@ -18,7 +18,7 @@ import copy
 import infomarket as im
 from infomarket.config import validate
 
-from ..reference import Entry, Params, Reference, Robot
+from ..reference import Params, Reference, Robot
 
 STEPS = 2500
 TOL = 1e-9
@@ -47,7 +47,7 @@ def start_reference(cfg, sim) -> Reference:
                comm_range=cfg.robot.communication_range, noise_sd=cfg.robot.noise_sd,
                sites=[(cfg.food.x, cfg.food.y, cfg.food.radius), (cfg.nest.x, cfg.nest.y, cfg.nest.radius)],
                reward=cfg.payment.reward, info_share=cfg.payment.information_share, stake=cfg.payment.stake,
-               scheme=cfg.payment.scheme, theta=cfg.payment.params.get("theta", 30.0), transitory=cfg.transitory,
+               scheme=cfg.payment.scheme, theta=cfg.payment_params()["theta"], transitory=cfg.transitory,
                rho=cfg.random_walk.rho, alpha=cfg.random_walk.alpha, steps=cfg.steps)
     robots = []
     for g in cfg.swarm.groups:
