@@ -47,7 +47,7 @@ def start_reference(cfg, sim) -> Reference:
                comm_range=cfg.robot.communication_range, noise_sd=cfg.robot.noise_sd,
                sites=[(cfg.food.x, cfg.food.y, cfg.food.radius), (cfg.nest.x, cfg.nest.y, cfg.nest.radius)],
                reward=cfg.payment.reward, info_share=cfg.payment.information_share, stake=cfg.payment.stake,
-               scheme=cfg.payment.scheme, theta=cfg.payment_params()["theta"], transitory=cfg.transitory,
+               scheme=cfg.payment.scheme, theta=cfg.payment_params().get("theta", 0.0), transitory=cfg.transitory,
                rho=cfg.random_walk.rho, alpha=cfg.random_walk.alpha, steps=cfg.steps)
     robots = []
     for g in cfg.swarm.groups:
@@ -118,20 +118,40 @@ def compare_events(mine: list[tuple], theirs) -> None:
     assert len(mine) == len(rows), f"{len(mine)} events in the reference, {len(rows)} in the engine"
 
 
-def test_engine_matches_the_reference_step_by_step():
-    cfg = validate(SETUP)
-    sim = im.Simulation(cfg, seed=11, record_events=True)
+def run_side_by_side(setup: dict, seed: int, steps: int) -> tuple[Reference, list[tuple]]:
+    cfg = validate(setup)
+    sim = im.Simulation(cfg, seed=seed, record_events=True)
     ref = start_reference(cfg, sim)
     all_events = []
-    for step in range(1, STEPS + 1):
+    for step in range(1, steps + 1):
         sim.step(1)
         all_events += ref.step()
         compare_and_resync(ref, sim.world, step)
     compare_events(all_events, sim.result().events)
-    kinds = [e[1] for e in all_events]
+    return ref, all_events
+
+
+def test_engine_matches_the_reference_step_by_step():
+    ref, events = run_side_by_side(SETUP, 11, STEPS)
+    kinds = [e[1] for e in events]
     # the run exercised what the comparison is for
     assert kinds.count("deposit") >= 10 and kinds.count("purchase") >= 100 and kinds.count("refused") >= 10
     assert any(r.items for r in ref.robots)  # deposits after the transitory period
     byzantine = {7, 8}
-    assert any(e[1] == "purchase" and e[3] in byzantine for e in all_events)
-    assert sum(e[1] == "purchase" and e[2] in (4, 5, 6) for e in all_events) >= 20  # sceptics buy
+    assert any(e[1] == "purchase" and e[3] in byzantine for e in events)
+    assert sum(e[1] == "purchase" and e[2] in (4, 5, 6) for e in events) >= 20  # sceptics buy
+
+
+#: The other built-in behaviours and the delayed scheme without a stake.
+OTHERS = {**SETUP, "transitory": 0, "swarm": {"robots": 9, "groups": [
+    {"behaviour": "naive", "count": 3}, {"behaviour": "sceptical", "count": 3},
+    {"behaviour": "greedy", "count": 2}, {"behaviour": "free_rider", "count": 1}]},
+    "payment": {"scheme": "delayed", "initial_wealth": 1.0}}
+
+
+def test_engine_matches_the_reference_with_greedy_free_riders_and_delayed_payment():
+    _, events = run_side_by_side(OTHERS, 12, 1200)
+    sold = [e for e in events if e[1] == "purchase"]
+    assert sum(e[1] == "deposit" for e in events) >= 5
+    assert sum(e[3] in (6, 7) for e in sold) >= 10 and not any(e[3] == 8 for e in sold)
+    assert any(e[2] == 8 for e in sold)  # the free rider buys
