@@ -37,12 +37,24 @@ def test_a_nondeterministic_seller_is_caught():
 
 
 def test_a_random_rule_gets_the_runs_generator_and_stays_reproducible():
-    def random_liar(w, me, site, rng, lie_probability=0.5):
-        valid, x, y, age = w.tab_valid[me, site], w.tab_vec[me, site, 0], w.tab_vec[me, site, 1], w.tab_age[me, site]
-        if rng.random() < lie_probability:
-            return valid, -x, -y, age
-        return valid, x, y, age
+    def random_age_liar(w, me, site, rng, spread=3.0):
+        """Sells its entry claiming an age of 1, 2 or 3, drawn at random."""
+        return w.tab_valid[me, site], w.tab_vec[me, site, 0], w.tab_vec[me, site, 1], 1 + int(rng.random() * spread)
 
-    spec = im.register_behaviour("tmp_random_liar", buy="naive", sell=random_liar, honest=False, replace=True)
-    assert spec.sell.wants_rng and spec.params == ("lie_probability",)
+    spec = im.register_behaviour("tmp_random_liar", buy="naive", sell=random_age_liar, honest=False, replace=True)
+    assert spec.sell.wants_rng and spec.params == ("spread",)
     checks.check_behaviour("tmp_random_liar", steps=800)  # reproducible from the seed, money conserved
+
+    cfg = im.Experiment.model_validate({"steps": 1500, "swarm": {"robots": 25, "groups": [
+        {"behaviour": "naive", "count": 20}, {"behaviour": "tmp_random_liar", "count": 5}]}})
+
+    def liar_sales(seed):
+        ev = im.simulate(cfg, seed=seed, record_events=True).events
+        return ev[(ev.kind == "purchase") & (ev.seller >= 20)].age.to_numpy()
+
+    ages = liar_sales(1)
+    # the rule really draws: a constant generator would give one claimed age, this one gives all three
+    counts = np.bincount(ages, minlength=4)[1:]
+    assert len(ages) >= 60 and counts.min() >= len(ages) / 50, counts
+    assert np.array_equal(liar_sales(1), ages)  # from the run's seeded generator
+    assert not np.array_equal(liar_sales(2), ages)

@@ -1,6 +1,5 @@
 import numpy as np
 import pytest
-from scipy import stats as sps
 
 from infomarket.analysis import stats
 
@@ -66,12 +65,17 @@ def test_mean_band_of_equal_samples_has_no_width():
 
 
 def test_regression_band_follows_least_squares():
-    rng = np.random.default_rng(7)
-    x = rng.uniform(0, 1, 300)
-    y = 5 - 3 * x + rng.normal(0, 0.5, 300)
-    grid = np.linspace(0, 1, 11)
-    band = stats.regression_band(x, y, grid)
-    fit = sps.linregress(x, y)
-    np.testing.assert_allclose(band.centre, fit.intercept + fit.slope * grid)
+    # x = 0, 1, 2, 3 (ten times each), y = 1, 3, 2, 5: by hand, mean x = 1.5, mean y = 2.75,
+    # Sxy = 1.5*1.75 - 0.5*0.25 - 0.5*0.75 + 1.5*2.25 = 5.5, Sxx = 5, slope 1.1, intercept 2.75 - 1.65 = 1.1
+    x = np.tile([0.0, 1.0, 2.0, 3.0], 10)
+    y = np.tile([1.0, 3.0, 2.0, 5.0], 10)
+    band = stats.regression_band(x, y, [0.0, 1.0, 3.0])
+    np.testing.assert_allclose(band.centre, [1.1, 2.2, 4.4], rtol=1e-12)
     assert np.all(band.low < band.centre) and np.all(band.centre < band.high)
-    assert np.all(band.high - band.low < 0.3)
+
+
+def test_regression_band_of_points_on_a_line_is_the_line():
+    x = np.arange(10.0)
+    band = stats.regression_band(x, 2 * x + 1, [0.0, 4.5, 20.0])
+    for edge in (band.centre, band.low, band.high):
+        np.testing.assert_allclose(edge, [1.0, 10.0, 41.0], rtol=1e-9)

@@ -24,7 +24,7 @@ def test_neighbours_strict_range_and_id_order():
 
 
 def test_wall_sensors_and_reflection_use_the_reflected_move():
-    h = Handle(make_config(1))
+    h = Handle(make_config(1, robot={"noise_sd": 0.0}))
     w = h.world
     h.place(0, 1200 - 8 - 1.0, 300, 0.0)  # facing the right wall, one unit away
     w.levy[0] = 50  # no turn this step: intended move is (v, 0)
@@ -35,11 +35,11 @@ def test_wall_sensors_and_reflection_use_the_reflected_move():
     assert w.tab_vec[0, FOOD, 0] == pytest.approx(97.5)
     assert w.tab_vec[0, FOOD, 1] == pytest.approx(0.0, abs=1e-9)
     assert w.tab_age[0, FOOD] == 1
-    w.noise_sd  # noqa: B018  (scalar present)
+    # the robot moves by the reflected vector: with no odometry noise, exactly 2.5 away from the wall
     w.bias[0] = 0.0
     K.move(h.view, 0, dx, dy, np.random.default_rng(1))
-    assert w.pos[0, 0] < 1200 - 8 - 1.0  # it moved away from the wall
-    assert abs(headings(w)[0] - 180.0) < 1.0
+    assert w.pos[0] == pytest.approx([1200 - 8 - 1.0 - 2.5, 300.0], abs=1e-12)
+    assert headings(w)[0] == pytest.approx(180.0, abs=1e-12)
 
 
 def test_walls_report_each_side():
@@ -86,7 +86,7 @@ def test_deposit_in_transitory_period_pays_but_does_not_count():
     w.has_spot[0, NEST] = True
     w.spot[0, NEST] = (1000, 300)
     h.place(0, 1000, 300, 0.0)
-    w.clock[0] = 10
+    w.clock[0] = 9  # the last step of the transitory period (the step equal to it counts in the original)
     assert K.forage(h.view, 0, h.rng)
     assert w.items[0] == 0
 
@@ -124,24 +124,31 @@ def test_odometry_update_moves_and_turns_every_entry():
 
 
 def test_wrapped_cauchy_table_by_sampling():
+    """Turns drawn with the kernel's own sampler follow eq. 2.  On whole degrees the mass of k degrees is
+    the density times one degree, (1 - rho^2) / (360 (1 + rho^2 - 2 rho cos k)); for rho = 0.9 that is
+    0.19 / 3.6 = 0.05278 at 0, 0.19 / (360 x 1.81) = 2.916e-4 at 90 and 0.19 / (360 x 3.61) = 1.462e-4 at 180."""
     rho = 0.9
     cdf = cauchy_cdf(rho)
-    u = np.random.default_rng(3).random(200_000)
     guide = guide_table(cdf)
-    draws = np.array([K.draw_index(cdf, guide, x) for x in u[:20_000]])
-    assert np.array_equal(draws, np.searchsorted(cdf, u[:20_000], side="right"))
-    draws = np.searchsorted(cdf, u, side="right")
-    phi = np.radians(np.arange(360))
-    pmf = (1 - rho**2) / (1 + rho**2 - 2 * rho * np.cos(phi))
-    pmf /= pmf.sum()
-    observed = np.bincount(draws, minlength=360)
-    # pool the tail bins so each expected count is large enough for the chi-square test
+    n = 200_000
+    u = np.random.default_rng(3).random(n)
+    draws = np.array([K.draw_index(cdf, guide, x) for x in u])
+    assert draws.min() >= 0 and draws.max() <= 359
+    observed = np.bincount(draws, minlength=360) / n
+    for k, p in ((0, 0.19 / 3.6), (90, 0.19 / (360 * 1.81)), (180, 0.19 / (360 * 3.61))):
+        assert abs(observed[k] - p) < 5 * math.sqrt(p / n), (k, observed[k], p)
+    # symmetric: turning k degrees left is as likely as k degrees right (k and 360 - k)
+    left, right = observed[1:180].sum(), observed[181:].sum()
+    assert abs(left - right) < 5 * math.sqrt(0.5 / n)
+    # the whole distribution, against the density written above (tail bins pooled for the chi-square)
+    k = np.arange(360)
+    pmf = (1 - rho**2) / (360 * (1 + rho**2 - 2 * rho * np.cos(np.radians(k))))
     order = np.argsort(pmf)[::-1]
     head = order[:60]
-    obs = np.append(observed[head], observed[order[60:]].sum())
-    exp = np.append(pmf[head], pmf[order[60:]].sum()) * len(u)
+    obs = np.append(observed[head], observed[order[60:]].sum()) * n
+    exp = np.append(pmf[head], pmf[order[60:]].sum()) * n
+    exp *= obs.sum() / exp.sum()  # the Riemann sum of the density is 1 to within 1e-15
     assert stats.chisquare(obs, exp).pvalue > 1e-3
-    assert observed[0] > observed[180] * 50  # strongly correlated: small turns dominate
 
 
 def test_levy_table_by_sampling():

@@ -4,11 +4,12 @@ from pathlib import Path
 
 import pytest
 
+from infomarket.engine.world import SITE_NAMES
 from infomarket.ledger import LedgerEvent, replay_events
 
 CASES = json.loads((Path(__file__).parents[1] / "fixtures" / "payment_vectors.json").read_text())["cases"]
 SCHEMES = {"delayed": ("delayed", False), "outlier": ("outlier", False), "outlier+stake": ("outlier", True)}
-SITES = {"food": 0, "nest": 1}
+SITES = {name: code for code, name in enumerate(SITE_NAMES)}
 
 
 def _events(case):

@@ -25,15 +25,24 @@ def test_valid_commands(msg, want):
     assert parse_command(json.dumps(msg), robots=25) == want
 
 
-@pytest.mark.parametrize("text", [
-    "{", "3", '{"cmd": 1}', '{"cmd": "jump"}', '{"cmd": "step", "n": 0}', '{"cmd": "step", "n": 1.5}',
-    f'{{"cmd": "speed", "value": {MAX_SPEED + 1}}}', '{"cmd": "speed"}', '{"cmd": "select", "robot": -1}',
-    '{"cmd": "select", "robot": "3"}', '{"cmd": "restart", "seed": false}',
+@pytest.mark.parametrize("text, why", [
+    ("{", "not JSON: '{'"),
+    ("3", "expected an object"),
+    ('{"cmd": 1}', "expected an object"),
+    ('{"cmd": "jump"}', "unknown command 'jump'"),
+    ('{"cmd": "step", "n": 0}', "step: n must be an integer in [1, "),
+    ('{"cmd": "step", "n": 1.5}', "got 1.5"),
+    (f'{{"cmd": "speed", "value": {MAX_SPEED + 1}}}',
+     f"speed: value must be an integer in [1, {MAX_SPEED}], got {MAX_SPEED + 1}"),
+    ('{"cmd": "speed"}', "speed: value must be an integer in [1, "),
+    ('{"cmd": "select", "robot": -1}', "select: robot must be an integer in [0, 24], got -1"),
+    ('{"cmd": "select", "robot": "3"}', "got '3'"),
+    ('{"cmd": "restart", "seed": false}', "restart: seed must be an integer"),
 ])
-def test_invalid_commands_say_why(text):
+def test_invalid_commands_say_why(text, why):
     with pytest.raises(CommandError) as err:
         parse_command(text, robots=25)
-    assert str(err.value)
+    assert why in str(err.value)
 
 
 def test_session_steps_restarts_and_reports(fig2b):

@@ -18,12 +18,13 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
+from ..registry import get_payment
 from . import metrics, stats
 from .boxplots import BYZANTINE, HONEST, draw_boxes, honest_vs_byzantine, legend_handles
 from .frames import Frames, MissingDataError, composition, experiment
 
 EQUAL_SHARE_PCT = 100.0 / 25  # every robot's wealth share when wealth is equal (MODEL.md §7)
-THETA_DEG = 30.0              # outlier threshold of the smart contract (paper, Fig. 7)
+THETA_DEG = get_payment("outlier").defaults["theta"]  # outlier threshold (paper, Fig. 7): the scheme's default
 STAKING, NO_STAKING = "#2ca02c", "#ff7f0e"
 
 

@@ -15,11 +15,17 @@ BEHAVIOUR_CLASSES = {
     "ScepticalBehavior": "sceptical",
     "ScaboteurBehavior": "scaboteur",
     "GreedyBehavior": "greedy",
-    "FreeRiderBehavior": "free_rider",
+    # The original's free rider buys sceptically and never sells (our "free_rider" buys naively).
+    "FreeRiderBehavior": "sceptical_free_rider",
 }
 PAYMENT_CLASSES = {
     "DelayedPaymentPaymentSystem": ("delayed", 0.0),
     "OutlierPenalisationPaymentSystem": ("outlier", 0.04),  # the original's default stake
+}
+#: Parameters each original payment class accepts (the original rejects a stake for delayed payment).
+PAYMENT_PARAMETERS = {
+    "DelayedPaymentPaymentSystem": {"information_share"},
+    "OutlierPenalisationPaymentSystem": {"information_share", "stake_amount"},
 }
 TOP_KEYS = {"width", "height", "food", "nest", "simulation_steps", "transitory_period", "number_runs",
             "visualization", "random_walk", "agent", "behaviors", "payment_system", "market",
@@ -95,7 +101,7 @@ def from_legacy(data: dict[str, Any], name: str) -> dict[str, Any]:
             raise ConfigError(f"payment_system.class: unknown class {cls!r}; allowed: {', '.join(PAYMENT_CLASSES)}")
         scheme, default_stake = PAYMENT_CLASSES[cls]
         params = dict(ps.get("parameters", {}))
-        _check_keys("payment_system.parameters", params, {"information_share", "stake_amount"})
+        _check_keys("payment_system.parameters", params, PAYMENT_PARAMETERS[cls])
         payment = {"scheme": scheme, "stake": params.pop("stake_amount", default_stake)}
         if "information_share" in params:
             payment["information_share"] = params["information_share"]

@@ -66,7 +66,7 @@ def forage(w, i, rng):
         w.carrying[i] = True
         return False
     w.carrying[i] = False
-    if w.clock[0] > w.transitory:
+    if w.clock[0] >= w.transitory:  # from step == transitory on, as the original counts
         w.items[i] += 1
     return True
 

@@ -16,8 +16,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..engine.world import EVENT_NAMES, SITE_NAMES, STATE_NAMES, headings, open_transactions
+from ..engine import kernels
+from ..engine.world import EVENT_NAMES, FOOD, NEST, SITE_NAMES, STATE_NAMES, headings, open_transactions
 from ..registry import behaviours
+
+#: The engine's own robot-frame -> world rotation, as plain Python (it also takes arrays of robots).
+_to_world = getattr(kernels.to_world, "py_func", kernels.to_world)
 
 #: Header fields, float64 each, in order.
 HEADER = ("step", "items_honest", "items_byzantine", "wealth_honest", "wealth_byzantine")
@@ -77,9 +81,8 @@ def scene(sim) -> dict:
 
 def _believed(w, site: int) -> tuple[np.ndarray, np.ndarray]:
     """World position each robot's table points at for ``site`` (robot frame: x axis = heading)."""
-    v = w.tab_vec[:, site]
-    c, s = w.hdir[:, 0], w.hdir[:, 1]
-    return w.pos[:, 0] + c * v[:, 0] - s * v[:, 1], w.pos[:, 1] + s * v[:, 0] + c * v[:, 1]
+    dx, dy = _to_world(w, slice(None), w.tab_vec[:, site, 0], w.tab_vec[:, site, 1])
+    return w.pos[:, 0] + dx, w.pos[:, 1] + dy
 
 
 def encode(sim, honest: np.ndarray | None = None) -> bytes:
@@ -89,13 +92,13 @@ def encode(sim, honest: np.ndarray | None = None) -> bytes:
     items = w.items.astype(np.float64)
     header = np.array([sim.clock, items[honest].sum(), items[~honest].sum(),
                        w.balance[honest].sum(), w.balance[~honest].sum()], dtype="<f8")
-    fx, fy = _believed(w, 0)
-    nx, ny = _believed(w, 1)
+    fx, fy = _believed(w, FOOD)
+    nx, ny = _believed(w, NEST)
     flags = (w.carrying.astype(np.uint8) * CARRYING
-             | w.tab_valid[:, 0].astype(np.uint8) * FOOD_VALID
-             | w.tab_valid[:, 1].astype(np.uint8) * NEST_VALID
-             | (w.last_site == 0).astype(np.uint8) * LAST_FOOD
-             | (w.last_site == 1).astype(np.uint8) * LAST_NEST)
+             | w.tab_valid[:, FOOD].astype(np.uint8) * FOOD_VALID
+             | w.tab_valid[:, NEST].astype(np.uint8) * NEST_VALID
+             | (w.last_site == FOOD).astype(np.uint8) * LAST_FOOD
+             | (w.last_site == NEST).astype(np.uint8) * LAST_NEST)
     pend = np.minimum(w.pend_count, 255)
     values = {
         "x": w.pos[:, 0], "y": w.pos[:, 1], "heading": headings(w), "wealth": w.balance, "items": items,
@@ -164,15 +167,14 @@ def robot_detail(sim, i: int, last: int = LAST_EVENTS) -> dict:
     purchases with the world position each points at, its open transactions as buyer since its last
     deposit, and its last events."""
     w = sim.world
-    c, s = w.hdir[i]
     pending = []
-    for site in (0, 1):
+    for site in (FOOD, NEST):
         for k in range(int(w.pend_count[i, site])):
-            vx, vy = w.pend_vec[i, site, k]
+            dx, dy = _to_world(w, i, *w.pend_vec[i, site, k])
             pending.append({"site": SITE_NAMES[site], "seller": int(w.pend_seller[i, site, k]),
                             "age": int(w.pend_age[i, site, k]),
-                            "x": round(float(w.pos[i, 0] + c * vx - s * vy), 2),
-                            "y": round(float(w.pos[i, 1] + s * vx + c * vy), 2)})
+                            "x": round(float(w.pos[i, 0] + dx), 2),
+                            "y": round(float(w.pos[i, 1] + dy), 2)})
     sellers, sites, directions = open_transactions(w, i)
     open_tx = [{"seller": int(a), "site": SITE_NAMES[int(b)], "direction": round(float(d), 1)}
                for a, b, d in zip(sellers, sites, directions)]

@@ -1,0 +1,92 @@
+"""The commands that README.md and docs/*.md show are real: each one is parsed by the CLI's own parser
+(so a renamed command or option fails here), and the cheap ones are run.  Every console line must be
+listed below, as run or as not run with the reason, so a new or edited command needs a decision."""
+from __future__ import annotations
+
+import re
+import shlex
+from pathlib import Path
+
+import pytest
+
+from infomarket.cli import build_parser, main
+
+ROOT = Path(__file__).parents[1]
+DOCS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+
+#: Run as written (in a scratch folder holding README's minimal experiment file as my.toml).
+RUN = {
+    "infomarket list",
+    "infomarket check my.toml",
+}
+#: Parsed only, with the reason they are not run here.
+NOT_RUN = {
+    "make demo": "the same as `infomarket demo`, run with --runs 1 in tests/test_commands.py",
+    "make test": "the test suite itself",
+    "infomarket run fig2B --runs 16 --out results/2b": "16 full runs; `run` is tested in tests/test_cli.py",
+    "infomarket run my.toml --history 100": "16 full runs; --history is tested in tests/test_cli.py",
+    "infomarket run path/to/original/fig4C.json": "a placeholder path; the format is tested in tests/config",
+    "infomarket bench --json": "a timing of 21 full runs; bench --json is tested with --steps 300",
+    "infomarket reproduce paper --out results/paper": "the whole paper (2 656 runs)",
+    "infomarket reproduce paper --out /tmp/quick --scale 0.125": "332 runs; --scale: tests/test_commands.py",
+    "infomarket reproduce paper --out results/paper --scale 0.125": "332 runs, as above",
+    "infomarket figures results/paper --out results/figures": "needs the paper's results store",
+    "infomarket figures results/paper --out results/paper-report": "needs the paper's results store",
+    "infomarket figures results/paper --out report --vector pdf": "needs the paper's results store",
+    "infomarket sweep fig7 --out results/fig7 --dask-local 4": "1 280 runs on a Dask cluster",
+    "infomarket sweep fig7 --out results/fig7": "1 280 runs",
+    "infomarket sweep my.toml --out store --workers 8": "16 full runs in 8 processes",
+    "infomarket sweep my.toml --out store --dask-local 4": "16 full runs on a Dask cluster",
+    "infomarket sweep my.toml --out store --scheduler tcp://head:8786": "needs a Dask scheduler at that address",
+    "infomarket chain demo --robots 10 --steps 3000 --scheme staking": "an EVM run; the chain demo has its own tests",
+    "infomarket run examples/age_liar.toml": "a full run; the example is tested in tests/test_extending.py",
+}
+
+
+def console_commands() -> list[tuple[str, str]]:
+    """(file, command) for every line of every ```console block, without prompts, the .venv/bin/
+    prefix and trailing comments."""
+    out = []
+    for doc in DOCS:
+        for block in re.findall(r"```console\n(.*?)```", doc.read_text(), re.S):
+            for line in block.splitlines():
+                cmd = line.split(" #")[0].strip().removeprefix("$ ").removeprefix(".venv/bin/")
+                if cmd:
+                    out.append((doc.name, " ".join(shlex.split(cmd))))
+    return out
+
+
+COMMANDS = console_commands()
+
+
+def test_every_documented_command_is_classified():
+    found = {cmd for _, cmd in COMMANDS}
+    assert len(found) >= 15
+    unlisted = found - RUN - set(NOT_RUN)
+    assert not unlisted, f"documented commands neither run nor listed as not run: {sorted(unlisted)}"
+    stale = (RUN | set(NOT_RUN)) - found
+    assert not stale, f"listed here but no longer in the docs: {sorted(stale)}"
+
+
+@pytest.mark.parametrize("doc, cmd", COMMANDS, ids=[c for _, c in COMMANDS])
+def test_documented_command_parses(doc, cmd):
+    words = shlex.split(cmd)
+    if words[0] == "make":
+        targets = re.findall(r"^([\w-]+):", (ROOT / "Makefile").read_text(), re.M)
+        assert words[1] in targets, f"{doc}: no make target {words[1]!r}"
+        return
+    assert words[0] == "infomarket", f"{doc}: {cmd}"
+    build_parser().parse_args(words[1:])  # exits with status 2 on an unknown command or option
+
+
+def readme_minimal_experiment() -> str:
+    text = (ROOT / "README.md").read_text()
+    return re.findall(r"```toml\n(.*?)```", text, re.S)[0]
+
+
+@pytest.mark.parametrize("cmd", sorted(RUN))
+def test_cheap_documented_command_runs(cmd, tmp_path, monkeypatch, capsys):
+    (tmp_path / "my.toml").write_text(readme_minimal_experiment())
+    monkeypatch.chdir(tmp_path)
+    assert main(shlex.split(cmd)[1:]) == 0
+    assert capsys.readouterr().out.strip()
