@@ -37,7 +37,7 @@ def test_reveal_records_the_sale_and_moves_the_stake_into_the_buyers_pot(make_ma
     result, lc, info = sell(market, seller, buyer, NEST, 123.456789, age=17)
 
     (revealed,) = logs(market, "InformationRevealed", result)
-    key = market.contract.functions.revealKey(NEST, 17, lc.offer.max_block, buyer.address, seller.address).call()
+    key = market.view("revealKey", NEST, 17, lc.offer.max_block, buyer.address, seller.address)
     assert dict(revealed.args) == {"buyer": buyer.address, "seller": seller.address, "key": key, "index": 0,
                                    "site": NEST, "age": 17, "x": info.x, "y": info.y, "direction": 123_456_789}
     (locked,) = logs(market, "StakeLocked", result)
@@ -45,7 +45,7 @@ def test_reveal_records_the_sale_and_moves_the_stake_into_the_buyers_pot(make_ma
     assert market.contributors(buyer.address) == [(seller.address, NEST, 123_456_789)]
     assert market.locked_stake(buyer.address) == 40_000_000
     assert market.balance_of(seller.address) == 960_000_000
-    assert market.contract.functions.isRevealed(key).call()
+    assert market.view("isRevealed", key)
 
 
 def test_buy_item_without_records_pays_only_the_reward(make_market, robots):

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from statistics import mean
 
-from .market import ChainMarket, MarketParams, connect, derived_account, fund_gas
+from .market import ChainMarket, MarketParams, connect, derived_account
 from .protocol import FOOD, PathInfo
 from .units import to_units
 
