@@ -283,6 +283,8 @@ contract InformationMarket {
     /// test stays below 2^250.
     int256 private constant _COS_SCALE = 1e9;
     int256 private constant _MAX_COMPONENT = 2 ** 47;
+    /// @dev Pair comparisons that count as one record of settlement work.
+    uint256 private constant _PAIRS_PER_UNIT = 64;
     uint8 private constant _EXPIRE = 0;
     uint8 private constant _WEIGH = 1;
     uint8 private constant _PAY = 2;
@@ -429,7 +431,9 @@ contract InformationMarket {
     /// @dev Requirements: a settlement is pending. Emits {RecordExpired}, {RewardShared} and, at the
     /// end, {SettlementCompleted}.
     /// @param robot The depositing robot.
-    /// @param maxRecords Work bound: each record processed in a phase counts one.
+    /// @param maxRecords Work bound: each record refunded or paid counts one, each record weighed
+    /// ceil(m / 64) for m live records (at least one record is weighed when `maxRecords` equals
+    /// `settleBatch`, so the default batch always makes progress).
     /// @return done Whether the round trip is now fully settled.
     function settle(address robot, uint256 maxRecords) external returns (bool done) {
         if (_settlements[robot].end == 0) revert InfoMarketNothingToSettle(robot);
@@ -758,10 +762,17 @@ contract InformationMarket {
             if (_scheme == Scheme.Delayed) s.totalWeight = end - next;
         }
         if (s.phase == _WEIGH) {
-            if (next < end && budget > 0) {
-                uint64 stop = next + uint64(budget < end - next ? budget : end - next);
+            // Weighing one record compares it with every live record: it costs ceil(m / 64) units of
+            // the budget, so a batch's gas stays bounded however long the round trip (docs/gas.md).
+            uint256 cost = (end - s.live + _PAIRS_PER_UNIT - 1) / _PAIRS_PER_UNIT;
+            if (cost == 0) cost = 1; // no live record: nothing to weigh
+            uint256 affordable = budget / cost;
+            if (next < end && affordable == 0 && budget == _settleBatch) affordable = 1;
+            if (next < end && affordable > 0) {
+                uint64 stop = next + uint64(affordable < end - next ? affordable : end - next);
                 s.totalWeight += _weigh(robot, s.live, next, stop, end);
-                budget -= stop - next;
+                uint256 spent = (stop - next) * cost;
+                budget = spent < budget ? budget - spent : 0;
                 next = stop;
             }
             if (next < end) {
@@ -821,9 +832,14 @@ contract InformationMarket {
         int256 cosTheta = _cosTheta;
         for (uint256 i = from - live; i < to - live; ++i) {
             uint256 w = 1;
+            (int256 x, int256 y, uint256 n, uint256 site) = (xs[i], ys[i], norms[i], sites[i]);
             for (uint256 j; j < m; ++j) {
-                if (j == i || sites[j] != sites[i]) continue;
-                if (_similar(xs[i], ys[i], norms[i], xs[j], ys[j], norms[j], cosTheta)) ++w;
+                if (j == i || sites[j] != site) continue;
+                if (_similar(x, y, n, xs[j], ys[j], norms[j], cosTheta)) {
+                    unchecked {
+                        ++w;
+                    }
+                }
             }
             records[live + i].weight = uint64(w);
             sum += w;
@@ -831,7 +847,9 @@ contract InformationMarket {
     }
 
     function _norm2(int256 x, int256 y) private pure returns (uint256) {
-        return uint256(x * x + y * y);
+        unchecked {
+            return uint256(x * x + y * y); // below 2^95: components are below 2^47
+        }
     }
 
     /// @dev angle(a, b) < theta  <=>  a.b > cos(theta) |a| |b|, decided without square roots:
@@ -844,11 +862,13 @@ contract InformationMarket {
         pure
         returns (bool)
     {
-        int256 d = ax * bx + ay * by;
-        uint256 lhs = uint256(d * d) * uint256(_COS_SCALE * _COS_SCALE);
-        uint256 rhs = uint256(c * c) * na * nb;
-        if (c >= 0) return d > 0 && lhs > rhs;
-        return d >= 0 || lhs < rhs;
+        unchecked {
+            int256 d = ax * bx + ay * by;
+            uint256 lhs = uint256(d * d) * uint256(_COS_SCALE * _COS_SCALE);
+            uint256 rhs = uint256(c * c) * na * nb;
+            if (c >= 0) return d > 0 && lhs > rhs;
+            return d >= 0 || lhs < rhs;
+        }
     }
 
     function _domainSeparator() private view returns (bytes32) {
