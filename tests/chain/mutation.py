@@ -93,8 +93,8 @@ def main() -> int:
     original = SOURCE.read_text()
     variants = []
     for check, condition, tests in MUTANTS:
-        pattern = re.compile(r"if \(" + re.escape(condition) + r"\) revert")
-        variants.append(("without: " + check, *pattern.subn("if (false) revert", original), tests))
+        pattern = re.compile(r"if \(" + re.escape(condition) + r"\)(\s*\{?\s*)revert")
+        variants.append(("without: " + check, *pattern.subn(r"if (false)\1revert", original), tests))
     for rule, old, new, tests in REWRITES:
         if tests:
             variants.append(("broken: " + rule, original.replace(old, new), original.count(old), tests))

@@ -206,7 +206,9 @@ def test_a_saboteurs_rotated_vector_gets_the_outliers_weight_whatever_it_says(ma
     declared the honest direction, and the contract weighed the declaration. Now there is nothing to
     declare: the weight comes from the committed vector minus the buyer-signed seller position."""
     buyer, saboteur = robots[0], robots[4]
-    position = (2.0, -1.0)
+    # The seller stands far from the buyer, so the purchased vectors (position + rotated vector) all
+    # point roughly the same way: only the seller's own vector tells the saboteur apart.
+    position = (-30.0, 40.0)
     honest = [(10.0, 1.0), (9.0, 2.5), (11.0, 0.0)]  # directions 5.7, 15.5 and 0 degrees from the seller
     for seller, (dx, dy) in zip(robots[1:4], honest):
         info = PathInfo.from_floats(position[0] + dx, position[1] + dy)

@@ -118,7 +118,7 @@ def _report_text(report, rows) -> str:
         f"  reveals                 {s['reveals']}",
         f"  gas per reveal          {s['gas_per_reveal']:,.0f} (mean)",
         f"  gas per deposit         {s['gas_per_buy_item']:,.0f} (mean), {s['max_gas_buy_item']:,} (max): buyItem "
-        f"and {s['settle_calls']} settle calls in all",
+        f"and {s['settle_calls']} settle calls in all; largest single transaction {s['largest_tx']:,}",
         f"  gas per item delivered  {s['gas_per_item']:,.0f}  ({s['items']} items, reveals included)",
         f"  blocks used             {s['blocks_used']}",
         f"  refusals confirmed      {s['refusals_confirmed']}",

@@ -56,6 +56,7 @@ class ReplayReport:
     last_block: int = 0
     refusals_confirmed: int = 0
     expired: int = 0
+    largest_tx: int = 0
     settle_calls: int = 0
     backend: str = ""
     disagreements: list[str] = field(default_factory=list)
@@ -96,7 +97,7 @@ class ReplayReport:
         return {"reveals": len(self.reveal_gas), "items": self.items, "gas_per_reveal": avg(self.reveal_gas),
                 "gas_per_buy_item": avg(self.buy_gas), "max_gas_buy_item": max(self.buy_gas, default=0),
                 "gas_per_item": self.gas_per_item, "blocks_used": self.blocks_used,
-                "refusals_confirmed": self.refusals_confirmed, "expired": self.expired,
+                "refusals_confirmed": self.refusals_confirmed, "expired": self.expired, "largest_tx": self.largest_tx,
                 "settle_calls": self.settle_calls}
 
 
@@ -149,6 +150,7 @@ def replay_on_chain(events: Iterable[Mapping] | object, *, robots: int, params: 
             buyer = int(ev["buyer"])
             results = market.deposit(accounts[buyer].address)
             report.buy_gas.append(sum(r.gas_used for r in results))
+            report.largest_tx = max(report.largest_tx, *(r.gas_used for r in results))
             report.settle_calls += len(results) - 1
             report.minted += params.reward
             _count_rounding(report.rounding_bound, buyer, [s for _, s in open_steps[buyer]])
