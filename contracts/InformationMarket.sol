@@ -9,11 +9,20 @@ pragma solidity 0.8.28;
 /// ERC-20: robots never transfer tokens to each other directly, every movement of money is one of the
 /// market's rules (stake, reward, share), and leaving `transfer`/`approve` out keeps the only ways to
 /// move money the ones this contract audits. Invariant: the sum of all balances plus all locked stakes
-/// equals `totalSupply()` (initial wealth granted plus every reward issued); rounding dust of a share
-/// stays with the depositing robot, so no token is ever created or destroyed by a division.
+/// equals `totalSupply()` (initial wealth granted plus every reward issued); stakes still locked in a
+/// buyer's pot or in a settlement count as locked. Rounding dust of a share stays with the depositing
+/// robot, so no token is ever created or destroyed by a division.
 ///
-/// Fixed point: token amounts in units of 1e-9 token; directions in microdegrees in [0, 360e6);
-/// positions in micro arena units (signed). The similarity window theta is in microdegrees.
+/// The contract trusts no seller's word about its information: the direction each record is weighed
+/// by is that of the vector the seller committed to, minus the seller's position the buyer signed
+/// (MODEL.md section 4), and "within theta" is decided on those integer vectors with dot products
+/// against a fixed cos(theta), exactly. A stake never stays locked for ever: records older than
+/// `stakeExpiry` blocks give their stake back to their seller (anyone may trigger it). A round trip
+/// of any length settles in bounded gas per transaction: `buyItem` settles what fits in one batch and
+/// `settle` continues where it stopped.
+///
+/// Fixed point: token amounts in units of 1e-9 token; positions and vectors in micro arena units
+/// (signed); cos(theta) in units of 1e-9.
 contract InformationMarket {
     // ------------------------------------------------------------------------------------------------
     // Types
@@ -32,8 +41,8 @@ contract InformationMarket {
     /// @param seller Account that sells and must submit the reveal.
     /// @param site 0 = food, 1 = nest.
     /// @param age Age of the offered information, in simulation steps.
-    /// @param maxBlock Last block in which the reveal may be included.
-    /// @param pathHash `keccak256(abi.encode(x, y, direction, salt))` of the `PathInfo` to be revealed.
+    /// @param maxBlock Last block in which the reveal may be included (at most `maxValidity` ahead).
+    /// @param pathHash `keccak256(abi.encode(x, y, salt))` of the `PathInfo` to be revealed.
     struct Offer {
         address seller;
         uint8 site;
@@ -60,26 +69,54 @@ contract InformationMarket {
         bytes32 s;
     }
 
-    /// @notice The revealed path information, in the buyer's frame.
+    /// @notice The revealed path information, in the buyer's frame. There is no declared direction:
+    /// the contract derives it from the vector.
     /// @param x Purchased vector to the site, x, micro units (rotated offer plus seller position).
     /// @param y Same, y.
-    /// @param direction Direction of the rotated offer (before adding the seller position), microdegrees.
     /// @param salt Seller's random nonce, so that the committed hash cannot be inverted by guessing.
     struct PathInfo {
         int64 x;
         int64 y;
-        uint32 direction;
         bytes32 salt;
     }
 
-    /// @notice One sale recorded under its buyer until the buyer's next deposit (one storage slot).
+    /// @notice One sale recorded under its buyer until the buyer's deposit settles it (two slots).
     /// @param seller Who sold it.
+    /// @param openedAt Block of the reveal (its expiry counts from there).
     /// @param site 0 = food, 1 = nest.
-    /// @param direction Direction of the sold vector in the buyer's frame, microdegrees.
+    /// @param dx The seller's rotated vector in the buyer's frame (purchased vector minus the seller's
+    /// position), x, micro units; a zero vector is stored as (1, 0), direction 0 like atan2(0, 0).
+    /// @param dy Same, y.
+    /// @param weight The record's weight, written while its round trip is settled.
     struct Information {
         address seller;
+        uint64 openedAt;
         uint8 site;
-        uint32 direction;
+        int64 dx;
+        int64 dy;
+        uint64 weight;
+    }
+
+    /// @dev A buyer's records are `_records[buyer][i]`; its open round trip is [start, count).
+    /// `trip` numbers its round trips (for the per-seller bound).
+    struct Round {
+        uint64 start;
+        uint64 count;
+        uint64 trip;
+    }
+
+    /// @dev A deposited round trip being settled, records [next, end) still to process in `phase`.
+    /// `escrow` holds the reward share and the stakes not yet paid out; `amount` is what the live
+    /// records share (fixed when the expired ones are refunded); `live` is the first live record.
+    struct Settlement {
+        uint64 next;
+        uint64 end;
+        uint64 closedAt;
+        uint64 live;
+        uint8 phase;
+        uint256 escrow;
+        uint256 amount;
+        uint256 totalWeight;
     }
 
     // ------------------------------------------------------------------------------------------------
@@ -97,16 +134,19 @@ contract InformationMarket {
     /// @param amount Stake, 1e-9 units.
     event StakeLocked(address indexed seller, address indexed buyer, uint256 amount);
 
-    /// @notice A light contract was executed and its path information revealed.
+    /// @notice A light contract was executed and its path information revealed. The event carries all
+    /// a record's weight depends on, so a settlement can be recomputed from the logs alone.
     /// @param buyer Buyer of the information.
     /// @param seller Seller of the information.
     /// @param key `revealKey(site, age, maxBlock, buyer, seller)`, now spent.
-    /// @param index Position of the record in the buyer's list of contributors.
+    /// @param index Position of the record in the buyer's list (`_records[buyer][index]`).
     /// @param site 0 = food, 1 = nest.
     /// @param age Age of the information.
     /// @param x Revealed vector, x, micro units, buyer's frame.
     /// @param y Revealed vector, y.
-    /// @param direction Direction of the rotated offer, microdegrees.
+    /// @param sellerX Seller's position in the buyer's frame (signed by the buyer), x.
+    /// @param sellerY Same, y.
+    /// @param pathHash The commitment the revealed information matched.
     event InformationRevealed(
         address indexed buyer,
         address indexed seller,
@@ -116,24 +156,41 @@ contract InformationMarket {
         uint32 age,
         int64 x,
         int64 y,
-        uint32 direction
+        int64 sellerX,
+        int64 sellerY,
+        bytes32 pathHash
     );
 
-    /// @notice The market paid `robot` the reward for one item and settled its round trip.
+    /// @notice A record expired (its buyer did not deposit within `stakeExpiry` blocks): its stake went
+    /// back to its seller and it takes no part in the buyer's settlement.
+    /// @param buyer The buyer.
+    /// @param seller The seller, refunded.
+    /// @param index The record.
+    /// @param amount Stake returned, 1e-9 units (0 without staking).
+    event RecordExpired(address indexed buyer, address indexed seller, uint256 index, uint256 amount);
+
+    /// @notice The market paid `robot` the reward for one item and closed its round trip for settlement.
     /// @param robot Depositing robot.
     /// @param reward Reward minted to it, 1e-9 units.
-    /// @param pot Stakes released to it before sharing.
-    /// @param shared Amount actually paid to its sellers (the rest of the share is rounding dust it keeps).
-    /// @param transactions Number of records settled.
-    event ItemBought(address indexed robot, uint256 reward, uint256 pot, uint256 shared, uint256 transactions);
+    /// @param pot Stakes of the round trip (refunds of expired records come out of it).
+    /// @param transactions Number of records in the round trip, expired ones included.
+    event ItemBought(address indexed robot, uint256 reward, uint256 pot, uint256 transactions);
 
     /// @notice One record's seller received its share of a deposit.
     /// @param robot Depositing robot (the buyer of the information).
     /// @param seller Receiving seller.
-    /// @param index Position of the record in the robot's list.
+    /// @param index The record.
     /// @param weight The record's weight (1 under delayed payment, similar-transaction count otherwise).
     /// @param amount Share paid, 1e-9 units.
     event RewardShared(address indexed robot, address indexed seller, uint256 index, uint256 weight, uint256 amount);
+
+    /// @notice A round trip's settlement finished: `shared` went to the sellers of its live records and
+    /// `kept` (rounding dust, or the whole share when no record was live) back to `robot`.
+    /// @param robot Depositing robot.
+    /// @param shared Sum of the shares paid.
+    /// @param kept Returned to the robot.
+    /// @param totalWeight Sum of the live records' weights.
+    event SettlementCompleted(address indexed robot, uint256 shared, uint256 kept, uint256 totalWeight);
 
     // ------------------------------------------------------------------------------------------------
     // Errors (EIP-6093 style: domain prefix and the values that explain the refusal)
@@ -152,6 +209,11 @@ contract InformationMarket {
     /// @param maxBlock Last block the light contract allowed.
     /// @param currentBlock Block the reveal would have been included in.
     error InfoMarketExpiredContract(uint64 maxBlock, uint256 currentBlock);
+
+    /// @notice The light contract's last block lies further ahead than `maxValidity` blocks.
+    /// @param maxBlock Last block the light contract asks for.
+    /// @param limit The furthest block allowed now.
+    error InfoMarketValidityTooLong(uint64 maxBlock, uint256 limit);
 
     /// @notice The buyer's signature does not recover to the buyer named in the light contract.
     /// @param buyer Buyer named in the light contract.
@@ -185,19 +247,31 @@ contract InformationMarket {
     /// @param site The refused code.
     error InfoMarketInvalidSite(uint8 site);
 
-    /// @notice The direction is not in [0, 360e6) microdegrees.
-    /// @param direction The refused value.
-    error InfoMarketInvalidDirection(uint32 direction);
+    /// @notice The seller's vector (purchased vector minus seller position) has a component of
+    /// magnitude 2^47 micro units or more, beyond what the similarity test computes exactly.
+    /// @param dx Its x component.
+    /// @param dy Its y component.
+    error InfoMarketVectorOutOfRange(int256 dx, int256 dy);
 
-    /// @notice The buyer already holds the most records one deposit can settle within a block's gas.
+    /// @notice The seller already sold `limit` records to this buyer in its current round trip.
     /// @param buyer The buyer.
-    /// @param limit `maxContributors()`.
-    error InfoMarketTooManyContributors(address buyer, uint256 limit);
+    /// @param seller The seller.
+    /// @param limit `maxRecordsPerSeller`.
+    error InfoMarketTooManyRecords(address buyer, address seller, uint256 limit);
+
+    /// @notice The robot's previous round trip is still being settled: call `settle` first.
+    /// @param robot The robot.
+    /// @param remaining Records its settlement still has to process.
+    error InfoMarketSettlementPending(address robot, uint256 remaining);
+
+    /// @notice There is no deposited round trip of `robot` to settle.
+    /// @param robot The robot.
+    error InfoMarketNothingToSettle(address robot);
 
     /// @notice A constructor argument is out of range.
     /// @param parameter Name of the argument (ASCII, right-padded with zeros).
     /// @param value Its value.
-    error InfoMarketInvalidParameter(bytes32 parameter, uint256 value);
+    error InfoMarketInvalidParameter(bytes32 parameter, int256 value);
 
     // ------------------------------------------------------------------------------------------------
     // Constants and configuration
@@ -205,8 +279,15 @@ contract InformationMarket {
 
     /// @dev One whole information share (the share is a WAD).
     uint256 private constant _WAD = 1e18;
-    uint32 private constant _FULL_TURN = 360_000_000;
-    uint32 private constant _HALF_TURN = 180_000_000;
+    /// @dev Scale of cos(theta): 1e9 = 1. With components below 2^47, every product of the similarity
+    /// test stays below 2^250.
+    int256 private constant _COS_SCALE = 1e9;
+    int256 private constant _MAX_COMPONENT = 2 ** 47;
+    /// @dev Pair comparisons that count as one record of settlement work.
+    uint256 private constant _PAIRS_PER_UNIT = 64;
+    uint8 private constant _EXPIRE = 0;
+    uint8 private constant _WEIGH = 1;
+    uint8 private constant _PAY = 2;
     /// @dev secp256k1 order / 2: a larger s is the malleated twin of a valid signature (EIP-2).
     uint256 private constant _HALF_ORDER = 0x7fffffffffffffffffffffffffffffff5d576e7357a4501ddfe92f46681b20a0;
 
@@ -219,15 +300,18 @@ contract InformationMarket {
         "Offer(address seller,uint8 site,uint32 age,uint64 maxBlock,bytes32 pathHash)"
     );
     bytes32 private constant _NAME_HASH = keccak256("InformationMarket");
-    bytes32 private constant _VERSION_HASH = keccak256("1");
+    bytes32 private constant _VERSION_HASH = keccak256("2");
 
     address private immutable _market;
     Scheme private immutable _scheme;
     uint256 private immutable _reward;
     uint256 private immutable _informationShare;
     uint256 private immutable _stake;
-    uint32 private immutable _theta;
-    uint256 private immutable _maxContributors;
+    int256 private immutable _cosTheta;
+    uint64 private immutable _stakeExpiry;
+    uint256 private immutable _maxRecordsPerSeller;
+    uint64 private immutable _maxValidity;
+    uint256 private immutable _settleBatch;
     uint256 private immutable _cachedChainId;
     bytes32 private immutable _cachedDomainSeparator;
 
@@ -237,12 +321,13 @@ contract InformationMarket {
 
     uint256 private _totalSupply;
     mapping(address robot => uint256) private _balances;
-    /// @dev Stakes locked by the sales recorded under each buyer, released at its next deposit.
+    /// @dev Stakes locked by the records of each buyer's open round trip.
     mapping(address buyer => uint256) private _pots;
-    /// @dev The buyer's records live in slots [0, count); clearing a list only resets its count, so the
-    /// next round trip rewrites warm non-zero slots (about 5k gas) instead of fresh ones (about 22k).
     mapping(address buyer => mapping(uint256 => Information)) private _records;
-    mapping(address buyer => uint256) private _recordCount;
+    mapping(address buyer => Round) private _rounds;
+    mapping(address buyer => Settlement) private _settlements;
+    /// @dev (round trip number << 32) | records sold in it, per buyer and seller.
+    mapping(address buyer => mapping(address seller => uint256)) private _sold;
     mapping(bytes32 key => bool) private _revealed;
 
     /// @notice Deploys a market with a fixed payment scheme; `market` alone can grant wealth and buy items.
@@ -251,29 +336,43 @@ contract InformationMarket {
     /// @param reward_ Reward R per item, 1e-9 units.
     /// @param informationShare_ Part of R shared with the sellers, as a WAD (0.5 = 5e17); at most 1e18.
     /// @param stake_ Stake per sale, 1e-9 units (0 = no staking); must be 0 under delayed payment.
-    /// @param theta_ Similarity window, microdegrees, at most 180e6 (only the outlier scheme uses it).
-    /// @param maxContributors_ Most records one buyer may hold; bounds `buyItem`'s gas (at least 1).
+    /// @param cosTheta_ cos(theta) of the similarity window, in units of 1e-9 (in [-1e9, 1e9]); two
+    /// records are similar when the angle between their vectors is strictly less than theta.
+    /// @param stakeExpiry_ Blocks after which an undeposited record expires (0 = never).
+    /// @param maxRecordsPerSeller_ Most records one seller may sell one buyer in one round trip (>= 1).
+    /// @param maxValidity_ Furthest a light contract's last block may lie ahead of its reveal (>= 1).
+    /// @param settleBatch_ Records `buyItem` settles itself before leaving the rest to `settle` (>= 1).
     constructor(
         address market_,
         Scheme scheme_,
         uint256 reward_,
         uint256 informationShare_,
         uint256 stake_,
-        uint32 theta_,
-        uint256 maxContributors_
+        int256 cosTheta_,
+        uint64 stakeExpiry_,
+        uint256 maxRecordsPerSeller_,
+        uint64 maxValidity_,
+        uint256 settleBatch_
     ) {
         if (market_ == address(0)) revert InfoMarketInvalidParameter("market", 0);
-        if (informationShare_ > _WAD) revert InfoMarketInvalidParameter("informationShare", informationShare_);
-        if (scheme_ == Scheme.Delayed && stake_ != 0) revert InfoMarketInvalidParameter("stake", stake_);
-        if (theta_ > _HALF_TURN) revert InfoMarketInvalidParameter("theta", theta_);
-        if (maxContributors_ == 0) revert InfoMarketInvalidParameter("maxContributors", 0);
+        if (informationShare_ > _WAD) revert InfoMarketInvalidParameter("informationShare", int256(informationShare_));
+        if (scheme_ == Scheme.Delayed && stake_ != 0) revert InfoMarketInvalidParameter("stake", int256(stake_));
+        if (cosTheta_ > _COS_SCALE || cosTheta_ < -_COS_SCALE) revert InfoMarketInvalidParameter("cosTheta", cosTheta_);
+        if (maxRecordsPerSeller_ == 0 || maxRecordsPerSeller_ >= 2 ** 32) {
+            revert InfoMarketInvalidParameter("maxRecordsPerSeller", int256(maxRecordsPerSeller_));
+        }
+        if (maxValidity_ == 0) revert InfoMarketInvalidParameter("maxValidity", 0);
+        if (settleBatch_ == 0) revert InfoMarketInvalidParameter("settleBatch", 0);
         _market = market_;
         _scheme = scheme_;
         _reward = reward_;
         _informationShare = informationShare_;
         _stake = stake_;
-        _theta = theta_;
-        _maxContributors = maxContributors_;
+        _cosTheta = cosTheta_;
+        _stakeExpiry = stakeExpiry_;
+        _maxRecordsPerSeller = maxRecordsPerSeller_;
+        _maxValidity = maxValidity_;
+        _settleBatch = settleBatch_;
         _cachedChainId = block.chainid;
         _cachedDomainSeparator = _buildDomainSeparator();
     }
@@ -293,47 +392,72 @@ contract InformationMarket {
         emit WealthGranted(robot, amount);
     }
 
-    /// @notice Buys the item `robot` deposited: pays it the reward, then shares the information part of
-    /// the reward (plus its pot of stakes under the outlier scheme) among the sellers of its records,
-    /// and clears its records and pot.
-    /// @dev Each record x receives floor(shared * w_x / sum w); the remainder stays with `robot`, so the
-    /// supply changes by exactly the reward. With no records nothing is shared. Requirements: the caller
-    /// is the market. Emits an {ItemBought} event and one {RewardShared} event per record.
+    /// @notice Buys the item `robot` deposited: pays it the reward, closes its round trip and settles
+    /// up to `settleBatch` records of it; `settle` finishes the rest.
+    /// @dev The reward share and the pot go into the settlement's escrow. Settling refunds the records
+    /// that expired before this block, weighs the live ones and pays each floor(amount * w / sum w);
+    /// the remainder goes back to `robot`, so the supply changes by exactly the reward.
+    /// Requirements: the caller is the market; the robot's previous round trip is fully settled.
+    /// Emits {ItemBought}, then what {settle} emits.
     /// @param robot The depositing robot.
-    function buyItem(address robot) external {
+    /// @return done Whether the round trip is fully settled.
+    function buyItem(address robot) external returns (bool done) {
         _requireMarket();
-        uint256 n = _recordCount[robot];
+        Settlement storage s = _settlements[robot];
+        if (s.end != 0) revert InfoMarketSettlementPending(robot, s.end - s.next);
+        Round storage round = _rounds[robot];
         uint256 pot = _pots[robot];
-        // The pot is empty under delayed payment: the constructor refuses stakes with that scheme.
-        uint256 amount = (_reward * _informationShare) / _WAD + pot;
-
-        uint256 paid;
-        if (n > 0) {
-            mapping(uint256 => Information) storage records = _records[robot];
-            address[] memory sellers = new address[](n);
-            uint256[] memory keys = new uint256[](n);
-            for (uint256 i; i < n; ++i) {
-                Information storage record = records[i];
-                sellers[i] = record.seller;
-                keys[i] = (uint256(record.site) << 32) | record.direction;
-            }
-            uint256[] memory weights = _weights(keys);
-            uint256 total;
-            for (uint256 i; i < n; ++i) total += weights[i];
-            for (uint256 i; i < n; ++i) {
-                uint256 share = (amount * weights[i]) / total;
-                _balances[sellers[i]] += share;
-                paid += share;
-                emit RewardShared(robot, sellers[i], i, weights[i], share);
-            }
-        }
-        // The robot receives the reward and its pot, and pays what its sellers received: it never goes
-        // negative because `paid <= informationShare * reward + pot <= reward + pot`.
-        _balances[robot] = _balances[robot] + _reward + pot - paid;
+        uint256 share = (_reward * _informationShare) / _WAD;
+        // The robot receives the reward and escrows the share: never negative since share <= reward.
+        _balances[robot] += _reward - share;
         _totalSupply += _reward;
         _pots[robot] = 0;
-        _recordCount[robot] = 0;
-        emit ItemBought(robot, _reward, pot, paid, n);
+        uint64 start = round.start;
+        uint64 end = round.count;
+        round.start = end;
+        round.trip += 1;
+        emit ItemBought(robot, _reward, pot, end - start);
+        s.next = start;
+        s.end = end;
+        s.closedAt = uint64(block.number);
+        s.live = start;
+        s.phase = _EXPIRE;
+        s.escrow = share + pot;
+        done = _settle(robot, _settleBatch);
+    }
+
+    /// @notice Continues the settlement of `robot`'s deposited round trip for at most `maxRecords`
+    /// records of work; anyone may call it (it moves money only by the market's rules).
+    /// @dev Requirements: a settlement is pending. Emits {RecordExpired}, {RewardShared} and, at the
+    /// end, {SettlementCompleted}.
+    /// @param robot The depositing robot.
+    /// @param maxRecords Work bound: each record refunded or paid counts one, each record weighed
+    /// ceil(m / 64) for m live records (at least one record is weighed when `maxRecords` equals
+    /// `settleBatch`, so the default batch always makes progress).
+    /// @return done Whether the round trip is now fully settled.
+    function settle(address robot, uint256 maxRecords) external returns (bool done) {
+        if (_settlements[robot].end == 0) revert InfoMarketNothingToSettle(robot);
+        return _settle(robot, maxRecords);
+    }
+
+    /// @notice Returns to their sellers the stakes of `buyer`'s open records that expired (opened
+    /// `stakeExpiry` blocks ago or more), oldest first, at most `maxRecords`; anyone may call it.
+    /// @dev Records are appended in block order, so the expired ones are a prefix of the open round
+    /// trip. Does nothing when `stakeExpiry` is 0. Emits {RecordExpired} per record.
+    /// @param buyer The buyer whose pot holds the stakes.
+    /// @param maxRecords Most records to refund in this call.
+    /// @return refunded How many records expired.
+    function refundExpired(address buyer, uint256 maxRecords) external returns (uint256 refunded) {
+        if (_stakeExpiry == 0) return 0;
+        Round storage round = _rounds[buyer];
+        uint64 i = round.start;
+        uint64 end = round.count;
+        while (i < end && refunded < maxRecords && _expired(_records[buyer][i].openedAt, block.number)) {
+            _pots[buyer] -= _refund(buyer, i);
+            ++i;
+            ++refunded;
+        }
+        round.start = i;
     }
 
     // ------------------------------------------------------------------------------------------------
@@ -343,9 +467,10 @@ contract InformationMarket {
     /// @notice Executes a light contract: records the sale under the buyer, reveals the path information
     /// and locks the seller's stake.
     /// @dev Checks, each with its own error: the seller is the caller; the current block is at most the
-    /// agreed max block; the buyer's EIP-712 signature over the acceptance is valid and not malleable;
-    /// (site, age, max block, buyer, seller) was never revealed before; the information hashes to the
-    /// committed value; the seller can lock the stake; the buyer has room for another record.
+    /// agreed max block, which lies at most `maxValidity` blocks ahead; the buyer's EIP-712 signature
+    /// over the acceptance is valid and not malleable; (site, age, max block, buyer, seller) was never
+    /// revealed before; the information hashes to the committed value; the seller's vector is in range;
+    /// the seller has not reached `maxRecordsPerSeller` in this round trip; it can lock the stake.
     /// Emits {StakeLocked} (under staking) and {InformationRevealed}.
     /// @param lc The double-signed light contract.
     /// @param info The path information in the buyer's frame.
@@ -355,9 +480,11 @@ contract InformationMarket {
         address buyer = lc.buyer;
         if (msg.sender != seller) revert InfoMarketUnauthorizedSeller(msg.sender, seller);
         if (block.number > offer.maxBlock) revert InfoMarketExpiredContract(offer.maxBlock, block.number);
+        if (offer.maxBlock > block.number + _maxValidity) {
+            revert InfoMarketValidityTooLong(offer.maxBlock, block.number + _maxValidity);
+        }
         if (buyer == seller) revert InfoMarketSelfDealing(seller);
         if (offer.site > 1) revert InfoMarketInvalidSite(offer.site);
-        if (info.direction >= _FULL_TURN) revert InfoMarketInvalidDirection(info.direction);
 
         _checkBuyerSignature(lc);
 
@@ -365,11 +492,11 @@ contract InformationMarket {
         if (_revealed[key]) revert InfoMarketAlreadyRevealed(key);
         _revealed[key] = true;
 
-        bytes32 revealed = keccak256(abi.encode(info.x, info.y, info.direction, info.salt));
+        bytes32 revealed = keccak256(abi.encode(info.x, info.y, info.salt));
         if (revealed != offer.pathHash) revert InfoMarketInformationMismatch(offer.pathHash, revealed);
 
-        uint256 index = _recordCount[buyer];
-        if (index >= _maxContributors) revert InfoMarketTooManyContributors(buyer, _maxContributors);
+        (int64 dx, int64 dy) = _sellerVector(info.x, info.y, lc.sellerX, lc.sellerY);
+        _countSale(buyer, seller);
 
         uint256 stake_ = _stake;
         if (stake_ > 0) {
@@ -380,9 +507,13 @@ contract InformationMarket {
             emit StakeLocked(seller, buyer, stake_);
         }
 
-        _records[buyer][index] = Information(seller, offer.site, info.direction);
-        _recordCount[buyer] = index + 1;
-        emit InformationRevealed(buyer, seller, key, index, offer.site, offer.age, info.x, info.y, info.direction);
+        Round storage round = _rounds[buyer];
+        uint64 index = round.count;
+        _records[buyer][index] = Information(seller, uint64(block.number), offer.site, dx, dy, 0);
+        round.count = index + 1;
+        emit InformationRevealed(
+            buyer, seller, key, index, offer.site, offer.age, info.x, info.y, lc.sellerX, lc.sellerY, offer.pathHash
+        );
     }
 
     // ------------------------------------------------------------------------------------------------
@@ -396,14 +527,26 @@ contract InformationMarket {
         return _balances[robot];
     }
 
-    /// @notice Stakes locked by the sales recorded under `buyer`, released at its next deposit.
+    /// @notice Stakes and shares locked under `buyer`: the pot of its open round trip plus what its
+    /// pending settlement still holds.
     /// @param buyer The account.
-    /// @return The pot, 1e-9 units.
+    /// @return The locked amount, 1e-9 units.
     function lockedStake(address buyer) external view returns (uint256) {
-        return _pots[buyer];
+        return _pots[buyer] + _settlements[buyer].escrow;
     }
 
-    /// @notice Tokens in existence: all balances plus all pots.
+    /// @notice Whether `robot` has a deposited round trip still to settle, and where it stands.
+    /// @param robot The account.
+    /// @return pending True until the settlement completes.
+    /// @return phase 0 refunding expired records, 1 weighing, 2 paying.
+    /// @return remaining Records left in the current phase.
+    function pendingSettlement(address robot) external view returns (bool pending, uint8 phase, uint256 remaining) {
+        Settlement storage s = _settlements[robot];
+        if (s.end == 0) return (false, 0, 0);
+        return (true, s.phase, s.end - s.next);
+    }
+
+    /// @notice Tokens in existence: all balances plus everything locked.
     /// @return The supply, 1e-9 units.
     function totalSupply() external view returns (uint256) {
         return _totalSupply;
@@ -415,13 +558,14 @@ contract InformationMarket {
         return 9;
     }
 
-    /// @notice The records `buyer` accumulated since its last deposit, in reveal order.
+    /// @notice The records of `buyer`'s open round trip (unexpired, not yet deposited), in reveal order.
     /// @param buyer The account.
     /// @return list Its contributors' records.
     function contributors(address buyer) external view returns (Information[] memory list) {
-        uint256 n = _recordCount[buyer];
-        list = new Information[](n);
-        for (uint256 i; i < n; ++i) list[i] = _records[buyer][i];
+        Round storage round = _rounds[buyer];
+        uint256 start = round.start;
+        list = new Information[](round.count - start);
+        for (uint256 i; i < list.length; ++i) list[i] = _records[buyer][start + i];
     }
 
     /// @notice Whether the light contract identified by `key` was already revealed.
@@ -429,6 +573,19 @@ contract InformationMarket {
     /// @return True once revealed.
     function isRevealed(bytes32 key) external view returns (bool) {
         return _revealed[key];
+    }
+
+    /// @notice Whether two seller vectors are similar: the angle between them is strictly less than
+    /// theta. Exposed so that clients and tests can check the rule on its own.
+    /// @param ax First vector, x.
+    /// @param ay First vector, y.
+    /// @param bx Second vector, x.
+    /// @param by Second vector, y.
+    /// @return Whether they are similar.
+    function similar(int64 ax, int64 ay, int64 bx, int64 by) external view returns (bool) {
+        (ax, ay) = _nonZero(ax, ay);
+        (bx, by) = _nonZero(bx, by);
+        return _similar(ax, ay, _norm2(ax, ay), bx, by, _norm2(bx, by), _cosTheta);
     }
 
     /// @notice The identity of a light contract for the never-twice check: the paper's tuple.
@@ -467,7 +624,7 @@ contract InformationMarket {
     /// @notice The EIP-712 domain (EIP-5267), so that clients sign for this contract on this chain only.
     /// @return fields Bit mask of the fields used (name, version, chainId, verifyingContract).
     /// @return name "InformationMarket".
-    /// @return version "1".
+    /// @return version "2".
     /// @return chainId Current chain id.
     /// @return verifyingContract This contract.
     /// @return salt Unused.
@@ -485,17 +642,20 @@ contract InformationMarket {
             uint256[] memory extensions
         )
     {
-        return (hex"0f", "InformationMarket", "1", block.chainid, address(this), bytes32(0), new uint256[](0));
+        return (hex"0f", "InformationMarket", "2", block.chainid, address(this), bytes32(0), new uint256[](0));
     }
 
-    /// @notice The market's configuration.
+    /// @notice The market's configuration (the constructor's arguments).
     /// @return market_ Market account.
     /// @return scheme_ Payment scheme.
     /// @return reward_ Reward per item, 1e-9 units.
     /// @return informationShare_ Shared part of the reward, WAD.
     /// @return stake_ Stake per sale, 1e-9 units.
-    /// @return theta_ Similarity window, microdegrees.
-    /// @return maxContributors_ Most records per buyer.
+    /// @return cosTheta_ cos(theta), 1e-9 units.
+    /// @return stakeExpiry_ Blocks before a record expires (0 = never).
+    /// @return maxRecordsPerSeller_ Most records per seller, buyer and round trip.
+    /// @return maxValidity_ Furthest a light contract's last block may lie ahead.
+    /// @return settleBatch_ Records `buyItem` settles itself.
     function configuration()
         external
         view
@@ -505,11 +665,25 @@ contract InformationMarket {
             uint256 reward_,
             uint256 informationShare_,
             uint256 stake_,
-            uint32 theta_,
-            uint256 maxContributors_
+            int256 cosTheta_,
+            uint64 stakeExpiry_,
+            uint256 maxRecordsPerSeller_,
+            uint64 maxValidity_,
+            uint256 settleBatch_
         )
     {
-        return (_market, _scheme, _reward, _informationShare, _stake, _theta, _maxContributors);
+        return (
+            _market,
+            _scheme,
+            _reward,
+            _informationShare,
+            _stake,
+            _cosTheta,
+            _stakeExpiry,
+            _maxRecordsPerSeller,
+            _maxValidity,
+            _settleBatch
+        );
     }
 
     // ------------------------------------------------------------------------------------------------
@@ -527,35 +701,173 @@ contract InformationMarket {
         if (recovered == address(0) || recovered != lc.buyer) revert InfoMarketInvalidBuyerSignature(lc.buyer, recovered);
     }
 
-    /// @dev Weights of a round trip's records, given as `site << 32 | direction`. Delayed: 1 each.
-    /// Outlier: for each record, the number of same-site records (itself included) whose direction is
-    /// circularly within theta of its own. Each pair is compared once and credited to both, so the cost
-    /// is n(n-1)/2 comparisons; within one site the keys differ only in their direction bits, so the
-    /// key difference is the direction difference.
-    function _weights(uint256[] memory keys) private view returns (uint256[] memory weights) {
-        uint256 n = keys.length;
-        weights = new uint256[](n);
-        if (_scheme == Scheme.Delayed) {
-            for (uint256 i; i < n; ++i) weights[i] = 1;
-            return weights;
+    /// @dev The seller's rotated vector (MODEL.md section 4: purchased vector minus seller position),
+    /// range-checked, a zero vector replaced by (1, 0).
+    function _sellerVector(int64 x, int64 y, int64 sx, int64 sy) private pure returns (int64, int64) {
+        int256 dx = int256(x) - sx;
+        int256 dy = int256(y) - sy;
+        if (dx >= _MAX_COMPONENT || dx <= -_MAX_COMPONENT || dy >= _MAX_COMPONENT || dy <= -_MAX_COMPONENT) {
+            revert InfoMarketVectorOutOfRange(dx, dy);
         }
-        uint256 theta = _theta;
-        unchecked {
-            for (uint256 i; i < n; ++i) {
-                uint256 a = keys[i];
-                uint256 similar = weights[i] + 1;
-                for (uint256 j = i + 1; j < n; ++j) {
-                    uint256 b = keys[j];
-                    if ((a ^ b) >> 32 != 0) continue;
-                    uint256 d = a > b ? a - b : b - a;
-                    if (d > _HALF_TURN) d = _FULL_TURN - d;
-                    if (d < theta) {
-                        ++similar;
-                        ++weights[j];
+        return _nonZero(int64(dx), int64(dy));
+    }
+
+    function _nonZero(int64 x, int64 y) private pure returns (int64, int64) {
+        return x == 0 && y == 0 ? (int64(1), int64(0)) : (x, y);
+    }
+
+    /// @dev Counts a sale of `seller` to `buyer` in the buyer's open round trip, within the bound.
+    function _countSale(address buyer, address seller) private {
+        uint256 trip = _rounds[buyer].trip;
+        uint256 packed = _sold[buyer][seller];
+        uint256 n = packed >> 32 == trip ? packed & 0xffffffff : 0;
+        if (n >= _maxRecordsPerSeller) revert InfoMarketTooManyRecords(buyer, seller, _maxRecordsPerSeller);
+        _sold[buyer][seller] = (trip << 32) | (n + 1);
+    }
+
+    function _expired(uint64 openedAt, uint256 now_) private view returns (bool) {
+        return _stakeExpiry != 0 && uint256(openedAt) + _stakeExpiry <= now_;
+    }
+
+    /// @dev Gives record `index` of `buyer` its stake back; returns the stake (the caller debits it).
+    function _refund(address buyer, uint256 index) private returns (uint256 amount) {
+        address seller = _records[buyer][index].seller;
+        amount = _stake;
+        if (amount > 0) _balances[seller] += amount;
+        emit RecordExpired(buyer, seller, index, amount);
+    }
+
+    /// @dev Runs the pending settlement of `robot` for at most `budget` records of work, phase by
+    /// phase: refund the expired prefix, weigh the live records, pay them; then return the rest.
+    function _settle(address robot, uint256 budget) private returns (bool) {
+        Settlement storage s = _settlements[robot];
+        uint64 next = s.next;
+        uint64 end = s.end;
+        if (s.phase == _EXPIRE) {
+            uint64 closedAt = s.closedAt;
+            uint256 escrow = s.escrow;
+            while (next < end && budget > 0 && _expired(_records[robot][next].openedAt, closedAt)) {
+                escrow -= _refund(robot, next);
+                ++next;
+                --budget;
+            }
+            s.escrow = escrow;
+            if (next < end && budget == 0) {
+                s.next = next;
+                return false;
+            }
+            s.live = next;
+            s.amount = escrow;
+            s.phase = _scheme == Scheme.Outlier ? _WEIGH : _PAY;
+            if (_scheme == Scheme.Delayed) s.totalWeight = end - next;
+        }
+        if (s.phase == _WEIGH) {
+            // Weighing one record compares it with every live record: it costs ceil(m / 64) units of
+            // the budget, so a batch's gas stays bounded however long the round trip (docs/gas.md).
+            uint256 cost = (end - s.live + _PAIRS_PER_UNIT - 1) / _PAIRS_PER_UNIT;
+            if (cost == 0) cost = 1; // no live record: nothing to weigh
+            uint256 affordable = budget / cost;
+            if (next < end && affordable == 0 && budget == _settleBatch) affordable = 1;
+            if (next < end && affordable > 0) {
+                uint64 stop = next + uint64(affordable < end - next ? affordable : end - next);
+                s.totalWeight += _weigh(robot, s.live, next, stop, end);
+                uint256 spent = (stop - next) * cost;
+                budget = spent < budget ? budget - spent : 0;
+                next = stop;
+            }
+            if (next < end) {
+                s.next = next;
+                return false;
+            }
+            s.phase = _PAY;
+            next = s.live;
+        }
+        uint256 amount = s.amount;
+        uint256 total = s.totalWeight;
+        uint256 escrowLeft = s.escrow;
+        while (next < end && budget > 0) {
+            Information storage record = _records[robot][next];
+            uint256 weight = _scheme == Scheme.Outlier ? record.weight : 1;
+            uint256 share = (amount * weight) / total;
+            _balances[record.seller] += share;
+            escrowLeft -= share;
+            emit RewardShared(robot, record.seller, next, weight, share);
+            ++next;
+            --budget;
+        }
+        s.escrow = escrowLeft;
+        if (next < end) {
+            s.next = next;
+            return false;
+        }
+        _balances[robot] += escrowLeft;
+        emit SettlementCompleted(robot, amount - (s.live < end ? escrowLeft : amount), escrowLeft, total);
+        delete _settlements[robot];
+        // When nothing was revealed to the robot since its deposit, its next round trip can start
+        // again at index 0 and rewrite warm slots (about 5k gas each) instead of fresh ones (22k).
+        Round storage round = _rounds[robot];
+        if (round.start == round.count) {
+            round.start = 0;
+            round.count = 0;
+        }
+        return true;
+    }
+
+    /// @dev Weights of records [from, to) of `robot`: for each, the number of records among the live
+    /// ones [live, end) of the same site (itself included) whose vector lies strictly within theta of
+    /// its own. Loads the live records once into memory: O(end - live) storage reads and
+    /// O((to - from) * (end - live)) comparisons, bounded by the caller's batch. Returns their sum.
+    function _weigh(address robot, uint64 live, uint64 from, uint64 to, uint64 end) private returns (uint256 sum) {
+        uint256 m = end - live;
+        int256[] memory xs = new int256[](m);
+        int256[] memory ys = new int256[](m);
+        uint256[] memory norms = new uint256[](m);
+        uint256[] memory sites = new uint256[](m);
+        mapping(uint256 => Information) storage records = _records[robot];
+        for (uint256 k; k < m; ++k) {
+            Information storage r = records[live + k];
+            (xs[k], ys[k], sites[k]) = (r.dx, r.dy, r.site);
+            norms[k] = _norm2(r.dx, r.dy);
+        }
+        int256 cosTheta = _cosTheta;
+        for (uint256 i = from - live; i < to - live; ++i) {
+            uint256 w = 1;
+            (int256 x, int256 y, uint256 n, uint256 site) = (xs[i], ys[i], norms[i], sites[i]);
+            for (uint256 j; j < m; ++j) {
+                if (j == i || sites[j] != site) continue;
+                if (_similar(x, y, n, xs[j], ys[j], norms[j], cosTheta)) {
+                    unchecked {
+                        ++w;
                     }
                 }
-                weights[i] = similar;
             }
+            records[live + i].weight = uint64(w);
+            sum += w;
+        }
+    }
+
+    function _norm2(int256 x, int256 y) private pure returns (uint256) {
+        unchecked {
+            return uint256(x * x + y * y); // below 2^95: components are below 2^47
+        }
+    }
+
+    /// @dev angle(a, b) < theta  <=>  a.b > cos(theta) |a| |b|, decided without square roots:
+    /// with c = cos(theta) * S (S = 1e9) and d = a.b,
+    /// - c >= 0: similar iff d > 0 and d^2 S^2 > c^2 |a|^2 |b|^2;
+    /// - c < 0: similar iff d >= 0 or d^2 S^2 < c^2 |a|^2 |b|^2.
+    /// Components are below 2^47, so every product is below 2^250: exact integer arithmetic.
+    function _similar(int256 ax, int256 ay, uint256 na, int256 bx, int256 by, uint256 nb, int256 c)
+        private
+        pure
+        returns (bool)
+    {
+        unchecked {
+            int256 d = ax * bx + ay * by;
+            uint256 lhs = uint256(d * d) * uint256(_COS_SCALE * _COS_SCALE);
+            uint256 rhs = uint256(c * c) * na * nb;
+            if (c >= 0) return d > 0 && lhs > rhs;
+            return d >= 0 || lhs < rhs;
         }
     }
 

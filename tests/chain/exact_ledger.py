@@ -2,12 +2,28 @@
 
 The contract floors every share to a whole unit; this model does not round at all, so the tests can
 check the contract against the rules themselves (within the rounding bound), not against a copy of
-the contract's own integer arithmetic.
+the contract's own integer arithmetic. Directions are compared in degrees, as the simulation does; the
+contract compares vectors, so tests build each vector from its direction (``vector_for``) far enough
+from Theta that the micro-unit rounding cannot matter. With ``expiry`` = T > 0 it also applies the
+stake-expiry rule: at ``advance(step)``, transactions opened at a step t with t + T <= step are
+dropped and their stakes returned.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from fractions import Fraction
+
+#: Where every test seller stands in its buyer's frame, and how long its rotated vector is.
+SELLER_POSITION = (1.5, -0.5)
+VECTOR_LENGTH = 7.0
+
+
+def vector_for(direction_deg: float) -> tuple[float, float]:
+    """The purchased vector (buyer's frame) of a seller at ``SELLER_POSITION`` whose rotated vector
+    points at ``direction_deg``."""
+    rad = math.radians(direction_deg)
+    return (SELLER_POSITION[0] + VECTOR_LENGTH * math.cos(rad), SELLER_POSITION[1] + VECTOR_LENGTH * math.sin(rad))
 
 
 def circular_distance(a: Fraction, b: Fraction) -> Fraction:
@@ -26,9 +42,10 @@ class ExactLedger:
     stake: Fraction
     theta: Fraction
     initial: Fraction
+    expiry: int = 0
     balance: list[Fraction] = field(init=False)
     pot: list[Fraction] = field(init=False)
-    open: list[list[tuple[int, int, Fraction]]] = field(init=False)
+    open: list[list[tuple[int, int, Fraction, int]]] = field(init=False)
     bound: list[int] = field(init=False)
 
     def __post_init__(self) -> None:
@@ -37,14 +54,25 @@ class ExactLedger:
         self.open = [[] for _ in range(self.robots)]
         self.bound = [0] * self.robots
 
-    def purchase(self, buyer: int, seller: int, site: int, direction: Fraction) -> bool:
+    def advance(self, step: int) -> None:
+        """Start ``step``: expire what its age allows."""
+        if not self.expiry:
+            return
+        for buyer, txs in enumerate(self.open):
+            keep = [t for t in txs if t[3] + self.expiry > step]
+            for seller, _, _, _ in txs[: len(txs) - len(keep)]:
+                self.balance[seller] += self.stake
+                self.pot[buyer] -= self.stake
+            self.open[buyer] = keep
+
+    def purchase(self, buyer: int, seller: int, site: int, direction: Fraction, step: int = 0) -> bool:
         """Record a sale; False (nothing recorded) when the seller cannot lock the stake."""
         if self.stake > 0:
             if self.balance[seller] < self.stake:
                 return False
             self.balance[seller] -= self.stake
             self.pot[buyer] += self.stake
-        self.open[buyer].append((seller, site, direction))
+        self.open[buyer].append((seller, site, direction, step))
         return True
 
     def deposit(self, robot: int) -> None:
@@ -56,10 +84,10 @@ class ExactLedger:
             if self.scheme == "delayed":
                 weights = [1] * len(txs)
             else:
-                weights = [sum(1 for (_, s2, d2) in txs if s2 == s and circular_distance(d, d2) < self.theta)
-                           for (_, s, d) in txs]
+                weights = [sum(1 for (_, s2, d2, _) in txs if s2 == s and circular_distance(d, d2) < self.theta)
+                           for (_, s, d, _) in txs]
             total = sum(weights)
-            for (seller, _, _), w in zip(txs, weights):
+            for (seller, _, _, _), w in zip(txs, weights):
                 self.balance[seller] += amount * w / total
                 self.bound[seller] += 1
             self.balance[robot] -= amount

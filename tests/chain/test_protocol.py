@@ -12,7 +12,10 @@ from infomarket.chain.protocol import (
     PathInfo,
     ProtocolError,
     accept_offer,
+    acceptance_digest,
     acceptance_typed_data,
+    offer_digest,
+    offer_typed_data,
     path_in_buyer_frame,
     sign_offer,
 )
@@ -48,19 +51,27 @@ def test_positions_must_fit_int64():
 
 
 def test_path_information_is_the_rotated_offer_plus_the_seller_position():
-    x, y, direction = path_in_buyer_frame((10.0, 0.0), 90.0, (3.0, -4.0))
+    x, y = path_in_buyer_frame((10.0, 0.0), 90.0, (3.0, -4.0))
     assert (x, y) == pytest.approx((3.0, 6.0))
-    assert direction == pytest.approx(90.0)  # the direction ignores the seller's offset
-    _, _, direction = path_in_buyer_frame((1.0, 1.0), 180.0, (100.0, 100.0))
-    assert direction == pytest.approx(225.0)
+    x, y = path_in_buyer_frame((1.0, 1.0), 180.0, (100.0, 100.0))
+    assert (x, y) == pytest.approx((99.0, 99.0))
 
 
 def test_path_commitment_binds_every_field():
-    info = PathInfo(1, 2, 3, b"\x01" * 32)
-    changed = [PathInfo(9, 2, 3, info.salt), PathInfo(1, 9, 3, info.salt), PathInfo(1, 2, 9, info.salt),
-               PathInfo(1, 2, 3, b"\x02" * 32)]
-    assert len({info.digest(), *(c.digest() for c in changed)}) == 5
-    assert PathInfo.from_floats(1.0, 2.0, 3.0).salt != PathInfo.from_floats(1.0, 2.0, 3.0).salt
+    info = PathInfo(1, 2, b"\x01" * 32)
+    changed = [PathInfo(9, 2, info.salt), PathInfo(1, 9, info.salt), PathInfo(1, 2, b"\x02" * 32)]
+    assert len({info.digest(), *(c.digest() for c in changed)}) == 4
+    assert PathInfo.from_floats(1.0, 2.0).salt != PathInfo.from_floats(1.0, 2.0).salt
+
+
+def test_hand_hashed_digests_equal_eth_accounts_typed_data_encoding():
+    domain = Domain(7, "0x" + "44" * 20)
+    offer = _offer("0x" + "55" * 20)
+    for typed, digest in ((offer_typed_data(domain, offer), offer_digest(domain, offer)),
+                          (acceptance_typed_data(domain, offer, "0x" + "66" * 20, -3, 4),
+                           acceptance_digest(domain, offer, "0x" + "66" * 20, -3, 4))):
+        signable = encode_typed_data(full_message=typed)
+        assert digest == keccak(b"\x19" + signable.version + signable.header + signable.body)
 
 
 def _offer(seller: str, domain_block: int = 10) -> Offer:
@@ -93,12 +104,11 @@ def test_acceptance_signature_recovers_to_the_buyer_and_signs_the_seller_positio
 def test_python_and_contract_hash_the_acceptance_identically(make_market, robots):
     market = make_market("outlier")
     seller, buyer = robots[1], robots[0]
-    info = PathInfo.from_floats(12.0, -3.0, 200.0)
+    info = PathInfo.from_floats(12.0, -3.0)
     lc = market.light_contract(seller, buyer, 0, 42, info, (-7.25, 0.5))
-    on_chain = market.contract.functions.acceptanceDigest(lc.offer.as_abi(), buyer.address, lc.seller_x,
-                                                          lc.seller_y).call()
+    on_chain = market.view("acceptanceDigest", lc.offer.as_abi(), buyer.address, lc.seller_x, lc.seller_y)
     typed = acceptance_typed_data(market.domain, lc.offer, buyer.address, lc.seller_x, lc.seller_y)
     signable = encode_typed_data(full_message=typed)
     assert on_chain == keccak(b"\x19" + signable.version + signable.header + signable.body)
-    assert market.domain.verifying_contract == market.contract.address
-    assert market.domain.chain_id == market.w3.eth.chain_id
+    assert market.domain.verifying_contract == market.address
+    assert market.domain.chain_id == market.backend.chain_id

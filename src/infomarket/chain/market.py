@@ -1,47 +1,58 @@
 """A deployed ``InformationMarket`` and the accounts that use it.
 
-Every robot is an account with its own secp256k1 key and signs its own transactions locally, as it
-would on a real swarm; the market node is one more account, the only one allowed to grant wealth and
-buy items. The chain is either an in-process EVM (web3.py's ``EthereumTesterProvider`` over py-evm,
-the default: nothing to install or run) or any JSON-RPC node (``rpc_url``), whose first unlocked
-account pays the robots' gas (a development node such as anvil or ``geth --dev`` has one).
+Every robot is an account with its own secp256k1 key; the market node is one more account, the only
+one allowed to grant wealth and buy items. Where the contract runs is a backend (backends.py): revm
+in process (the default, fast), py-evm in process (the reference EVM), or a JSON-RPC node.
+``ChainMarket`` only encodes calls with the contract's ABI, hands them to the backend and decodes what
+comes back, so the same client and the same tests run on every backend.
 
-Refusals come back as ``ContractRevert`` with the custom error's name and decoded arguments, on both
-backends: every transaction is dry-run first (``eth_call``), which surfaces the revert data before
-anything is mined.
+Refusals come back as ``ContractRevert`` with the custom error's name and decoded arguments, on every
+backend.
 """
 from __future__ import annotations
 
 import ast
 import json
-from contextlib import contextmanager
+import math
 from dataclasses import dataclass
 from functools import cached_property
 from importlib import resources
 from typing import Any, NamedTuple
 
 from eth_abi import decode as abi_decode
+from eth_abi import encode as abi_encode
 from eth_account import Account
 from eth_account.signers.local import LocalAccount
 from eth_utils import keccak, to_checksum_address
-from web3 import Web3
+from eth_utils.abi import event_abi_to_log_topic, function_abi_to_4byte_selector, get_abi_input_types, get_abi_output_types
 
+from .backends import Receipt, RevertedCall, make_backend
 from .errors import ChainError, ContractRevert
 from .protocol import Domain, LightContract, Offer, PathInfo, accept_offer, sign_offer
-from .units import share_to_wad, to_microdegrees, to_units
+from .units import COS_SCALE, share_to_wad, to_units
 
 SCHEMES = {"delayed": 0, "outlier": 1}
-#: Gas money given to every robot and to the market account (wei); far above what a demo spends.
-GAS_ALLOWANCE_WEI = 10**20
-#: Default cap on records per buyer: keeps the O(n^2) outlier weighting of ``buyItem`` inside a 30M
-#: block (16.3M gas measured at 256 records; docs/gas.md has the curve up to 64).
-DEFAULT_MAX_CONTRIBUTORS = 256
+#: Most records one seller may sell one buyer per round trip: far above what a paper run reaches
+#: (82 at most in a 25-robot, 15 000-step run), low enough that no seller can crowd out the rest.
+DEFAULT_MAX_RECORDS_PER_SELLER = 256
+#: Furthest a light contract's last block may lie ahead of its reveal.
+DEFAULT_MAX_VALIDITY = 256
+#: Records ``buyItem`` settles itself; ``settle`` continues in batches of ``SETTLE_BATCH``.
+DEFAULT_SETTLE_BATCH = 48
+SETTLE_BATCH = 48
 
 
 def load_artifact() -> dict:
     """ABI and bytecode compiled by tools/solc/compile.js and shipped inside the package."""
     text = resources.files(__package__).joinpath("artifacts/InformationMarket.json").read_text()
     return json.loads(text)
+
+
+def cos_theta(theta_deg: float) -> int:
+    """cos(theta) in the contract's fixed point (1e-9), nearest."""
+    if not 0.0 <= theta_deg <= 180.0:
+        raise ValueError(f"theta must be in [0, 180] degrees, not {theta_deg}")
+    return round(math.cos(math.radians(theta_deg)) * COS_SCALE)
 
 
 @dataclass(frozen=True)
@@ -52,29 +63,45 @@ class MarketParams:
     reward: int
     information_share: int
     stake: int
-    theta: int
-    max_contributors: int = DEFAULT_MAX_CONTRIBUTORS
+    cos_theta: int
+    stake_expiry: int = 0
+    max_records_per_seller: int = DEFAULT_MAX_RECORDS_PER_SELLER
+    max_validity: int = DEFAULT_MAX_VALIDITY
+    settle_batch: int = DEFAULT_SETTLE_BATCH
 
     @classmethod
     def from_floats(cls, scheme: str, *, reward: float = 1.0, information_share: float = 0.5,
-                    stake: float = 0.0, theta_deg: float = 30.0,
-                    max_contributors: int = DEFAULT_MAX_CONTRIBUTORS) -> MarketParams:
+                    stake: float = 0.0, theta_deg: float = 30.0, stake_expiry: int = 0,
+                    max_records_per_seller: int = DEFAULT_MAX_RECORDS_PER_SELLER,
+                    max_validity: int = DEFAULT_MAX_VALIDITY, settle_batch: int = DEFAULT_SETTLE_BATCH) -> MarketParams:
         if scheme not in SCHEMES:
             raise ValueError(f"scheme must be one of {sorted(SCHEMES)}, not {scheme!r}")
         return cls(scheme, to_units(reward), share_to_wad(information_share), to_units(stake),
-                   to_microdegrees(theta_deg), max_contributors)
+                   cos_theta(theta_deg), stake_expiry, max_records_per_seller, max_validity, settle_batch)
 
     def constructor_args(self, market: str) -> tuple:
         return (market, SCHEMES[self.scheme], self.reward, self.information_share, self.stake,
-                self.theta, self.max_contributors)
+                self.cos_theta, self.stake_expiry, self.max_records_per_seller, self.max_validity,
+                self.settle_batch)
+
+
+class Event(NamedTuple):
+    """A decoded event log."""
+
+    name: str
+    args: dict
 
 
 class TxResult(NamedTuple):
-    """What a mined transaction cost and where it landed."""
+    """What a mined transaction cost, where it landed, and its decoded events."""
 
     gas_used: int
     block_number: int
-    receipt: Any
+    events: list[Event]
+
+    def of(self, name: str) -> list[dict]:
+        """The arguments of this transaction's ``name`` events, in order."""
+        return [e.args for e in self.events if e.name == name]
 
 
 def derived_account(label: str, index: int, seed: int = 0) -> LocalAccount:
@@ -85,155 +112,175 @@ def derived_account(label: str, index: int, seed: int = 0) -> LocalAccount:
     return Account.from_key(keccak(f"infomarket/{label}/{seed}/{index}".encode()))
 
 
-def connect(rpc_url: str | None = None) -> Web3:
-    """An in-process EVM, or the JSON-RPC node at ``rpc_url``."""
-    if rpc_url is None:
-        from web3 import EthereumTesterProvider
+def connect(rpc_url: str | None = None, backend: str | None = None):
+    """A chain: revm in process (default), ``backend="py-evm"``, or the JSON-RPC node at ``rpc_url``."""
+    return make_backend(backend, rpc_url)
 
-        return Web3(EthereumTesterProvider())
-    w3 = Web3(Web3.HTTPProvider(rpc_url))
-    if not w3.is_connected():
-        raise ChainError(f"no JSON-RPC node answers at {rpc_url}")
-    return w3
+
+class _Codec:
+    """The contract's ABI: calldata encoding, result, event and error decoding."""
+
+    def __init__(self, abi: list):
+        self.abi = abi
+        self.functions = {e["name"]: e for e in abi if e["type"] == "function"}
+        self.events = {event_abi_to_log_topic(e): e for e in abi if e["type"] == "event"}
+        self.errors = _error_table(abi)
+
+    def calldata(self, name: str, args: tuple) -> bytes:
+        fn = self.functions[name]
+        return function_abi_to_4byte_selector(fn) + abi_encode(get_abi_input_types(fn), list(args))
+
+    def result(self, name: str, data: bytes) -> Any:
+        fn = self.functions[name]
+        values = abi_decode(get_abi_output_types(fn), data)
+        return values[0] if len(values) == 1 else values
+
+    def decode_event(self, topics: list[bytes], data: bytes) -> Event | None:
+        abi = self.events.get(topics[0]) if topics else None
+        if abi is None:
+            return None
+        indexed = [i for i in abi["inputs"] if i["indexed"]]
+        plain = [i for i in abi["inputs"] if not i["indexed"]]
+        args = {}
+        for inp, topic in zip(indexed, topics[1:]):
+            args[inp["name"]] = abi_decode([inp["type"]], topic)[0]
+        for inp, value in zip(plain, abi_decode([i["type"] for i in plain], data)):
+            args[inp["name"]] = value
+        names = [i["name"] for i in abi["inputs"]]
+        return Event(abi["name"], {k: _checksum(args[k]) for k in names})
+
+    def refusal(self, data: bytes) -> ContractRevert | None:
+        if len(data) < 4 or data[:4] not in self.errors:
+            return None
+        name, names, types = self.errors[data[:4]]
+        values = [_checksum(v) for v in abi_decode(types, data[4:])]
+        return ContractRevert(name, dict(zip(names, values)), data)
+
+
+def _checksum(value):
+    return to_checksum_address(value) if isinstance(value, str) and value.startswith("0x") and len(value) == 42 else value
 
 
 class ChainMarket:
     """One deployed market and the account of its market node."""
 
-    def __init__(self, w3: Web3, address: str, market: LocalAccount, abi: list | None = None):
-        self.w3 = w3
+    def __init__(self, backend, address: str, market: LocalAccount, abi: list | None = None):
+        self.backend = backend
         self.market = market
-        self.contract = w3.eth.contract(address=to_checksum_address(address), abi=abi or load_artifact()["abi"])
-        self._errors = _error_table(self.contract.abi)
-        self._chain_id = w3.eth.chain_id
-        self._gas_limit = w3.eth.get_block("latest")["gasLimit"]
+        self.address = to_checksum_address(address)
+        self.codec = _Codec(abi or load_artifact()["abi"])
 
     @classmethod
-    def deploy(cls, params: MarketParams, *, w3: Web3 | None = None, market: LocalAccount | None = None,
+    def deploy(cls, params: MarketParams, *, backend=None, market: LocalAccount | None = None,
                artifact: dict | None = None, seed: int = 0) -> ChainMarket:
         """Deploy a fresh market from ``market`` (funded with gas money first)."""
-        w3 = w3 or connect()
+        backend = backend or connect()
         artifact = artifact or load_artifact()
         market = market or derived_account("market", 0, seed)
-        fund_gas(w3, [market.address])
-        factory = w3.eth.contract(abi=artifact["abi"], bytecode=artifact["bytecode"])
-        with _refusals_decoded(_error_table(artifact["abi"])):
-            tx = factory.constructor(*params.constructor_args(market.address)).build_transaction(
-                {"from": market.address, "nonce": w3.eth.get_transaction_count(market.address, "pending"),
-                 "chainId": w3.eth.chain_id})
-        receipt = _send(w3, market, tx)
-        return cls(w3, receipt.contractAddress, market, artifact["abi"])
+        backend.fund([market.address])
+        codec = _Codec(artifact["abi"])
+        ctor = next(e for e in artifact["abi"] if e["type"] == "constructor")
+        code = bytes.fromhex(artifact["bytecode"].removeprefix("0x")) + abi_encode(
+            get_abi_input_types(ctor), list(params.constructor_args(market.address)))
+        try:
+            address, _ = backend.deploy(market, code)
+        except RevertedCall as exc:
+            raise codec.refusal(exc.data) or exc from exc
+        return cls(backend, address, market, artifact["abi"])
 
     # -- transactions -------------------------------------------------------------------------------
 
     def grant_wealth(self, robot: str, amount: int) -> TxResult:
         """Market mints ``amount`` units to ``robot`` (initial wealth)."""
-        return self.transact(self.market, self.contract.functions.grantWealth(robot, amount))
+        return self.transact(self.market, "grantWealth", robot, amount)
 
     def buy_item(self, robot: str, sender: LocalAccount | None = None) -> TxResult:
-        """Market buys ``robot``'s deposited item (``sender`` only to test who may call it)."""
-        return self.transact(sender or self.market, self.contract.functions.buyItem(robot))
+        """Market buys ``robot``'s deposited item and settles what fits in one batch (``sender`` only
+        to test who may call it)."""
+        return self.transact(sender or self.market, "buyItem", robot)
+
+    def settle(self, robot: str, max_records: int = SETTLE_BATCH, sender: LocalAccount | None = None) -> TxResult:
+        """Continue ``robot``'s pending settlement (anyone may; the market by default)."""
+        return self.transact(sender or self.market, "settle", robot, max_records)
+
+    def deposit(self, robot: str, batch: int = SETTLE_BATCH) -> list[TxResult]:
+        """``buyItem`` and as many ``settle`` calls as the round trip needs: a whole deposit."""
+        results = [self.buy_item(robot)]
+        while self.pending_settlement(robot)[0]:
+            results.append(self.settle(robot, batch))
+        return results
+
+    def refund_expired(self, buyer: str, max_records: int = 2**32, sender: LocalAccount | None = None) -> TxResult:
+        """Return the stakes of ``buyer``'s expired records to their sellers (anyone may)."""
+        return self.transact(sender or self.market, "refundExpired", buyer, max_records)
 
     def reveal(self, sender: LocalAccount, lc: LightContract, info: PathInfo) -> TxResult:
         """Submit a light contract and its path information (normally ``sender`` is the seller)."""
-        return self.transact(sender, self.contract.functions.revealInformation(lc.as_abi(), info.as_abi()))
+        return self.transact(sender, "revealInformation", lc.as_abi(), info.as_abi())
 
     def check_reveal(self, sender: LocalAccount, lc: LightContract, info: PathInfo) -> None:
         """Dry-run a reveal against the current state; raises ``ContractRevert`` if it would fail."""
-        self._dry_run(sender, self.contract.functions.revealInformation(lc.as_abi(), info.as_abi()))
+        self._call(sender.address, "revealInformation", lc.as_abi(), info.as_abi(), static=False)
 
-    def transact(self, sender: LocalAccount, fn) -> TxResult:
-        """Sign ``fn`` with ``sender``'s own key and wait for it to be mined.
+    def transact(self, sender: LocalAccount, fn: str, *args) -> TxResult:
+        """Send ``fn(*args)`` from ``sender`` and wait for it to be mined."""
+        try:
+            receipt = self.backend.transact(sender, self.address, self.codec.calldata(fn, args))
+        except RevertedCall as exc:
+            raise self.codec.refusal(exc.data) or exc from exc
+        return self._result(receipt)
 
-        The call is dry-run first (one EVM execution, which also yields the revert data on every
-        backend), then sent with the block's gas limit as its limit: a gas estimate would cost a
-        dozen executions on py-evm, and the limit does not change the gas used.
-        """
-        self._dry_run(sender, fn)
-        # The nonce is asked for every time: several markets (and tests) may share one account.
-        nonce = self.w3.eth.get_transaction_count(sender.address, "pending")
-        tx = fn.build_transaction({"from": sender.address, "nonce": nonce, "chainId": self._chain_id,
-                                   "gas": self._gas_limit})
-        receipt = _send(self.w3, sender, tx)
-        return TxResult(receipt.gasUsed, receipt.blockNumber, receipt)
+    def _call(self, sender: str, fn: str, *args, static: bool = True) -> Any:
+        try:
+            out = self.backend.call(sender, self.address, self.codec.calldata(fn, args), static=static)
+        except RevertedCall as exc:
+            raise self.codec.refusal(exc.data) or exc from exc
+        return self.codec.result(fn, out)
 
-    def _dry_run(self, sender: LocalAccount, fn) -> None:
-        with _refusals_decoded(self._errors):
-            fn.call({"from": sender.address, "gas": self._gas_limit}, block_identifier="pending")
+    def _result(self, receipt: Receipt) -> TxResult:
+        events = [self.codec.decode_event(lg.topics, lg.data) for lg in receipt.logs
+                  if to_checksum_address(lg.address) == self.address]
+        return TxResult(receipt.gas_used, receipt.block_number, [e for e in events if e is not None])
 
     # -- the light-contract protocol, both sides ----------------------------------------------------
 
     @cached_property
     def domain(self) -> Domain:
         """This market's EIP-712 domain, read from the contract itself (EIP-5267)."""
-        _, name, version, chain_id, contract, _, _ = self.contract.functions.eip712Domain().call()
-        return Domain(chain_id, contract, name, version)
+        _, name, version, chain_id, contract, _, _ = self._call(self.market.address, "eip712Domain")
+        return Domain(chain_id, to_checksum_address(contract), name, version)
 
     def light_contract(self, seller: LocalAccount, buyer: LocalAccount, site: int, age: int, info: PathInfo,
                        seller_position: tuple[float, float] = (0.0, 0.0), blocks_valid: int = 8,
                        domain: Domain | None = None) -> LightContract:
-        """Run steps 1-2 of the protocol: the seller offers (valid ``blocks_valid`` blocks from now),
-        the buyer verifies and accepts."""
+        """Run steps 1-2 of the protocol: the seller offers (valid for ``blocks_valid`` blocks, the
+        block the next transaction lands in being the first), the buyer verifies and accepts."""
         domain = domain or self.domain
-        offer = Offer(seller.address, site, age, self.w3.eth.block_number + blocks_valid, info.digest())
+        offer = Offer(seller.address, site, age, self.backend.block_number - 1 + blocks_valid, info.digest())
         signature = sign_offer(seller.key, domain, offer)
         return accept_offer(buyer.key, domain, offer, signature, seller_position)
 
     # -- views --------------------------------------------------------------------------------------
 
+    def view(self, fn: str, *args) -> Any:
+        """Any view function, called by the market account."""
+        return self._call(self.market.address, fn, *args)
+
     def balance_of(self, robot: str) -> int:
-        return self.contract.functions.balanceOf(robot).call()
+        return self.view("balanceOf", robot)
 
     def locked_stake(self, buyer: str) -> int:
-        return self.contract.functions.lockedStake(buyer).call()
+        return self.view("lockedStake", buyer)
 
     def total_supply(self) -> int:
-        return self.contract.functions.totalSupply().call()
+        return self.view("totalSupply")
 
-    def contributors(self, buyer: str) -> list[tuple[str, int, int]]:
-        return [tuple(x) for x in self.contract.functions.contributors(buyer).call()]
+    def pending_settlement(self, robot: str) -> tuple[bool, int, int]:
+        return tuple(self.view("pendingSettlement", robot))
 
-    # -- internals ----------------------------------------------------------------------------------
-
-
-def fund_gas(w3: Web3, addresses: list[str], amount: int = GAS_ALLOWANCE_WEI) -> None:
-    """Give each address gas money from the node's first unlocked account."""
-    accounts = w3.eth.accounts
-    if not accounts:
-        raise ChainError("the node has no unlocked account to pay the robots' gas")
-    hashes = [w3.eth.send_transaction({"from": accounts[0], "to": a, "value": amount}) for a in addresses]
-    for h in hashes:
-        w3.eth.wait_for_transaction_receipt(h)
-
-
-def _send(w3: Web3, sender: LocalAccount, tx: dict):
-    signed = sender.sign_transaction(tx)
-    receipt = w3.eth.wait_for_transaction_receipt(w3.eth.send_raw_transaction(signed.raw_transaction))
-    if receipt.status != 1:
-        raise ChainError(f"transaction {receipt.transactionHash.hex()} failed after a successful estimate")
-    return receipt
-
-
-@contextmanager
-def _refusals_decoded(errors: dict):
-    """Turn a contract refusal raised inside the block into ``ContractRevert``; let the rest through."""
-    try:
-        yield
-    except Exception as exc:  # noqa: BLE001 - anything that is not a refusal is re-raised as it came
-        revert = decode_revert(errors, exc)
-        if revert is None:
-            raise
-        raise revert from exc
-
-
-def decode_revert(errors: dict, exc: Exception) -> ContractRevert | None:
-    """The contract refusal inside ``exc`` (an error of ``errors``, see ``_error_table``), if any."""
-    data = _revert_data(exc)
-    if data is None or len(data) < 4 or data[:4] not in errors:
-        return None
-    name, names, types = errors[data[:4]]
-    values = [to_checksum_address(v) if t == "address" else v for t, v in zip(types, abi_decode(types, data[4:]))]
-    return ContractRevert(name, dict(zip(names, values)), data)
+    def contributors(self, buyer: str) -> list[tuple]:
+        """The open round trip's records: (seller, openedAt, site, dx, dy, weight)."""
+        return [(to_checksum_address(r[0]),) + tuple(r[1:]) for r in self.view("contributors", buyer)]
 
 
 def _error_table(abi: list) -> dict[bytes, tuple[str, list[str], list[str]]]:
@@ -248,7 +295,7 @@ def _error_table(abi: list) -> dict[bytes, tuple[str, list[str], list[str]]]:
     return table
 
 
-def _revert_data(exc: BaseException) -> bytes | None:
+def revert_data(exc: BaseException) -> bytes | None:
     """The raw revert bytes, wherever the backend put them.
 
     A JSON-RPC node's answer reaches us as web3's ``ContractCustomError``/``ContractLogicError`` with a

@@ -5,26 +5,31 @@
    age, max block, hash) as EIP-712 typed data. The offer is addressed to one buyer because the hash
    commits to information in that buyer's frame.
 2. The buyer checks the seller's signature and signs an ``Acceptance`` (the offer, itself, and the
-   seller's position in its own frame). That double-signed pair is the ``LightContract``.
+   seller's position in its own frame). That double-signed pair is the ``LightContract``. The revealed
+   information is the purchased vector only: the contract derives its direction itself (the vector
+   minus the signed seller position), so a seller has nothing to declare and nothing to lie about.
 3. The seller submits ``revealInformation(lightContract, pathInfo)``; the contract checks the buyer's
    signature against its own EIP-712 domain (name, version, chain id, contract address), so a
    signature is good for one contract on one chain only.
 
-Signatures are produced by eth-account, which always emits the low-s form the contract requires.
+Signatures are produced by eth-account, which always emits the low-s form the contract requires. The
+EIP-712 digests are hashed here directly (``offer_digest``, ``acceptance_digest``: a replay signs tens
+of thousands of them); tests check them against eth-account's generic typed-data encoder.
 """
 from __future__ import annotations
 
+import functools
 import secrets
 from dataclasses import dataclass, field
 
 from eth_abi import encode as abi_encode
 from eth_account import Account
-from eth_account.messages import encode_typed_data
+from eth_keys import keys
 from eth_utils import keccak, to_checksum_address
 
-from ..engine.geometry import direction, rotate
+from ..engine.geometry import rotate
 from .errors import ChainError
-from .units import to_micro, to_microdegrees
+from .units import to_micro
 
 FOOD, NEST = 0, 1
 #: Order of the secp256k1 group; a signature's twin with s' = N - s recovers to the same signer.
@@ -62,7 +67,7 @@ class Domain:
     chain_id: int
     verifying_contract: str
     name: str = "InformationMarket"
-    version: str = "1"
+    version: str = "2"
 
     def as_dict(self) -> dict:
         return {
@@ -75,24 +80,23 @@ class Domain:
 
 @dataclass(frozen=True)
 class PathInfo:
-    """Revealed path information in the buyer's frame, fixed point (see ``units``)."""
+    """Revealed path information: the purchased vector in the buyer's frame, micro units."""
 
     x: int
     y: int
-    direction: int
     salt: bytes = field(default_factory=lambda: secrets.token_bytes(32))
 
     @classmethod
-    def from_floats(cls, x: float, y: float, direction_deg: float, salt: bytes | None = None) -> PathInfo:
-        """Encode a purchased vector and the direction of the rotated offer (degrees)."""
-        return cls(to_micro(x), to_micro(y), to_microdegrees(direction_deg), salt or secrets.token_bytes(32))
+    def from_floats(cls, x: float, y: float, salt: bytes | None = None) -> PathInfo:
+        """Encode a purchased vector (arena units)."""
+        return cls(to_micro(x), to_micro(y), salt or secrets.token_bytes(32))
 
     def digest(self) -> bytes:
-        """The commitment the offer carries: ``keccak256(abi.encode(x, y, direction, salt))``."""
-        return keccak(abi_encode(["int64", "int64", "uint32", "bytes32"], list(self.as_abi())))
+        """The commitment the offer carries: ``keccak256(abi.encode(x, y, salt))``."""
+        return keccak(abi_encode(["int64", "int64", "bytes32"], list(self.as_abi())))
 
     def as_abi(self) -> tuple:
-        return (self.x, self.y, self.direction, self.salt)
+        return (self.x, self.y, self.salt)
 
 
 @dataclass(frozen=True)
@@ -151,11 +155,48 @@ def acceptance_typed_data(domain: Domain, offer: Offer, buyer: str, seller_x: in
     }
 
 
+_DOMAIN_TYPEHASH = keccak(text="EIP712Domain(string name,string version,uint256 chainId,address verifyingContract)")
+_OFFER_TYPE = "Offer(address seller,uint8 site,uint32 age,uint64 maxBlock,bytes32 pathHash)"
+_OFFER_TYPEHASH = keccak(text=_OFFER_TYPE)
+_ACCEPTANCE_TYPEHASH = keccak(text="Acceptance(Offer offer,address buyer,int64 sellerX,int64 sellerY)" + _OFFER_TYPE)
+
+
+@functools.lru_cache(maxsize=64)
+def _separator(domain: Domain) -> bytes:
+    return keccak(abi_encode(["bytes32", "bytes32", "bytes32", "uint256", "address"],
+                             [_DOMAIN_TYPEHASH, keccak(text=domain.name), keccak(text=domain.version),
+                              domain.chain_id, to_checksum_address(domain.verifying_contract)]))
+
+
+def _offer_hash(offer: Offer) -> bytes:
+    return keccak(abi_encode(["bytes32", "address", "uint8", "uint32", "uint64", "bytes32"],
+                             [_OFFER_TYPEHASH, *offer.as_abi()]))
+
+
+def offer_digest(domain: Domain, offer: Offer) -> bytes:
+    """The EIP-712 digest of ``offer_typed_data``."""
+    return keccak(b"\x19\x01" + _separator(domain) + _offer_hash(offer))
+
+
+def acceptance_digest(domain: Domain, offer: Offer, buyer: str, seller_x: int, seller_y: int) -> bytes:
+    """The EIP-712 digest of ``acceptance_typed_data`` (what the contract's ``acceptanceDigest`` returns)."""
+    struct = keccak(abi_encode(["bytes32", "bytes32", "address", "int64", "int64"],
+                               [_ACCEPTANCE_TYPEHASH, _offer_hash(offer), to_checksum_address(buyer), seller_x, seller_y]))
+    return keccak(b"\x19\x01" + _separator(domain) + struct)
+
+
+def _sign(key: bytes, digest: bytes) -> tuple[int, bytes, bytes]:
+    """(v, r, s) of a low-s signature of ``digest`` (v is 27 or 28)."""
+    sig = keys.PrivateKey(bytes(key)).sign_msg_hash(digest)
+    return sig.v + 27, sig.r.to_bytes(32, "big"), sig.s.to_bytes(32, "big")
+
+
 def sign_offer(seller_key: bytes, domain: Domain, offer: Offer) -> bytes:
     """The seller's 65-byte signature over its offer."""
     if Account.from_key(seller_key).address != to_checksum_address(offer.seller):
         raise ProtocolError("an offer can only be signed by the seller it names")
-    return bytes(Account.sign_typed_data(seller_key, full_message=offer_typed_data(domain, offer)).signature)
+    v, r, s = _sign(seller_key, offer_digest(domain, offer))
+    return r + s + bytes([v])
 
 
 def accept_offer(buyer_key: bytes, domain: Domain, offer: Offer, offer_signature: bytes,
@@ -166,24 +207,20 @@ def accept_offer(buyer_key: bytes, domain: Domain, offer: Offer, offer_signature
     it lets anyone audit, after the reveal, that the revealed direction is that of the revealed vector
     minus this position.
     """
-    signer = Account.recover_message(encode_typed_data(full_message=offer_typed_data(domain, offer)),
-                                     signature=offer_signature)
+    signer = Account._recover_hash(offer_digest(domain, offer), signature=offer_signature)
     if signer != to_checksum_address(offer.seller):
         raise ProtocolError(f"offer claims seller {offer.seller} but is signed by {signer}")
     buyer = Account.from_key(buyer_key).address
     sx, sy = to_micro(seller_position[0]), to_micro(seller_position[1])
-    signed = Account.sign_typed_data(buyer_key, full_message=acceptance_typed_data(domain, offer, buyer, sx, sy))
-    return LightContract(offer, offer_signature, buyer, sx, sy, signed.v,
-                         signed.r.to_bytes(32, "big"), signed.s.to_bytes(32, "big"))
+    v, r, s = _sign(buyer_key, acceptance_digest(domain, offer, buyer, sx, sy))
+    return LightContract(offer, offer_signature, buyer, sx, sy, v, r, s)
 
 
 def path_in_buyer_frame(vector: tuple[float, float], heading_offset_deg: float,
-                        seller_position: tuple[float, float]) -> tuple[float, float, float]:
+                        seller_position: tuple[float, float]) -> tuple[float, float]:
     """What the seller reveals (MODEL.md section 4): its vector rotated into the buyer's frame by
-    ``heading_seller - heading_buyer``, plus its own position in the buyer's frame.
-
-    Returns ``(x, y, direction_deg)``; the direction is that of the rotated vector before the offset,
-    which is what the outlier rule compares.
+    ``heading_seller - heading_buyer``, plus its own position in the buyer's frame, as ``(x, y)``.
+    The contract subtracts the position again to get the rotated vector the outlier rule compares.
     """
     rx, ry = rotate(vector[0], vector[1], heading_offset_deg)
-    return rx + seller_position[0], ry + seller_position[1], direction(rx, ry)
+    return rx + seller_position[0], ry + seller_position[1]

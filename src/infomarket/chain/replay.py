@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from statistics import mean
 
 from .errors import ChainError, ContractRevert
-from .market import SCHEMES, ChainMarket, MarketParams, connect, derived_account, fund_gas
+from .market import SCHEMES, ChainMarket, MarketParams, connect, derived_account
 from .protocol import PathInfo
 from .units import TOKEN_UNIT, to_units
 
@@ -55,7 +55,10 @@ class ReplayReport:
     first_block: int = 0
     last_block: int = 0
     refusals_confirmed: int = 0
-    boundary_refusals: int = 0
+    expired: int = 0
+    largest_tx: int = 0
+    settle_calls: int = 0
+    backend: str = ""
     disagreements: list[str] = field(default_factory=list)
     balances: list[int] = field(default_factory=list)
     pots: list[int] = field(default_factory=list)
@@ -73,7 +76,7 @@ class ReplayReport:
 
     @property
     def gas_per_item(self) -> float:
-        """All the gas of the market's activity (reveals and buys) per item delivered."""
+        """All the gas of the market's activity (reveals, buys and settlements) per item delivered."""
         return (sum(self.reveal_gas) + sum(self.buy_gas)) / self.items if self.items else float("nan")
 
     def conserved(self) -> bool:
@@ -94,47 +97,67 @@ class ReplayReport:
         return {"reveals": len(self.reveal_gas), "items": self.items, "gas_per_reveal": avg(self.reveal_gas),
                 "gas_per_buy_item": avg(self.buy_gas), "max_gas_buy_item": max(self.buy_gas, default=0),
                 "gas_per_item": self.gas_per_item, "blocks_used": self.blocks_used,
-                "refusals_confirmed": self.refusals_confirmed, "boundary_refusals": self.boundary_refusals}
+                "refusals_confirmed": self.refusals_confirmed, "expired": self.expired, "largest_tx": self.largest_tx,
+                "settle_calls": self.settle_calls}
 
 
 def replay_on_chain(events: Iterable[Mapping] | object, *, robots: int, params: MarketParams,
-                    initial_wealth: float, rpc_url: str | None = None, seed: int = 0,
-                    blocks_valid: int = 8) -> ReplayReport:
+                    initial_wealth: float, rpc_url: str | None = None, backend: str | None = None,
+                    seed: int = 0, blocks_valid: int = 8, progress=None) -> ReplayReport:
     """Deploy a market, give ``robots`` accounts their initial wealth, and replay ``events``.
 
     ``events`` are the simulator's event records (a DataFrame or mappings) with ``kind`` in
-    ``purchase | refused | deposit``, ``buyer``, ``seller``, ``site``, ``direction_deg``, ``x``, ``y``,
-    ``age``, and optionally ``seller_x``/``seller_y`` (the seller's position in the buyer's frame,
-    which the buyer signs; (0, 0) when the log does not carry it). A purchase the chain refuses, or a
-    refusal the chain would accept, is recorded in ``disagreements`` rather than stopping the replay;
-    except a refusal whose seller's exact balance equals the stake to within the comparison's
-    precision, which only float rounding in the simulator refused (counted in ``boundary_refusals``).
+    ``purchase | refused | deposit``, ``step``, ``buyer``, ``seller``, ``site``, ``x``, ``y``, ``age``,
+    ``seller_x``/``seller_y`` (the seller's position in the buyer's frame, which the buyer signs).
+    Step ``s`` is replayed in block ``b0 + s`` (``b0``: the first block after the setup), every
+    transaction of the step in that block when the backend sets its blocks (revm); a backend that
+    mines one block per transaction (py-evm, a node) only needs ``stake_expiry == 0``. Before the
+    first event of each step, the stakes that expire at that step are refunded (``refundExpired``),
+    as the simulation does at the start of its step. A deposit is ``buyItem`` followed by ``settle``
+    until the round trip is settled. A purchase the chain refuses, or a refusal the chain would accept,
+    is recorded in ``disagreements`` rather than stopping the replay.
     """
-    w3 = connect(rpc_url)
-    market = ChainMarket.deploy(params, w3=w3, seed=seed)
+    chain = connect(rpc_url, backend)
+    market = ChainMarket.deploy(params, backend=chain, seed=seed)
     accounts = [derived_account("robot", i, seed) for i in range(robots)]
-    fund_gas(w3, [a.address for a in accounts])
+    chain.fund([a.address for a in accounts])
     wealth = to_units(initial_wealth)
     for a in accounts:
         market.grant_wealth(a.address, wealth)
+    base = chain.block_number + 1
+    chain.advance_to(base)
 
-    report = ReplayReport(robots, first_block=w3.eth.block_number, rounding_bound=[0] * robots,
+    report = ReplayReport(robots, first_block=chain.block_number, rounding_bound=[0] * robots,
                           minted=wealth * robots)
-    open_sellers: list[list[int]] = [[] for _ in range(robots)]
+    open_steps: list[list[tuple[int, int]]] = [[] for _ in range(robots)]  # (step, seller) per open record
     records = events.to_dict("records") if hasattr(events, "to_dict") else events
+    step = None
     for number, ev in enumerate(records):
+        if progress is not None and number % 1000 == 0:
+            progress(number)
         kind = ev["kind"]
+        if kind not in ("purchase", "refused", "deposit"):
+            raise ChainError(f"event {number}: unknown kind {kind!r}")
+        ev_step = int(ev.get("step", 0))
+        if step is None or ev_step > step:
+            step = ev_step
+            if params.stake_expiry and chain.block_number > base + step:
+                raise ChainError("stake expiry needs one block per step: replay on the revm backend")
+            chain.advance_to(base + step)
+            if params.stake_expiry:
+                _expire(market, accounts, open_steps, step, params.stake_expiry, report)
         if kind == "deposit":
             buyer = int(ev["buyer"])
-            report.buy_gas.append(market.buy_item(accounts[buyer].address).gas_used)
+            results = market.deposit(accounts[buyer].address)
+            report.buy_gas.append(sum(r.gas_used for r in results))
+            report.largest_tx = max(report.largest_tx, *(r.gas_used for r in results))
+            report.settle_calls += len(results) - 1
             report.minted += params.reward
-            _count_rounding(report.rounding_bound, buyer, open_sellers[buyer])
-            open_sellers[buyer] = []
+            _count_rounding(report.rounding_bound, buyer, [s for _, s in open_steps[buyer]])
+            open_steps[buyer] = []
             continue
-        if kind not in ("purchase", "refused"):
-            raise ChainError(f"event {number}: unknown kind {kind!r}")
         buyer, seller = int(ev["buyer"]), int(ev["seller"])
-        info = PathInfo.from_floats(float(ev["x"]), float(ev["y"]), float(ev["direction_deg"]))
+        info = PathInfo.from_floats(float(ev["x"]), float(ev["y"]))
         position = (float(ev.get("seller_x", 0.0)), float(ev.get("seller_y", 0.0)))
         lc = market.light_contract(accounts[seller], accounts[buyer], SITE_CODES[ev["site"]], int(ev["age"]),
                                    info, position, blocks_valid)
@@ -142,9 +165,9 @@ def replay_on_chain(events: Iterable[Mapping] | object, *, robots: int, params: 
             try:
                 report.reveal_gas.append(market.reveal(accounts[seller], lc, info).gas_used)
             except ContractRevert as err:
-                report.disagreements.append(f"event {number} (step {ev.get('step')}): purchase refused on chain: {err}")
+                report.disagreements.append(f"event {number} (step {step}): purchase refused on chain: {err}")
                 continue
-            open_sellers[buyer].append(seller)
+            open_steps[buyer].append((step, seller))
         else:
             try:
                 market.check_reveal(accounts[seller], lc, info)
@@ -153,21 +176,28 @@ def replay_on_chain(events: Iterable[Mapping] | object, *, robots: int, params: 
                     report.refusals_confirmed += 1
                     continue
                 raise
-            # The contract would accept: fine only if the seller's balance *is* the stake, within the
-            # precision of the comparison (the simulator's float balance, e.g. 1 - 24 * 0.04, can land
-            # a hair under a stake that the exact balance equals).
             margin = market.balance_of(accounts[seller].address) - params.stake
-            if margin <= report.rounding_bound[seller] + FLOAT_SLACK_UNITS:
-                report.boundary_refusals += 1
-            else:
-                report.disagreements.append(f"event {number} (step {ev.get('step')}): refused purchase "
-                                            f"accepted on chain (seller {seller} has {margin} units above the stake)")
+            report.disagreements.append(f"event {number} (step {step}): refused purchase accepted on chain "
+                                        f"(seller {seller} has {margin} units above the stake)")
 
-    report.last_block = w3.eth.block_number
+    report.last_block = chain.block_number
     report.balances = [market.balance_of(a.address) for a in accounts]
     report.pots = [market.locked_stake(a.address) for a in accounts]
     report.total_supply = market.total_supply()
+    report.backend = chain.name
     return report
+
+
+def _expire(market, accounts, open_steps, step: int, expiry: int, report: ReplayReport) -> None:
+    """Refund, on chain, every open record opened at ``step - expiry`` or before (anyone may)."""
+    for buyer, opened in enumerate(open_steps):
+        n = 0
+        while n < len(opened) and opened[n][0] + expiry <= step:
+            n += 1
+        if n:
+            result = market.refund_expired(accounts[buyer].address, n)
+            report.expired += len(result.of("RecordExpired"))
+            del opened[:n]
 
 
 def market_params(config) -> MarketParams:
@@ -184,15 +214,17 @@ def market_params(config) -> MarketParams:
     theta = config.payment_params().get("theta", 30.0) if payment.scheme == "outlier" else 30.0
     return MarketParams.from_floats(payment.scheme, reward=payment.reward,
                                     information_share=payment.information_share, stake=payment.stake,
-                                    theta_deg=theta)
+                                    theta_deg=theta, stake_expiry=int(getattr(payment, "stake_expiry", 0) or 0))
 
 
-def replay_result(result, *, rpc_url: str | None = None) -> tuple[ReplayReport, list[BalanceRow]]:
+def replay_result(result, *, rpc_url: str | None = None, backend: str | None = None,
+                  progress=None) -> tuple[ReplayReport, list[BalanceRow]]:
     """Replay a simulation's events (``simulate(..., record_events=True)``) on a fresh market and
     compare every robot's on-chain balance with its final wealth in the simulation."""
     config = result.config
     report = replay_on_chain(result.events, robots=config.swarm.robots, params=market_params(config),
-                             initial_wealth=config.payment.initial_wealth, rpc_url=rpc_url, seed=result.seed)
+                             initial_wealth=config.payment.initial_wealth, rpc_url=rpc_url, backend=backend,
+                             seed=result.seed, progress=progress)
     wealth = result.robots.sort_values("robot")["wealth"].to_numpy()
     return report, report.compare(wealth)
 

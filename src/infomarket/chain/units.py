@@ -8,9 +8,12 @@ through one of these functions, so the encoding is decided in one place:
   (about 1e-13 after thousands of operations) stays far below one unit, so "equal up to the unit"
   is a meaningful comparison between the two ledgers;
 - information share: a WAD (1e18 = the whole reward);
-- directions: integer microdegrees in [0, 360e6). A rounding of 5e-7 degrees can only change an
-  outlier-similarity decision when two directions differ by Theta within that amount;
-- positions: signed integer micro arena units (int64), enough for any vector a robot can hold.
+- directions: integer microdegrees in [0, 360e6), for display and for the simulated ledger only; the
+  contract never sees a direction, it compares vectors;
+- positions and vectors: signed integer micro arena units (int64), enough for any vector a robot can
+  hold. Rounding a 10-unit vector to micro units turns it by under 1e-7 rad, so it can only change an
+  outlier-similarity decision when two directions differ by Theta within about 6e-6 degrees;
+- cos(Theta): integer units of 1e-9 (``COS_SCALE``).
 """
 from __future__ import annotations
 
@@ -20,6 +23,7 @@ TOKEN_UNIT = 10**9
 WAD = 10**18
 MICRO = 10**6
 FULL_TURN = 360 * MICRO
+COS_SCALE = 10**9
 _INT64 = 2**63
 
 

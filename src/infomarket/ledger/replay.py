@@ -30,21 +30,27 @@ class Replayed:
 
 @dataclass(frozen=True)
 class LedgerEvent:
-    """``kind`` is 'purchase' (buyer, seller, site, direction_deg) or 'deposit' (buyer)."""
+    """``kind`` is 'purchase' (buyer, seller, site, direction_deg) or 'deposit' (buyer); ``step`` is
+    the simulation step it happened in (only the stake-expiry rule reads it)."""
 
     kind: str
     buyer: int
     seller: int = -1
     site: int = -1
     direction_deg: float = 0.0
+    step: int = 0
 
 
 def replay_events(events: Iterable, robots: int, *, scheme: str = "delayed", initial_wealth: float = 1.0,
                   reward: float = 1.0, information_share: float = 0.5, stake: float = 0.0,
-                  params: dict | None = None) -> Replayed:
+                  params: dict | None = None, stake_expiry: int = 0) -> Replayed:
     """Apply purchases and deposits in order; return the final balances and pots and, per purchase,
     whether it was accepted.  Events are LedgerEvent-like objects or mappings with the same fields
-    (a DataFrame's ``itertuples()`` works; 'refused' events are replayed as purchases)."""
+    (a DataFrame's ``itertuples()`` works; 'refused' events are replayed as purchases).
+
+    ``stake_expiry`` = T > 0 applies the stake-expiry rule (docs/chain.md): at the start of each step
+    s (before its first event), every open transaction opened at a step t with t + T <= s expires:
+    its stake goes back to its seller and it leaves the buyer's round trip."""
     cfg = Experiment.model_validate({
         "swarm": {"robots": robots, "groups": [{"behaviour": "naive", "count": robots}]},
         "payment": {"scheme": scheme, "initial_wealth": initial_wealth, "reward": reward,
@@ -55,21 +61,52 @@ def replay_events(events: Iterable, robots: int, *, scheme: str = "delayed", ini
     kernel = specialise.kernel_module(("naive",), scheme)
     view = kernel_view(world, kernel)
     accepted: list[bool] = []
+    opened: list[list[tuple[int, float]]] = [[] for _ in range(robots)]  # (step, stake locked) per open tx
+    step = None
     for ev in events:
         get = ev.get if isinstance(ev, dict) else (lambda k, e=ev: getattr(e, k))
         kind = str(get("kind"))
+        if stake_expiry:
+            now = int(get("step"))
+            if step is None or now > step:
+                step = now
+                _expire(world, opened, step, stake_expiry)
         if kind in ("purchase", "refused"):
             buyer = int(get("buyer"))
             while not reserve(view, buyer, int(world.tx_count[buyer]) + 1):
                 world = make_room(world, tx_need=world.tx_count + 1)
                 view = kernel_view(world, kernel)
-            accepted.append(bool(open_transaction(view, int(get("buyer")), int(get("seller")),
-                                                  int(get("site")), float(get("direction_deg")))))
+            buyer = int(get("buyer"))
+            pot = float(world.pot[buyer])
+            ok = bool(open_transaction(view, buyer, int(get("seller")), int(get("site")), float(get("direction_deg"))))
+            accepted.append(ok)
+            if ok:
+                opened[buyer].append((step, float(world.pot[buyer]) - pot))
         elif kind == "deposit":
             kernel.settle(view, int(get("buyer")), rng)
+            opened[int(get("buyer"))] = []
         else:
             raise ValueError(f"unknown ledger event kind {kind!r}")
         flags = ErrorFlags(int(world.flags[0]))
         if flags:
             raise SimulationError(flags.describe())
     return Replayed(world.balance.copy(), world.pot.copy(), accepted)
+
+
+def _expire(world, opened: list[list[tuple[int, float]]], step: int, expiry: int) -> None:
+    """The stake-expiry rule on the world's arrays: drop each buyer's transactions opened at
+    ``step - expiry`` or before (a prefix: they are recorded in step order), returning their stakes."""
+    for buyer, txs in enumerate(opened):
+        n = 0
+        while n < len(txs) and txs[n][0] + expiry <= step:
+            n += 1
+        if not n:
+            continue
+        k = int(world.tx_count[buyer])
+        for x in range(n):
+            world.balance[world.tx_seller[buyer, x]] += txs[x][1]
+            world.pot[buyer] -= txs[x][1]
+        for arr in (world.tx_seller, world.tx_site, world.tx_dir):
+            arr[buyer, : k - n] = arr[buyer, n:k].copy()
+        world.tx_count[buyer] = k - n
+        del txs[:n]

@@ -1,0 +1,167 @@
+"""One conformance suite, two ledgers: the simulated ledger (the engine's compiled ledger code, through
+``infomarket.ledger.replay``) and the contract (through ``infomarket.chain.replay``, every purchase a
+real light contract, every deposit ``buyItem`` plus ``settle``).
+
+``LedgerConformance`` is written once; each subclass says how to run an event sequence on its ledger.
+Both must reproduce the 32 payment vectors of the original simulator (tests/fixtures) and, on random
+event sequences (up to 25 robots and 1 000 operations, stake expiry on or off), the exact rational
+model of tests/chain/exact_ledger.py: the simulated ledger to 1e-9 token, the contract within its
+rounding bound (one unit per share a robot took part in). The property runs 200 examples on the
+simulated ledger and on the contract over revm, and a smaller sample over py-evm (a pure-Python EVM
+takes about a second per hundred transactions).
+"""
+from __future__ import annotations
+
+import json
+import random
+from fractions import Fraction
+from pathlib import Path
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from infomarket.chain.market import MarketParams
+from infomarket.chain.replay import FLOAT_SLACK_UNITS, replay_on_chain
+from infomarket.chain.units import TOKEN_UNIT
+from infomarket.ledger.replay import replay_events
+
+from .exact_ledger import SELLER_POSITION, ExactLedger, vector_for
+
+CASES = json.loads((Path(__file__).parents[1] / "fixtures" / "payment_vectors.json").read_text())["cases"]
+SCHEMES = {"delayed": ("delayed", 0.0), "outlier": ("outlier", 0.0), "outlier+stake": ("outlier", 0.04)}
+#: Directions 7.3 k degrees (k < 50): no two differ by Theta = 30 within 0.1 degree, so the
+#: simulation's degrees and the contract's micro-unit vectors cannot decide a pair differently.
+DIRECTIONS = [round(7.3 * k % 360, 6) for k in range(50)]
+
+
+def purchase(step, buyer, seller, site, direction, age, kind="purchase"):
+    x, y = vector_for(direction)
+    return {"kind": kind, "step": step, "buyer": buyer, "seller": seller, "site": site,
+            "direction_deg": direction, "x": x, "y": y, "seller_x": SELLER_POSITION[0],
+            "seller_y": SELLER_POSITION[1], "age": age}
+
+
+def deposit(step, robot):
+    return {"kind": "deposit", "step": step, "buyer": robot, "seller": -1, "site": -1, "direction_deg": 0.0,
+            "x": 0.0, "y": 0.0, "seller_x": 0.0, "seller_y": 0.0, "age": 0}
+
+
+@st.composite
+def scenarios(draw, expiries=(0, 0, 3, 10), longest=1000):
+    """(robots, scheme, wealth, expiry, events): hypothesis draws the sizes and a seed, the events
+    come from the seed (1 000 operations drawn one by one would exceed hypothesis' data budget);
+    most sequences are short, one in eight is long (up to ``longest`` operations)."""
+    robots = draw(st.integers(2, 25))
+    scheme = draw(st.sampled_from(sorted(SCHEMES)))
+    wealth = draw(st.sampled_from([0.05, 0.1, 1.0]))
+    expiry = draw(st.sampled_from(expiries))
+    length = draw(st.one_of(*[st.integers(0, 40)] * 7, st.integers(40, longest)))
+    rng = random.Random(draw(st.integers(0, 2**32 - 1)))
+    events, step = [], 1
+    for age in range(length):
+        step += rng.randrange(3)
+        buyer = rng.randrange(robots)
+        if rng.random() < 0.15:
+            events.append(deposit(step, buyer))
+        else:
+            seller = (buyer + rng.randrange(1, robots)) % robots
+            events.append(purchase(step, buyer, seller, rng.randrange(2), rng.choice(DIRECTIONS), age))
+    return robots, scheme, wealth, expiry, events
+
+
+def exact_run(robots, scheme, wealth, expiry, events) -> tuple[ExactLedger, list[bool]]:
+    """The rational model, and whether each purchase is accepted (the simulation decides refusals:
+    the event kinds fed to the ledgers are taken from this model, as the simulator's log would be)."""
+    name, stake = SCHEMES[scheme]
+    exact = ExactLedger(robots, name, Fraction(1), Fraction(1, 2), Fraction(str(stake)), Fraction(30),
+                        Fraction(str(wealth)), expiry)
+    accepted = []
+    for ev in events:
+        exact.advance(ev["step"])
+        if ev["kind"] == "deposit":
+            exact.deposit(ev["buyer"])
+        else:
+            ok = exact.purchase(ev["buyer"], ev["seller"], ev["site"], Fraction(str(ev["direction_deg"])), ev["step"])
+            ev["kind"] = "purchase" if ok else "refused"
+            accepted.append(ok)
+    return exact, accepted
+
+
+class LedgerConformance:
+    """The behaviour every ledger must show; subclasses implement ``run``."""
+
+    examples = 200
+    expiries = (0, 0, 3, 10)
+    longest = 1000
+
+    def run(self, robots: int, scheme: str, wealth: float, expiry: int, events: list[dict]) -> list[float]:
+        """Replay ``events`` on a fresh ledger; each robot's final balance, in tokens."""
+        raise NotImplementedError
+
+    def tolerance(self, bound: int) -> float:
+        """How far (tokens) a balance may be from the exact model, given its rounding bound."""
+        raise NotImplementedError
+
+    @pytest.mark.parametrize("case", CASES, ids=[f"{i}-{c['scheme']}" for i, c in enumerate(CASES)])
+    def test_payment_vectors_of_the_original_simulator(self, case):
+        events = [purchase(1, case["buyer"], t["seller"], 0 if t["site"] == "food" else 1, t["direction_deg"], k,
+                           "purchase" if t["accepted"] else "refused") for k, t in enumerate(case["transactions"])]
+        events.append(deposit(2, case["buyer"]))
+        balances = self.run(case["robots"], case["scheme"], case["initial_wealth"], 0, events)
+        n = len(case["transactions"])
+        for i in range(case["robots"]):
+            assert balances[i] == pytest.approx(case["balances_after_deposit"][str(i)],
+                                                abs=self.tolerance(n) + 1e-9)
+
+    def test_random_event_sequences_agree_with_the_exact_model(self):
+        @settings(max_examples=self.examples, deadline=None, derandomize=True,
+                  suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+        @given(scenarios(self.expiries, self.longest))
+        def check(scenario):
+            robots, scheme, wealth, expiry, events = scenario
+            exact, _ = exact_run(robots, scheme, wealth, expiry, events)
+            balances = self.run(robots, scheme, wealth, expiry, events)
+            for i in range(robots):
+                assert abs(balances[i] - float(exact.balance[i])) <= self.tolerance(exact.bound[i]), (i, scheme, expiry)
+
+        check()
+
+
+class TestSimulatedLedger(LedgerConformance):
+    def run(self, robots, scheme, wealth, expiry, events):
+        name, stake = SCHEMES[scheme]
+        replayed = replay_events(events, robots, scheme=name, initial_wealth=wealth, stake=stake,
+                                 params={"theta": 30.0} if name == "outlier" else None, stake_expiry=expiry)
+        # what the simulation would have in pots at the end (stakes of open round trips) is not a balance
+        return [float(b) for b in replayed.balances]
+
+    def tolerance(self, bound):
+        return 1e-9
+
+    def test_random_event_sequences_agree_with_the_exact_model(self):
+        super().test_random_event_sequences_agree_with_the_exact_model()
+
+
+class TestContractLedger(LedgerConformance):
+    backend = "revm"
+
+    def run(self, robots, scheme, wealth, expiry, events):
+        name, stake = SCHEMES[scheme]
+        params = MarketParams.from_floats(name, stake=stake, stake_expiry=expiry, max_records_per_seller=1000)
+        report = replay_on_chain(events, robots=robots, params=params, initial_wealth=wealth, backend=self.backend)
+        assert not report.disagreements, report.disagreements[:3]
+        assert report.conserved()
+        return [b / TOKEN_UNIT for b in report.balances]
+
+    def tolerance(self, bound):
+        return (max(bound, 1) + FLOAT_SLACK_UNITS) / TOKEN_UNIT
+
+
+class TestContractLedgerOnPyEvm(TestContractLedger):
+    """The same suite on the reference EVM: every payment vector, and a small random sample."""
+
+    backend = "py-evm"
+    examples = 4
+    longest = 150
+    expiries = (0,)  # py-evm mines one block per transaction: expiry needs one block per step (revm)
