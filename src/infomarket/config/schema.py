@@ -85,6 +85,8 @@ class Payment(_Strict):
     reward: NonNegFloat = 1.0
     information_share: Annotated[float, Field(ge=0, le=1)] = 0.5
     stake: NonNegFloat = 0.0
+    #: Steps after which an open purchase's stake goes back to its seller (0 = never; docs/chain.md).
+    stake_expiry: NonNegInt = 0
     params: dict[str, Finite] = Field(default_factory=dict)
 
 

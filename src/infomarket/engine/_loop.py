@@ -16,7 +16,7 @@ from numba import njit
 from infomarket.engine.kernels import (begin_communication, behaviour_step, forage, install_table, move,
                                        record_history)
 from infomarket.engine.neighbours import find_neighbours
-from infomarket.ledger.kernels import distribute, reserve, settlement
+from infomarket.ledger.kernels import distribute, expire_stakes, reserve, settlement
 
 DONE = 0
 NEED_ROOM = 1
@@ -75,6 +75,9 @@ def run_steps(w, rng, t_end):
         if not has_room(w):
             return NEED_ROOM
         clock[0] += 1
+        if w.stake_expiry > 0:
+            for i in range(n):
+                expire_stakes(w, i)
         begin_communication(w)
         for i in range(n):
             for site in range(2):

@@ -98,7 +98,7 @@ def build_world(cfg: Experiment, rng: np.random.Generator, *, record_events: boo
         site_pos=np.array([[cfg.food.x, cfg.food.y], [cfg.nest.x, cfg.nest.y]], dtype=np.float64),
         site_r=np.array([cfg.food.radius, cfg.nest.radius], dtype=np.float64),
         reward=float(cfg.payment.reward), info_share=float(cfg.payment.information_share),
-        stake=float(cfg.payment.stake), fuel_cost=float(cfg.robot.fuel_cost),
+        stake=float(cfg.payment.stake), stake_expiry=int(cfg.payment.stake_expiry), fuel_cost=float(cfg.robot.fuel_cost),
         transitory=int(cfg.transitory), stop_time=int(cfg.robot.stop_time), cooldown=int(cfg.robot.cooldown),
         cauchy_cdf=cauchy, cauchy_guide=guide_table(cauchy), levy_cdf=levy, levy_guide=guide_table(levy),
         turn_cos=turn_cos, turn_sin=turn_sin,
@@ -119,7 +119,7 @@ def build_world(cfg: Experiment, rng: np.random.Generator, *, record_events: boo
         balance=np.full(n, float(cfg.payment.initial_wealth)), pot=z(n), burned=z(1),
         tx_off=np.arange(n, dtype=np.int64) * kt, tx_cap=np.full(n, kt, np.int64), tx_count=z(n, np.int64),
         tx_seller=z(n * kt, np.int64), tx_site=z(n * kt, np.int64), tx_dir=z(n * kt),
-        tx_step=z(n * kt, np.int64), pool_top=np.array([n * kt], np.int64),
+        tx_step=z(n * kt, np.int64), tx_stake=z(n * kt), pool_top=np.array([n * kt], np.int64),
         ev_step=z(ecap, np.int64), ev_kind=z(ecap, np.int64), ev_buyer=z(ecap, np.int64),
         ev_seller=z(ecap, np.int64), ev_site=z(ecap, np.int64), ev_dir=z(ecap), ev_x=z(ecap), ev_y=z(ecap),
         ev_age=z(ecap, np.int64), ev_stake=z(ecap), ev_sx=z(ecap), ev_sy=z(ecap), ev_count=z(1, np.int64),
@@ -163,7 +163,7 @@ def make_room(world: World, tx_need: np.ndarray | None = None) -> World:
         size = 2 * int(caps.sum())
         src = _ranges(world.tx_off, world.tx_count)
         dst = _ranges(starts, world.tx_count)
-        for f in ("tx_seller", "tx_site", "tx_dir", "tx_step"):
+        for f in ("tx_seller", "tx_site", "tx_dir", "tx_step", "tx_stake"):
             old = getattr(world, f)
             new = np.zeros(size, old.dtype)
             new[dst] = old[src]

@@ -18,7 +18,7 @@ per site, the transaction pool ``P`` and the event log ``E``.  Nothing is [n, n]
 PARAMS:
     width, height, radius, speed, comm_range, noise_sd: float
     site_pos [2, 2] float64 site centres;  site_r [2] float64 site radii
-    reward, info_share, stake, fuel_cost: float;  transitory, stop_time, cooldown: int
+    reward, info_share, stake, fuel_cost: float;  stake_expiry, transitory, stop_time, cooldown: int
     cauchy_cdf [360] turn-angle CDF (whole degrees);  levy_cdf [steps + 1] step-length CDF
     cauchy_guide, levy_guide: int64 guide tables that make sampling those CDFs O(1) (build.guide_table)
     turn_cos, turn_sin [360]: cos and sin of each whole-degree turn (computed with the kernel's libm)
@@ -48,7 +48,8 @@ LEDGER:
     balance [n], pot [n] stakes locked by the robot's open purchases, burned [1] fuel burned
     tx_off [n], tx_cap [n], tx_count [n]: buyer i's open transactions (since its last deposit) are
         pool entries tx_off[i] .. tx_off[i] + tx_count[i] - 1, in purchase order
-    tx_seller [P], tx_site [P], tx_dir [P] float64 degrees, tx_step [P]: the transaction pool;
+    tx_seller [P], tx_site [P], tx_dir [P] float64 degrees, tx_step [P] step opened, tx_stake [P] stake
+        locked: the transaction pool;
         pool_top [1] the first unused pool entry
 
 LOG:
@@ -64,7 +65,7 @@ import numpy as np
 
 PARAMS = (
     "width", "height", "radius", "speed", "comm_range", "noise_sd", "site_pos", "site_r",
-    "reward", "info_share", "stake", "fuel_cost", "transitory", "stop_time", "cooldown",
+    "reward", "info_share", "stake", "stake_expiry", "fuel_cost", "transitory", "stop_time", "cooldown",
     "cauchy_cdf", "cauchy_guide", "levy_cdf", "levy_guide", "turn_cos", "turn_sin",
     "bparams", "pparams", "record", "hist_every", "grid_cell", "grid_nx", "grid_ny",
 )
@@ -78,7 +79,7 @@ ROBOTS = (
 )
 LEDGER = (
     "balance", "pot", "burned", "tx_off", "tx_cap", "tx_count",
-    "tx_seller", "tx_site", "tx_dir", "tx_step", "pool_top",
+    "tx_seller", "tx_site", "tx_dir", "tx_step", "tx_stake", "pool_top",
 )
 LOG = (
     "ev_step", "ev_kind", "ev_buyer", "ev_seller", "ev_site", "ev_dir", "ev_x", "ev_y", "ev_age",

@@ -57,6 +57,7 @@ def reserve(w, buyer, need):
         w.tx_site[top + x] = w.tx_site[a + x]
         w.tx_dir[top + x] = w.tx_dir[a + x]
         w.tx_step[top + x] = w.tx_step[a + x]
+        w.tx_stake[top + x] = w.tx_stake[a + x]
     w.tx_off[buyer] = top
     w.tx_cap[buyer] = cap
     w.pool_top[0] = top + cap
@@ -70,6 +71,7 @@ def open_transaction(w, buyer, seller, site, direction):
     if k >= w.tx_cap[buyer]:
         w.flags[0] |= flags.TX_OVERFLOW
         return False
+    lock = 0.0
     if w.stake > 0.0:
         if w.balance[seller] < w.stake - STAKE_TOLERANCE:
             return False
@@ -81,8 +83,34 @@ def open_transaction(w, buyer, seller, site, direction):
     w.tx_site[x] = site
     w.tx_dir[x] = direction
     w.tx_step[x] = w.clock[0]
+    w.tx_stake[x] = lock
     w.tx_count[buyer] = k + 1
     return True
+
+
+@njit
+def expire_stakes(w, buyer):
+    """The stake-expiry rule (docs/chain.md): at the start of step s, each open transaction of the
+    buyer opened at a step t with t + stake_expiry <= s gives its stake back to its seller and leaves
+    the round trip.  Transactions are in step order, so the expired ones are a prefix."""
+    k = w.tx_count[buyer]
+    a = w.tx_off[buyer]
+    now = w.clock[0]
+    m = 0
+    while m < k and w.tx_step[a + m] + w.stake_expiry <= now:
+        m += 1
+    if m == 0:
+        return
+    for x in range(m):
+        w.balance[w.tx_seller[a + x]] += w.tx_stake[a + x]
+        w.pot[buyer] -= w.tx_stake[a + x]
+    for x in range(k - m):
+        w.tx_seller[a + x] = w.tx_seller[a + m + x]
+        w.tx_site[a + x] = w.tx_site[a + m + x]
+        w.tx_dir[a + x] = w.tx_dir[a + m + x]
+        w.tx_step[a + x] = w.tx_step[a + m + x]
+        w.tx_stake[a + x] = w.tx_stake[a + m + x]
+    w.tx_count[buyer] = k - m
 
 
 @njit

@@ -16,7 +16,7 @@ from ..engine.build import build_world, make_room
 from ..engine.flags import ErrorFlags
 from ..errors import SimulationError
 from ..engine.worldref import kernel_view
-from .kernels import open_transaction, reserve
+from .kernels import expire_stakes, open_transaction, reserve
 
 
 @dataclass(frozen=True)
@@ -54,59 +54,37 @@ def replay_events(events: Iterable, robots: int, *, scheme: str = "delayed", ini
     cfg = Experiment.model_validate({
         "swarm": {"robots": robots, "groups": [{"behaviour": "naive", "count": robots}]},
         "payment": {"scheme": scheme, "initial_wealth": initial_wealth, "reward": reward,
-                    "information_share": information_share, "stake": stake, "params": params or {}},
+                    "information_share": information_share, "stake": stake, "params": params or {},
+                    "stake_expiry": int(stake_expiry)},
     })
     rng = np.random.default_rng(0)  # only a rule that asks for one uses it
     world, _ = build_world(cfg, rng)
     kernel = specialise.kernel_module(("naive",), scheme)
     view = kernel_view(world, kernel)
     accepted: list[bool] = []
-    opened: list[list[tuple[int, float]]] = [[] for _ in range(robots)]  # (step, stake locked) per open tx
     step = None
     for ev in events:
         get = ev.get if isinstance(ev, dict) else (lambda k, e=ev: getattr(e, k))
         kind = str(get("kind"))
         if stake_expiry:
             now = int(get("step"))
-            if step is None or now > step:
+            if step is None or now > step:  # a new step begins: the engine's expiry, then the event
                 step = now
-                _expire(world, opened, step, stake_expiry)
+                world.clock[0] = step
+                for buyer in range(robots):
+                    expire_stakes(view, buyer)
         if kind in ("purchase", "refused"):
             buyer = int(get("buyer"))
             while not reserve(view, buyer, int(world.tx_count[buyer]) + 1):
                 world = make_room(world, tx_need=world.tx_count + 1)
                 view = kernel_view(world, kernel)
-            buyer = int(get("buyer"))
-            pot = float(world.pot[buyer])
-            ok = bool(open_transaction(view, buyer, int(get("seller")), int(get("site")), float(get("direction_deg"))))
-            accepted.append(ok)
-            if ok:
-                opened[buyer].append((step, float(world.pot[buyer]) - pot))
+            accepted.append(bool(open_transaction(view, buyer, int(get("seller")), int(get("site")),
+                                                  float(get("direction_deg")))))
         elif kind == "deposit":
             kernel.settle(view, int(get("buyer")), rng)
-            opened[int(get("buyer"))] = []
         else:
             raise ValueError(f"unknown ledger event kind {kind!r}")
         flags = ErrorFlags(int(world.flags[0]))
         if flags:
             raise SimulationError(flags.describe())
     return Replayed(world.balance.copy(), world.pot.copy(), accepted)
-
-
-def _expire(world, opened: list[list[tuple[int, float]]], step: int, expiry: int) -> None:
-    """The stake-expiry rule on the world's arrays: drop each buyer's transactions opened at
-    ``step - expiry`` or before (a prefix: they are recorded in step order), returning their stakes."""
-    for buyer, txs in enumerate(opened):
-        n = 0
-        while n < len(txs) and txs[n][0] + expiry <= step:
-            n += 1
-        if not n:
-            continue
-        k = int(world.tx_count[buyer])
-        for x in range(n):
-            world.balance[world.tx_seller[buyer, x]] += txs[x][1]
-            world.pot[buyer] -= txs[x][1]
-        for arr in (world.tx_seller, world.tx_site, world.tx_dir):
-            arr[buyer, : k - n] = arr[buyer, n:k].copy()
-        world.tx_count[buyer] = k - n
-        del txs[:n]
