@@ -17,8 +17,10 @@ $(STAMP): pyproject.toml
 demo: venv
 	$(BIN)/infomarket demo
 
+# Two processes (CI has 2 cores); a test module stays in one process.  TEST_WORKERS=0 runs them inline.
+TEST_WORKERS ?= 2
 test: venv
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist loadfile
 
 bench: venv
 	$(BIN)/infomarket bench

@@ -40,6 +40,14 @@ NOT_RUN = {
     "infomarket sweep my.toml --out store --scheduler tcp://head:8786": "needs a Dask scheduler at that address",
     "infomarket chain demo --robots 10 --steps 3000 --scheme staking": "an EVM run; the chain demo has its own tests",
     "infomarket run examples/age_liar.toml": "a full run; the example is tested in tests/test_extending.py",
+    "infomarket chain demo --robots 25 --steps 15000 --scheme staking":
+        "a paper-length replay on the EVM (about 80 s); tests/chain/test_cli.py runs short ones",
+    "infomarket store verify STORE": "a placeholder store; verify is tested in tests/store/test_integrity.py",
+    "infomarket store repair STORE": "a placeholder store; repair is tested in tests/store/test_integrity.py",
+    "infomarket sweep EXP --out STORE": "a placeholder experiment; sweeps are tested in tests/runner",
+    "infomarket bench --robots 25,100,1000,10000 --json":
+        "minutes of timing (10 000 robots x 15 000 steps); tests/bench runs --robots 25,60 --steps 50",
+    "infomarket bench --scaling": "96 timed runs; tests/bench runs the same code with 2 runs of 200 steps",
 }
 
 

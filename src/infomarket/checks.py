@@ -12,6 +12,7 @@ from .config import validate
 from .engine.simulation import simulate
 from .errors import InfomarketError
 from .ledger import LedgerEvent, replay_events
+from .payments import MARKETS, PAPER_STAKE
 from .registry import get_behaviour, get_payment
 
 
@@ -40,7 +41,7 @@ def _invariants(res, what: str, initial: float, robots: int) -> None:
 def check_behaviour(name: str, *, robots: int = 10, steps: int = 3000, seed: int = 0) -> None:
     """Run ``name`` among naive robots, with and without staking, twice each with the same seed."""
     get_behaviour(name)  # a clear ConfigError for an unknown name
-    for scheme, stake in (("delayed", 0.0), ("outlier", 0.04)):
+    for scheme, stake in (MARKETS["delayed"], MARKETS["staking"]):
         cfg = _swarm(name, robots, scheme, stake, steps)
         a = simulate(cfg, seed, record_events=True)
         b = simulate(cfg, seed, record_events=True)
@@ -65,7 +66,7 @@ def check_payment(name: str, *, robots: int = 6, sequences: int = 30, seed: int 
                 events.append(LedgerEvent("purchase", buyer, seller, int(rng.integers(2)),
                                            float(rng.uniform(0, 360))))
         events.append(LedgerEvent("deposit", int(rng.integers(robots))))
-        stake = 0.04 if k % 2 else 0.0
+        stake = PAPER_STAKE if k % 2 else 0.0
         first = replay_events(events, robots, scheme=spec.name, stake=stake)
         again = replay_events(events, robots, scheme=spec.name, stake=stake)
         what = f"payment scheme {name!r} (sequence {k}, stake {stake})"

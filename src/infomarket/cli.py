@@ -14,7 +14,7 @@ from pathlib import Path
 
 from . import __version__
 from .bench import cli as bench_cli
-from .cliargs import Parser, UsageError, at_least, writable_dir
+from .cliargs import Parser, UsageError, at_least, seed_value, writable_dir
 from .errors import ConfigError, InfomarketError, report
 
 SUBCOMMAND_MODULES = ("infomarket.runner.cli", "infomarket.analysis.cli", "infomarket.viewer.cli",
@@ -143,7 +143,7 @@ def build_parser() -> Parser:
     r = sub.add_parser("run", help="run an experiment N times and write robots.parquet")
     r.add_argument("experiment", help="a .toml file, an original .json file, or a shipped name (e.g. fig2B)")
     r.add_argument("--runs", type=at_least(1), help="number of runs (default: the file's)")
-    r.add_argument("--seed", type=at_least(0), help="master seed (default: the file's)")
+    r.add_argument("--seed", type=seed_value, help="master seed (default: the file's)")
     r.add_argument("--steps", type=at_least(1), help="steps per run (default: the file's)")
     r.add_argument("--history", type=at_least(0), metavar="K",
                    help="also write wealth_history.parquet: every robot's wealth every K steps")

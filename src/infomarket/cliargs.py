@@ -9,7 +9,7 @@ from pathlib import Path
 
 from .errors import UsageError, report
 
-__all__ = ["Parser", "UsageError", "at_least", "fraction", "writable_dir", "writable_file"]
+__all__ = ["Parser", "UsageError", "at_least", "fraction", "seed_value", "writable_dir", "writable_file"]
 
 
 class Parser(argparse.ArgumentParser):
@@ -52,6 +52,16 @@ def writable_file(path: str | Path, option: str = "--out") -> Path:
     except OSError as exc:
         raise UsageError(f"{option} {path}: cannot write there ({exc.strerror or exc})") from None
     return path
+
+
+def seed_value(text: str) -> int:
+    """A seed: an integer in [0, 2**63 - 1], as in experiment files and the Python API."""
+    from .engine.seeds import MAX_SEED
+
+    value = at_least(0)(text)
+    if value > MAX_SEED:
+        raise argparse.ArgumentTypeError(f"must be at most 2**63 - 1 = {MAX_SEED}, got {value}")
+    return value
 
 
 def at_least(low: int):

@@ -44,7 +44,7 @@ def make_market(chain, robots, artifact):
     """Factory: a fresh market with every robot granted ``wealth`` tokens."""
 
     def make(scheme: str = "outlier", *, stake: float = 0.04, wealth: float | list[float] = 1.0,
-             theta_deg: float = 30.0, **options) -> ChainMarket:
+             theta_deg: float | None = None, **options) -> ChainMarket:
         params = MarketParams.from_floats(scheme, stake=stake, theta_deg=theta_deg, **options)
         market = ChainMarket.deploy(params, backend=chain, artifact=artifact)
         wealths = wealth if isinstance(wealth, list) else [wealth] * len(robots)

@@ -93,7 +93,7 @@ from infomarket.config import validate
 sim = im.Simulation(validate(json.loads(sys.argv[1])), seed=11, record_events=True)
 sim.step(int(sys.argv[2]))
 r = sim.result()
-print(json.dumps({"pos": sim.world.pos.tolist(), "heading": sim.world.heading.tolist(),
+print(json.dumps({"pos": sim.world.pos.tolist(), "hdir": sim.world.hdir.tolist(),
                   "items": r.robots.items_collected.tolist(), "wealth": r.robots.wealth.tolist(),
                   "events": r.events.astype({"kind": str}).values.tolist()}))
 """
@@ -117,7 +117,7 @@ def test_plain_python_path_runs_the_same_code():
     assert kinds["deposit"] >= 10 and kinds["purchase"] >= 100 and kinds["refused"] >= 100  # money moved
     assert plain["items"] == jit.robots.items_collected.tolist()
     np.testing.assert_allclose(plain["pos"], sim.world.pos, rtol=0, atol=1e-9)
-    assert plain["heading"] == pytest.approx(sim.world.heading.tolist(), abs=1e-9)
+    np.testing.assert_allclose(plain["hdir"], sim.world.hdir, rtol=0, atol=1e-12)
     assert plain["wealth"] == pytest.approx(jit.robots.wealth.tolist(), abs=1e-12)
     theirs = jit.events.astype({"kind": str}).values.tolist()
     assert len(plain["events"]) == len(theirs)
@@ -150,4 +150,44 @@ def test_snapshot_is_plain_python_of_the_current_state():
     snap = sim.snapshot()
     assert snap["step"] == 200 and len(snap["pos"]) == 25 and len(snap["pos"][0]) == 2
     assert snap["wealth"] == sim.world.balance.tolist() and snap["items"] == sim.world.items.tolist()
-    assert set(snap["state"]) <= {0, 1, 2} and snap["sites"] == ("food", "nest")
+    assert set(snap["state"]) <= {"exploring", "seeking_food", "seeking_nest"} and snap["sites"] == ("food", "nest")
+    # fig2B: 24 naive robots then one saboteur (ids follow the groups)
+    assert snap["behaviour"] == ["naive"] * 24 + ["saboteur"] and snap["honest"] == [True] * 24 + [False]
+    assert set(snap["last_site"]) <= {None, "food", "nest"}
+
+
+def test_the_python_api_takes_a_shipped_name_or_a_path_like_the_command_line(tmp_path):
+    by_object = im.simulate(im.load_experiment("fig2D"), seed=3, steps=300)
+    by_name = im.simulate("fig2D", seed=3, steps=300)
+    from infomarket.config.load import shipped_experiments
+
+    by_path = im.simulate(shipped_experiments()["fig2D"], seed=3, steps=300)
+    pd.testing.assert_frame_equal(by_object.robots, by_name.robots, check_exact=True)
+    pd.testing.assert_frame_equal(by_object.robots, by_path.robots, check_exact=True)
+    with pytest.raises(im.ConfigError, match="no experiment file"):
+        im.simulate("fig9Z")
+
+
+@pytest.mark.parametrize("bad", [0, -3, 2.5, "10", True])
+def test_step_takes_only_a_positive_whole_number_of_steps(bad):
+    sim = im.Simulation("fig2A", seed=1)
+    with pytest.raises(ValueError, match="positive integer"):
+        sim.step(bad)
+    assert sim.clock == 0
+    sim.step(np.int64(2))
+    assert sim.clock == 2
+
+
+def test_seeds_have_one_range_in_files_the_api_and_the_command_line(capsys):
+    from infomarket.cli import main
+
+    top = 2**63 - 1
+    assert im.Simulation("fig2A", seed=top).seed == top
+    for bad in (2**63, 2**100, -1):
+        with pytest.raises(im.ConfigError, match="seed must be"):
+            im.Simulation("fig2A", seed=bad)
+        with pytest.raises(im.ConfigError, match="seed"):  # an experiment file's seed
+            validate({"seed": bad, "swarm": {"robots": 2, "groups": [{"behaviour": "naive", "count": 2}]}})
+    with pytest.raises(SystemExit) as exc:
+        main(["run", "fig2A", "--seed", str(2**63), "--runs", "1"])
+    assert exc.value.code == 2 and "2**63 - 1" in capsys.readouterr().err

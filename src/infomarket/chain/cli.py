@@ -17,9 +17,10 @@ import argparse
 import sys
 import time
 
-from ..cliargs import at_least
+from ..cliargs import at_least, seed_value
+from ..payments import MARKETS
 
-DEMO_SCHEMES = {"delayed": ("delayed", 0.0), "outlier": ("outlier", 0.0), "staking": ("outlier", 0.04)}
+DEMO_SCHEMES = MARKETS
 
 
 def _rpc_url(text: str) -> str:
@@ -43,7 +44,7 @@ def add_subcommand(subparsers) -> None:
                            "default staking")
     demo.add_argument("--experiment", default="fig4C",
                       help="experiment whose swarm composition is scaled down (default fig4C)")
-    demo.add_argument("--seed", type=at_least(0), default=0, help="simulation seed (default 0)")
+    demo.add_argument("--seed", type=seed_value, default=0, help="simulation seed (default 0)")
     demo.add_argument("--backend", choices=("revm", "py-evm"), default="revm",
                       help="in-process EVM: revm (fast, default) or py-evm (the pure-Python reference)")
     demo.add_argument("--rpc", type=_rpc_url, metavar="URL",

@@ -19,12 +19,13 @@ from statistics import mean
 
 import math
 
+from ..payments import MARKETS
 from .market import SETTLE_BATCH, ChainMarket, MarketParams, connect, derived_account
 from .protocol import FOOD, PathInfo
 from .units import to_units
 
 SIZES = (1, 4, 16, 64, 256, 1024)
-SCHEMES = {"delayed": ("delayed", 0.0), "outlier": ("outlier", 0.0), "outlier + staking": ("outlier", 0.04)}
+SCHEMES = {"delayed": MARKETS["delayed"], "outlier": MARKETS["outlier"], "outlier + staking": MARKETS["staking"]}
 SELLERS = 8
 #: No transaction of a deposit may come near a 30M-gas block.
 TX_LIMIT = 15_000_000

@@ -26,6 +26,7 @@ from eth_account.signers.local import LocalAccount
 from eth_utils import keccak, to_checksum_address
 from eth_utils.abi import event_abi_to_log_topic, function_abi_to_4byte_selector, get_abi_input_types, get_abi_output_types
 
+from ..payments import default_theta
 from .backends import Receipt, RevertedCall, make_backend
 from .errors import ChainError, ContractRevert
 from .protocol import Domain, LightContract, Offer, PathInfo, accept_offer, sign_offer
@@ -71,13 +72,14 @@ class MarketParams:
 
     @classmethod
     def from_floats(cls, scheme: str, *, reward: float = 1.0, information_share: float = 0.5,
-                    stake: float = 0.0, theta_deg: float = 30.0, stake_expiry: int = 0,
+                    stake: float = 0.0, theta_deg: float | None = None, stake_expiry: int = 0,
                     max_records_per_seller: int = DEFAULT_MAX_RECORDS_PER_SELLER,
                     max_validity: int = DEFAULT_MAX_VALIDITY, settle_batch: int = DEFAULT_SETTLE_BATCH) -> MarketParams:
         if scheme not in SCHEMES:
             raise ValueError(f"scheme must be one of {sorted(SCHEMES)}, not {scheme!r}")
+        theta = default_theta() if theta_deg is None else theta_deg  # the outlier rule's own default
         return cls(scheme, to_units(reward), share_to_wad(information_share), to_units(stake),
-                   cos_theta(theta_deg), stake_expiry, max_records_per_seller, max_validity, settle_batch)
+                   cos_theta(theta), stake_expiry, max_records_per_seller, max_validity, settle_batch)
 
     def constructor_args(self, market: str) -> tuple:
         return (market, SCHEMES[self.scheme], self.reward, self.information_share, self.stake,

@@ -28,10 +28,10 @@ from eth_keys import keys
 from eth_utils import keccak, to_checksum_address
 
 from ..engine.geometry import rotate
+from ..engine.world import FOOD, NEST  # noqa: F401  (one definition of the site codes)
 from .errors import ChainError
 from .units import to_micro
 
-FOOD, NEST = 0, 1
 #: Order of the secp256k1 group; a signature's twin with s' = N - s recovers to the same signer.
 SECP256K1_N = 0xFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFFEBAAEDCE6AF48A03BBFD25E8CD0364141
 

@@ -17,6 +17,8 @@ from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from statistics import mean
 
+from ..engine.world import SITE_NAMES
+from ..payments import default_theta
 from .errors import ChainError, ContractRevert
 from .market import SCHEMES, ChainMarket, MarketParams, connect, derived_account
 from .protocol import PathInfo
@@ -24,7 +26,7 @@ from .units import TOKEN_UNIT, to_units
 
 #: Allowance for the simulator's own floating-point error, in units (1e-9 token).
 FLOAT_SLACK_UNITS = 0.5
-SITE_CODES = {0: 0, 1: 1, "food": 0, "nest": 1}
+SITE_CODES = {**{k: k for k in range(len(SITE_NAMES))}, **{name: k for k, name in enumerate(SITE_NAMES)}}
 
 
 @dataclass(frozen=True)
@@ -211,7 +213,7 @@ def market_params(config) -> MarketParams:
         raise ChainError(f"the contract implements the {' and '.join(SCHEMES)} schemes, not {payment.scheme!r}")
     if config.robot.fuel_cost:
         raise ChainError("the contract has no fuel cost: replay a configuration with robot.fuel_cost = 0")
-    theta = config.payment_params().get("theta", 30.0) if payment.scheme == "outlier" else 30.0
+    theta = config.payment_params().get("theta", default_theta()) if payment.scheme == "outlier" else default_theta()
     return MarketParams.from_floats(payment.scheme, reward=payment.reward,
                                     information_share=payment.information_share, stake=payment.stake,
                                     theta_deg=theta, stake_expiry=int(getattr(payment, "stake_expiry", 0) or 0))

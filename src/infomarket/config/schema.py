@@ -18,6 +18,9 @@ from .. import plugins
 from ..registry import behaviours, payments
 from . import sizes
 
+#: Seeds are 63-bit everywhere (files, the command line, the Python API, the store's int64 columns).
+MAX_SEED = 2**63 - 1
+
 PosFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 NonNegFloat = Annotated[float, Field(ge=0, allow_inf_nan=False)]
 Finite = Annotated[float, Field(allow_inf_nan=False)]
@@ -127,7 +130,7 @@ class Experiment(_Strict):
     steps: PosInt = 15000
     transitory: NonNegInt = 0
     runs: PosInt = 1
-    seed: NonNegInt = 0
+    seed: Annotated[int, Field(ge=0, le=MAX_SEED, strict=True)] = 0
     history_every: NonNegInt = 0
     arena: Arena = Arena()
     food: Site = Site(x=200.0, y=300.0)

@@ -17,8 +17,8 @@ import os
 import re
 
 ENV = "INFOMARKET_MEMORY_LIMIT"
-ROBOT_BYTES = 512            # O(1) per-robot state: position, heading, odometry, wealth, counters, flags
-SLOT_BYTES = 64              # per neighbour slot per robot: index, pending offer, transaction scratch
+ROBOT_BYTES = 1200           # O(1) per-robot state (~480 B: engine.world) + its first 16-entry transaction block (40 B each)
+SLOT_BYTES = 160             # per neighbour slot per robot: index (8), a pending entry per site (2 x 32), 2 transactions (2 x 40)
 LEVY_BYTES = 16              # per entry of the step-length table (CDF + guide), steps + 1 entries
 HISTORY_BYTES = 8 + 24       # per robot per sample: the float64 array, then its long table (step, robot, wealth)
 EVENTS_PER_ROBOT_STEP = 0.5  # the paper's runs log 0.21-0.29 events per robot per step
@@ -70,8 +70,10 @@ def run_bytes(cfg, *, record_events: bool = False, history_every: int | None = N
     """Estimated bytes of one run of ``cfg``, by part."""
     n, steps = cfg.swarm.robots, cfg.steps
     every = cfg.history_every if history_every is None else history_every
-    cell = max(cfg.robot.communication_range, 2 * cfg.robot.radius)
-    cells = math.ceil(cfg.arena.width / cell) * math.ceil(cfg.arena.height / cell)
+    from ..engine.neighbours import grid_shape
+
+    _, nx, ny = grid_shape(cfg.arena.width, cfg.arena.height, cfg.robot.communication_range, n)
+    cells = nx * ny
     parts = {
         "robot state": n * (ROBOT_BYTES + ROBOT_ROW_BYTES),
         "neighbour and transaction buffers": n * neighbour_slots(cfg) * SLOT_BYTES + 8 * (cells + n),

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..config.schema import MAX_SEED  # noqa: F401  (one definition; re-exported for the engine)
+
 
 def run_seed(master: int, run: int, condition: int = 0) -> int:
     """The 63-bit seed of run ``run`` of condition ``condition`` under ``master``."""

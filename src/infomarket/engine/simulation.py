@@ -8,17 +8,20 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from ..config.schema import Experiment
-from ..errors import SimulationError
+from ..config.load import load_experiment
+from ..errors import ConfigError, SimulationError
 from ..registry import behaviours
 from . import specialise
 from .build import behaviour_kinds, build_world, make_room
 from .flags import ErrorFlags
-from .world import EVENT_NAMES, SITE_NAMES, headings
+from .seeds import MAX_SEED
+from .world import EVENT_NAMES, SITE_NAMES, STATE_NAMES, headings
 from .worldref import kernel_view
 
 
@@ -45,10 +48,12 @@ class Result:
 class Simulation:
     """One simulated swarm.  ``Simulation(cfg, seed).run()`` → Result; ``step(k)`` advances k steps."""
 
-    def __init__(self, config: Experiment, seed: int | None = None, *, record_events: bool = False,
+    def __init__(self, config: Experiment | str | Path, seed: int | None = None, *, record_events: bool = False,
                  history_every: int | None = None):
+        if not isinstance(config, Experiment):  # a shipped name or a path, as on the command line
+            config = load_experiment(config)
         self.config = config
-        self.seed = int(seed if seed is not None else config.seed)
+        self.seed = _checked_seed(config.seed if seed is None else seed)
         self.rng = np.random.default_rng(self.seed)
         self.kinds = behaviour_kinds(config)
         hist = config.history_every if history_every is None else history_every
@@ -66,8 +71,10 @@ class Simulation:
         return int(self.world.clock[0])
 
     def step(self, k: int = 1) -> None:
-        """Advance ``k`` steps."""
-        self.advance_to(self.clock + k)
+        """Advance ``k`` steps (a positive integer)."""
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
+            raise ValueError(f"step(k): k must be a positive integer number of steps, got {k!r}")
+        self.advance_to(self.clock + int(k))
 
     def advance_to(self, t_end: int) -> None:
         t0 = time.perf_counter()
@@ -126,13 +133,24 @@ class Simulation:
     def snapshot(self) -> dict:
         """Plain-Python view of the current state, for viewers and inspection."""
         w = self.world
+        specs = behaviours()
         return {"step": self.clock, "pos": w.pos.tolist(), "heading": headings(w).tolist(),
-                "state": w.state.tolist(), "carrying": w.carrying.tolist(), "last_site": w.last_site.tolist(),
+                "state": [STATE_NAMES[s] for s in w.state], "carrying": w.carrying.tolist(),
+                "last_site": [SITE_NAMES[s] if s >= 0 else None for s in w.last_site],
                 "items": w.items.tolist(), "wealth": w.balance.tolist(),
+                "behaviour": list(self.behaviour_names), "honest": [specs[b].honest for b in self.behaviour_names],
                 "sites": SITE_NAMES}
 
 
-def simulate(config: Experiment, seed: int | None = None, *, steps: int | None = None,
+def _checked_seed(seed) -> int:
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) <= MAX_SEED:
+        raise ConfigError(f"seed must be an integer in [0, 2**63 - 1] (as in experiment files and on the "
+                          f"command line), got {seed!r}")
+    return int(seed)
+
+
+def simulate(config: Experiment | str | Path, seed: int | None = None, *, steps: int | None = None,
              record_events: bool = False, history_every: int | None = None) -> Result:
-    """Run one experiment once.  The same configuration and seed give identical results."""
+    """Run one experiment (an Experiment, a shipped name like ``"fig2D"`` or a file path) once.
+    The same configuration and seed give identical results."""
     return Simulation(config, seed, record_events=record_events, history_every=history_every).run(steps)

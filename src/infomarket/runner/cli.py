@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..cliargs import UsageError, at_least, fraction
+from ..cliargs import UsageError, at_least, fraction, seed_value
 from ..errors import EXIT_FAILED, report
 
 PAPER = ("fig2A", "fig2B", "fig2C", "fig2D", "fig3A", "fig3B", "fig3C", "fig4A", "fig4B", "fig4C",
@@ -118,7 +118,7 @@ def add_subcommand(sub) -> None:
     s = sub.add_parser("sweep", help="run every condition of an experiment into a results store (resumable)")
     s.add_argument("experiment")
     s.add_argument("--runs", type=at_least(1), help="runs per condition (default: the file's)")
-    s.add_argument("--seed", type=at_least(0), help="master seed (default: the file's)")
+    s.add_argument("--seed", type=seed_value, help="master seed (default: the file's)")
     _executor_options(s)
     s.set_defaults(func=cmd_sweep)
 

@@ -10,7 +10,7 @@ import sys
 import time
 from pathlib import Path
 
-from ..cliargs import UsageError, at_least, writable_file
+from ..cliargs import UsageError, at_least, seed_value, writable_file
 from ..errors import InfomarketError
 from . import DEFAULT_PORT
 
@@ -113,7 +113,7 @@ def add_subcommand(subparsers) -> None:
                     "Each browser tab gets its own simulation. From another machine: "
                     "ssh -L 8765:127.0.0.1:8765 HOST, then open the printed URL.")
     v.add_argument("experiment", help="a .toml file, an original .json file, or a shipped name (e.g. fig2B)")
-    v.add_argument("--seed", type=at_least(0), help="seed of the first swarm (default: the file's)")
+    v.add_argument("--seed", type=seed_value, help="seed of the first swarm (default: the file's)")
     v.add_argument("--port", type=_port, default=DEFAULT_PORT,
                    help=f"port on 127.0.0.1 (default {DEFAULT_PORT}; a free one if taken; 0 = any free one)")
     v.add_argument("--keep-running", action="store_true",
@@ -127,7 +127,7 @@ def add_subcommand(subparsers) -> None:
     r.add_argument("experiment", help="a .toml file, an original .json file, or a shipped name (e.g. fig2B)")
     r.add_argument("--out", metavar="FILE.html", help="write the HTML replay here")
     r.add_argument("--movie", metavar="FILE.mp4|FILE.gif", help="write a movie here (.mp4 needs ffmpeg)")
-    r.add_argument("--seed", type=at_least(0), help="seed (default: the file's)")
+    r.add_argument("--seed", type=seed_value, help="seed (default: the file's)")
     r.add_argument("--steps", type=at_least(1), help="steps to record (default: the file's)")
     r.add_argument("--every", type=at_least(1), metavar="K",
                    help="keep a frame every K steps (default: about 1500 frames in all)")
