@@ -38,7 +38,6 @@ NOT_RUN = {
     "infomarket sweep my.toml --out store --workers 8": "16 full runs in 8 processes",
     "infomarket sweep my.toml --out store --dask-local 4": "16 full runs on a Dask cluster",
     "infomarket sweep my.toml --out store --scheduler tcp://head:8786": "needs a Dask scheduler at that address",
-    "infomarket chain demo --robots 10 --steps 3000 --scheme staking": "an EVM run; the chain demo has its own tests",
     "infomarket run examples/age_liar.toml": "a full run; the example is tested in tests/test_extending.py",
     "infomarket chain demo --robots 25 --steps 15000 --scheme staking":
         "a paper-length replay on the EVM (about 80 s); tests/chain/test_cli.py runs short ones",

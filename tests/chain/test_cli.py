@@ -41,14 +41,14 @@ def test_unknown_experiment_is_a_usage_error(capsys):
     _simulator()
     assert main(["chain", "demo", "--experiment", "no-such-experiment"]) == 2
     err = capsys.readouterr().err
-    assert err.startswith("error:") and "Traceback" not in err
+    assert err.startswith("infomarket: error:") and "Traceback" not in err
 
 
 def test_an_unreachable_node_is_reported_before_simulating(capsys):
     _simulator()
     assert main(["chain", "demo", "--rpc", "http://127.0.0.1:9"]) == 2
     captured = capsys.readouterr()
-    assert captured.err == "error: no JSON-RPC node answers at http://127.0.0.1:9\n"
+    assert captured.err == "infomarket: error: no JSON-RPC node answers at http://127.0.0.1:9\n"
     assert "simulated" not in captured.out
 
 

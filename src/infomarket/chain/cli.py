@@ -18,6 +18,7 @@ import sys
 import time
 
 from ..cliargs import at_least, seed_value
+from ..errors import report as report_error
 from ..payments import MARKETS
 
 DEMO_SCHEMES = MARKETS
@@ -79,18 +80,15 @@ def run_demo(args: argparse.Namespace) -> int:
         from .market import connect
         from .replay import replay_result
     except ImportError as exc:
-        print(f"error: infomarket chain needs the chain extra (pip install 'infomarket[chain]'): {exc}",
-              file=sys.stderr)
-        return 1
+        return report_error(f"infomarket chain needs the chain extra (pip install 'infomarket[chain]'): {exc}", 1)
     try:
         config = demo_config(load_experiment(args.experiment), args.robots, args.steps, args.scheme)
         if args.rpc:
             connect(args.rpc)  # fail before simulating if the node is not there
-        if config.payment.scheme == "outlier" and config.payment_params().get("theta", 30.0) > 180:
+        if config.payment.scheme == "outlier" and config.payment_params()["theta"] > 180:
             raise ValueError("the contract needs theta in [0, 180] degrees")
     except (ConfigError, ValueError, ChainError) as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
+        return report_error(exc, 2)
     composition = ", ".join(f"{g.count} {g.behaviour}" for g in config.swarm.groups if g.count)
     print(f"chain demo: {args.robots} robots ({composition}), {args.steps} steps, scheme {args.scheme} "
           f"(stake {config.payment.stake:g}), seed {args.seed}")
@@ -103,8 +101,7 @@ def run_demo(args: argparse.Namespace) -> int:
     try:
         report, rows = replay_result(result, rpc_url=args.rpc, backend=args.backend)
     except ChainError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 1
+        return report_error(exc, 1)
     print(f"replayed on {args.rpc or f'the in-process EVM ({args.backend})'} in {time.perf_counter() - t0:.1f} s")
     print(_report_text(report, rows))
     good = all(r.ok for r in rows) and report.conserved() and not report.disagreements
