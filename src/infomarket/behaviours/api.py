@@ -36,7 +36,7 @@ def offer(w, seller, site):
     return w.off_valid[seller, site], w.off_age[seller, site]
 
 
-@njit
+@njit(inline="always")
 def next_candidate(w, nbrs, site, after_age, after_id):
     """The neighbour with a valid offer that comes next after (after_age, after_id) in (age, id) order,
     or -1.  Start with (-1, -1) to get the freshest offer; ties go to the lower id."""
@@ -56,7 +56,7 @@ def next_candidate(w, nbrs, site, after_age, after_id):
     return best
 
 
-@njit
+@njit(inline="always")
 def buy(w, me, seller, site):
     """Buy the seller's offer for ``site``: (ok, x, y, age), the vector in the buyer's frame.
 
@@ -83,7 +83,7 @@ def buy(w, me, seller, site):
     return True, rx + ox, ry + oy, age
 
 
-@njit
+@njit(inline="always")
 def weighted(ax, ay, a_age, bx, by, b_age):
     """Age-weighted average of eqs. (4)-(5): the younger information gets the larger weight.
     Returns (x, y, age) with age floor((a + b) / 2); equal weights when both ages are 0."""
@@ -104,7 +104,7 @@ def install(w, me, site, x, y, age):
     w.new_valid[me, site] = True
 
 
-@njit
+@njit(inline="always")
 def combine(w, me, site, x, y, age):
     """Combine bought information with the robot's current entry (eqs. 4-5) and install the result;
     an invalid entry is replaced by the bought vector (its age still averaged, as the original does)."""
@@ -115,7 +115,7 @@ def combine(w, me, site, x, y, age):
     install(w, me, site, nx, ny, nage)
 
 
-@njit
+@njit(inline="always")
 def diff(ax, ay, bx, by):
     """Difference score of eq. (6): |a - b| / |a|, and 1000 when |a| = 0."""
     na = norm(ax, ay)
@@ -144,7 +144,7 @@ def pending_has(w, me, site, seller):
     return False
 
 
-@njit
+@njit(inline="always")
 def pending_add(w, me, site, seller, x, y, age):
     """Append a purchase to the pending list; the list holds at most one entry per seller."""
     k = w.pend_count[me, site]

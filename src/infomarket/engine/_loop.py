@@ -44,7 +44,8 @@ def has_room(w):
             return False
         if w.pend_count[i, 0] + c > kp or w.pend_count[i, 1] + c > kp:
             return False
-        if not reserve(w, i, w.tx_count[i] + 2 * c):
+        need = w.tx_count[i] + 2 * c
+        if need > w.tx_cap[i] and not reserve(w, i, need):
             return False
         events += 2 * c
     if w.record and w.ev_count[0] + events > w.ev_step.shape[0]:

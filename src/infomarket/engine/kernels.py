@@ -14,13 +14,14 @@ from .world import EXPLORING, FOOD, NEST, SEEKING_FOOD, SEEKING_NEST
 @njit
 def begin_communication(w):
     """Start-of-phase copy: purchases go to the new table; sellers keep selling the old one."""
-    n = w.pos.shape[0]
-    for i in range(n):
+    tab_vec, new_vec, tab_age, new_age, tab_valid, new_valid = (w.tab_vec, w.new_vec, w.tab_age, w.new_age,
+                                                                w.tab_valid, w.new_valid)
+    for i in range(tab_age.shape[0]):  # arrays read once: a field read per element costs a reference count
         for s in range(2):
-            w.new_vec[i, s, 0] = w.tab_vec[i, s, 0]
-            w.new_vec[i, s, 1] = w.tab_vec[i, s, 1]
-            w.new_age[i, s] = w.tab_age[i, s]
-            w.new_valid[i, s] = w.tab_valid[i, s]
+            new_vec[i, s, 0] = tab_vec[i, s, 0]
+            new_vec[i, s, 1] = tab_vec[i, s, 1]
+            new_age[i, s] = tab_age[i, s]
+            new_valid[i, s] = tab_valid[i, s]
 
 
 @njit(inline="always")
@@ -40,7 +41,7 @@ def within(x, y, cx, cy, r):
     return dx * dx + dy * dy < r * r
 
 
-@njit
+@njit(inline="always")
 def draw_spot(w, i, site, rng):
     """A pick-up / drop point uniform in the site's disc."""
     a = rng.random() * 2.0 * math.pi
@@ -50,7 +51,7 @@ def draw_spot(w, i, site, rng):
     w.has_spot[i, site] = True
 
 
-@njit
+@njit(inline="always")
 def forage(w, i, rng):
     """Pick-up and drop spots (MODEL.md §6).  Returns True when robot i deposits an item this step
     (the caller then pays and shares the reward)."""
@@ -93,7 +94,7 @@ def to_world(w, i, x, y):
     return c * x - s * y, s * x + c * y
 
 
-@njit
+@njit(inline="always")
 def walls(x, y, c, s, r, width, height):
     """Wall sensors FRONT, RIGHT, BACK, LEFT: would a move of (c, s) (the heading times the speed),
     turned by 0, -90, 180, +90 degrees, put the robot's disc outside the arena?
@@ -102,7 +103,7 @@ def walls(x, y, c, s, r, width, height):
             outside(x - c, y - s, r, width, height), outside(x - s, y + c, r, width, height))
 
 
-@njit
+@njit(inline="always")
 def sense_sites(w, i):
     """A robot inside a site knows exactly where its target point there is (its spot, else the centre)."""
     x = w.pos[i, 0]
@@ -123,7 +124,7 @@ def sense_sites(w, i):
             w.last_site[i] = s
 
 
-@njit
+@njit(inline="always")
 def update_state(w, i, front):
     """The three-state machine (EXPLORING, SEEKING_FOOD, SEEKING_NEST)."""
     st = w.state[i]
@@ -164,7 +165,7 @@ def draw_index(cdf, guide, u):
     return k
 
 
-@njit
+@njit(inline="always")
 def intended_move(w, i, rng):
     """The movement the robot wants, in its own frame: towards the sought site, or a random-walk step."""
     st = w.state[i]
@@ -189,7 +190,7 @@ def intended_move(w, i, rng):
     return w.speed * w.turn_cos[k], w.speed * w.turn_sin[k]
 
 
-@njit
+@njit(inline="always")
 def odometry_update(w, i, dx, dy):
     """Dead reckoning: every table and pending entry moves by -dr, turns by -heading(dr), ages by one.
     Turning by -heading(dr) is multiplying by dr's conjugate unit vector, so no trigonometry is needed."""
@@ -210,7 +211,7 @@ def odometry_update(w, i, dx, dy):
             w.pend_age[i, k, j] += 1
 
 
-@njit
+@njit(inline="always")
 def behaviour_step(w, i, rng):
     """Sensors, state machine, intended movement with wall reflection, table update (MODEL.md §3).
     Returns the reflected intended movement (robot frame)."""
@@ -228,7 +229,7 @@ def behaviour_step(w, i, rng):
     return dx, dy
 
 
-@njit
+@njit(inline="always")
 def move(w, i, dx, dy, rng):
     """Execute the movement with odometry noise: the robot turns by N(bias, noise_sd) more than it
     thinks; its new heading is the direction it actually moved; positions are clamped to the arena."""

@@ -99,14 +99,14 @@ def generate_source(behaviours: list[BehaviourSpec], payment: PaymentSpec) -> st
         lines.append(f"_b{k}_buy = _rule_function('behaviour', {b.name!r}, 'buy')")
         lines.append(f"_b{k}_sell = _rule_function('behaviour', {b.name!r}, 'sell')")
     lines.append(f"_pay = _rule_function('payment', {payment.name!r}, 'weights')")
-    lines += ["", "", "@njit(cache=True)", "def sell_dispatch(kind, w, i, site, rng):"]
+    lines += ["", "", "@njit(cache=True, inline='always')", "def sell_dispatch(kind, w, i, site, rng):"]
     for k, b in enumerate(behaviours):
         call = f"return _b{k}_sell(w, i, site{_args(b.sell, b.params, 'w.bparams[i]')})"
         if k == len(behaviours) - 1:
             lines.append(f"    {call}")
         else:
             lines += [f"    if kind == {k}:", f"        {call}"]
-    lines += ["", "", "@njit(cache=True)", "def buy_dispatch(kind, w, i, nbrs, rng):"]
+    lines += ["", "", "@njit(cache=True, inline='always')", "def buy_dispatch(kind, w, i, nbrs, rng):"]
     for k, b in enumerate(behaviours):
         lines += [f"    {'if' if k == 0 else 'elif'} kind == {k}:",
                   f"        _b{k}_buy(w, i, nbrs{_args(b.buy, b.params, 'w.bparams[i]')})"]

@@ -64,7 +64,7 @@ def reserve(w, buyer, need):
     return True
 
 
-@njit
+@njit(inline="always")
 def open_transaction(w, buyer, seller, site, direction):
     """Lock the seller's stake and record the transaction; False (nothing recorded) when refused."""
     k = w.tx_count[buyer]
@@ -121,7 +121,7 @@ def settlement(w, buyer):
     return w.tx_seller[a:b], w.tx_site[a:b], w.tx_dir[a:b]
 
 
-@njit
+@njit(inline="always")
 def purchase_events(w, ok, buyer, seller, site, direction, x, y, age, sx, sy):
     log_event(w, EV_PURCHASE if ok else EV_REFUSED, buyer, seller, site, direction, x, y, age,
               w.stake if ok else 0.0, sx, sy)
