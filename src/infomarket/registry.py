@@ -89,7 +89,7 @@ def _jit(func: Callable) -> Callable:
         return func
     if not callable(func):
         raise TypeError(f"a rule must be a function, got {func!r}")
-    return numba.njit(func, inline="always")
+    return numba.njit(func)
 
 
 def _rule(func: Callable, fixed: tuple[str, ...], what: str) -> Rule:
