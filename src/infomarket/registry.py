@@ -187,7 +187,7 @@ def payment(name: str, *, description: str = "", replace: bool = False):
 _ENTRY_POINTS_LOADED: list[bool] = []
 
 
-def _ensure_builtins() -> None:
+def _load_entry_points() -> None:
     """Load third-party rules from the "infomarket.plugins" entry-point group, once.  (The built-ins
     are registered by ``infomarket.builtins``, which the package imports; this module never does.)"""
     if not _ENTRY_POINTS_LOADED:
@@ -199,7 +199,7 @@ def _ensure_builtins() -> None:
 
 
 def get_behaviour(name: str) -> BehaviourSpec:
-    _ensure_builtins()
+    _load_entry_points()
     try:
         return _BEHAVIOURS[name]
     except KeyError:
@@ -207,7 +207,7 @@ def get_behaviour(name: str) -> BehaviourSpec:
 
 
 def get_payment(name: str) -> PaymentSpec:
-    _ensure_builtins()
+    _load_entry_points()
     try:
         return _PAYMENTS[name]
     except KeyError:
@@ -215,12 +215,12 @@ def get_payment(name: str) -> PaymentSpec:
 
 
 def behaviours() -> dict[str, BehaviourSpec]:
-    _ensure_builtins()
+    _load_entry_points()
     return dict(_BEHAVIOURS)
 
 
 def payments() -> dict[str, PaymentSpec]:
-    _ensure_builtins()
+    _load_entry_points()
     return dict(_PAYMENTS)
 
 

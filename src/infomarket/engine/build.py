@@ -9,7 +9,7 @@ from ..config.schema import Experiment
 from ..registry import behaviours
 from .kernels import turn_tables
 from .neighbours import grid_shape
-from .world import LOG, World
+from .world import LOG, TX_POOL, World
 
 #: First capacities; the host grows each when the kernel asks for room (``make_room``).
 NEIGHBOUR_CAPACITY = 8
@@ -163,7 +163,7 @@ def make_room(world: World, tx_need: np.ndarray | None = None) -> World:
         size = 2 * int(caps.sum())
         src = _ranges(world.tx_off, world.tx_count)
         dst = _ranges(starts, world.tx_count)
-        for f in ("tx_seller", "tx_site", "tx_dir", "tx_step", "tx_stake"):
+        for f in TX_POOL:
             old = getattr(world, f)
             new = np.zeros(size, old.dtype)
             new[dst] = old[src]

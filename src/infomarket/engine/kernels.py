@@ -5,6 +5,7 @@ configuration by ``engine.specialise`` around ``engine._loop``; everything here 
 """
 import math
 
+import numpy as np
 from numba import njit
 
 from .geometry import DEG, norm, rotate
@@ -178,16 +179,15 @@ def intended_move(w, i, rng):
             x *= w.speed / length
             y *= w.speed / length
         return x, y
-    turn = 0.0
+    turn = 0
     if w.levy[i] <= 1:
-        turn = float(draw_index(w.cauchy_cdf, w.cauchy_guide, rng.random()))
+        turn = draw_index(w.cauchy_cdf, w.cauchy_guide, rng.random())
     w.levy[i] -= 1
     if w.levy[i] <= 0:
         w.levy[i] = draw_index(w.levy_cdf, w.levy_guide, rng.random()) + 1
-    if turn == 0.0:
+    if turn == 0:
         return w.speed, 0.0
-    k = int(turn)
-    return w.speed * w.turn_cos[k], w.speed * w.turn_sin[k]
+    return w.speed * w.turn_cos[turn], w.speed * w.turn_sin[turn]
 
 
 @njit(inline="always")
@@ -266,8 +266,6 @@ def _turn_tables(cos_out, sin_out):
 def turn_tables():
     """cos and sin of every whole-degree turn, computed by compiled code (the same libm calls the
     kernel made before it looked them up), so a turn costs a table read instead of two calls."""
-    import numpy as np
-
     c = np.empty(360)
     s = np.empty(360)
     _turn_tables(c, s)

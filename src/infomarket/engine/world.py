@@ -77,10 +77,9 @@ ROBOTS = (
     "spot", "has_spot", "last_site", "items", "stop_timer", "cool_timer",
     "nbr", "nbr_count", "cell_start", "cell_items",
 )
-LEDGER = (
-    "balance", "pot", "burned", "tx_off", "tx_cap", "tx_count",
-    "tx_seller", "tx_site", "tx_dir", "tx_step", "tx_stake", "pool_top",
-)
+#: The fields of one transaction in the pool (moved together when a block moves or is compacted).
+TX_POOL = ("tx_seller", "tx_site", "tx_dir", "tx_step", "tx_stake")
+LEDGER = ("balance", "pot", "burned", "tx_off", "tx_cap", "tx_count", *TX_POOL, "pool_top")
 LOG = (
     "ev_step", "ev_kind", "ev_buyer", "ev_seller", "ev_site", "ev_dir", "ev_x", "ev_y", "ev_age",
     "ev_stake", "ev_sx", "ev_sy", "ev_count", "hist", "flags",

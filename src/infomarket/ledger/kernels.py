@@ -40,6 +40,16 @@ def log_event(w, kind, buyer, seller, site, direction, x, y, age, stake, sx=0.0,
     w.ev_count[0] = k + 1
 
 
+@njit(inline="always")
+def _move_transaction(w, src, dst):
+    """Copy pool entry ``src`` (every field of a transaction) to ``dst``."""
+    w.tx_seller[dst] = w.tx_seller[src]
+    w.tx_site[dst] = w.tx_site[src]
+    w.tx_dir[dst] = w.tx_dir[src]
+    w.tx_step[dst] = w.tx_step[src]
+    w.tx_stake[dst] = w.tx_stake[src]
+
+
 @njit
 def reserve(w, buyer, need):
     """Make the buyer's block of the transaction pool hold at least ``need`` transactions, moving it to
@@ -53,11 +63,7 @@ def reserve(w, buyer, need):
         return False
     a = w.tx_off[buyer]
     for x in range(w.tx_count[buyer]):
-        w.tx_seller[top + x] = w.tx_seller[a + x]
-        w.tx_site[top + x] = w.tx_site[a + x]
-        w.tx_dir[top + x] = w.tx_dir[a + x]
-        w.tx_step[top + x] = w.tx_step[a + x]
-        w.tx_stake[top + x] = w.tx_stake[a + x]
+        _move_transaction(w, a + x, top + x)
     w.tx_off[buyer] = top
     w.tx_cap[buyer] = cap
     w.pool_top[0] = top + cap
@@ -105,11 +111,7 @@ def expire_stakes(w, buyer):
         w.balance[w.tx_seller[a + x]] += w.tx_stake[a + x]
         w.pot[buyer] -= w.tx_stake[a + x]
     for x in range(k - m):
-        w.tx_seller[a + x] = w.tx_seller[a + m + x]
-        w.tx_site[a + x] = w.tx_site[a + m + x]
-        w.tx_dir[a + x] = w.tx_dir[a + m + x]
-        w.tx_step[a + x] = w.tx_step[a + m + x]
-        w.tx_stake[a + x] = w.tx_stake[a + m + x]
+        _move_transaction(w, a + m + x, a + x)
     w.tx_count[buyer] = k - m
 
 
