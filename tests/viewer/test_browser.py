@@ -75,7 +75,9 @@ def wait_for(driver, script, timeout=20.0, what=None):
 
 def open_page(driver, url):
     driver.get(url)
-    wait_for(driver, "window.infomarketViewer && infomarketViewer.ready", what="the first frame")
+    # the first frame has arrived *and* been drawn (drawing waits for the next animation frame)
+    wait_for(driver, "window.infomarketViewer && infomarketViewer.ready && infomarketViewer.framesDrawn > 0",
+             what="the first frame drawn")
 
 
 def settle(driver):
