@@ -6,8 +6,9 @@ the ledger alone, when transactions settle (``ledger.kernels.distribute``), so n
 or anyone's reputation.  Every helper is O(1), cheap enough to call per neighbour per step.
 
 The record counts a robot's *sales*: a transaction in which it sold information is **settled** when the
-buyer deposits an item, and **reduced** when the payment scheme weighed it 0 or below the best weight
-given to a transaction of the same site in that settlement (an outlier, under outlier penalisation).
+buyer deposits an item, and **reduced** when the payment scheme weighed it 0 or below half the best
+weight given to a transaction of the same site in that settlement (an outlier, under outlier
+penalisation).
 Under delayed payment every weight is equal, so nothing is ever reduced.
 """
 from numba import njit
@@ -36,7 +37,7 @@ def sales_settled(w, j):
 
 @njit(inline="always")
 def sales_reduced(w, j):
-    """How many of j's settled sales were weighed as outliers (0, or below the best of their site)."""
+    """How many of j's settled sales were weighed as outliers (0, or below half the best of their site)."""
     return w.rep_reduced[j]
 
 

@@ -7,8 +7,8 @@ from .api import (buy, combine, current, diff, install, next_candidate, own_entr
 from .market import sales_settled, seller_reputation, wealth_share
 
 
-def reputation_sceptic_buy(w, me, nbrs, threshold=0.25, trust_reputation=0.9, trust_share=0.06,
-                           distrust_reputation=0.6, min_record=10.0):
+def reputation_sceptic_buy(w, me, nbrs, threshold=0.25, trust_reputation=0.85, trust_share=0.06,
+                           distrust_reputation=0.55, min_record=10.0):
     """The sceptical rule, with the seller's standing deciding how much confirmation it needs.  A seller
     with at least ``min_record`` settled sales and a reputation below ``distrust_reputation`` is ignored
     (never bought from, so never paid); one with a record and a reputation of at least

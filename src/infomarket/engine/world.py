@@ -56,7 +56,7 @@ LEDGER:
     REPUTATION (``REPUTATION``, part of the ledger): what the ledger itself knows about each robot, updated
         when its transactions settle; rules read it through ``behaviours.market``, never write it.
         rep_settled [n] transactions it sold that were settled by a deposit;  rep_reduced [n] of those,
-        the ones weighed 0 or below the largest weight of the same site in their settlement (outliers);
+        the ones weighed 0 or below half the largest weight of the same site in their settlement (outliers);
         rep_earned [n] money it was paid for them;  rep_stake_lost [n] stake it locked in them and did
         not get back (stake minus payment, when positive);  rep_deposits [n] deposits it made as buyer
 

@@ -14,6 +14,11 @@ from ..engine.world import EV_DEPOSIT, EV_PURCHASE, EV_REFUSED
 #: A seller whose balance falls short of the stake by less than this (float rounding of sums of
 #: stakes, e.g. 1 - 24 x 0.04) can still lock it: the exact on-chain ledger would accept it.
 STAKE_TOLERANCE = 1e-9
+#: A settled sale counts as an outlier in its seller's reputation record when the scheme weighed it
+#: below this fraction of the best weight given to the same site in that settlement (or 0).  Half, not
+#: "below the best": with outlier penalisation honest sales weigh anywhere near the best (drift spreads
+#: them), while a rotated one agrees only with the other liars' and weighs a fraction of it.
+OUTLIER_FRACTION = 0.5
 
 
 @njit
@@ -135,7 +140,7 @@ def purchase_events(w, ok, buyer, seller, site, direction, x, y, age, sx, sy):
 def _record_sale(w, seller, weight, top, pay, stake):
     """The seller's reputation record for one settled transaction (engine.world, REPUTATION): O(1)."""
     w.rep_settled[seller] += 1
-    if weight <= 0.0 or weight < top:
+    if weight <= 0.0 or weight < OUTLIER_FRACTION * top:
         w.rep_reduced[seller] += 1
     w.rep_earned[seller] += pay
     if stake > pay:
@@ -146,8 +151,8 @@ def _record_sale(w, seller, weight, top, pay, stake):
 def distribute(w, buyer, weights):
     """Settle a deposit: reward and pot to the buyer, then ``info_share * reward + pot`` from the buyer
     to the sellers of its open transactions in proportion to ``weights``; clear its transactions.
-    Each seller's reputation record is updated from its weight (an outlier when below the best weight
-    of its site in this settlement), so rules can read how the market has judged it."""
+    Each seller's reputation record is updated from its weight (an outlier when below half the best
+    weight of its site in this settlement), so rules can read how the market has judged it."""
     k = w.tx_count[buyer]
     w.balance[buyer] += w.reward
     pot = w.pot[buyer]
