@@ -9,7 +9,7 @@ from ..errors import EXIT_FAILED, report
 PAPER = ("fig2A", "fig2B", "fig2C", "fig2D", "fig3A", "fig3B", "fig3C", "fig4A", "fig4B", "fig4C",
          "fig5", "fig6A", "fig6B", "fig7")
 #: Named sets of shipped experiments that ``infomarket sweep NAME`` runs into one store.
-SUITES = {"future": ("future_liar", "future_farmer", "future_surfer", "future_honest")}
+SUITES = {"future": ("future_honest", "future_liar", "future_farmer", "future_surfer")}
 
 
 def _client(args):
