@@ -164,10 +164,12 @@ def _beats(experiment: str, defence: str):
                 helped.append(a)
             parts.append(f"{a:g} deg: {_med(x):g} (paper {_med(y):g}, p = {q:.2g})")
         yes = bool(dropped) and not helped
+        def at(angles):
+            return f"{', '.join(f'{a:g}' for a in angles)} deg" if angles else "no angle"
+
         return Answer(YES if yes else NO,
                       f"{defence} without Byzantines: median {_med(own):g}, floor {floor:g}; below the floor at "
-                      f"{', '.join(f'{a:g}' for a in dropped) or 'no angle'} deg; significantly better than the "
-                      f"paper at {', '.join(f'{a:g}' for a in helped) or 'no angle'} deg; " + "; ".join(parts))
+                      f"{at(dropped)}; significantly better than the paper at {at(helped)}; " + "; ".join(parts))
     return measure
 
 
