@@ -19,6 +19,7 @@ from .errors import ConfigError, InfomarketError, report
 
 SUBCOMMAND_MODULES = ("infomarket.runner.cli", "infomarket.analysis.cli", "infomarket.viewer.cli",
                       "infomarket.chain.cli")
+SUBCOMMAND_MODULES += ("infomarket.analysis.terrain",)  # terrain-report (docs/terrain.md)
 EXIT_INTERRUPTED = 130
 
 
