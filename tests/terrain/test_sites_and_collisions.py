@@ -108,3 +108,38 @@ def test_items_before_the_transitory_period_are_not_counted_per_site():
     sim, picked = _per_site_run(transitory=5)
     assert picked[0] and not sim.world.carrying[0]  # it did pick up and deposit
     assert sim.world.site_items.tolist() == [0, 0, 0, 0] and sim.world.items[0] == 0
+
+
+def test_sensing_robots_reflects_off_a_robot_ahead():
+    # robot 0 at (100, 300) heading +x, robot 1 at (117, 300): robot 0's FRONT probe (102.5, 300) is
+    # 14.5 from robot 1 (<= 16): with sense_robots it fires, robot 0 (seeking) drops its food entry,
+    # explores and reflects its (2.5, 0) move to (-2.5, 0); robot 1, heading -x, probes (114.5, 300),
+    # 14.5 from robot 0's start... but robot 0 has moved to 97.5 first (id order): 17 away, no fire.
+    from infomarket.engine.world import EXPLORING, SEEKING_FOOD
+
+    sim = simulation(terrain_config(robots=2, collisions=True, sense_robots=True))
+    place(sim, 0, 100.0, 300.0, 0.0)
+    place(sim, 1, 117.0, 300.0, 180.0)
+    sim.world.hdir[1] = (-1.0, 0.0)
+    for i in (0, 1):
+        seek_food(sim, i, 1000.0, 0.0)
+    sim.world.levy[:] = 5
+    sim.step(1)
+    w = sim.world
+    assert w.state.tolist() == [EXPLORING, SEEKING_FOOD]
+    assert w.pos[:, 0].tolist() == [97.5, 114.5]
+
+
+def test_without_sensing_robots_the_same_pair_is_blocked_not_reflected():
+    from infomarket.engine.world import SEEKING_FOOD
+
+    sim = simulation(terrain_config(robots=2, collisions=True))
+    place(sim, 0, 100.0, 300.0, 0.0)
+    place(sim, 1, 117.0, 300.0, 180.0)
+    sim.world.hdir[1] = (-1.0, 0.0)
+    for i in (0, 1):
+        seek_food(sim, i, 1000.0, 0.0)
+    sim.step(1)
+    w = sim.world
+    assert w.state.tolist() == [SEEKING_FOOD, SEEKING_FOOD]
+    assert w.pos[:, 0].tolist() == [100.0, 117.0]  # each would end 14.5 from the other

@@ -102,6 +102,8 @@ class Robot(_Strict):
     line_of_sight: StrictBool = False
     #: Robots are discs that cannot overlap: a move that would overlap another robot is not made.
     collisions: StrictBool = False
+    #: The proximity sensors also fire for other robots' discs (as for obstacles; engine.terrain).
+    sense_robots: StrictBool = False
 
 
 class RandomWalk(_Strict):
@@ -272,7 +274,7 @@ class Experiment(_Strict):
     def terrain(self) -> bool:
         """Does this setup leave the paper's plane (obstacles, several sites of a kind, line of sight,
         collisions)?  Only then does the engine compile the terrain-aware step (engine.terrain)."""
-        return bool(self.obstacles or self.robot.line_of_sight or self.robot.collisions
+        return bool(self.obstacles or self.robot.line_of_sight or self.robot.collisions or self.robot.sense_robots
                     or len(self.sites("food")) > 1 or len(self.sites("nest")) > 1)
 
     def behaviour_params(self, group: Group) -> dict[str, float]:

@@ -35,6 +35,6 @@ def drop_defaults(data: dict[str, Any]) -> None:
     if not data.get("obstacles"):
         data.pop("obstacles", None)
     robot = data.get("robot", {})
-    for key in ("line_of_sight", "collisions"):
+    for key in ("line_of_sight", "collisions", "sense_robots"):
         if robot.get(key) is False:
             robot.pop(key)

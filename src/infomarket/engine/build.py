@@ -111,6 +111,7 @@ def build_world(cfg: Experiment, rng: np.random.Generator, *, record_events: boo
         grid_cell=cell, grid_nx=nx, grid_ny=ny,
         sites_xy=sites_xy, sites_r=sites_r, sites_kind=sites_kind, obs_kind=obs_kind, obs_geom=obs_geom,
         line_of_sight=bool(cfg.robot.line_of_sight), collisions=bool(cfg.robot.collisions),
+        sense_robots=bool(cfg.robot.sense_robots),
         clock=z(1, np.int64), pos=pos,
         hdir=np.stack([np.cos(np.radians(heading)), np.sin(np.radians(heading))], axis=1), bias=bias, kind=kind,
         state=z(n, np.int64), carrying=z(n, np.bool_), levy=np.ones(n, np.int64),

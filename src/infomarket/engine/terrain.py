@@ -25,6 +25,9 @@ Rules (docs/terrain.md says the same for users):
   inside a site of the kind it needs gets a spot there (a new one if its spot lies in another site);
   items are counted per site in ``site_items`` (pick-ups at food sites, deposits at nests, after the
   transitory period).
+* **Sensing robots** (``robot.sense_robots``, added after the crowd's first answer, see
+  docs/research.md).  The proximity sensors also fire when the probed disc would touch another
+  robot's disc (centres at most ``2 r`` apart), so robots reflect off each other as off walls.
 * **Line of sight** (``robot.line_of_sight``).  A neighbour pair is dropped when an obstacle cuts the
   segment between the two centres (touching counts).
 """
@@ -168,11 +171,23 @@ def sense_sites(w, i):
 
 
 @njit(inline="always")
-def probe(w, x, y):
-    """A proximity sensor: would a disc centred at (x, y) leave the arena or touch an obstacle?"""
+def probe(w, i, x, y):
+    """A proximity sensor of robot i: would a disc centred at (x, y) leave the arena or touch an
+    obstacle (or, with ``sense_robots``, another robot's disc: centres at most 2 r apart)?"""
     if outside(x, y, w.radius, w.width, w.height):
         return True
-    return nearest(w.obs_kind, w.obs_geom, x, y) <= w.radius
+    if nearest(w.obs_kind, w.obs_geom, x, y) <= w.radius:
+        return True
+    if w.sense_robots:
+        pos = w.pos
+        d2 = 4.0 * w.radius * w.radius
+        for j in range(pos.shape[0]):
+            if j != i:
+                ex = pos[j, 0] - x
+                ey = pos[j, 1] - y
+                if ex * ex + ey * ey <= d2:
+                    return True
+    return False
 
 
 @njit(inline="always")
@@ -182,7 +197,8 @@ def sensors(w, i):
     y = w.pos[i, 1]
     c = w.speed * w.hdir[i, 0]
     s = w.speed * w.hdir[i, 1]
-    return probe(w, x + c, y + s), probe(w, x + s, y - c), probe(w, x - c, y - s), probe(w, x - s, y + c)
+    return (probe(w, i, x + c, y + s), probe(w, i, x + s, y - c), probe(w, i, x - c, y - s),
+            probe(w, i, x - s, y + c))
 
 
 @njit(inline="always")

@@ -27,7 +27,7 @@ PARAMS:
     grid_cell: float cell side of the neighbour grid (>= comm_range);  grid_nx, grid_ny: int cells
     sites_xy [S, 2], sites_r [S], sites_kind [S] (FOOD / NEST): every site, in file order, food first
         (site_pos / site_r hold the first site of each kind, all the paper's plane needs)
-    obs_kind [K], obs_geom [K, 4]: obstacles (engine.obstacles);  line_of_sight, collisions: bool
+    obs_kind [K], obs_geom [K, 4]: obstacles (engine.obstacles);  line_of_sight, collisions, sense_robots: bool
 
 ROBOTS:
     clock [1] int64 the last completed step (the first step is 1)
@@ -76,6 +76,7 @@ PARAMS = (
     "bparams", "pparams", "record", "hist_every", "grid_cell", "grid_nx", "grid_ny",
     # terrain (engine.terrain; only the terrain-aware step reads these)
     "sites_xy", "sites_r", "sites_kind", "obs_kind", "obs_geom", "line_of_sight", "collisions",
+    "sense_robots",
 )
 ROBOTS = (
     "clock", "pos", "hdir", "bias", "kind", "state", "carrying", "levy",
