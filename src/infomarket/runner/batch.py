@@ -55,6 +55,7 @@ class RunOutput:
     robots: pd.DataFrame
     history: pd.DataFrame
     events: pd.DataFrame
+    payments: pd.DataFrame = field(default_factory=pd.DataFrame)
     compile_seconds: float = 0.0
     run_seconds: float = 0.0
     steps: int = 0
@@ -70,8 +71,8 @@ def _one(cfg: Experiment, run: int, seed: int, steps: int | None, history_every:
     r = simulate(cfg, seed, steps=steps, history_every=history_every, record_events=record_events)
     robots = r.robots
     robots.insert(0, "run", np.int64(run))
-    hist, events = r.history, r.events
-    for table in (hist, events):
+    hist, events, payments = r.history, r.events, r.payments
+    for table in (hist, events, payments):
         if len(table):
             table.insert(0, "run", np.int64(run))
             table.insert(1, "seed", np.uint64(seed))
@@ -80,14 +81,16 @@ def _one(cfg: Experiment, run: int, seed: int, steps: int | None, history_every:
         sites.insert(0, "run", np.int64(run))
         sites.insert(1, "seed", np.uint64(seed))
         sites.insert(2, "site", np.arange(len(sites), dtype=np.int64))
-    return RunOutput(run, seed, robots, hist, events if record_events else pd.DataFrame(),
-                     r.compile_seconds, r.run_seconds, r.steps, sites=sites)
+    empty = pd.DataFrame()
+    return RunOutput(run, seed, robots, hist, events if record_events else empty,
+                     payments if record_events else empty, r.compile_seconds, r.run_seconds, r.steps,
+                     sites=sites)
 
 
 def _failed(run: int, seed: int, exc: BaseException) -> RunOutput:
     text = "".join(traceback.format_exception(exc))[-MAX_ERROR_CHARS:]
     empty = pd.DataFrame()
-    return RunOutput(run, seed, empty, empty, empty, error=text)
+    return RunOutput(run, seed, empty, empty, empty, empty, error=text)
 
 
 def _chunk(cfg: Experiment, items: list[tuple[int, int]], steps, history_every, record_events=False,

@@ -111,7 +111,7 @@ def _concat(frames: list[pd.DataFrame]) -> pd.DataFrame | None:
 
 
 def _frames(task: Task, outputs: list[RunOutput]) -> dict[str, pd.DataFrame | None]:
-    """The part's tables: robots, history, events (None when empty) and the runs record."""
+    """The part's tables: robots, history, events, payments (None when empty) and the runs record."""
     c = task.condition
 
     def label(df: pd.DataFrame, keys: bool) -> pd.DataFrame:
@@ -122,7 +122,7 @@ def _frames(task: Task, outputs: list[RunOutput]) -> dict[str, pd.DataFrame | No
                 df[k] = v
         return df
 
-    robots, hists, events, rows = [], [], [], []
+    robots, hists, events, payments, rows = [], [], [], [], []
     for o, run in zip(outputs, task.runs):
         if o.error is None:
             robots.append(label(o.robots, True))
@@ -131,13 +131,15 @@ def _frames(task: Task, outputs: list[RunOutput]) -> dict[str, pd.DataFrame | No
                 hists.append(label(o.history.merge(meta, on="robot", how="left"), False))
             if len(o.events):
                 events.append(label(o.events, True))
+            if len(o.payments):
+                payments.append(label(o.payments, True))
         rows.append({"experiment": c.experiment, "condition": c.id, "run": np.int64(run),
                      "seed": np.uint64(c.seed(run)), "master_seed": np.int64(c.master_seed),
                      "config_hash": c.config.config_hash(), "package_version": __version__,
                      "duration_s": o.run_seconds, "steps": o.steps, "transitory": c.config.transitory,
                      "status": OK if o.error is None else FAILED, "error": o.error or "", **c.keys})
     return {"robots": _concat(robots), "history": _concat(hists), "events": _concat(events),
-            "runs": pd.DataFrame(rows)}
+            "payments": _concat(payments), "runs": pd.DataFrame(rows)}
 
 
 def run_sweep(conds: list[Condition], store: Store, *, workers: int = 1, client=None,
