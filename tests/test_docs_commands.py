@@ -18,6 +18,7 @@ DOCS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 RUN = {
     "infomarket list",
     "infomarket check my.toml",
+    "infomarket check corridor",
 }
 #: Parsed only, with the reason they are not run here.
 NOT_RUN = {
@@ -47,6 +48,13 @@ NOT_RUN = {
     "infomarket bench --robots 25,100,1000,10000 --json":
         "minutes of timing (10 000 robots x 15 000 steps); tests/bench runs --robots 25,60 --steps 50",
     "infomarket bench --scaling": "96 timed runs; tests/bench runs the same code with 2 runs of 200 steps",
+    # docs/terrain.md
+    "infomarket run two_food --runs 4 --out results/two_food": "4 full runs; sites.parquet: tests/terrain/test_cli.py",
+    "infomarket sweep crowd --out results/crowd": "128 full runs (100 robots); sweeps are tested in tests/runner",
+    "infomarket terrain-report results --out results/terrain":
+        "needs the three full stores; tests/terrain/test_report.py runs it on small ones",
+    "infomarket view corridor": "a web server that runs until stopped; tests/viewer",
+    "infomarket replay crowd --movie crowd.gif": "a full-length recording; movies: tests/viewer/test_terrain_view.py",
 }
 
 

@@ -19,6 +19,7 @@ from .errors import ConfigError, InfomarketError, report
 
 SUBCOMMAND_MODULES = ("infomarket.runner.cli", "infomarket.analysis.cli", "infomarket.viewer.cli",
                       "infomarket.chain.cli")
+SUBCOMMAND_MODULES += ("infomarket.analysis.terrain",)  # terrain-report (docs/terrain.md)
 EXIT_INTERRUPTED = 130
 
 
@@ -62,6 +63,7 @@ def cmd_run(args) -> int:
     seed = cfg.seed if args.seed is None else args.seed
     out = Path(args.out or Path("results") / cfg.name)
     names = ["robots.parquet"] + (["wealth_history.parquet"] if cfg.history_every else [])
+    names += ["sites.parquet"] if cfg.terrain else []  # items per site per run (docs/terrain.md)
     existing = [n for n in names if (out / n).exists()]
     if existing and not args.force:
         raise UsageError(f"--out {out}: {existing[0]} exists (an earlier run's results); --force replaces it, "
@@ -91,7 +93,7 @@ def cmd_run(args) -> int:
 def _write_run_tables(res, out: Path, names: list[str]) -> list[Path]:
     from .store import write_parquet_atomic
 
-    tables = {"robots.parquet": res.robots, "wealth_history.parquet": res.history}
+    tables = {"robots.parquet": res.robots, "wealth_history.parquet": res.history, "sites.parquet": res.sites}
     return [write_parquet_atomic(tables[n], out / n) for n in names]
 
 
