@@ -18,7 +18,7 @@ from .cliargs import Parser, UsageError, at_least, seed_value, writable_dir
 from .errors import ConfigError, InfomarketError, report
 
 SUBCOMMAND_MODULES = ("infomarket.runner.cli", "infomarket.analysis.cli", "infomarket.viewer.cli",
-                      "infomarket.chain.cli")
+                      "infomarket.chain.cli", "infomarket.analysis.sensitivity_cli")
 EXIT_INTERRUPTED = 130
 
 

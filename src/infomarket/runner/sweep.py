@@ -150,11 +150,20 @@ def run_sweep(conds: list[Condition], store: Store, *, workers: int = 1, client=
     with store.lock():
         store.check()  # a damaged store is refused until repaired
         check_compatible(store, conds)  # first: a refused store is left exactly as it was
+        _save_designs(store, conds)  # refuses a store holding another design of the same experiment
         retried = store.uncommit_failed() if retry_failed else 0
         store.remove_orphans()
         report = _run(conds, store, workers, client, on_done, on_plan, record_events)
     report.retried = retried
     return report
+
+
+def _save_designs(store: Store, conds: list[Condition]) -> None:
+    """Keep each sampled design in the store before its points run (``runner.design``)."""
+    from .design import save
+
+    for design in {id(c.design): c.design for c in conds if c.design is not None}.values():
+        save(store, design)
 
 
 def _run(conds, store, workers, client, on_done, on_plan, record_events) -> SweepReport:
