@@ -213,8 +213,8 @@ def _heatmap(s: Sensitivity):
         for r in t[(t.output == output) & (t["index"] == "S2")].itertuples():
             a, b = d.names.index(r.parameter), d.names.index(r.parameter2)
             m[a, b] = m[b, a] = r.value
-        im = ax.imshow(m, cmap="viridis", vmin=0, vmax=max(0.05, float(np.nanmax(m)) if np.isfinite(m).any()
-                                                             else 0.05))
+        top = max(0.05, float(np.nanmax(np.abs(m))) if np.isfinite(m).any() else 0.05)
+        im = ax.imshow(m, cmap="RdBu_r", vmin=-top, vmax=top)  # estimates can be negative: show them so
         ax.set_xticks(range(n), d.names, rotation=45, ha="right", fontsize=7)
         ax.set_yticks(range(n), d.names, fontsize=7)
         ax.set_title(f"{output}: S2", fontsize=10)

@@ -55,7 +55,7 @@ class Sample(_Strict):
 
     def bound(self, key: str) -> Bound:
         b = self.bounds[key]
-        return b if isinstance(b, Bound) else Bound(range=b)
+        return b if isinstance(b, Bound) else Bound.model_construct(range=list(b), name=None, also=[])
 
     @model_validator(mode="after")
     def _usable(self) -> "Sample":
