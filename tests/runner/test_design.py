@@ -172,3 +172,18 @@ def test_a_design_is_kept_in_the_store_resumed_and_not_mixed_with_another(tmp_pa
     assert "design" in capsys.readouterr().err
     assert sorted(p.name for p in (out / "runs").iterdir()) == before
     assert load(out, "design").points == 24
+
+
+def test_the_store_keeps_one_design_per_experiment_but_outputs_may_change(tmp_path):
+    from infomarket.runner.design import save
+
+    store = Store(tmp_path / "s").create()
+    exp = im.load_experiment(write(tmp_path, samples=4))
+    first = make_design(exp)
+    save(store, first)
+    with pytest.raises(StoreError, match="other settings.*samples"):
+        save(store, make_design(im.load_experiment(write(tmp_path, samples=8))))
+    body = SAMPLE.format(method="sobol", samples=4).replace('["items"]', '["items", "share_gap"]')
+    save(store, make_design(im.load_experiment(write(tmp_path, body=body))))  # the analysis may change
+    assert load(store.root, "design").outputs == ["items", "share_gap"]
+    np.testing.assert_array_equal(load(store.root, "design").X, first.X)
