@@ -47,6 +47,11 @@ NOT_RUN = {
     "infomarket bench --robots 25,100,1000,10000 --json":
         "minutes of timing (10 000 robots x 15 000 steps); tests/bench runs --robots 25,60 --steps 50",
     "infomarket bench --scaling": "96 timed runs; tests/bench runs the same code with 2 runs of 200 steps",
+    "infomarket sweep sensitivity --out results/sensitivity --workers 1": "the full study, 5 120 runs (~25 min)",
+    "infomarket sweep sensitivity --samples 16 --out /tmp/sens-quick":
+        "160 runs; tests/analysis/test_sensitivity.py runs the study with --samples 2",
+    "infomarket sensitivity /tmp/sens-quick --out /tmp/sens-quick-report":
+        "needs the store above; tests/analysis/test_sensitivity.py runs it on --samples 2",
 }
 
 

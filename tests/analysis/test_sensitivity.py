@@ -160,3 +160,36 @@ def test_an_incomplete_design_or_a_store_without_one_is_refused(tmp_path, capsys
     assert "holds no sampled design" in capsys.readouterr().err
     assert main(["sensitivity", str(tmp_path / "nowhere"), "--out", str(tmp_path / "o")]) == 2
     assert "not an infomarket results store" in capsys.readouterr().err
+
+
+def test_the_shipped_study_runs_at_reduced_size(tmp_path, capsys):
+    store, out = tmp_path / "s", tmp_path / "r"
+    assert main(["sweep", "sensitivity", "--samples", "2", "--out", str(store), "--quiet"]) == 0
+    assert len(Store(store).runs()) == 2 * (8 + 2)
+    assert main(["sensitivity", str(store), "--out", str(out)]) == 0
+    table = pd.read_csv(out / "sensitivity-sensitivity.csv")
+    assert set(table.output) == {"items", "share_gap", "byzantine_share"}
+    assert set(table.parameter) == {"noise_sd", "bias_mean", "communication_range", "threshold", "theta", "stake",
+                                    "byzantines", "rotation_angle"}
+    assert (out / "sensitivity-sensitivity-indices.png").exists()
+    assert "## Global sensitivity: sensitivity" in (out / "sensitivity-sensitivity.md").read_text()
+
+
+def test_local_robustness_compares_the_points_bin_with_its_neighbours(sobol_store, tmp_path):
+    from infomarket.analysis.sensitivity import robustness
+
+    s = from_store(sobol_store)
+    runs = run_outputs(Store(sobol_store).robots(), s.design)
+    rows = robustness(s, runs, {"robots": 12, "byzantines": 5, "noise_sd": 0.05}).set_index(["output", "parameter"])
+    # only the parameters that drive an output are examined (noise is idle, items are all 0 in 2 steps)
+    assert set(rows.index) == {("honest_robots", "robots"), ("honest_robots", "byzantines")}
+    edge = rows.loc[("honest_robots", "robots")]
+    # integer key: the bin is the value itself; at the low edge the only neighbour is 13 robots
+    assert edge.runs_in_bin == (runs.merge(s.design.frame()[["point", "robots"]], on="point").robots == 12).sum()
+    assert edge.median_in_bin < edge.median_adjacent  # one more robot, one more honest robot
+    assert bool(edge.robust) == (abs(edge.difference) < 0.1 * edge.range_5_95)
+    assert robustness(s, runs, {"robots": 12}, tolerance=0.0).robust.eq(False).all()
+    assert main(["sensitivity", str(sobol_store), "--out", str(tmp_path / "o"), "--at", "robots=12,byzantines=5"]) == 0
+    assert (tmp_path / "o" / "sensitivity-known-robustness.csv").exists()
+    assert main(["sensitivity", str(sobol_store), "--out", str(tmp_path / "p"), "--at", "speed=3"]) == 2
+    assert not (tmp_path / "p").exists()

@@ -187,3 +187,28 @@ def test_the_store_keeps_one_design_per_experiment_but_outputs_may_change(tmp_pa
     save(store, make_design(im.load_experiment(write(tmp_path, body=body))))  # the analysis may change
     assert load(store.root, "design").outputs == ["items", "share_gap"]
     np.testing.assert_array_equal(load(store.root, "design").X, first.X)
+
+
+def test_design_points_give_the_same_store_on_every_executor_and_rerun_alone(tmp_path):
+    import pandas as pd
+
+    exp = im.load_experiment(write(tmp_path, samples=4)).with_overrides(steps=200)
+    conds = conditions(exp)
+    tables = []
+    for k, kw in enumerate(({"workers": 1}, {"workers": 2})):
+        s = Store(tmp_path / f"s{k}")
+        run_sweep(conds, s, **kw)
+        tables.append(s.robots())
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster, distributed.Client(cluster) as client:
+        s = Store(tmp_path / "dask")
+        run_sweep(conds, s, client=client)
+        tables.append(s.robots())
+    for t in tables[1:]:
+        pd.testing.assert_frame_equal(tables[0], t, check_exact=True)
+    c = conds[7]  # any point rerun alone with its seed gives its rows
+    alone = im.simulate(c.config, seed=c.seed(0)).robots
+    row = tables[0][tables[0].condition == c.id].reset_index(drop=True)
+    assert len(row) == 10 and (row.items_collected.to_numpy() == alone.items_collected.to_numpy()).all()
+    assert (row.wealth.to_numpy() == alone.wealth.to_numpy()).all()

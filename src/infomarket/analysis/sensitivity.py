@@ -175,6 +175,68 @@ def from_store(store, experiment: str | None = None) -> Sensitivity:
     return sensitivity(store.robots(), designs.load(store.root, experiment))
 
 
+# ------------------------------------------------------------------------------------ robustness
+DRIVES = 0.1  # a parameter drives an output when its total index (Sobol') is at least this
+
+
+def drivers(s: Sensitivity, threshold: float = DRIVES) -> dict[str, list[str]]:
+    """The parameters whose total index (Sobol'), μ* share (Morris) or S1 (RBD-FAST) is ≥ ``threshold``."""
+    t = s.table
+    kind = {"sobol": "ST", "morris": "mu_star", "lhs": "S1"}[s.design.method]
+    out = {}
+    for output in s.design.outputs:
+        rows = t[(t.output == output) & (t["index"] == kind)]
+        values = rows.value / rows.value.sum() if kind == "mu_star" and rows.value.sum() > 0 else rows.value
+        out[output] = rows.parameter[values >= threshold].tolist()
+    return out
+
+
+def robustness(s: Sensitivity, runs: pd.DataFrame, at: dict[str, float], *, bins: int = 10,
+               tolerance: float = 0.1) -> pd.DataFrame:
+    """Whether the point ``at`` (a value per parameter) sits in a flat region of each output.
+
+    For each output and each parameter that drives it, the runs are cut into ``bins`` equal-width bins
+    of that parameter (one bin per value for an integer parameter); the medians of the runs in ``at``'s bin and in the adjacent bins are compared
+    with the output's 5-95 % range over the design (robust when the difference is below ``tolerance``
+    of it), with a two-sided Mann-Whitney U test on the two sets of runs.  ``runs``: ``run_outputs``."""
+    from scipy.stats import mannwhitneyu
+
+    d = s.design
+    unknown = sorted(set(at) - set(d.names))
+    if unknown:
+        raise MissingDataError(f"--at: unknown parameter {unknown[0]!r}; the design has {', '.join(d.names)}")
+    values = d.frame().set_index("point")
+    rows = []
+    for output, params in drivers(s).items():
+        y = runs[output].to_numpy(dtype=float)
+        lo, hi = np.nanpercentile(y, [5, 95])
+        for p in params:
+            if p not in at:
+                continue
+            j = d.names.index(p)
+            if d.integer[j]:  # an integer key: one bin per value
+                edges = np.arange(d.low[j] - 0.5, d.high[j] + 1.0)
+            else:
+                edges = np.linspace(d.low[j], d.high[j], bins + 1)
+            nb = len(edges) - 1
+            x = values.loc[runs["point"].to_numpy(), p].to_numpy(dtype=float)
+            which = np.clip(np.searchsorted(edges, x, side="right") - 1, 0, nb - 1)
+            home = int(np.clip(np.searchsorted(edges, at[p], side="right") - 1, 0, nb - 1))
+            near = [b for b in (home - 1, home + 1) if 0 <= b < nb]
+            a, b = y[which == home], y[np.isin(which, near)]
+            diff = float(np.median(b) - np.median(a)) if len(a) and len(b) else np.nan
+            pval = float(mannwhitneyu(a, b, alternative="two-sided").pvalue) if len(a) and len(b) else np.nan
+            rows.append({"output": output, "parameter": p, "at": at[p],
+                         "bin": f"[{edges[home]:g}, {edges[home + 1]:g})", "runs_in_bin": len(a),
+                         "runs_adjacent": len(b), "median_in_bin": float(np.median(a)) if len(a) else np.nan,
+                         "median_adjacent": float(np.median(b)) if len(b) else np.nan, "difference": diff,
+                         "range_5_95": float(hi - lo), "relative": abs(diff) / (hi - lo) if hi > lo else np.nan,
+                         "mann_whitney_p": pval,
+                         "robust": bool(abs(diff) < tolerance * (hi - lo)) if np.isfinite(diff) else False,
+                         "positive_in_bin": float(np.mean(a > 0)) if len(a) else np.nan})
+    return pd.DataFrame(rows)
+
+
 # --------------------------------------------------------------------------------------- figures
 def _bars(s: Sensitivity):
     from matplotlib.figure import Figure

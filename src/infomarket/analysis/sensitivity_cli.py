@@ -17,7 +17,23 @@ def add_subcommand(subparsers) -> None:
     p.add_argument("--out", required=True, metavar="DIR", help="folder for the table, figures and report")
     p.add_argument("--experiment", help="which design, when the store holds several")
     p.add_argument("--vector", choices=("svg", "pdf"), default="svg", help="vector format besides PNG")
+    p.add_argument("--at", type=_point, metavar="NAME=VALUE,...",
+                   help="a point (e.g. the paper's) whose local robustness to check along every driving "
+                        "parameter: writes sensitivity-EXPERIMENT-robustness.csv")
     p.set_defaults(func=cmd_sensitivity)
+
+
+def _point(text: str) -> dict[str, float]:
+    out = {}
+    for part in text.split(","):
+        name, eq, value = part.partition("=")
+        try:
+            out[name.strip()] = float(value)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{part!r} is not NAME=NUMBER") from None
+        if not eq or not name.strip():
+            raise argparse.ArgumentTypeError(f"{part!r} is not NAME=NUMBER")
+    return out
 
 
 def cmd_sensitivity(args: argparse.Namespace) -> int:
@@ -32,8 +48,22 @@ def cmd_sensitivity(args: argparse.Namespace) -> int:
         s = from_store(args.store, args.experiment)
     except MissingDataError as exc:
         return report(f"{args.store}: {exc}", 2)
+    local = None
+    if args.at:
+        from ..store import Store
+        from .sensitivity import robustness, run_outputs
+
+        try:
+            local = robustness(s, run_outputs(Store(args.store).robots(), s.design), args.at)
+        except MissingDataError as exc:
+            raise UsageError(str(exc)) from None
     writable_dir(out)
     files = write(s, out, vector=args.vector)
     print(summary_table(s).to_string(index=False))
+    if local is not None:
+        path = out / f"sensitivity-{s.design.experiment}-robustness.csv"
+        local.to_csv(path, index=False)
+        files.append(path)
+        print(local.to_string(index=False))
     print(f"wrote {', '.join(str(p) for p in files)}")
     return 0
