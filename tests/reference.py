@@ -147,6 +147,8 @@ class Reference:
                                   for a in phi])
         self.levy_table = cumulative([k ** -(p.alpha + 1.0) for k in range(1, p.steps + 2)])
         self.events: list[tuple] = []
+        #: every payment of the run: (step, buyer, seller, site, weight share, amount), in settlement order
+        self.payments: list[tuple] = []
 
     # ------------------------------------------------------------------ communication
     def offer(self, s: int, site: int) -> Entry:
@@ -283,9 +285,12 @@ class Reference:
                 weights.append(float(close))
         if tx and sum(weights) > 0:
             amount = p.info_share * p.reward + pot
-            for (s, _, _), w in zip(tx, weights):
+            for (s, site, _), w in zip(tx, weights):
                 self.robots[s].balance += amount * w / sum(weights)
+                self.payments.append((self.clock, i, s, site, w / sum(weights), amount * w / sum(weights)))
             r.balance -= amount
+        else:
+            self.payments += [(self.clock, i, s, site, 0.0, 0.0) for s, site, _ in tx]
         r.transactions = []
         self.events.append((self.clock, "deposit", i, -1, -1, 0.0, 0.0, 0.0, 0, 0.0, 0.0, 0.0))
 

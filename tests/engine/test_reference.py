@@ -119,6 +119,15 @@ def compare_events(mine: list[tuple], theirs) -> None:
     assert len(mine) == len(rows), f"{len(mine)} events in the reference, {len(rows)} in the engine"
 
 
+def compare_payments(mine: list[tuple], theirs) -> None:
+    """Every payment of the run: who received what at which deposit, in settlement order."""
+    cols = ["step", "buyer", "seller", "site", "weight", "amount"]
+    rows = list(zip(*(theirs[c].tolist() for c in cols)))
+    for a, b in zip(mine, rows):
+        assert a[:4] == b[:4] and close(a[4:], b[4:]), f"payment {a} != {b}"
+    assert len(mine) == len(rows), f"{len(mine)} payments in the reference, {len(rows)} in the engine"
+
+
 def run_side_by_side(setup: dict, seed: int, steps: int) -> tuple[Reference, list[tuple]]:
     cfg = validate(setup)
     sim = im.Simulation(cfg, seed=seed, record_events=True)
@@ -128,7 +137,9 @@ def run_side_by_side(setup: dict, seed: int, steps: int) -> tuple[Reference, lis
         sim.step(1)
         all_events += ref.step()
         compare_and_resync(ref, sim.world, step)
-    compare_events(all_events, sim.result().events)
+    result = sim.result()
+    compare_events(all_events, result.events)
+    compare_payments(ref.payments, result.payments)
     return ref, all_events
 
 
@@ -141,6 +152,7 @@ def test_engine_matches_the_reference_step_by_step():
     byzantine = {7, 8}
     assert any(e[1] == "purchase" and e[3] in byzantine for e in events)
     assert sum(e[1] == "purchase" and e[2] in (4, 5, 6) for e in events) >= 20  # sceptics buy
+    assert len(ref.payments) >= 50 and any(p[2] in byzantine for p in ref.payments)  # Byzantines get paid too
 
 
 #: The other built-in behaviours and the delayed scheme without a stake.

@@ -23,6 +23,7 @@ LEVY_BYTES = 16              # per entry of the step-length table (CDF + guide),
 HISTORY_BYTES = 8 + 24       # per robot per sample: the float64 array, then its long table (step, robot, wealth)
 EVENTS_PER_ROBOT_STEP = 0.5  # the paper's runs log 0.21-0.29 events per robot per step
 EVENT_BYTES = 96 + 96        # 12 int64/float64 columns, in the engine's log and in its DataFrame
+PAYMENT_BYTES = 48 + 48      # 6 columns, at most one row per purchase (bounded by the events' rate)
 ROBOT_ROW_BYTES = 96         # one row of the robots table (9 columns, categorical behaviour)
 RUN_ROW_BYTES = 256          # one row of the runs table (strings included) and its seed bookkeeping
 _UNITS = {"": 1, "b": 1, "k": 10**3, "kb": 10**3, "m": 10**6, "mb": 10**6, "g": 10**9, "gb": 10**9,
@@ -80,6 +81,7 @@ def run_bytes(cfg, *, record_events: bool = False, history_every: int | None = N
         "Lévy step-length table": LEVY_BYTES * (steps + 1),
         "wealth history": n * (steps // every) * HISTORY_BYTES if every else 0,
         "event log": int(n * steps * EVENTS_PER_ROBOT_STEP * EVENT_BYTES) if record_events else 0,
+        "payments log": int(n * steps * EVENTS_PER_ROBOT_STEP * PAYMENT_BYTES) if record_events else 0,
     }
     return parts
 

@@ -31,13 +31,15 @@ sell_dispatch = buy_dispatch = pay_dispatch = None
 @njit(cache=True)
 def has_room(w):
     """Can this step fit?  Per robot and site a buy rule may make one purchase per neighbour, and add
-    one pending entry per neighbour; the log gets at most one event per purchase plus a deposit.
+    one pending entry per neighbour; the log gets at most one event per purchase plus a deposit, and
+    the payments log one row per transaction a deposit settles.
     Transaction blocks that could overflow are moved to bigger ones while the pool has space."""
     nbr_count = w.nbr_count
     n = nbr_count.shape[0]
     kn = w.nbr.shape[1]
     kp = w.pend_seller.shape[2]
     events = n
+    payments = 0
     for i in range(n):
         c = nbr_count[i]
         if c > kn:
@@ -48,7 +50,9 @@ def has_room(w):
         if need > w.tx_cap[i] and not reserve(w, i, need):
             return False
         events += 2 * c
-    if w.record and w.ev_count[0] + events > w.ev_step.shape[0]:
+        payments += need
+    if w.record and (w.ev_count[0] + events > w.ev_step.shape[0]
+                     or w.pay_count[0] + payments > w.pay_step.shape[0]):
         return False
     return True
 

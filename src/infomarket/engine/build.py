@@ -123,6 +123,8 @@ def build_world(cfg: Experiment, rng: np.random.Generator, *, record_events: boo
         ev_step=z(ecap, np.int64), ev_kind=z(ecap, np.int64), ev_buyer=z(ecap, np.int64),
         ev_seller=z(ecap, np.int64), ev_site=z(ecap, np.int64), ev_dir=z(ecap), ev_x=z(ecap), ev_y=z(ecap),
         ev_age=z(ecap, np.int64), ev_stake=z(ecap), ev_sx=z(ecap), ev_sy=z(ecap), ev_count=z(1, np.int64),
+        pay_step=z(ecap, np.int64), pay_buyer=z(ecap, np.int64), pay_seller=z(ecap, np.int64),
+        pay_site=z(ecap, np.int64), pay_weight=z(ecap), pay_amount=z(ecap), pay_count=z(1, np.int64),
         hist=z((hist_rows, n)), flags=z(1, np.int64),
     )
     return world, names
@@ -175,6 +177,11 @@ def make_room(world: World, tx_need: np.ndarray | None = None) -> World:
         if need_e > ecap:
             for f in [f for f in LOG if f.startswith("ev_") and f != "ev_count"]:
                 changes[f] = _grown(getattr(world, f), 0, max(2 * ecap, need_e))
+        pcap = world.pay_step.shape[0]
+        need_pay = int(world.pay_count[0]) + int(need_t.sum())
+        if need_pay > pcap:
+            for f in [f for f in LOG if f.startswith("pay_") and f != "pay_count"]:
+                changes[f] = _grown(getattr(world, f), 0, max(2 * pcap, need_pay))
     return world._replace(**changes)
 
 

@@ -13,7 +13,7 @@ class ErrorFlags(IntFlag):
         text = {
             ErrorFlags.TX_OVERFLOW: "a buy rule made more than 2 purchases per neighbour in one step",
             ErrorFlags.BAD_WEIGHTS: "a payment rule returned a negative or non-finite weight",
-            ErrorFlags.EVENT_OVERFLOW: "more events in one step than the event log reserves",
+            ErrorFlags.EVENT_OVERFLOW: "more events or payments in one step than their logs reserve",
         }
         return "; ".join(msg for bit, msg in text.items() if bit in self)
 

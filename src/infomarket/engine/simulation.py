@@ -28,7 +28,8 @@ from .worldref import kernel_view
 @dataclass
 class Result:
     """What one run produced.  ``robots``: one row per robot; ``history``: wealth every K steps (long
-    format, empty unless asked); ``events``: the ledger's event log (empty unless asked)."""
+    format, empty unless asked); ``events``: the ledger's event log and ``payments``: what each seller
+    received at each deposit, one row per settled transaction (both empty unless events are recorded)."""
 
     config: Experiment
     seed: int
@@ -39,6 +40,7 @@ class Result:
     compile_seconds: float
     run_seconds: float
     totals: dict = field(default_factory=dict)
+    payments: pd.DataFrame = field(default_factory=pd.DataFrame)
 
     @property
     def steps_per_second(self) -> float:
@@ -125,10 +127,15 @@ class Simulation:
             "direction_deg": w.ev_dir[:k], "x": w.ev_x[:k], "y": w.ev_y[:k], "age": w.ev_age[:k],
             "stake": w.ev_stake[:k], "seller_x": w.ev_sx[:k], "seller_y": w.ev_sy[:k],
         })
+        k = int(w.pay_count[0])
+        payments = pd.DataFrame({
+            "step": w.pay_step[:k], "buyer": w.pay_buyer[:k], "seller": w.pay_seller[:k],
+            "site": w.pay_site[:k], "weight": w.pay_weight[:k], "amount": w.pay_amount[:k],
+        })
         totals = {"wealth": total, "pots": float(w.pot.sum()), "burned": float(w.burned[0]),
                   "items": int(w.items.sum())}
         return Result(self.config, self.seed, robots, history, events, self.clock, self.compile_seconds,
-                      self.run_seconds, totals)
+                      self.run_seconds, totals, payments)
 
     def snapshot(self) -> dict:
         """Plain-Python view of the current state, for viewers and inspection."""

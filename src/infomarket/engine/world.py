@@ -55,6 +55,9 @@ LEDGER:
 LOG:
     ev_* [E] and ev_count [1]: event log (purchase / refused / deposit) when ``record``; ev_sx, ev_sy are
         the seller's position in the buyer's frame (what the on-chain light contract signs)
+    pay_step, pay_buyer, pay_seller, pay_site [Q] int64, pay_weight, pay_amount [Q] float64 and
+        pay_count [1]: the payments log when ``record``, one row per settled transaction: at the buyer's
+        deposit, the seller's normalised weight and the amount it received (0 when weighted out)
     hist [m, n] wealth every ``hist_every`` steps;  flags [1] error bits (engine.flags)
 """
 from __future__ import annotations
@@ -82,7 +85,9 @@ TX_POOL = ("tx_seller", "tx_site", "tx_dir", "tx_step", "tx_stake")
 LEDGER = ("balance", "pot", "burned", "tx_off", "tx_cap", "tx_count", *TX_POOL, "pool_top")
 LOG = (
     "ev_step", "ev_kind", "ev_buyer", "ev_seller", "ev_site", "ev_dir", "ev_x", "ev_y", "ev_age",
-    "ev_stake", "ev_sx", "ev_sy", "ev_count", "hist", "flags",
+    "ev_stake", "ev_sx", "ev_sy", "ev_count",
+    "pay_step", "pay_buyer", "pay_seller", "pay_site", "pay_weight", "pay_amount", "pay_count",
+    "hist", "flags",
 )
 #: Everything but the parameters changes during a run.
 STATE = ROBOTS + LEDGER + LOG

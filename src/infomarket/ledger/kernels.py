@@ -40,6 +40,22 @@ def log_event(w, kind, buyer, seller, site, direction, x, y, age, stake, sx=0.0,
     w.ev_count[0] = k + 1
 
 
+@njit
+def log_payment(w, buyer, tx, weight, amount):
+    """Append one row to the payments log: what the seller of pool transaction ``tx`` received."""
+    k = w.pay_count[0]
+    if k >= w.pay_step.shape[0]:
+        w.flags[0] |= flags.EVENT_OVERFLOW
+        return
+    w.pay_step[k] = w.clock[0]
+    w.pay_buyer[k] = buyer
+    w.pay_seller[k] = w.tx_seller[tx]
+    w.pay_site[k] = w.tx_site[tx]
+    w.pay_weight[k] = weight
+    w.pay_amount[k] = amount
+    w.pay_count[0] = k + 1
+
+
 @njit(inline="always")
 def _move_transaction(w, src, dst):
     """Copy pool entry ``src`` (every field of a transaction) to ``dst``."""
@@ -146,11 +162,17 @@ def distribute(w, buyer, weights):
             w.tx_count[buyer] = 0
             return
         total += wx
+    a = w.tx_off[buyer]
     if k > 0 and total > 0.0:
         amount = w.info_share * w.reward + pot
-        a = w.tx_off[buyer]
         for x in range(k):
             w.balance[w.tx_seller[a + x]] += amount * (weights[x] / total)
         w.balance[buyer] -= amount
+        if w.record:
+            for x in range(k):
+                log_payment(w, buyer, a + x, weights[x] / total, amount * (weights[x] / total))
+    elif w.record:
+        for x in range(k):
+            log_payment(w, buyer, a + x, 0.0, 0.0)
     w.tx_count[buyer] = 0
     log_event(w, EV_DEPOSIT, buyer, -1, -1, 0.0, 0.0, 0.0, 0, 0.0, 0.0, 0.0)

@@ -11,7 +11,7 @@ import sys
 import time
 import traceback
 from concurrent.futures import Executor, ProcessPoolExecutor
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
@@ -53,6 +53,7 @@ class RunOutput:
     robots: pd.DataFrame
     history: pd.DataFrame
     events: pd.DataFrame
+    payments: pd.DataFrame = field(default_factory=pd.DataFrame)
     compile_seconds: float = 0.0
     run_seconds: float = 0.0
     steps: int = 0
@@ -67,19 +68,20 @@ def _one(cfg: Experiment, run: int, seed: int, steps: int | None, history_every:
     r = simulate(cfg, seed, steps=steps, history_every=history_every, record_events=record_events)
     robots = r.robots
     robots.insert(0, "run", np.int64(run))
-    hist, events = r.history, r.events
-    for table in (hist, events):
+    hist, events, payments = r.history, r.events, r.payments
+    for table in (hist, events, payments):
         if len(table):
             table.insert(0, "run", np.int64(run))
             table.insert(1, "seed", np.uint64(seed))
-    return RunOutput(run, seed, robots, hist, events if record_events else pd.DataFrame(),
-                     r.compile_seconds, r.run_seconds, r.steps)
+    empty = pd.DataFrame()
+    return RunOutput(run, seed, robots, hist, events if record_events else empty,
+                     payments if record_events else empty, r.compile_seconds, r.run_seconds, r.steps)
 
 
 def _failed(run: int, seed: int, exc: BaseException) -> RunOutput:
     text = "".join(traceback.format_exception(exc))[-MAX_ERROR_CHARS:]
     empty = pd.DataFrame()
-    return RunOutput(run, seed, empty, empty, empty, error=text)
+    return RunOutput(run, seed, empty, empty, empty, empty, error=text)
 
 
 def _chunk(cfg: Experiment, items: list[tuple[int, int]], steps, history_every, record_events=False,

@@ -127,7 +127,8 @@ def _executor_options(p) -> None:
     g.add_argument("--scheduler", metavar="ADDRESS", help="run on a Dask scheduler, e.g. tcp://host:8786")
     g.add_argument("--dask-local", type=at_least(1), metavar="N", help="run on a local Dask cluster of N workers")
     p.add_argument("--events", action="store_true",
-                   help="also store every run's event log (purchases, refusals, deposits) as the events table")
+                   help="also store every run's event log (purchases, refusals, deposits) and what each "
+                        "seller was paid at each deposit (the events and payments tables)")
     p.add_argument("--retry-failed", action="store_true", help="rerun the runs that failed in an earlier sweep")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
 

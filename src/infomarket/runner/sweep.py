@@ -145,14 +145,14 @@ def _concat(frames: list[pd.DataFrame]) -> pd.DataFrame | None:
 
 
 def _frames(task: Task, outputs: list[RunOutput]) -> dict[str, pd.DataFrame | None]:
-    """The part's tables: robots, history, events (None when empty) and the runs record."""
+    """The part's tables: robots, history, events, payments (None when empty) and the runs record."""
     if task.more:
         parts, k = [], 0
         for c, runs in task.members:
             parts.append(_frames(Task(c, runs), outputs[k:k + len(runs)]))
             k += len(runs)
-        return {t: _concat([p[t] for p in parts if p[t] is not None]) for t in ("robots", "history", "events",
-                                                                               "runs")}
+        return {t: _concat([p[t] for p in parts if p[t] is not None])
+                for t in ("robots", "history", "events", "payments", "runs")}
     c = task.condition
 
     def label(df: pd.DataFrame, keys: bool) -> pd.DataFrame:
@@ -163,7 +163,7 @@ def _frames(task: Task, outputs: list[RunOutput]) -> dict[str, pd.DataFrame | No
                 df[k] = v
         return df
 
-    robots, hists, events, rows = [], [], [], []
+    robots, hists, events, payments, rows = [], [], [], [], []
     for o, run in zip(outputs, task.runs):
         if o.error is None:
             robots.append(label(o.robots, True))
@@ -172,13 +172,15 @@ def _frames(task: Task, outputs: list[RunOutput]) -> dict[str, pd.DataFrame | No
                 hists.append(label(o.history.merge(meta, on="robot", how="left"), False))
             if len(o.events):
                 events.append(label(o.events, True))
+            if len(o.payments):
+                payments.append(label(o.payments, True))
         rows.append({"experiment": c.experiment, "condition": c.id, "run": np.int64(run),
                      "seed": np.uint64(c.seed(run)), "master_seed": np.int64(c.master_seed),
                      "config_hash": c.config.config_hash(), "package_version": __version__,
                      "duration_s": o.run_seconds, "steps": o.steps, "transitory": c.config.transitory,
                      "status": OK if o.error is None else FAILED, "error": o.error or "", **c.keys})
     return {"robots": _concat(robots), "history": _concat(hists), "events": _concat(events),
-            "runs": pd.DataFrame(rows)}
+            "payments": _concat(payments), "runs": pd.DataFrame(rows)}
 
 
 def run_sweep(conds: list[Condition], store: Store, *, workers: int = 1, client=None,

@@ -7,13 +7,14 @@ Layout (each part file written atomically, see ``files``)::
     STORE/robots/part-ID.parquet   one row per robot per run
     STORE/history/part-ID.parquet  wealth of every robot every K steps (when asked)
     STORE/events/part-ID.parquet   the ledger's event log: purchases, refusals, deposits (``--events``)
+    STORE/payments/part-ID.parquet what each seller received at each deposit (``--events``)
     STORE/runs/part-ID.parquet     one row per run: the commit record of its part
     STORE/damaged/...              parts that ``repair`` moved aside
 
 Columns common to the tables: ``experiment`` (e.g. ``fig2A``), ``condition`` (a stable id such as
 ``byzantines=3,market=staking,rotation_angle=40``; ``base`` without a sweep), ``run``, ``seed``, and one
 column per condition key (e.g. ``rotation_angle``).  A part counts only once its ``runs`` part exists:
-the runs part is written last, so a crash leaves at most an orphan robots/history/events part, which
+the runs part is written last, so a crash leaves at most an orphan data part (robots, history, ...), which
 readers ignore and the next sweep deletes.
 
 **Integrity.**  The runs part records, for each other table, the SHA-256 and the row count of the part
@@ -44,7 +45,7 @@ from ..errors import InfomarketError
 from .files import sha256_file, write_atomic, write_text_atomic
 
 FORMAT = 1
-DATA_TABLES = ("robots", "history", "events")
+DATA_TABLES = ("robots", "history", "events", "payments")
 TABLES = DATA_TABLES + ("runs",)
 KEY = ["experiment", "condition", "run"]
 OK, FAILED = "ok", "failed"
@@ -195,7 +196,7 @@ class Store:
         return sorted(self._parts("runs"))
 
     def remove_orphans(self) -> int:
-        """Delete robots/history/events parts without a runs part (left by a crash); returns how many."""
+        """Delete data parts (robots, history, events, payments) without a runs part (left by a crash); returns how many."""
         done = set(self._parts("runs"))
         removed = 0
         for t in DATA_TABLES:
@@ -209,13 +210,14 @@ class Store:
 
     # ------------------------------------------------------------------ writing
     def write_part(self, part_id: str, robots: pd.DataFrame | None, runs: pd.DataFrame,
-                   history: pd.DataFrame | None = None, events: pd.DataFrame | None = None) -> None:
-        """Write one part: the data tables (robots, history, events) first, then the runs record with
-        their checksums and row counts, last."""
+                   history: pd.DataFrame | None = None, events: pd.DataFrame | None = None,
+                   payments: pd.DataFrame | None = None) -> None:
+        """Write one part: the data tables (robots, history, events, payments) first, then the runs
+        record with their checksums and row counts, last."""
         if self.part_path("runs", part_id).exists():
             raise StoreError(f"{self.root}: part {part_id} is already committed")
         runs = runs.copy()
-        tables = {"robots": robots, "history": history, "events": events}
+        tables = {"robots": robots, "history": history, "events": events, "payments": payments}
         for t in DATA_TABLES:
             df = tables[t]
             sha, rows = "", 0
@@ -363,6 +365,10 @@ class Store:
     def events(self) -> pd.DataFrame:
         """The ledger's event log of the runs swept with ``--events``."""
         return self._read("events")
+
+    def payments(self) -> pd.DataFrame:
+        """What each seller received at each deposit (one row per settled transaction), ``--events`` runs."""
+        return self._read("payments")
 
     def failed(self) -> pd.DataFrame:
         """The committed runs that raised, with their error text."""
