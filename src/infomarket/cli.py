@@ -131,6 +131,12 @@ def cmd_check(args) -> int:
     print(f"{cfg.name}: valid. {groups}; scheme {cfg.payment.scheme} (stake {cfg.payment.stake}); "
           f"{cfg.steps} steps, transitory {cfg.transitory}, {cfg.runs} runs, seed {cfg.seed}; "
           f"config hash {cfg.config_hash()}")
+    if cfg.sweep is not None and cfg.sweep.sample is not None:  # the design is checked at every corner
+        from .runner.design import make_design
+
+        d = make_design(cfg)
+        print(f"sampled design: {d.method}, {d.samples} base samples, {d.points} points over {len(d.names)} "
+              f"keys ({', '.join(d.names)}); outputs {', '.join(d.outputs)}")
     return 0
 
 

@@ -106,6 +106,8 @@ def test_outputs_comparing_honest_and_byzantine_need_both_at_every_corner(tmp_pa
     body = SAMPLE.format(method="sobol", samples=8).replace('[1, 4]', '[0, 4]').replace(
         '["items"]', '["items", "share_gap"]')
     refused(tmp_path, capsys, write(tmp_path, body=body), "share_gap", "0 Byzantine")
+    assert main(["check", str(write(tmp_path, body=body))]) == 2  # `check` checks the corners too
+    assert "0 Byzantine" in capsys.readouterr().err
     # the same range is fine for an output that does not compare them
     assert main(["check", str(write(tmp_path, body=body.replace(', "share_gap"', "")))]) == 0
 
@@ -212,3 +214,18 @@ def test_design_points_give_the_same_store_on_every_executor_and_rerun_alone(tmp
     row = tables[0][tables[0].condition == c.id].reset_index(drop=True)
     assert len(row) == 10 and (row.items_collected.to_numpy() == alone.items_collected.to_numpy()).all()
     assert (row.wealth.to_numpy() == alone.wealth.to_numpy()).all()
+
+
+def test_grouped_points_keep_their_event_and_payment_logs(tmp_path):
+    exp = im.load_experiment(write(tmp_path, samples=2)).with_overrides(steps=300)
+    conds = conditions(exp)
+    store = Store(tmp_path / "s")
+    run_sweep(conds, store, record_events=True)
+    assert len(list((tmp_path / "s" / "runs").glob("*.parquet"))) < len(conds)  # points share parts
+    events = store.events()
+    assert set(events.condition) <= {c.id for c in conds} and events.condition.nunique() > 1
+    for c in conds[:3]:  # each point's log is its own run's log
+        alone = im.simulate(c.config, seed=c.seed(0), record_events=True).events
+        mine = events[events.condition == c.id]
+        assert len(mine) == len(alone)
+        assert (mine.step.to_numpy() == alone.step.to_numpy()).all()
