@@ -55,6 +55,11 @@ NOT_RUN = {
         "needs the three full stores; tests/terrain/test_report.py runs it on small ones",
     "infomarket view corridor": "a web server that runs until stopped; tests/viewer",
     "infomarket replay crowd --movie crowd.gif": "a full-length recording; movies: tests/viewer/test_terrain_view.py",
+    "infomarket sweep sensitivity --out results/sensitivity --workers 1": "the full study, 5 120 runs (~25 min)",
+    "infomarket sweep sensitivity --samples 16 --out /tmp/sens-quick":
+        "160 runs; tests/analysis/test_sensitivity.py runs the study with --samples 2",
+    "infomarket sensitivity /tmp/sens-quick --out /tmp/sens-quick-report":
+        "needs the store above; tests/analysis/test_sensitivity.py runs it on --samples 2",
 }
 
 

@@ -18,7 +18,7 @@ from .cliargs import Parser, UsageError, at_least, seed_value, writable_dir
 from .errors import ConfigError, InfomarketError, report
 
 SUBCOMMAND_MODULES = ("infomarket.runner.cli", "infomarket.analysis.cli", "infomarket.viewer.cli",
-                      "infomarket.chain.cli")
+                      "infomarket.chain.cli", "infomarket.analysis.sensitivity_cli")
 SUBCOMMAND_MODULES += ("infomarket.analysis.terrain",)  # terrain-report (docs/terrain.md)
 EXIT_INTERRUPTED = 130
 
@@ -133,6 +133,12 @@ def cmd_check(args) -> int:
     print(f"{cfg.name}: valid. {groups}; scheme {cfg.payment.scheme} (stake {cfg.payment.stake}); "
           f"{cfg.steps} steps, transitory {cfg.transitory}, {cfg.runs} runs, seed {cfg.seed}; "
           f"config hash {cfg.config_hash()}")
+    if cfg.sweep is not None and cfg.sweep.sample is not None:  # the design is checked at every corner
+        from .runner.design import make_design
+
+        d = make_design(cfg)
+        print(f"sampled design: {d.method}, {d.samples} base samples, {d.points} points over {len(d.names)} "
+              f"keys ({', '.join(d.names)}); outputs {', '.join(d.outputs)}")
     return 0
 
 

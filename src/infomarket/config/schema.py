@@ -17,6 +17,7 @@ from pydantic import BaseModel, StrictBool, ConfigDict, Field, ValidationInfo, f
 from .. import plugins
 from ..registry import behaviours, payments
 from . import sizes, terrain
+from .sample import Sample
 
 #: Seeds are 63-bit everywhere (files, the command line, the Python API, the store's int64 columns).
 MAX_SEED = 2**63 - 1
@@ -158,11 +159,15 @@ class Sweep(_Strict):
     runs: PosInt | None = None
     grid: dict[str, list[Any]] = Field(default_factory=dict)
     axes: dict[str, list[AxisValue]] = Field(default_factory=dict)
+    #: A sampled design (docs/sweeps.md, "Sampled designs"), instead of a grid and axes.
+    sample: Sample | None = None
 
     @model_validator(mode="after")
     def _not_empty(self) -> "Sweep":
-        if not self.grid and not self.axes:
-            raise ValueError("a sweep needs a grid or axes with at least one key")
+        if self.sample is not None and (self.grid or self.axes):
+            raise ValueError("a sweep has either a grid and axes or a sample design, not both")
+        if not self.grid and not self.axes and self.sample is None:
+            raise ValueError("a sweep needs a grid or axes with at least one key, or a [sweep.sample] design")
         for key, values in self.grid.items():
             if not values:
                 raise ValueError(f"grid.{key}: empty list of values")
