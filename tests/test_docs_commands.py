@@ -18,6 +18,7 @@ DOCS = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 RUN = {
     "infomarket list",
     "infomarket check my.toml",
+    "infomarket check corridor",
 }
 #: Parsed only, with the reason they are not run here.
 NOT_RUN = {
@@ -53,6 +54,18 @@ NOT_RUN = {
         "296 runs of 30 000 steps; the plan and --scale are tested in tests/test_commands.py",
     "infomarket figures results/future --out results/future-report":
         "needs the future sweep's store; tests/analysis/test_future.py draws it from a synthetic one",
+    # docs/terrain.md
+    "infomarket run two_food --runs 4 --out results/two_food": "4 full runs; sites.parquet: tests/terrain/test_cli.py",
+    "infomarket sweep crowd --out results/crowd": "128 full runs (100 robots); sweeps are tested in tests/runner",
+    "infomarket terrain-report results --out results/terrain":
+        "needs the three full stores; tests/terrain/test_report.py runs it on small ones",
+    "infomarket view corridor": "a web server that runs until stopped; tests/viewer",
+    "infomarket replay crowd --movie crowd.gif": "a full-length recording; movies: tests/viewer/test_terrain_view.py",
+    "infomarket sweep sensitivity --out results/sensitivity --workers 1": "the full study, 5 120 runs (~25 min)",
+    "infomarket sweep sensitivity --samples 16 --out /tmp/sens-quick":
+        "160 runs; tests/analysis/test_sensitivity.py runs the study with --samples 2",
+    "infomarket sensitivity /tmp/sens-quick --out /tmp/sens-quick-report":
+        "needs the store above; tests/analysis/test_sensitivity.py runs it on --samples 2",
 }
 
 

@@ -18,7 +18,8 @@ from .cliargs import Parser, UsageError, at_least, seed_value, writable_dir
 from .errors import ConfigError, InfomarketError, report
 
 SUBCOMMAND_MODULES = ("infomarket.runner.cli", "infomarket.analysis.cli", "infomarket.viewer.cli",
-                      "infomarket.chain.cli")
+                      "infomarket.chain.cli", "infomarket.analysis.sensitivity_cli")
+SUBCOMMAND_MODULES += ("infomarket.analysis.terrain",)  # terrain-report (docs/terrain.md)
 EXIT_INTERRUPTED = 130
 
 
@@ -62,6 +63,7 @@ def cmd_run(args) -> int:
     seed = cfg.seed if args.seed is None else args.seed
     out = Path(args.out or Path("results") / cfg.name)
     names = ["robots.parquet"] + (["wealth_history.parquet"] if cfg.history_every else [])
+    names += ["sites.parquet"] if cfg.terrain else []  # items per site per run (docs/terrain.md)
     existing = [n for n in names if (out / n).exists()]
     if existing and not args.force:
         raise UsageError(f"--out {out}: {existing[0]} exists (an earlier run's results); --force replaces it, "
@@ -91,7 +93,7 @@ def cmd_run(args) -> int:
 def _write_run_tables(res, out: Path, names: list[str]) -> list[Path]:
     from .store import write_parquet_atomic
 
-    tables = {"robots.parquet": res.robots, "wealth_history.parquet": res.history}
+    tables = {"robots.parquet": res.robots, "wealth_history.parquet": res.history, "sites.parquet": res.sites}
     return [write_parquet_atomic(tables[n], out / n) for n in names]
 
 
@@ -131,6 +133,12 @@ def cmd_check(args) -> int:
     print(f"{cfg.name}: valid. {groups}; scheme {cfg.payment.scheme} (stake {cfg.payment.stake}); "
           f"{cfg.steps} steps, transitory {cfg.transitory}, {cfg.runs} runs, seed {cfg.seed}; "
           f"config hash {cfg.config_hash()}")
+    if cfg.sweep is not None and cfg.sweep.sample is not None:  # the design is checked at every corner
+        from .runner.design import make_design
+
+        d = make_design(cfg)
+        print(f"sampled design: {d.method}, {d.samples} base samples, {d.points} points over {len(d.names)} "
+              f"keys ({', '.join(d.names)}); outputs {', '.join(d.outputs)}")
     return 0
 
 

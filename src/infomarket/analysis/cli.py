@@ -28,9 +28,10 @@ def cmd_figures(args: argparse.Namespace) -> int:
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {out}: exists and is not a directory")
     # raises StoreError for a missing or foreign folder, StoreDamaged (naming the repair) for a damaged one
-    frames = Frames.of(Store(args.store))
+    store = Store(args.store)
+    frames = Frames.of(store)
     if frames.robots.empty and frames.history.empty:
         print(f"{args.store}: the store holds no completed runs; writing an empty report")
     writable_dir(out)
-    build_report(frames, out, vector=args.vector, echo=print, label=str(args.store))
+    build_report(frames, out, vector=args.vector, echo=print, label=str(args.store), store=store)
     return 0

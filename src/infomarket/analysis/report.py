@@ -40,16 +40,18 @@ class Report:
     provenance: Provenance
     files: list[Path] = field(default_factory=list)
     future: future.Section | None = None  # the open-questions section, for stores with the future sweep
+    sections: list[tuple[str, str]] = field(default_factory=list)  # (markdown, html), e.g. sensitivity
 
     def counts(self) -> dict[str, int]:
         return {v: int((self.table["verdict"] == v).sum()) for v in (PASS, FAIL, NO_DATA)}
 
 
 def build_report(source, out: str | Path, *, vector: str = "svg", label: str | None = None,
-                 echo: Callable[[str], None] = lambda line: None) -> Report:
+                 echo: Callable[[str], None] = lambda line: None, store: Store | None = None) -> Report:
     """Write the figures, ``report.md`` and ``report.html`` under ``out``; ``echo`` gets one line per step.
 
-    ``source`` is anything ``Frames.of`` reads; ``label`` names it in the report (default: its path)."""
+    ``source`` is anything ``Frames.of`` reads; ``label`` names it in the report (default: its path).
+    ``store`` (or ``source`` when it is a store): its sampled designs get a global-sensitivity section."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     label = label or _label(source)
@@ -68,6 +70,12 @@ def build_report(source, out: str | Path, *, vector: str = "svg", label: str | N
     table = headline_table(frames)
     report = Report(label, results, table, collect_provenance(frames, label))
     report.future = future.section(frames, out, vector, echo)
+    store = store if store is not None else (Store(source) if isinstance(source, (str, Path)) else
+                                             source if isinstance(source, Store) else None)
+    if store is not None:
+        from .sensitivity import report_section
+
+        report.sections = report_section(store, out, vector, echo)
     c = report.counts()
     echo(f"paper vs this store: {c[PASS]} pass, {c[FAIL]} fail, {c[NO_DATA]} no data")
     for name, text in (("report.md", to_markdown(report)), ("report.html", to_html(report))):
@@ -126,6 +134,8 @@ def to_markdown(report: Report) -> str:
     md += [f"- {k}: {v}" for k, v in report.provenance.facts.items()]
     if not report.provenance.experiments.empty:
         md += ["", _md_table(report.provenance.experiments)]
+    for section, _ in report.sections:
+        md += ["", section]
     return "\n".join(md) + "\n"
 
 
@@ -172,5 +182,6 @@ def to_html(report: Report) -> str:
     parts.append("</ul>")
     if not report.provenance.experiments.empty:
         parts.append(_html_table(report.provenance.experiments))
+    parts += [section for _, section in report.sections]
     parts.append("</body></html>")
     return "\n".join(parts) + "\n"

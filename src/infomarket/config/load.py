@@ -12,7 +12,7 @@ from pydantic import ValidationError
 
 from ..errors import ConfigError
 from .legacy import from_legacy, is_legacy
-from .schema import Experiment
+from .schema import CircleObstacle, Experiment, Rect, Segment
 
 SHIPPED = "infomarket.experiments"
 
@@ -68,6 +68,41 @@ def _allowed_keys(model: type, loc: tuple) -> list[str]:
     return sorted(model.model_fields)
 
 
+#: Union branches that pydantic names inside error locations (``food`` is one site or a list of sites;
+#: an obstacle's ``shape`` picks its model): left out of the key paths users see.
+_BRANCHES = {"Site": None, "list[Site]": None, "rect": Rect, "circle": CircleObstacle, "segment": Segment}
+
+
+def _union_errors(errors: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """One error per problem for union-typed keys: drop a branch's "not a dict" / "not a list" error
+    when the other branch says what is really wrong, and take branch names out of locations."""
+    out = []
+    for err in errors:
+        loc = err["loc"]
+        branch = [p for p in loc if isinstance(p, str) and p in _BRANCHES]
+        if branch and err["type"] in ("model_type", "list_type") and any(
+                e["loc"][:1] == loc[:1] and e["type"] not in ("model_type", "list_type") for e in errors):
+            continue
+        if branch and err["type"] in ("model_type", "list_type"):
+            err = {**err, "msg": "expected one site {x, y, radius} or a list of them"}
+        if branch:
+            model = _BRANCHES[branch[0]]
+            err = {**err, "loc": tuple(p for p in loc if not (isinstance(p, str) and p in _BRANCHES)),
+                   "allowed": sorted(model.model_fields) if model else None}
+        if err["type"] == "union_tag_invalid" or err["type"] == "union_tag_not_found":
+            err = {**err, "msg": "shape must be one of rect, circle, segment"}
+        out.append(err)
+    kept, seen = [], set()
+    for err in out:  # a deeper error explains a branch mismatch above it; say each thing once
+        deeper = err["type"] in ("model_type", "list_type") and any(
+            len(e["loc"]) > len(err["loc"]) and e["loc"][:len(err["loc"])] == err["loc"] for e in out)
+        key = (err["loc"], err["msg"])
+        if not deeper and key not in seen:
+            seen.add(key)
+            kept.append(err)
+    return kept
+
+
 def validate(data: dict[str, Any], source: str = "configuration", base: Path | None = None) -> Experiment:
     """Validate a dictionary in our schema; raise ConfigError listing every problem.  ``base`` is the
     folder relative plugin paths are resolved against (the experiment file's)."""
@@ -75,10 +110,11 @@ def validate(data: dict[str, Any], source: str = "configuration", base: Path | N
         return Experiment.model_validate(data, context={"base": base})
     except ValidationError as exc:
         lines = []
-        for err in exc.errors():
+        for err in _union_errors(exc.errors()):
             line = _describe(err)
             if err["type"] == "extra_forbidden":
-                line += f"; allowed keys here: {', '.join(_allowed_keys(Experiment, err['loc']))}"
+                allowed = err.get("allowed") or _allowed_keys(Experiment, err['loc'])
+                line += f"; allowed keys here: {', '.join(allowed)}"
             lines.append(line)
         raise ConfigError(f"{source}: invalid experiment\n  " + "\n  ".join(lines)) from None
 

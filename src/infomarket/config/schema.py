@@ -10,13 +10,14 @@ from __future__ import annotations
 
 import hashlib
 import json
-from typing import Annotated, Any
+from typing import Annotated, Any, Literal, Union
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationInfo, field_validator, model_validator
+from pydantic import BaseModel, StrictBool, ConfigDict, Field, ValidationInfo, field_validator, model_validator
 
 from .. import plugins
 from ..registry import behaviours, payments
-from . import sizes
+from . import sizes, terrain
+from .sample import Sample
 
 #: Seeds are 63-bit everywhere (files, the command line, the Python API, the store's int64 columns).
 MAX_SEED = 2**63 - 1
@@ -43,6 +44,51 @@ class Site(_Strict):
     radius: PosFloat = 50.0
 
 
+class Rect(_Strict):
+    """Axis-aligned rectangle obstacle, corners (x0, y0) and (x1, y1) with x0 < x1, y0 < y1."""
+
+    shape: Literal["rect"]
+    x0: Finite
+    y0: Finite
+    x1: Finite
+    y1: Finite
+
+    @model_validator(mode="after")
+    def _ordered(self) -> "Rect":
+        if not (self.x0 < self.x1 and self.y0 < self.y1):
+            raise ValueError(f"a rect needs x0 < x1 and y0 < y1, got ({self.x0}, {self.y0}) - ({self.x1}, {self.y1})")
+        return self
+
+
+class CircleObstacle(_Strict):
+    """Disc obstacle of centre (x, y)."""
+
+    shape: Literal["circle"]
+    x: Finite
+    y: Finite
+    radius: PosFloat
+
+
+class Segment(_Strict):
+    """Line segment obstacle (a thin wall) from (x0, y0) to (x1, y1); walls with gaps are several."""
+
+    shape: Literal["segment"]
+    x0: Finite
+    y0: Finite
+    x1: Finite
+    y1: Finite
+
+    @model_validator(mode="after")
+    def _long(self) -> "Segment":
+        if self.x0 == self.x1 and self.y0 == self.y1:
+            raise ValueError(f"a segment needs two different end points, got ({self.x0}, {self.y0}) twice")
+        return self
+
+
+#: ``[[obstacles]]`` entries, told apart by ``shape`` (engine.obstacles has the geometry).
+Obstacle = Annotated[Union[Rect, CircleObstacle, Segment], Field(discriminator="shape")]
+
+
 class Robot(_Strict):
     radius: PosFloat = 8.0
     speed: PosFloat = 2.5
@@ -53,6 +99,12 @@ class Robot(_Strict):
     stop_time: NonNegInt = 0
     cooldown: NonNegInt = 0
     fuel_cost: NonNegFloat = 0.0
+    #: Two robots communicate only if no obstacle cuts the segment between them (engine.obstacles).
+    line_of_sight: StrictBool = False
+    #: Robots are discs that cannot overlap: a move that would overlap another robot is not made.
+    collisions: StrictBool = False
+    #: The proximity sensors also fire for other robots' discs (as for obstacles; engine.terrain).
+    sense_robots: StrictBool = False
 
 
 class RandomWalk(_Strict):
@@ -107,11 +159,15 @@ class Sweep(_Strict):
     runs: PosInt | None = None
     grid: dict[str, list[Any]] = Field(default_factory=dict)
     axes: dict[str, list[AxisValue]] = Field(default_factory=dict)
+    #: A sampled design (docs/sweeps.md, "Sampled designs"), instead of a grid and axes.
+    sample: Sample | None = None
 
     @model_validator(mode="after")
     def _not_empty(self) -> "Sweep":
-        if not self.grid and not self.axes:
-            raise ValueError("a sweep needs a grid or axes with at least one key")
+        if self.sample is not None and (self.grid or self.axes):
+            raise ValueError("a sweep has either a grid and axes or a sample design, not both")
+        if not self.grid and not self.axes and self.sample is None:
+            raise ValueError("a sweep needs a grid or axes with at least one key, or a [sweep.sample] design")
         for key, values in self.grid.items():
             if not values:
                 raise ValueError(f"grid.{key}: empty list of values")
@@ -133,8 +189,9 @@ class Experiment(_Strict):
     seed: Annotated[int, Field(ge=0, le=MAX_SEED, strict=True)] = 0
     history_every: NonNegInt = 0
     arena: Arena = Arena()
-    food: Site = Site(x=200.0, y=300.0)
-    nest: Site = Site(x=1000.0, y=300.0)
+    food: Site | Annotated[list[Site], Field(min_length=1)] = Site(x=200.0, y=300.0)
+    nest: Site | Annotated[list[Site], Field(min_length=1)] = Site(x=1000.0, y=300.0)
+    obstacles: list[Obstacle] = Field(default_factory=list)
     robot: Robot = Robot()
     random_walk: RandomWalk = RandomWalk()
     swarm: Swarm
@@ -161,10 +218,13 @@ class Experiment(_Strict):
         if w - 1 - 2 * r < 0 or h - 1 - 2 * r < 0:
             raise ValueError(f"the arena ({w} x {h}) is too small for robots of radius {r}")
         for key in ("food", "nest"):
-            s = getattr(self, key)
-            if s.x - s.radius < 0 or s.x + s.radius > w or s.y - s.radius < 0 or s.y + s.radius > h:
-                raise ValueError(f"{key} site at ({s.x}, {s.y}) with radius {s.radius} lies outside the "
-                                 f"arena [0, {w}] x [0, {h}]")
+            for label, s in self._labelled_sites(key):
+                if s.x - s.radius < 0 or s.x + s.radius > w or s.y - s.radius < 0 or s.y + s.radius > h:
+                    raise ValueError(f"{label} site at ({s.x}, {s.y}) with radius {s.radius} lies outside the "
+                                     f"arena [0, {w}] x [0, {h}]")
+        why = terrain.site_overlap(self)
+        if why:
+            raise ValueError(why)
         if self.history_every > self.steps:
             raise ValueError(f"history_every = {self.history_every} must be at most steps = {self.steps}")
         known = behaviours()
@@ -204,6 +264,24 @@ class Experiment(_Strict):
         return self
 
     # ------------------------------------------------------------------ derived views
+    def sites(self, key: str) -> list[Site]:
+        """The sites of one kind (``food`` or ``nest``) as a list, whether the file gave one or several."""
+        value = getattr(self, key)
+        return list(value) if isinstance(value, list) else [value]
+
+    def _labelled_sites(self, key: str) -> list[tuple[str, Site]]:
+        value = getattr(self, key)
+        if isinstance(value, list):
+            return [(f"{key}[{k}]", s) for k, s in enumerate(value)]
+        return [(key, value)]
+
+    @property
+    def terrain(self) -> bool:
+        """Does this setup leave the paper's plane (obstacles, several sites of a kind, line of sight,
+        collisions)?  Only then does the engine compile the terrain-aware step (engine.terrain)."""
+        return bool(self.obstacles or self.robot.line_of_sight or self.robot.collisions or self.robot.sense_robots
+                    or len(self.sites("food")) > 1 or len(self.sites("nest")) > 1)
+
     def behaviour_params(self, group: Group) -> dict[str, float]:
         spec = behaviours()[group.behaviour]
         return {p: float(group.params.get(p, spec.defaults.get(p, 0.0))) for p in spec.params}
@@ -221,4 +299,5 @@ class Experiment(_Strict):
     def config_hash(self) -> str:
         """Hash of everything that determines results (not name, description, runs or seed)."""
         data = self.model_dump(exclude={"name", "description", "runs", "seed", "sweep"})
+        terrain.drop_defaults(data)  # setups on the paper's plane keep the hashes they always had
         return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:16]

@@ -8,7 +8,9 @@ import numpy as np
 from ..config.schema import Experiment
 from ..registry import behaviours
 from .kernels import turn_tables
+from . import obstacles
 from .neighbours import grid_shape
+from .terrain import place_clear, site_arrays
 from .world import LOG, TX_POOL, World
 
 #: First capacities; the host grows each when the kernel asks for room (``make_room``).
@@ -92,11 +94,14 @@ def build_world(cfg: Experiment, rng: np.random.Generator, *, record_events: boo
     ecap = EVENT_CAPACITY if record_events else 0
     kn, kp, kt = NEIGHBOUR_CAPACITY, PENDING_CAPACITY, TX_CAPACITY
     z = np.zeros
+    f, h = cfg.sites("food")[0], cfg.sites("nest")[0]
+    sites_xy, sites_r, sites_kind = site_arrays(cfg)
+    obs_kind, obs_geom = obstacles.encode(cfg.obstacles)
     world = World(
         width=float(w_), height=float(h_), radius=float(r), speed=float(cfg.robot.speed),
         comm_range=rc, noise_sd=float(cfg.robot.noise_sd),
-        site_pos=np.array([[cfg.food.x, cfg.food.y], [cfg.nest.x, cfg.nest.y]], dtype=np.float64),
-        site_r=np.array([cfg.food.radius, cfg.nest.radius], dtype=np.float64),
+        site_pos=np.array([[f.x, f.y], [h.x, h.y]], dtype=np.float64),
+        site_r=np.array([f.radius, h.radius], dtype=np.float64),
         reward=float(cfg.payment.reward), info_share=float(cfg.payment.information_share),
         stake=float(cfg.payment.stake), stake_expiry=int(cfg.payment.stake_expiry), fuel_cost=float(cfg.robot.fuel_cost),
         transitory=int(cfg.transitory), stop_time=int(cfg.robot.stop_time), cooldown=int(cfg.robot.cooldown),
@@ -104,6 +109,9 @@ def build_world(cfg: Experiment, rng: np.random.Generator, *, record_events: boo
         turn_cos=turn_cos, turn_sin=turn_sin,
         bparams=bparams, pparams=pparams, record=bool(record_events), hist_every=int(history_every),
         grid_cell=cell, grid_nx=nx, grid_ny=ny,
+        sites_xy=sites_xy, sites_r=sites_r, sites_kind=sites_kind, obs_kind=obs_kind, obs_geom=obs_geom,
+        line_of_sight=bool(cfg.robot.line_of_sight), collisions=bool(cfg.robot.collisions),
+        sense_robots=bool(cfg.robot.sense_robots),
         clock=z(1, np.int64), pos=pos,
         hdir=np.stack([np.cos(np.radians(heading)), np.sin(np.radians(heading))], axis=1), bias=bias, kind=kind,
         state=z(n, np.int64), carrying=z(n, np.bool_), levy=np.ones(n, np.int64),
@@ -115,7 +123,7 @@ def build_world(cfg: Experiment, rng: np.random.Generator, *, record_events: boo
         spot=z((n, 2, 2)), has_spot=z((n, 2), np.bool_), last_site=np.full(n, -1, np.int64),
         items=z(n, np.int64), stop_timer=z(n, np.int64), cool_timer=z(n, np.int64),
         nbr=z((n, kn), np.int64), nbr_count=z(n, np.int64),
-        cell_start=z(nx * ny + 1, np.int64), cell_items=z(n, np.int64),
+        cell_start=z(nx * ny + 1, np.int64), cell_items=z(n, np.int64), spot_site=z((n, 2), np.int64),
         balance=np.full(n, float(cfg.payment.initial_wealth)), pot=z(n), burned=z(1),
         tx_off=np.arange(n, dtype=np.int64) * kt, tx_cap=np.full(n, kt, np.int64), tx_count=z(n, np.int64),
         tx_seller=z(n * kt, np.int64), tx_site=z(n * kt, np.int64), tx_dir=z(n * kt),
@@ -127,8 +135,10 @@ def build_world(cfg: Experiment, rng: np.random.Generator, *, record_events: boo
         ev_age=z(ecap, np.int64), ev_stake=z(ecap), ev_sx=z(ecap), ev_sy=z(ecap), ev_count=z(1, np.int64),
         pay_step=z(ecap, np.int64), pay_buyer=z(ecap, np.int64), pay_seller=z(ecap, np.int64),
         pay_site=z(ecap, np.int64), pay_weight=z(ecap), pay_amount=z(ecap), pay_count=z(1, np.int64),
-        hist=z((hist_rows, n)), flags=z(1, np.int64),
+        hist=z((hist_rows, n)), flags=z(1, np.int64), site_items=z(len(sites_r), np.int64),
     )
+    if cfg.terrain:
+        place_clear(world, rng)
     return world, names
 
 

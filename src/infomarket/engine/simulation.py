@@ -62,7 +62,7 @@ class Simulation:
         self.world, self.behaviour_names = build_world(config, self.rng, record_events=record_events,
                                                        history_every=hist)
         t0 = time.perf_counter()
-        self._kernel = specialise.kernel_module(self.kinds, config.payment.scheme)
+        self._kernel = specialise.kernel_module(self.kinds, config.payment.scheme, config.terrain)
         self._view = kernel_view(self.world, self._kernel)
         self._kernel.run_steps(self._view, self.rng, 0)  # compile or load from cache; runs no step
         self.compile_seconds = time.perf_counter() - t0
@@ -134,8 +134,17 @@ class Simulation:
         })
         totals = {"wealth": total, "pots": float(w.pot.sum()), "burned": float(w.burned[0]),
                   "items": int(w.items.sum())}
+        if self.config.terrain:
+            totals["sites"] = self.site_counts()
         return Result(self.config, self.seed, robots, history, events, self.clock, self.compile_seconds,
                       self.run_seconds, totals, payments)
+
+    def site_counts(self) -> list[dict]:
+        """Every site (food first, file order) with the items picked up there (food) or deposited
+        there (nest) after the transitory period; counted only by the terrain-aware step."""
+        w = self.world
+        return [{"kind": SITE_NAMES[int(k)], "x": float(xy[0]), "y": float(xy[1]), "radius": float(r),
+                 "items": int(c)} for xy, r, k, c in zip(w.sites_xy, w.sites_r, w.sites_kind, w.site_items)]
 
     def snapshot(self) -> dict:
         """Plain-Python view of the current state, for viewers and inspection."""

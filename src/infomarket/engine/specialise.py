@@ -91,9 +91,17 @@ def _header(behaviours: list[BehaviourSpec], payment: PaymentSpec) -> str:
     return "\n".join(lines) + "\n"
 
 
-def generate_source(behaviours: list[BehaviourSpec], payment: PaymentSpec) -> str:
-    """Source of the specialised module (template + dispatch) for these behaviours, in kind order."""
-    lines = [_header(behaviours, payment), _TEMPLATE.read_text(), "", "# ---- generated dispatch " + "-" * 60,
+#: With ``terrain``, the loop's plane-only pieces are rebound to the terrain-aware ones before anything
+#: compiles (numba resolves a function's globals when it first compiles it).
+_TERRAIN = ("", "# ---- terrain: obstacles, several sites, line of sight, collisions (engine.terrain)",
+            "from infomarket.engine.terrain import behaviour_step, find_neighbours, forage, move  # noqa: F811")
+
+
+def generate_source(behaviours: list[BehaviourSpec], payment: PaymentSpec, terrain: bool = False) -> str:
+    """Source of the specialised module (template + dispatch) for these behaviours, in kind order;
+    ``terrain`` selects the terrain-aware step (engine.terrain)."""
+    lines = [_header(behaviours, payment), _TEMPLATE.read_text(), *(_TERRAIN if terrain else ()),
+             "", "# ---- generated dispatch " + "-" * 60,
              "from infomarket.registry import rule_function as _rule_function", ""]
     for k, b in enumerate(behaviours):
         lines.append(f"_b{k}_buy = _rule_function('behaviour', {b.name!r}, 'buy')")
@@ -118,11 +126,12 @@ def generate_source(behaviours: list[BehaviourSpec], payment: PaymentSpec) -> st
     return "\n".join(lines)
 
 
-def kernel_module(behaviour_names: tuple[str, ...], payment_name: str) -> ModuleType:
-    """The specialised kernel module (``run_steps``) for these behaviours (kind order) and scheme."""
+def kernel_module(behaviour_names: tuple[str, ...], payment_name: str, terrain: bool = False) -> ModuleType:
+    """The specialised kernel module (``run_steps``) for these behaviours (kind order) and scheme, on
+    the paper's plane or (``terrain``) with obstacles, several sites, line of sight and collisions."""
     behaviours = [get_behaviour(b) for b in behaviour_names]
     payment = get_payment(payment_name)
-    source = generate_source(behaviours, payment)
+    source = generate_source(behaviours, payment, terrain)
     digest = hashlib.sha256(source.encode())
     digest.update(f"{__version__} {numba.__version__} {sys.version} {_package_digest()}".encode())
     cacheable = True

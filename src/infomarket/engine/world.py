@@ -25,6 +25,9 @@ PARAMS:
     bparams [n, P] per-robot behaviour parameters;  pparams [Q] payment parameters
     record: bool, whether to log events;  hist_every: int, wealth-history interval (0 = off)
     grid_cell: float cell side of the neighbour grid (>= comm_range);  grid_nx, grid_ny: int cells
+    sites_xy [S, 2], sites_r [S], sites_kind [S] (FOOD / NEST): every site, in file order, food first
+        (site_pos / site_r hold the first site of each kind, all the paper's plane needs)
+    obs_kind [K], obs_geom [K, 4]: obstacles (engine.obstacles);  line_of_sight, collisions, sense_robots: bool
 
 ROBOTS:
     clock [1] int64 the last completed step (the first step is 1)
@@ -43,6 +46,7 @@ ROBOTS:
     stop_timer [n], cool_timer [n]: communication stop and cooldown
     nbr [n, kn], nbr_count [n]: neighbours in increasing id order (a count above kn asks for room)
     cell_start [grid_nx * grid_ny + 1], cell_items [n]: the neighbour grid, rebuilt every step
+    spot_site [n, 2]: which site (index into sites_*) each spot lies in
 
 LEDGER:
     balance [n], pot [n] stakes locked by the robot's open purchases, burned [1] fuel burned
@@ -67,6 +71,8 @@ LOG:
         pay_count [1]: the payments log when ``record``, one row per settled transaction: at the buyer's
         deposit, the seller's normalised weight and the amount it received (0 when weighted out)
     hist [m, n] wealth every ``hist_every`` steps;  flags [1] error bits (engine.flags)
+    site_items [S]: items picked up at each food site and deposited at each nest (after the transitory
+        period; counted by the terrain-aware step only)
 """
 from __future__ import annotations
 
@@ -79,6 +85,9 @@ PARAMS = (
     "reward", "info_share", "stake", "stake_expiry", "fuel_cost", "transitory", "stop_time", "cooldown",
     "cauchy_cdf", "cauchy_guide", "levy_cdf", "levy_guide", "turn_cos", "turn_sin",
     "bparams", "pparams", "record", "hist_every", "grid_cell", "grid_nx", "grid_ny",
+    # terrain (engine.terrain; only the terrain-aware step reads these)
+    "sites_xy", "sites_r", "sites_kind", "obs_kind", "obs_geom", "line_of_sight", "collisions",
+    "sense_robots",
 )
 ROBOTS = (
     "clock", "pos", "hdir", "bias", "kind", "state", "carrying", "levy",
@@ -87,6 +96,7 @@ ROBOTS = (
     "pend_vec", "pend_age", "pend_seller", "pend_count",
     "spot", "has_spot", "last_site", "items", "stop_timer", "cool_timer",
     "nbr", "nbr_count", "cell_start", "cell_items",
+    "spot_site",
 )
 #: The fields of one transaction in the pool (moved together when a block moves or is compacted).
 TX_POOL = ("tx_seller", "tx_site", "tx_dir", "tx_step", "tx_stake")
@@ -98,6 +108,7 @@ LOG = (
     "ev_stake", "ev_sx", "ev_sy", "ev_count",
     "pay_step", "pay_buyer", "pay_seller", "pay_site", "pay_weight", "pay_amount", "pay_count",
     "hist", "flags",
+    "site_items",
 )
 #: Everything but the parameters changes during a run.
 STATE = ROBOTS + LEDGER + LOG

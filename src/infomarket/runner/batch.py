@@ -29,6 +29,8 @@ class BatchResult:
     compile_seconds: float
     run_seconds: float
     steps: int
+    #: Items per site per run (terrain setups only: ``Simulation.site_counts``), else empty.
+    sites: pd.DataFrame = field(default_factory=pd.DataFrame)
 
     @property
     def env_steps_per_second(self) -> float:
@@ -58,6 +60,7 @@ class RunOutput:
     run_seconds: float = 0.0
     steps: int = 0
     error: str | None = None
+    sites: pd.DataFrame = field(default_factory=pd.DataFrame)
 
 
 MAX_ERROR_CHARS = 4000
@@ -73,9 +76,15 @@ def _one(cfg: Experiment, run: int, seed: int, steps: int | None, history_every:
         if len(table):
             table.insert(0, "run", np.int64(run))
             table.insert(1, "seed", np.uint64(seed))
+    sites = pd.DataFrame(r.totals.get("sites", []))
+    if len(sites):
+        sites.insert(0, "run", np.int64(run))
+        sites.insert(1, "seed", np.uint64(seed))
+        sites.insert(2, "site", np.arange(len(sites), dtype=np.int64))
     empty = pd.DataFrame()
     return RunOutput(run, seed, robots, hist, events if record_events else empty,
-                     payments if record_events else empty, r.compile_seconds, r.run_seconds, r.steps)
+                     payments if record_events else empty, r.compile_seconds, r.run_seconds, r.steps,
+                     sites=sites)
 
 
 def _failed(run: int, seed: int, exc: BaseException) -> RunOutput:
@@ -163,4 +172,6 @@ def _collect(outputs: list[RunOutput], warm_seconds: float) -> BatchResult:
     hists = [o.history for o in outputs if len(o.history)]
     history = pd.concat(hists, ignore_index=True) if hists else pd.DataFrame()
     compile_seconds = max([warm_seconds] + [o.compile_seconds for o in outputs])
-    return BatchResult(robots, history, compile_seconds, sum(o.run_seconds for o in outputs), outputs[0].steps)
+    sites = [o.sites for o in outputs if len(o.sites)]
+    return BatchResult(robots, history, compile_seconds, sum(o.run_seconds for o in outputs), outputs[0].steps,
+                       pd.concat(sites, ignore_index=True) if sites else pd.DataFrame())

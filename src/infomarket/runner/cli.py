@@ -95,7 +95,25 @@ def cmd_sweep(args) -> int:
 
     if args.experiment in SUITES and not Path(args.experiment).exists():
         return _execute([load_experiment(name) for name in SUITES[args.experiment]], args, args.experiment)
-    return _execute([load_experiment(args.experiment)], args, "sweep")
+    exp = load_experiment(args.experiment)
+    if getattr(args, "samples", None) is not None:
+        exp = _with_samples(exp, args.samples)
+    return _execute([exp], args, "sweep")
+
+
+def _with_samples(exp, samples: int):
+    """``exp`` with another base sample size of its sampled design (a quick look at a big study)."""
+    from ..config.load import validate
+    from ..errors import ConfigError
+
+    if exp.sweep is None or exp.sweep.sample is None:
+        raise UsageError(f"--samples: {exp.name} has no [sweep.sample] design")
+    data = exp.model_dump()
+    data["sweep"]["sample"]["samples"] = samples
+    try:
+        return validate(data, f"--samples {samples}")
+    except ConfigError as exc:
+        raise UsageError(str(exc).replace("invalid experiment\n  ", "")) from None
 
 
 def cmd_reproduce(args) -> int:
@@ -127,6 +145,8 @@ def add_subcommand(sub) -> None:
     s.add_argument("--scale", type=fraction, default=1.0,
                    help="fraction of the runs per condition (at least 2), e.g. 0.125 for a quick check")
     s.add_argument("--seed", type=seed_value, help="master seed (default: the file's)")
+    s.add_argument("--samples", type=at_least(1), metavar="N",
+                   help="base samples of a [sweep.sample] design (default: the file's), e.g. 16 for a quick look")
     _executor_options(s)
     s.set_defaults(func=cmd_sweep)
 

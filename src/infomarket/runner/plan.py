@@ -35,6 +35,7 @@ class Condition:
     runs: int
     master_seed: int
     number: int = field(default=0)  # the seed stream's condition index
+    design: Any = field(default=None, compare=False, repr=False)  # runner.design.Design of a sampled sweep
 
     def seed(self, run: int) -> int:
         return run_seed(self.master_seed, run, self.number)
@@ -91,6 +92,8 @@ def conditions(exp: Experiment, *, runs: int | None = None, seed: int | None = N
     if exp.sweep is None:
         return [Condition(exp.name, BASE, {}, exp, n_runs(exp.runs), master, 0)]
     sw = exp.sweep
+    if sw.sample is not None:
+        return _sampled(exp, master, n_runs(sw.runs or exp.runs))
     labels = [_label(p) for p in sw.grid] + list(sw.axes)
     dupes = {x for x in labels if labels.count(x) > 1}
     if dupes:
@@ -117,4 +120,20 @@ def conditions(exp: Experiment, *, runs: int | None = None, seed: int | None = N
             raise ConfigError(str(exc)) from None
         out.append(Condition(exp.name, cid, keys, cfg, n_runs(sw.runs or exp.runs), master,
                              condition_number(cid)))
+    return out
+
+
+def _sampled(exp: Experiment, master: int, runs: int) -> list[Condition]:
+    """One condition ``point=i`` per row of the experiment's sampled design (``runner.design``)."""
+    from .design import design_data, make_design
+
+    design = make_design(exp, master)
+    out = []
+    for keys, data in design_data(exp, design):
+        cid = f"point={keys['point']}"
+        try:
+            cfg = validate(data, f"{exp.name} [{cid}]")
+        except ConfigError as exc:
+            raise ConfigError(str(exc)) from None
+        out.append(Condition(exp.name, cid, keys, cfg, runs, master, condition_number(cid), design))
     return out

@@ -12,6 +12,7 @@ committed as ``failed`` with its error text; the others go on (``retry_failed`` 
 """
 from __future__ import annotations
 
+import hashlib
 import math
 import time
 from collections.abc import Callable, Iterable
@@ -34,10 +35,24 @@ from .plan import Condition, conditions
 class Task:
     condition: Condition
     runs: tuple[int, ...]
+    #: further (condition, runs) committed in the same part: the points of a sampled design, which have
+    #: a run or two each, are grouped so that a study of thousands of points is not thousands of parts
+    more: tuple[tuple[Condition, tuple[int, ...]], ...] = ()
+
+    @property
+    def members(self) -> list[tuple[Condition, tuple[int, ...]]]:
+        return [(self.condition, self.runs), *self.more]
+
+    @property
+    def size(self) -> int:
+        return sum(len(r) for _, r in self.members)
 
     @property
     def part_id(self) -> str:
         c = self.condition
+        if self.more:  # named by its members, so a resumed sweep's regrouped parts never collide
+            ids = ";".join(f"{m.id}:{','.join(map(str, r))}" for m, r in self.members)
+            return f"{c.experiment}-set-{hashlib.sha256(ids.encode()).hexdigest()[:16]}"
         tag = "base" if c.id == "base" else format(c.number, "x")[:12]
         return f"{c.experiment}-{tag}-{self.runs[0]:05d}-{self.runs[-1]:05d}"
 
@@ -97,12 +112,31 @@ def make_tasks(conds: list[Condition], done: set, workers: int) -> list[Task]:
     total = sum(len(r) for _, r in todo)
     size = max(1, min(16, math.ceil(total / max(1, workers * 8))))
     tasks = []
+    group: list[tuple[Condition, tuple[int, ...]]] = []  # points of a sampled design, filled up to ``size``
+
+    def flush() -> None:
+        if group:
+            tasks.append(Task(group[0][0], group[0][1], tuple(group[1:])))
+            group.clear()
+
     for c, runs in todo:
+        if c.design is not None and 0 < len(runs) < size:
+            if group and (group[0][0].experiment != c.experiment
+                          or sum(len(r) for _, r in group) + len(runs) > size):
+                flush()
+            group.append((c, tuple(runs)))
+            continue
         for k in range(0, len(runs), size):
             tasks.append(Task(c, tuple(runs[k:k + size])))
+    flush()
     # longest first, so the long runs (Figs. 5-6) do not finish alone at the end on one worker
-    tasks.sort(key=lambda t: -t.condition.config.steps * len(t.runs))
+    tasks.sort(key=lambda t: -t.condition.config.steps * t.size)
     return tasks
+
+
+def _chunks(calls: list[tuple]) -> list[RunOutput]:
+    """``batch._chunk`` for each (configuration, runs, ...) of one task, outputs in order."""
+    return [o for call in calls for o in _chunk(*call)]
 
 
 def _concat(frames: list[pd.DataFrame]) -> pd.DataFrame | None:
@@ -112,6 +146,13 @@ def _concat(frames: list[pd.DataFrame]) -> pd.DataFrame | None:
 
 def _frames(task: Task, outputs: list[RunOutput]) -> dict[str, pd.DataFrame | None]:
     """The part's tables: robots, history, events, payments (None when empty) and the runs record."""
+    if task.more:
+        parts, k = [], 0
+        for c, runs in task.members:
+            parts.append(_frames(Task(c, runs), outputs[k:k + len(runs)]))
+            k += len(runs)
+        return {t: _concat([p[t] for p in parts if p[t] is not None])
+                for t in ("robots", "history", "events", "payments", "runs")}
     c = task.condition
 
     def label(df: pd.DataFrame, keys: bool) -> pd.DataFrame:
@@ -152,6 +193,7 @@ def run_sweep(conds: list[Condition], store: Store, *, workers: int = 1, client=
     with store.lock():
         store.check()  # a damaged store is refused until repaired
         check_compatible(store, conds)  # first: a refused store is left exactly as it was
+        _save_designs(store, conds)  # refuses a store holding another design of the same experiment
         retried = store.uncommit_failed() if retry_failed else 0
         store.remove_orphans()
         report = _run(conds, store, workers, client, on_done, on_plan, record_events)
@@ -159,11 +201,19 @@ def run_sweep(conds: list[Condition], store: Store, *, workers: int = 1, client=
     return report
 
 
+def _save_designs(store: Store, conds: list[Condition]) -> None:
+    """Keep each sampled design in the store before its points run (``runner.design``)."""
+    from .design import save
+
+    for design in {id(c.design): c.design for c in conds if c.design is not None}.values():
+        save(store, design)
+
+
 def _run(conds, store, workers, client, on_done, on_plan, record_events) -> SweepReport:
     done = store.completed_runs()
     tasks = make_tasks(conds, done, workers)
     planned = sum(c.runs for c in conds)
-    todo = sum(len(t.runs) for t in tasks)
+    todo = sum(t.size for t in tasks)
     if on_plan:
         on_plan(todo)
     t0 = time.perf_counter()
@@ -177,35 +227,36 @@ def _run(conds, store, workers, client, on_done, on_plan, record_events) -> Swee
         env_steps += int(tables["runs"].steps.sum())
         failed.extend(o for o in outputs if o.error is not None)
         if on_done:
-            on_done(len(task.runs))
+            on_done(task.size)
 
     def args(t: Task):
-        return (t.condition.config, [(r, t.condition.seed(r)) for r in t.runs], None, None, record_events, True)
+        return ([(c.config, [(r, c.seed(r)) for r in runs], None, None, record_events, True)
+                 for c, runs in t.members],)
 
     if tasks and client is None and workers > 1:
         seen = set()
-        for t in tasks:  # load every kernel once here, so forked workers inherit them compiled
-            key = (behaviour_kinds(t.condition.config), t.condition.config.payment.scheme)
+        for c in (c for t in tasks for c, _ in t.members):  # every kernel loaded once here: forked workers
+            key = (behaviour_kinds(c.config), c.config.payment.scheme)  # inherit them compiled
             if key not in seen:
                 seen.add(key)
-                warm(t.condition.config)
+                warm(c.config)
     if not tasks:
         pass
     elif client is not None:
         from distributed import as_completed as dask_completed
 
-        for t in {(behaviour_kinds(t.condition.config), t.condition.config.payment.scheme): t
-                  for t in tasks}.values():
-            warm(t.condition.config)  # fills the disk cache once instead of in every worker at once
-        futures = {client.submit(_chunk, *args(t), pure=False): t for t in tasks}
+        for cfg in {(behaviour_kinds(c.config), c.config.payment.scheme): c.config
+                    for t in tasks for c, _ in t.members}.values():
+            warm(cfg)  # fills the disk cache once instead of in every worker at once
+        futures = {client.submit(_chunks, *args(t), pure=False): t for t in tasks}
         for fut in dask_completed(futures):
             finished(futures[fut], fut.result())
     elif workers <= 1:
         for t in tasks:
-            finished(t, _chunk(*args(t)))
+            finished(t, _chunks(*args(t)))
     else:
         with process_pool(workers) as pool:
-            futures = {pool.submit(_chunk, *args(t)): t for t in tasks}
+            futures = {pool.submit(_chunks, *args(t)): t for t in tasks}
             try:
                 for fut in futures_completed(futures):
                     finished(futures[fut], fut.result())

@@ -65,9 +65,13 @@ def scene(sim) -> dict:
         "steps": cfg.steps,
         "scheme": cfg.payment.scheme,
         "arena": {"width": cfg.arena.width, "height": cfg.arena.height},
-        "sites": [{"name": SITE_NAMES[k], "x": s.x, "y": s.y, "radius": s.radius}
-                  for k, s in enumerate((cfg.food, cfg.nest))],
-        "robot": {"radius": cfg.robot.radius, "comm_range": cfg.robot.communication_range},
+        # every site, food first (a site's "name" is its kind); events name a kind: site_kinds[k]
+        "sites": [{"name": key, "x": s.x, "y": s.y, "radius": s.radius}
+                  for key in SITE_NAMES for s in cfg.sites(key)],
+        "site_kinds": list(SITE_NAMES),
+        "obstacles": [o.model_dump() for o in cfg.obstacles],
+        "robot": {"radius": cfg.robot.radius, "comm_range": cfg.robot.communication_range,
+                  "collisions": cfg.robot.collisions, "line_of_sight": cfg.robot.line_of_sight},
         "n": len(sim.behaviour_names),
         "behaviours": [{"name": b, "honest": specs[b].honest} for b in names],
         "kind": [names.index(b) for b in sim.behaviour_names],

@@ -26,6 +26,31 @@ MAX_FRAMES = {".gif": 200, ".mp4": 450}
 WIDTH_PX = {".gif": 720, ".mp4": 1000}
 
 
+OBSTACLE = "#5a5a5a"
+CONTACT = "#111111"
+
+
+def draw_obstacles(ax, obstacles: list[dict]) -> None:
+    """Obstacles as on the page: rectangles and circles filled, segments as walls."""
+    from matplotlib.patches import Circle, Rectangle
+
+    for o in obstacles:
+        if o["shape"] == "rect":
+            ax.add_patch(Rectangle((o["x0"], o["y0"]), o["x1"] - o["x0"], o["y1"] - o["y0"], facecolor=OBSTACLE,
+                                   edgecolor="none"))
+        elif o["shape"] == "circle":
+            ax.add_patch(Circle((o["x"], o["y"]), o["radius"], facecolor=OBSTACLE, edgecolor="none"))
+        else:
+            ax.plot([o["x0"], o["x1"]], [o["y0"], o["y1"]], color=OBSTACLE, lw=3, solid_capstyle="round")
+
+
+def in_contact(xy: np.ndarray, radius: float) -> np.ndarray:
+    """[n] bool: robots whose disc touches another's (centres within 2 r + 0.1), as the page rings them."""
+    d2 = ((xy[:, None, :].astype(np.float64) - xy[None, :, :]) ** 2).sum(-1)
+    np.fill_diagonal(d2, np.inf)
+    return (d2 <= (2 * radius + 0.1) ** 2).any(axis=1)
+
+
 def ffmpeg_path() -> str | None:
     """An ffmpeg binary: on PATH, else the one inside the imageio-ffmpeg wheel, else None."""
     exe = shutil.which("ffmpeg")
@@ -86,6 +111,7 @@ def write_movie(rec: Recording, path: str | Path, *, fps: int | None = None, max
         c = SITE_COLOURS[site["name"]]
         ax.add_patch(Circle((site["x"], site["y"]), site["radius"], facecolor=c, alpha=0.35, edgecolor="none"))
         ax.add_patch(Circle((site["x"], site["y"]), site["radius"], facecolor="none", edgecolor=c, lw=1.5))
+    draw_obstacles(ax, s.get("obstacles", []))
     honest = np.array([s["behaviours"][k]["honest"] for k in s["kind"]])
     r = s["robot"]["radius"]
     n = s["n"]
@@ -97,6 +123,12 @@ def write_movie(rec: Recording, path: str | Path, *, fps: int | None = None, max
     headings = LineCollection([], colors="white", linewidths=1.2)
     ax.add_collection(headings)
     carried = ax.scatter([], [], s=6, c="#222", zorder=5)
+    collisions = bool(s["robot"].get("collisions"))
+    rings = EllipseCollection(np.zeros(0), np.zeros(0), np.zeros(0), units="xy", offsets=np.zeros((0, 2)),
+                              offset_transform=ax.transData, facecolors="none", edgecolors=CONTACT,
+                              linewidths=1.0)
+    if collisions:
+        ax.add_collection(rings)
     caption = fig.text(0.01, 1 - 0.5 * caption_px / height_px, "", va="center", fontsize=11)
     bar_ax = fig.add_axes((0.01, 0.2 * bar_px / height_px, 0.98, 0.6 * bar_px / height_px))
     bar_ax.set_xlim(0, 1)
@@ -127,6 +159,12 @@ def write_movie(rec: Recording, path: str | Path, *, fps: int | None = None, max
                                           np.where(c["flags"] & LAST_NEST, SITE_COLOURS["nest"], NO_SITE)))
             headings.set_segments(np.stack([xy, xy + r * np.c_[np.cos(a), np.sin(a)]], axis=1))
             carried.set_offsets(xy[(c["flags"] & CARRYING) > 0].reshape(-1, 2))
+            if collisions:
+                touching = xy[in_contact(xy, s["robot"]["radius"])]
+                rings.set_offsets(touching.reshape(-1, 2))
+                rings.set_widths(np.full(len(touching), 2 * r + 3))
+                rings.set_heights(np.full(len(touching), 2 * r + 3))
+                rings.set_angles(np.zeros(len(touching)))
             h = f.header
             items = h["items_honest"] + h["items_byzantine"]
             caption.set_text(f"{s['name']} ({groups}), seed {s['seed']}: {items:.0f} items collected "

@@ -9,7 +9,7 @@
 "use strict";
 (() => {
   const COLOUR = { honest: "#2f6fd6", byzantine: "#d62f2f", food: "#2ca02c", nest: "#e8b100",
-                   none: "#666666", heading: "#ffffff", comm: "rgba(110,110,110,0.35)" };
+                   none: "#666666", heading: "#ffffff", obstacle: "#5a5a5a", contact: "#111111", comm: "rgba(110,110,110,0.35)" };
   const FLAG = { carrying: 1, foodValid: 2, nestValid: 4, lastFood: 8, lastNest: 16 };
   const TYPED = { "<f8": Float64Array, "<f4": Float32Array, "|u1": Uint8Array, "<i4": Int32Array };
   const MAX_HISTORY = 4000;
@@ -76,7 +76,13 @@
     if (V.selected !== null && V.selected >= scene.n) V.selected = null;
     $("title").textContent = `infomarket · ${scene.name}`;
     const groups = scene.behaviours.map((b, k) => `${scene.kind.filter((x) => x === k).length} ${b.name}`).join(" + ");
-    $("subtitle").textContent = `${groups} · ${scene.scheme} payment · seed ${scene.seed}`;
+    const terrain = [];
+    const obstacles = scene.obstacles || [];
+    if (obstacles.length) terrain.push(`${obstacles.length} obstacle${obstacles.length > 1 ? "s" : ""}`);
+    if (scene.robot.collisions) terrain.push("collisions");
+    if (scene.robot.line_of_sight) terrain.push("line of sight");
+    $("subtitle").textContent = `${groups} · ${scene.scheme} payment · seed ${scene.seed}` +
+      terrain.map((t) => ` · ${t}`).join("");
     if (V.mode === "live") $("seed").placeholder = `random (now ${scene.seed})`;
     fit();
   }
@@ -139,6 +145,7 @@
       ctx.globalAlpha = 0.35; ctx.fillStyle = colour; ctx.fill();
       ctx.globalAlpha = 1; ctx.lineWidth = 2 * px; ctx.strokeStyle = colour; ctx.stroke();
     }
+    drawObstacles(s, px);
     const { x, y, heading, flags } = f.c;
     const n = s.n, r = Math.max(s.robot.radius, 2.5 * px);
     if (V.showComm) {
@@ -178,8 +185,42 @@
       ctx.moveTo(x[i] + r * 0.3, y[i]); ctx.arc(x[i], y[i], r * 0.3, 0, 2 * Math.PI);
     }
     ctx.fillStyle = "#222"; ctx.fill();
+    V.contacts = drawContacts(s, x, y, r, px);
     V.robotsDrawn = n;
     if (V.selected !== null) drawSelected(V.selected, px, r);
+  }
+
+  /** Obstacles (docs/terrain.md): rectangles and circles filled, segments as walls. */
+  function firstOfKind(s, k) { return s.sites.findIndex((o) => o.name === s.sites[k].name) === k; }
+
+  function drawObstacles(s, px) {
+    const obstacles = s.obstacles || [];
+    if (!obstacles.length) return;
+    ctx.fillStyle = COLOUR.obstacle; ctx.strokeStyle = COLOUR.obstacle;
+    for (const o of obstacles) {
+      if (o.shape === "rect") ctx.fillRect(o.x0, o.y0, o.x1 - o.x0, o.y1 - o.y0);
+      else if (o.shape === "circle") { ctx.beginPath(); ctx.arc(o.x, o.y, o.radius, 0, 2 * Math.PI); ctx.fill(); }
+      else {
+        ctx.beginPath(); ctx.moveTo(o.x0, o.y0); ctx.lineTo(o.x1, o.y1);
+        ctx.lineWidth = Math.max(4, 3 * px); ctx.lineCap = "round"; ctx.stroke(); ctx.lineCap = "butt";
+      }
+    }
+  }
+
+  /** With collisions on: robots whose discs touch another's (within a tenth of a unit) get a dark ring. */
+  function drawContacts(s, x, y, r, px) {
+    if (!s.robot.collisions || s.n > 3000) return 0;
+    const d = 2 * s.robot.radius + 0.1, d2 = d * d;
+    const touching = new Uint8Array(s.n);
+    for (let i = 0; i < s.n; i++) for (let j = i + 1; j < s.n; j++) {
+      const dx = x[i] - x[j], dy = y[i] - y[j];
+      if (dx * dx + dy * dy <= d2) { touching[i] = 1; touching[j] = 1; }
+    }
+    let count = 0;
+    ctx.beginPath();
+    for (let i = 0; i < s.n; i++) if (touching[i]) { count++; ctx.moveTo(x[i] + r + 1.5 * px, y[i]); ctx.arc(x[i], y[i], r + 1.5 * px, 0, 2 * Math.PI); }
+    ctx.lineWidth = 1.5 * px; ctx.strokeStyle = COLOUR.contact; ctx.stroke();
+    return count;
   }
 
   function drawSelected(i, px, r) {
@@ -189,8 +230,8 @@
     s.sites.forEach((site, k) => {
       // the true site: thin dashed grey arrow; where the robot believes it is: solid arrow in its colour
       arrow(c.x[i], c.y[i], site.x, site.y, "rgba(80,80,80,0.55)", true, 1 / px);
-      const valid = c.flags[i] & (k === 0 ? FLAG.foodValid : FLAG.nestValid);
-      if (!valid) return;
+      const valid = c.flags[i] & (site.name === "food" ? FLAG.foodValid : FLAG.nestValid);
+      if (!valid || !firstOfKind(s, k)) return; // one table entry per kind
       const bx = c[`${site.name}_x`][i], by = c[`${site.name}_y`][i];
       arrow(c.x[i], c.y[i], bx, by, COLOUR[site.name], false, 1 / px);
       ctx.beginPath(); ctx.arc(bx, by, 5 * px, 0, 2 * Math.PI); ctx.lineWidth = 2 * px; ctx.strokeStyle = "#000"; ctx.stroke();
@@ -306,10 +347,12 @@
     let html = `<h2>robot #${i}</h2><table>${rows.map(([k, v]) => `<tr><th>${k}</th><td>${v}</td></tr>`).join("")}</table>`;
     html += "<h3>navigation table</h3><table><tr><th>site</th><th>believed at</th><th>age</th><th>off by</th></tr>";
     s.sites.forEach((site, k) => {
-      const valid = flags & (k === 0 ? FLAG.foodValid : FLAG.nestValid);
+      if (!firstOfKind(s, k)) return; // one table entry per kind; "off by": from the nearest site of it
+      const valid = flags & (site.name === "food" ? FLAG.foodValid : FLAG.nestValid);
       const bx = c[`${site.name}_x`][i], by = c[`${site.name}_y`][i];
+      const off = Math.min(...s.sites.filter((o) => o.name === site.name).map((o) => Math.hypot(bx - o.x, by - o.y)));
       html += `<tr><td>${site.name}</td>` + (valid
-        ? `<td>(${bx.toFixed(0)}, ${by.toFixed(0)})</td><td>${c[`${site.name}_age`][i]}</td><td>${Math.hypot(bx - site.x, by - site.y).toFixed(0)}</td>`
+        ? `<td>(${bx.toFixed(0)}, ${by.toFixed(0)})</td><td>${c[`${site.name}_age`][i]}</td><td>${off.toFixed(0)}</td>`
         : `<td colspan="3" class="muted">unknown (age ${c[`${site.name}_age`][i]})</td>`) + "</tr>";
     });
     html += "</table>";
@@ -429,7 +472,7 @@
     for (let e = lo - 1; e >= 0 && out.length < 8; e--) {
       if (buyer[e] !== i && seller[e] !== i) continue;
       out.push({ step: steps[e], kind: V.scene.events[kind[e]], buyer: buyer[e], seller: seller[e],
-                 site: site[e] >= 0 ? V.scene.sites[site[e]].name : null });
+                 site: site[e] >= 0 ? (V.scene.site_kinds ? V.scene.site_kinds[site[e]] : V.scene.sites[site[e]].name) : null });
     }
     return out;
   }
@@ -511,6 +554,8 @@
     get playing() { return V.playing; },
     get robots() { return V.scene ? V.scene.n : 0; },
     get robotsDrawn() { return V.robotsDrawn; },
+    /** With collisions on: robots drawn in contact with another in the current frame. */
+    get contacts() { return V.contacts || 0; },
     get selected() { return V.selected; },
     get seed() { return V.scene ? V.scene.seed : null; },
     /** CSS pixel position of robot i relative to the arena canvas's top-left corner. */

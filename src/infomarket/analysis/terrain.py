@@ -1,0 +1,238 @@
+"""Answers to the terrain questions (``terrain_questions.toml``, declared before the runs) from the
+stores of the shipped experiments ``corridor``, ``two_food`` and ``crowd``, with a figure.
+
+``infomarket terrain-report RESULTS --out DIR`` reads RESULTS/corridor, RESULTS/two_food and
+RESULTS/crowd (``infomarket sweep NAME --out RESULTS/NAME``) and, when present,
+RESULTS/two_food_sites/sites.parquet (``infomarket run two_food``), and writes DIR/terrain.md,
+DIR/terrain.json and DIR/terrain.png.  Every test is on per-run values or on robots pooled over runs,
+as the questions say; the answers are whatever the rules give, "no" included.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from scipy import stats as sps
+
+from ..cliargs import UsageError
+from .stats import mann_whitney
+
+QUESTIONS = Path(__file__).with_name("terrain_questions.toml")
+
+
+def questions() -> dict:
+    return tomllib.loads(QUESTIONS.read_text())["questions"]
+
+
+def _robots(root: Path, name: str) -> pd.DataFrame:
+    from ..store.results import Store
+
+    path = root / name
+    store = Store(path)
+    if not store.exists():
+        raise UsageError(f"{path}: no results store; run `infomarket sweep {name} --out {path}` first")
+    return store.robots()
+
+
+def _ratio(a: float, b: float) -> float:
+    return float("inf") if b == 0 else a / b
+
+
+def chain_blocked(robots: pd.DataFrame, rule: dict) -> dict:
+    """Q1: per-run swarm items, market on vs off, behind the wall (and on the plane, descriptive)."""
+    per_run = robots.groupby(["world", "market", "run"], observed=True).items_collected.sum()
+    runs = {(w, m): per_run.loc[w, m].to_numpy() for w in ("corridor", "plane") for m in ("on", "off")}
+    med = {k: float(np.median(v)) for k, v in runs.items()}
+    test = mann_whitney(runs["corridor", "on"], runs["corridor", "off"])
+    ratio = _ratio(med["corridor", "on"], med["corridor", "off"])
+    yes = test.pvalue < rule["p_below"] and ratio >= rule["min_ratio"]
+    return {"answer": "yes" if yes else "no", "runs": len(runs["corridor", "on"]),
+            "median_items": {f"{w}/{m}": med[w, m] for w, m in med},
+            "iqr_items": {f"{w}/{m}": [float(np.percentile(v, 25)), float(np.percentile(v, 75))]
+                          for (w, m), v in runs.items()},
+            "p_corridor_on_gt_off": test.pvalue, "ratio_corridor": ratio,
+            "ratio_plane": _ratio(med["plane", "on"], med["plane", "off"]),
+            "corridor_share_of_plane": _ratio(med["corridor", "on"], med["plane", "on"]),
+            "per_run": {f"{w}/{m}": v.tolist() for (w, m), v in runs.items()}}
+
+
+def _separation(sub: pd.DataFrame) -> dict:
+    honest = sub[sub.honest].wealth_share.to_numpy()
+    byz = sub[~sub.honest].wealth_share.to_numpy()
+    test = mann_whitney(honest, byz)
+    means = sub.groupby(["run", "honest"]).wealth_share.mean().unstack()
+    gap = (means[True] - means[False]).to_numpy()
+    return {"median_honest_pct": 100 * float(np.median(honest)), "median_byzantine_pct": 100 * float(np.median(byz)),
+            "p_honest_gt_byzantine": test.pvalue, "runs": len(gap), "runs_separated": float((gap > 0).mean()),
+            "median_gap_pct": 100 * float(np.median(gap)), "gaps": gap}
+
+
+def outlier_two_food(robots: pd.DataFrame, rule: dict, sites: pd.DataFrame | None) -> dict:
+    """Q3: honest vs Byzantine wealth share with two food sites (and with one, descriptive)."""
+    two = _separation(robots[robots.food_sites == 2])
+    one = _separation(robots[robots.food_sites == 1])
+    yes = (two["median_honest_pct"] > two["median_byzantine_pct"] and two["p_honest_gt_byzantine"] < rule["p_below"]
+           and two["runs_separated"] >= rule["min_runs_separated"])
+    gaps = sps.mannwhitneyu(two["gaps"], one["gaps"], alternative="two-sided").pvalue
+    out = {"answer": "yes" if yes else "no", "two_sites": {k: v for k, v in two.items() if k != "gaps"},
+           "one_site": {k: v for k, v in one.items() if k != "gaps"}, "p_gaps_differ": float(gaps),
+           "gaps_pct": {"two": (100 * two["gaps"]).tolist(), "one": (100 * one["gaps"]).tolist()}}
+    if sites is not None and len(sites):
+        food = sites[sites.kind == "food"].pivot(index="run", columns="site", values="items")
+        total = food.sum(axis=1).replace(0, np.nan)
+        near = food.iloc[:, 1] / total
+        out["near_site_share"] = {"median": float(near.median()), "q25": float(near.quantile(0.25)),
+                                  "q75": float(near.quantile(0.75)), "runs": int(near.notna().sum())}
+    return out
+
+
+def crowd_collisions(robots: pd.DataFrame, rule: dict) -> dict:
+    """Q4: per-robot items per run with collisions on vs off, 100 robots (25, descriptive)."""
+    per_run = robots.groupby(["robots", "collisions", "run"], observed=True).items_collected.mean()
+    out = {}
+    for n in (100, 25):
+        on, off = per_run.loc[n, True].to_numpy(), per_run.loc[n, False].to_numpy()
+        p = float(sps.mannwhitneyu(on, off, alternative="two-sided").pvalue)
+        out[n] = {"median_on": float(np.median(on)), "median_off": float(np.median(off)),
+                  "ratio": _ratio(float(np.median(on)), float(np.median(off))), "p_two_sided": p,
+                  "runs": len(on), "per_run_on": on.tolist(), "per_run_off": off.tolist()}
+    out["answer"] = "yes" if out[100]["ratio"] >= rule["min_ratio"] else "no"
+    return out
+
+
+def figure(a: dict, path: Path) -> Path:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(1, 3, figsize=(14, 4.2))
+    q1 = a["chain_blocked"]["per_run"]
+    keys = ["plane/on", "plane/off", "corridor/on", "corridor/off"]
+    ax[0].boxplot([q1[k] for k in keys], tick_labels=["plane\nmarket", "plane\nno market", "corridor\nmarket",
+                                                      "corridor\nno market"])
+    ax[0].set_ylabel("items per run (whole swarm)")
+    ax[0].set_title(f"corridor: 25 naive, {a['chain_blocked']['runs']} runs each")
+    q3 = a["outlier_two_food"]["gaps_pct"]
+    ax[1].boxplot([q3["one"], q3["two"]], tick_labels=["one food site", "two food sites"])
+    ax[1].axhline(0, color="#999", lw=0.8)
+    ax[1].set_ylabel("honest − Byzantine mean wealth share per run (points of %)")
+    ax[1].set_title("two_food: 20 sceptical + 5 scaboteurs, staking")
+    q4 = a["crowd_collisions"]
+    data = [q4[n][k] for n in (25, 100) for k in ("per_run_off", "per_run_on")]
+    labels = ["25\nno coll.", "25\ncollisions", "100\nno coll.", "100\ncollisions"]
+    if "crowd_sensing" in a:  # exploratory: robots sense each other
+        e = a["crowd_sensing"]
+        data += [e[n]["per_run_on"] for n in (25, 100)]
+        labels += ["25 coll.\n+sensing*", "100 coll.\n+sensing*"]
+    ax[2].boxplot(data, tick_labels=labels)
+    ax[2].set_ylabel("items per robot per run")
+    ax[2].set_title("crowd: naive robots that collide (* exploratory)" if "crowd_sensing" in a
+                    else "crowd: naive robots that collide")
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return path
+
+
+def answer(root: Path) -> dict:
+    q = questions()
+    sites_path = root / "two_food_sites" / "sites.parquet"
+    sites = pd.read_parquet(sites_path) if sites_path.exists() else None
+    return {"chain_blocked": chain_blocked(_robots(root, "corridor"), q["chain_blocked"]),
+            "waypoints_restore": {"answer": "not run", "why": q["waypoints_restore"].get("status", "")},
+            "outlier_two_food": outlier_two_food(_robots(root, "two_food"), q["outlier_two_food"], sites),
+            "crowd_collisions": crowd_collisions(_robots(root, "crowd"), q["crowd_collisions"]),
+            **({"crowd_sensing": exploratory(crowd_collisions(_robots(root, "crowd_sensing"), q["crowd_collisions"]))}
+               if (root / "crowd_sensing").exists() else {})}
+
+
+def exploratory(a: dict) -> dict:
+    """Statistics of a condition added after the declared answers: reported, but no rule decides it."""
+    a.pop("answer", None)
+    a["exploratory"] = True
+    return a
+
+
+def _p(p: float) -> str:
+    return f"{p:.1e}" if p < 0.001 else f"{p:.3f}"
+
+
+def markdown(a: dict) -> str:
+    q = questions()
+    c, t, k = a["chain_blocked"], a["outlier_two_food"], a["crowd_collisions"]
+    m = c["median_items"]
+    lines = [
+        f"1. **{q['chain_blocked']['question']}** — **{c['answer']}**.  Median items per run "
+        f"({c['runs']} runs each): corridor with market {m['corridor/on']:g}, without {m['corridor/off']:g} "
+        f"(ratio {c['ratio_corridor']:.2f}, one-sided Mann–Whitney p = {_p(c['p_corridor_on_gt_off'])}); "
+        f"plane with market {m['plane/on']:g}, without {m['plane/off']:g} (ratio {c['ratio_plane']:.1f}).  "
+        f"Behind the wall the market keeps {100 * c['corridor_share_of_plane']:.0f} % of the plane's throughput.",
+        f"2. **{q['waypoints_restore']['question']}** — **not run**: {q['waypoints_restore'].get('status')}; "
+        "the waypoint behaviour is not part of this branch.",
+    ]
+    two, one = t["two_sites"], t["one_site"]
+    text = (f"3. **{q['outlier_two_food']['question']}** — **{t['answer']}**.  Two food sites: median wealth "
+            f"share honest {two['median_honest_pct']:.2f} % vs Byzantine {two['median_byzantine_pct']:.2f} % "
+            f"(one-sided Mann–Whitney p = {_p(two['p_honest_gt_byzantine'])}, robots pooled over "
+            f"{two['runs']} runs); honest ahead in {100 * two['runs_separated']:.0f} % of runs (median gap "
+            f"{two['median_gap_pct']:.2f} points).  One food site: {one['median_honest_pct']:.2f} % vs "
+            f"{one['median_byzantine_pct']:.2f} % (p = {_p(one['p_honest_gt_byzantine'])}), honest ahead in "
+            f"{100 * one['runs_separated']:.0f} % of runs (median gap {one['median_gap_pct']:.2f}); per-run gaps, "
+            f"two sites vs one: two-sided p = {_p(t['p_gaps_differ'])}.")
+    if "near_site_share" in t:
+        s = t["near_site_share"]
+        text += (f"  Share of food items picked at the near site: median {100 * s['median']:.0f} % "
+                 f"(IQR {100 * s['q25']:.0f}–{100 * s['q75']:.0f} %, {s['runs']} runs of `infomarket run two_food`).")
+    lines.append(text)
+    lines.append(
+        f"4. **{q['crowd_collisions']['question']}** — **{k['answer']}**.  100 robots: median items per robot "
+        f"per run {k[100]['median_on']:.2f} with collisions vs {k[100]['median_off']:.2f} without (ratio "
+        f"{k[100]['ratio']:.2f}, two-sided Mann–Whitney p = {_p(k[100]['p_two_sided'])}, {k[100]['runs']} runs "
+        f"each); 25 robots: {k[25]['median_on']:.2f} vs {k[25]['median_off']:.2f} (ratio {k[25]['ratio']:.2f}, "
+        f"p = {_p(k[25]['p_two_sided'])}).")
+    if "crowd_sensing" in a:
+        e = a["crowd_sensing"]
+        lines.append(
+            "5. *Exploratory, added after answer 4 (no rule declared):* with `robot.sense_robots` (robots "
+            f"reflect off each other), 100 robots: {e[100]['median_on']:.2f} items per robot per run with "
+            f"collisions vs {e[100]['median_off']:.2f} without (ratio {e[100]['ratio']:.2f}, p = "
+            f"{_p(e[100]['p_two_sided'])}); 25 robots: {e[25]['median_on']:.2f} vs {e[25]['median_off']:.2f} "
+            f"(ratio {e[25]['ratio']:.2f}, p = {_p(e[25]['p_two_sided'])}).")
+    return "\n".join(lines) + "\n"
+
+
+def _jsonable(a):
+    if isinstance(a, dict):
+        return {str(k): _jsonable(v) for k, v in a.items()}
+    if isinstance(a, (list, tuple)):
+        return [_jsonable(v) for v in a]
+    if isinstance(a, (np.floating, np.integer)):
+        return a.item()
+    return a
+
+
+def add_subcommand(subparsers) -> None:
+    p = subparsers.add_parser("terrain-report", help="answer the terrain questions (corridor, two_food, crowd) "
+                              "from their stores, with a figure")
+    p.add_argument("results", help="folder holding the stores corridor/, two_food/, crowd/ (and two_food_sites/)")
+    p.add_argument("--out", required=True, help="folder for terrain.md, terrain.json, terrain.png")
+    p.set_defaults(func=cmd_terrain_report)
+
+
+def cmd_terrain_report(args: argparse.Namespace) -> int:
+    from ..cliargs import writable_dir
+
+    root = Path(args.results)
+    a = answer(root)
+    out = writable_dir(Path(args.out))
+    (out / "terrain.md").write_text(markdown(a))
+    (out / "terrain.json").write_text(json.dumps(_jsonable(a), indent=1))
+    figure(a, out / "terrain.png")
+    print(markdown(a))
+    print(f"wrote {out / 'terrain.md'}, {out / 'terrain.json'}, {out / 'terrain.png'}")
+    return 0
