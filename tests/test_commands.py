@@ -125,3 +125,40 @@ def test_an_edited_rule_gets_a_new_kernel(tmp_path, monkeypatch):
     edited = kernel_for("w.tab_valid[me, site], w.tab_vec[me, site, 0], w.tab_vec[me, site, 1], 0")
     assert edited.__file__ != first.__file__
     assert len(list((tmp_path / "cache" / "kernels").glob("kernel_*.py"))) == 2
+
+
+def test_sweep_future_plans_the_declared_grid_and_scales(tmp_path, monkeypatch, capsys):
+    """The open-questions sweep (issue 10): per attack 6 angles x {1, 3} Byzantines x 4 defences = 48
+    conditions, 3 attacks, plus 4 honest baselines = 148 conditions of 32 runs (4 736); --scale 1/16
+    gives 2 runs each.  Bad input is refused with exit 2 and nothing written."""
+    from infomarket.runner import sweep
+
+    seen = []
+
+    def record(conds, store, **kw):
+        seen.extend(conds)
+        return sweep.SweepReport(len(conds), 0, 0, 0, 1.0)
+
+    monkeypatch.setattr(sweep, "run_sweep", record)
+    assert main(["sweep", "future", "--out", str(tmp_path / "f"), "--quiet", "--workers", "1"]) == 0
+    per = {}
+    for c in seen:
+        per.setdefault(c.experiment, []).append(c)
+    assert {k: len(v) for k, v in per.items()} == {"future_honest": 4, "future_liar": 48, "future_farmer": 48,
+                                                   "future_surfer": 48}
+    assert sum(c.runs for c in seen) == 4736 and {c.config.steps for c in seen} == {30000}
+    liar = {(c.keys["rotation_angle"], c.keys["byzantines"], c.keys["defence"]) for c in per["future_liar"]}
+    assert {a for a, _, _ in liar} == {5.0, 10.0, 20.0, 25.0, 40.0, 90.0} and {b for _, b, _ in liar} == {1, 3}
+    honest = {c.keys["defence"]: c.config for c in per["future_honest"]}
+    assert honest["both"].swarm.groups[0].behaviour == "reputation_sceptic"
+    assert honest["both"].payment.scheme == "adaptive_outlier" and honest["both"].payment.stake == 0.04
+    surfer = {c.keys["defence"]: c.config.swarm.groups[1].params["adaptive"] for c in per["future_surfer"]}
+    assert surfer == {"paper": 0.0, "reputation_sceptic": 0.0, "adaptive_theta": 1.0, "both": 1.0}
+    seen.clear()
+    assert main(["sweep", "future", "--out", str(tmp_path / "g"), "--scale", "0.0625", "--quiet"]) == 0
+    assert {c.runs for c in seen} == {2} and len(seen) == 148
+    capsys.readouterr()
+    with pytest.raises(SystemExit) as exc:
+        main(["sweep", "future", "--out", str(tmp_path / "h"), "--scale", "0"])
+    assert exc.value.code == 2
+    assert "--scale: must be in (0, 1]" in capsys.readouterr().err and not (tmp_path / "h").exists()

@@ -48,6 +48,12 @@ NOT_RUN = {
     "infomarket bench --robots 25,100,1000,10000 --json":
         "minutes of timing (10 000 robots x 15 000 steps); tests/bench runs --robots 25,60 --steps 50",
     "infomarket bench --scaling": "96 timed runs; tests/bench runs the same code with 2 runs of 200 steps",
+    "infomarket sweep future --out results/future --workers 1":
+        "4 736 runs of 30 000 steps; tests/test_commands.py plans it and its --scale",
+    "infomarket sweep future --out /tmp/future-small --scale 0.0625":
+        "296 runs of 30 000 steps; the plan and --scale are tested in tests/test_commands.py",
+    "infomarket figures results/future --out results/future-report":
+        "needs the future sweep's store; tests/analysis/test_future.py draws it from a synthetic one",
     # docs/terrain.md
     "infomarket run two_food --runs 4 --out results/two_food": "4 full runs; sites.parquet: tests/terrain/test_cli.py",
     "infomarket sweep crowd --out results/crowd": "128 full runs (100 robots); sweeps are tested in tests/runner",

@@ -1,4 +1,4 @@
-"""The two examples of docs/extending.md: they are the files in examples/, and they work."""
+"""The examples of docs/extending.md: they are the files in examples/, and they work."""
 import re
 from pathlib import Path
 
@@ -14,14 +14,14 @@ ROOT = Path(__file__).parents[1]
 
 @pytest.fixture(scope="module", autouse=True)
 def examples():
-    for name in ("age_liar.py", "equal_split.py"):
+    for name in ("age_liar.py", "equal_split.py", "reputation_outlier.py"):
         plugins.load(str(ROOT / "examples" / name))
 
 
 def test_doc_code_is_the_example_code():
     doc = (ROOT / "docs" / "extending.md").read_text()
     blocks = re.findall(r"```python\n(.*?)```", doc, re.S)
-    for name in ("age_liar.py", "equal_split.py"):
+    for name in ("age_liar.py", "equal_split.py", "reputation_outlier.py"):
         code = (ROOT / "examples" / name).read_text()
         assert code in blocks, f"docs/extending.md does not show examples/{name} as it is"
         assert len(code.strip().splitlines()) <= 20
@@ -32,6 +32,21 @@ def test_equal_split_pays_each_seller_the_same():
                                                           LedgerEvent("deposit", 0)]
     res = replay_events(events, 3, scheme="equal_split")
     assert res.balances == pytest.approx([1.5, 1.25, 1.25])
+
+
+def test_reputation_outlier_pays_by_the_sellers_records():
+    # deposit 1: agreement 3, 3, 3, 1 (the 100 deg sale is alone), every reputation 1/2 (newcomers):
+    # weights 1.5, 1.5, 1.5, 0.5 of 5, shares of 0.5: 0.15, 0.15, 0.15, 0.05; seller 4 is an outlier
+    # (0.5 < half of 1.5), so its reputation becomes 1/3 and the others' 2/3
+    first = [LedgerEvent("purchase", 0, s, 0, d) for s, d in ((1, 0.0), (2, 5.0), (3, 10.0), (4, 100.0))]
+    # deposit 2: sellers 1 and 4 agree (weight 2 each) but weigh 2 x 2/3 and 2 x 1/3: 1/3 and 1/6 of 0.5;
+    # 2/3 is exactly half the best weight 4/3, not below it, so seller 4 is no outlier this time
+    second = [LedgerEvent("purchase", 0, 1, 1, 0.0), LedgerEvent("purchase", 0, 4, 1, 0.0)]
+    res = replay_events(first + [LedgerEvent("deposit", 0)] + second + [LedgerEvent("deposit", 0)], 5,
+                        scheme="reputation_outlier")
+    assert res.balances == pytest.approx([2.0, 1 + 0.15 + 1 / 3, 1.15, 1.15, 1 + 0.05 + 1 / 6])
+    assert res.record["rep_reduced"].tolist() == [0, 0, 0, 0, 1]
+    assert res.record["rep_settled"].tolist() == [0, 2, 1, 1, 2]
 
 
 def test_age_liar_sells_far_more_than_an_honest_robot():

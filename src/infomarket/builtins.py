@@ -30,3 +30,34 @@ register_payment("delayed", schemes.delayed_weights,
 register_payment("outlier", schemes.outlier_weights,
                  description="sellers share information_share * reward + stakes by similarity weight",
                  limits={"theta": ("in (0, 180]", lambda v: 0 < v <= 180)})
+
+# The paper's open questions (issue 10, docs/research.md): rules that read the ledger's reputation record.
+from .behaviours import reputation  # noqa: E402
+from .payments import adaptive  # noqa: E402
+
+register_behaviour("reputation_sceptic", buy=reputation.reputation_sceptic_buy, sell="naive", honest=True,
+                   description="sceptical, but believes sellers with a high reputation or wealth share at once "
+                               "and ignores sellers with a poor record",
+                   limits={"threshold": ("> 0", lambda v: v > 0),
+                           "min_record": (">= 0", lambda v: v >= 0),
+                           "trust_reputation": ("in [0, 1]", lambda v: 0 <= v <= 1),
+                           "distrust_reputation": ("in [0, 1]", lambda v: 0 <= v <= 1),
+                           "trust_share": ("in [0, 1]", lambda v: 0 <= v <= 1)})
+register_behaviour("reputation_farmer", buy="sceptical", sell=reputation.reputation_farmer_sell, honest=False,
+                   description="sceptical buyer that sells the truth until its reputation or wealth share passes "
+                               "a threshold, then vectors rotated by rotation_angle",
+                   limits={"farm_record": (">= 0", lambda v: v >= 0),
+                           "farm_reputation": ("in [0, 1]", lambda v: 0 <= v <= 1),
+                           "farm_share": ("in [0, 1]", lambda v: 0 <= v <= 1)})
+register_behaviour("theta_surfer", buy="sceptical", sell=reputation.theta_surfer_sell, honest=False,
+                   description="sceptical buyer that lies by rotation_angle, capped at margin x the outlier "
+                               "threshold the (adaptive = 1: adaptive) contract applies to it now",
+                   limits={"margin": ("in (0, 1]", lambda v: 0 < v <= 1),
+                           "theta": ("in (0, 180]", lambda v: 0 < v <= 180),
+                           "theta_min": ("in (0, 180]", lambda v: 0 < v <= 180),
+                           "adaptive": ("0 or 1", lambda v: v in (0, 1))})
+register_payment("adaptive_outlier", adaptive.adaptive_outlier_weights,
+                 description="outlier penalisation with each seller's Theta between theta_min and theta by its "
+                             "reputation",
+                 limits={"theta": ("in (0, 180]", lambda v: 0 < v <= 180),
+                         "theta_min": ("in (0, 180]", lambda v: 0 < v <= 180)})

@@ -32,6 +32,8 @@ class Rule:
     params: tuple[str, ...]
     defaults: dict[str, float]
     wants_rng: bool = False  #: the rule takes the run's numpy Generator as ``rng`` after the fixed arguments
+    #: a payment rule that takes ``market`` (the world, to read with ``behaviours.market``) after the fixed ones
+    wants_market: bool = False
 
     @property
     def py_func(self) -> Callable:
@@ -92,13 +94,16 @@ def _jit(func: Callable) -> Callable:
     return numba.njit(func)
 
 
-def _rule(func: Callable, fixed: tuple[str, ...], what: str) -> Rule:
+def _rule(func: Callable, fixed: tuple[str, ...], what: str, market: bool = False) -> Rule:
     jitted = _jit(func)
     py = getattr(jitted, "py_func", jitted)
     sig = list(inspect.signature(py).parameters.values())
     if len(sig) < len(fixed):
         raise TypeError(f"{what} {py.__name__} must take the arguments {', '.join(fixed)} first")
     extra = sig[len(fixed):]
+    wants_market = market and bool(extra) and extra[0].name == "market"
+    if wants_market:
+        extra = extra[1:]
     wants_rng = bool(extra) and extra[0].name == "rng"
     if wants_rng:
         extra = extra[1:]
@@ -106,7 +111,7 @@ def _rule(func: Callable, fixed: tuple[str, ...], what: str) -> Rule:
         if p.kind not in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD):
             raise TypeError(f"{what} {py.__name__}: parameter {p.name} must be a plain positional argument")
     defaults = {p.name: float(p.default) for p in extra if p.default is not p.empty}
-    return Rule(jitted, tuple(p.name for p in extra), defaults, wants_rng)
+    return Rule(jitted, tuple(p.name for p in extra), defaults, wants_rng, wants_market)
 
 
 def register_behaviour(name: str, *, buy: Callable | str, sell: Callable | str, honest: bool,
@@ -167,10 +172,14 @@ def register_payment(name: str, weights: Callable, *, description: str = "", lim
     ``weights`` with one non-negative number per transaction.  On a deposit the ledger pays the buyer the
     reward and its pot of stakes, then moves ``information_share * reward + pot`` from the buyer to the
     sellers in proportion to those weights, so every scheme conserves money by construction.
+    A rule whose first argument after the fixed ones is named ``market`` receives the world there, to
+    read (never write) every robot's wealth and reputation record with ``infomarket.behaviours.market``;
+    ``rng``, if wanted, comes next.
     """
     if name in _PAYMENTS and not replace:
         raise ValueError(f"payment scheme {name!r} is already registered (pass replace=True to override)")
-    spec = PaymentSpec(name, _rule(weights, PAY_ARGS, "payment rule"), description, dict(limits or {}))
+    spec = PaymentSpec(name, _rule(weights, PAY_ARGS, "payment rule", market=True), description,
+                       dict(limits or {}))
     _PAYMENTS[name] = spec
     return spec
 

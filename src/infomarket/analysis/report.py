@@ -14,6 +14,7 @@ from pathlib import Path
 import pandas as pd
 
 from ..store import Store
+from . import future
 from .figures import FIGURES, save
 from .frames import Frames, MissingDataError
 from .headline import FAIL, NO_DATA, PASS, headline_table
@@ -38,6 +39,7 @@ class Report:
     table: pd.DataFrame
     provenance: Provenance
     files: list[Path] = field(default_factory=list)
+    future: future.Section | None = None  # the open-questions section, for stores with the future sweep
     sections: list[tuple[str, str]] = field(default_factory=list)  # (markdown, html), e.g. sensitivity
 
     def counts(self) -> dict[str, int]:
@@ -67,6 +69,7 @@ def build_report(source, out: str | Path, *, vector: str = "svg", label: str | N
         echo(f"{spec.name}: wrote {', '.join(p.name for p in files)}")
     table = headline_table(frames)
     report = Report(label, results, table, collect_provenance(frames, label))
+    report.future = future.section(frames, out, vector, echo)
     store = store if store is not None else (Store(source) if isinstance(source, (str, Path)) else
                                              source if isinstance(source, Store) else None)
     if store is not None:
@@ -124,8 +127,10 @@ def to_markdown(report: Report) -> str:
             md.append(f"*Skipped: {r.note}.*")
         md.append("")
     md += ["## Paper vs this store", "", _summary(report), "",
-           _md_table(report.table[list(TABLE_COLUMNS)].rename(columns=TABLE_COLUMNS)), "",
-           "## Provenance", ""]
+           _md_table(report.table[list(TABLE_COLUMNS)].rename(columns=TABLE_COLUMNS)), ""]
+    if report.future is not None:
+        md += future.to_markdown(report.future, _md_table)
+    md += ["## Provenance", ""]
     md += [f"- {k}: {v}" for k, v in report.provenance.facts.items()]
     if not report.provenance.experiments.empty:
         md += ["", _md_table(report.provenance.experiments)]
@@ -169,8 +174,10 @@ def to_html(report: Report) -> str:
         else:
             parts.append(f"<p class='note'>Skipped: {e(r.note)}.</p>")
     parts += ["<h2>Paper vs this store</h2>", f"<p>{e(_summary(report))}</p>",
-              _html_table(report.table[list(TABLE_COLUMNS)].rename(columns=TABLE_COLUMNS), verdicts=True),
-              "<h2>Provenance</h2><ul>"]
+              _html_table(report.table[list(TABLE_COLUMNS)].rename(columns=TABLE_COLUMNS), verdicts=True)]
+    if report.future is not None:
+        parts += future.to_html(report.future, _html_table)
+    parts.append("<h2>Provenance</h2><ul>")
     parts += [f"<li>{e(k)}: {e(v)}</li>" for k, v in report.provenance.facts.items()]
     parts.append("</ul>")
     if not report.provenance.experiments.empty:

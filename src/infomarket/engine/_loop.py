@@ -109,6 +109,7 @@ def run_steps(w, rng, t_end):
                 if fuel > 0.0:
                     balance[i] -= fuel
                     w.burned[0] += fuel
+                    w.money[0] -= fuel
                 dx, dy = behaviour_step(w, i, rng)
                 move(w, i, dx, dy, rng)
             if cool[i] > 0:

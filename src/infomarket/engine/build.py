@@ -128,6 +128,8 @@ def build_world(cfg: Experiment, rng: np.random.Generator, *, record_events: boo
         tx_off=np.arange(n, dtype=np.int64) * kt, tx_cap=np.full(n, kt, np.int64), tx_count=z(n, np.int64),
         tx_seller=z(n * kt, np.int64), tx_site=z(n * kt, np.int64), tx_dir=z(n * kt),
         tx_step=z(n * kt, np.int64), tx_stake=z(n * kt), pool_top=np.array([n * kt], np.int64),
+        money=np.array([n * float(cfg.payment.initial_wealth)]), rep_settled=z(n, np.int64),
+        rep_reduced=z(n, np.int64), rep_earned=z(n), rep_stake_lost=z(n), rep_deposits=z(n, np.int64),
         ev_step=z(ecap, np.int64), ev_kind=z(ecap, np.int64), ev_buyer=z(ecap, np.int64),
         ev_seller=z(ecap, np.int64), ev_site=z(ecap, np.int64), ev_dir=z(ecap), ev_x=z(ecap), ev_y=z(ecap),
         ev_age=z(ecap, np.int64), ev_stake=z(ecap), ev_sx=z(ecap), ev_sy=z(ecap), ev_count=z(1, np.int64),

@@ -67,7 +67,7 @@ def _rule_source(rule: Rule) -> str | None:
 
 
 def _args(rule: Rule, spec_params: tuple[str, ...], row: str) -> str:
-    rng = ", rng" if rule.wants_rng else ""
+    rng = (", w" if rule.wants_market else "") + (", rng" if rule.wants_rng else "")
     return rng + "".join(f", {row}[{spec_params.index(p)}]" for p in rule.params)
 
 

@@ -55,6 +55,14 @@ LEDGER:
     tx_seller [P], tx_site [P], tx_dir [P] float64 degrees, tx_step [P] step opened, tx_stake [P] stake
         locked: the transaction pool;
         pool_top [1] the first unused pool entry
+    money [1] the sum of all balances, kept up to date by every ledger operation (so a rule reads a
+        wealth share in O(1); equal to balance.sum() up to rounding)
+    REPUTATION (``REPUTATION``, part of the ledger): what the ledger itself knows about each robot, updated
+        when its transactions settle; rules read it through ``behaviours.market``, never write it.
+        rep_settled [n] transactions it sold that were settled by a deposit;  rep_reduced [n] of those,
+        the ones weighed 0 or below half the largest weight of the same site in their settlement (outliers);
+        rep_earned [n] money it was paid for them;  rep_stake_lost [n] stake it locked in them and did
+        not get back (stake minus payment, when positive);  rep_deposits [n] deposits it made as buyer
 
 LOG:
     ev_* [E] and ev_count [1]: event log (purchase / refused / deposit) when ``record``; ev_sx, ev_sy are
@@ -92,7 +100,9 @@ ROBOTS = (
 )
 #: The fields of one transaction in the pool (moved together when a block moves or is compacted).
 TX_POOL = ("tx_seller", "tx_site", "tx_dir", "tx_step", "tx_stake")
-LEDGER = ("balance", "pot", "burned", "tx_off", "tx_cap", "tx_count", *TX_POOL, "pool_top")
+#: The ledger's reputation record of every robot (read by rules through ``behaviours.market``).
+REPUTATION = ("money", "rep_settled", "rep_reduced", "rep_earned", "rep_stake_lost", "rep_deposits")
+LEDGER = ("balance", "pot", "burned", "tx_off", "tx_cap", "tx_count", *TX_POOL, "pool_top", *REPUTATION)
 LOG = (
     "ev_step", "ev_kind", "ev_buyer", "ev_seller", "ev_site", "ev_dir", "ev_x", "ev_y", "ev_age",
     "ev_stake", "ev_sx", "ev_sy", "ev_count",

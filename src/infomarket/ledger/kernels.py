@@ -14,6 +14,11 @@ from ..engine.world import EV_DEPOSIT, EV_PURCHASE, EV_REFUSED
 #: A seller whose balance falls short of the stake by less than this (float rounding of sums of
 #: stakes, e.g. 1 - 24 x 0.04) can still lock it: the exact on-chain ledger would accept it.
 STAKE_TOLERANCE = 1e-9
+#: A settled sale counts as an outlier in its seller's reputation record when the scheme weighed it
+#: below this fraction of the best weight given to the same site in that settlement (or 0).  Half, not
+#: "below the best": with outlier penalisation honest sales weigh anywhere near the best (drift spreads
+#: them), while a rotated one agrees only with the other liars' and weighs a fraction of it.
+OUTLIER_FRACTION = 0.5
 
 
 @njit
@@ -99,6 +104,7 @@ def open_transaction(w, buyer, seller, site, direction):
             return False
         lock = min(w.stake, w.balance[seller])  # never below zero, even within the tolerance
         w.balance[seller] -= lock
+        w.money[0] -= lock
         w.pot[buyer] += lock
     x = w.tx_off[buyer] + k
     w.tx_seller[x] = seller
@@ -125,6 +131,7 @@ def expire_stakes(w, buyer):
         return
     for x in range(m):
         w.balance[w.tx_seller[a + x]] += w.tx_stake[a + x]
+        w.money[0] += w.tx_stake[a + x]
         w.pot[buyer] -= w.tx_stake[a + x]
     for x in range(k - m):
         _move_transaction(w, a + m + x, a + x)
@@ -145,16 +152,34 @@ def purchase_events(w, ok, buyer, seller, site, direction, x, y, age, sx, sy):
               w.stake if ok else 0.0, sx, sy)
 
 
+@njit(inline="always")
+def _record_sale(w, seller, weight, top, pay, stake):
+    """The seller's reputation record for one settled transaction (engine.world, REPUTATION): O(1)."""
+    w.rep_settled[seller] += 1
+    if weight <= 0.0 or weight < OUTLIER_FRACTION * top:
+        w.rep_reduced[seller] += 1
+    w.rep_earned[seller] += pay
+    if stake > pay:
+        w.rep_stake_lost[seller] += stake - pay
+
+
 @njit
 def distribute(w, buyer, weights):
     """Settle a deposit: reward and pot to the buyer, then ``info_share * reward + pot`` from the buyer
-    to the sellers of its open transactions in proportion to ``weights``; clear its transactions."""
+    to the sellers of its open transactions in proportion to ``weights``; clear its transactions.
+    Each seller's reputation record is updated from its weight (an outlier when below half the best
+    weight of its site in this settlement), so rules can read how the market has judged it."""
     k = w.tx_count[buyer]
     w.balance[buyer] += w.reward
     pot = w.pot[buyer]
     w.balance[buyer] += pot
     w.pot[buyer] = 0.0
+    w.money[0] += w.reward + pot
+    w.rep_deposits[buyer] += 1
     total = 0.0
+    top0 = 0.0
+    top1 = 0.0
+    a = w.tx_off[buyer]
     for x in range(k):
         wx = weights[x]
         if not (wx >= 0.0) or math.isinf(wx):
@@ -162,11 +187,19 @@ def distribute(w, buyer, weights):
             w.tx_count[buyer] = 0
             return
         total += wx
-    a = w.tx_off[buyer]
-    if k > 0 and total > 0.0:
-        amount = w.info_share * w.reward + pot
-        for x in range(k):
-            w.balance[w.tx_seller[a + x]] += amount * (weights[x] / total)
+        if w.tx_site[a + x] == 0:
+            top0 = max(top0, wx)
+        else:
+            top1 = max(top1, wx)
+    amount = w.info_share * w.reward + pot
+    paid = k > 0 and total > 0.0
+    for x in range(k):
+        seller = w.tx_seller[a + x]
+        pay = amount * (weights[x] / total) if paid else 0.0
+        if paid:
+            w.balance[seller] += pay
+        _record_sale(w, seller, weights[x], top0 if w.tx_site[a + x] == 0 else top1, pay, w.tx_stake[a + x])
+    if paid:
         w.balance[buyer] -= amount
         if w.record:
             for x in range(k):

@@ -5,7 +5,7 @@ simulation: both feed the same purchases and deposits and compare balances.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Iterable
 
 import numpy as np
@@ -15,6 +15,7 @@ from ..engine import specialise
 from ..engine.build import build_world, make_room
 from ..engine.flags import ErrorFlags
 from ..errors import SimulationError
+from ..engine.world import REPUTATION
 from ..engine.worldref import kernel_view
 from .kernels import expire_stakes, open_transaction, reserve
 
@@ -26,6 +27,8 @@ class Replayed:
     balances: np.ndarray
     pots: np.ndarray
     accepted: list[bool]
+    #: the ledger's reputation record after the replay (``engine.world.REPUTATION``: field -> copy)
+    record: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -87,4 +90,5 @@ def replay_events(events: Iterable, robots: int, *, scheme: str = "delayed", ini
         flags = ErrorFlags(int(world.flags[0]))
         if flags:
             raise SimulationError(flags.describe())
-    return Replayed(world.balance.copy(), world.pot.copy(), accepted)
+    return Replayed(world.balance.copy(), world.pot.copy(), accepted,
+                    {f: getattr(world, f).copy() for f in REPUTATION})

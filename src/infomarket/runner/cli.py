@@ -8,6 +8,8 @@ from ..errors import EXIT_FAILED, report
 
 PAPER = ("fig2A", "fig2B", "fig2C", "fig2D", "fig3A", "fig3B", "fig3C", "fig4A", "fig4B", "fig4C",
          "fig5", "fig6A", "fig6B", "fig7")
+#: Named sets of shipped experiments that ``infomarket sweep NAME`` runs into one store.
+SUITES = {"future": ("future_honest", "future_liar", "future_farmer", "future_surfer")}
 
 
 def _client(args):
@@ -91,6 +93,8 @@ def _execute(experiments, args, label: str) -> int:
 def cmd_sweep(args) -> int:
     from ..config import load_experiment
 
+    if args.experiment in SUITES and not Path(args.experiment).exists():
+        return _execute([load_experiment(name) for name in SUITES[args.experiment]], args, args.experiment)
     exp = load_experiment(args.experiment)
     if getattr(args, "samples", None) is not None:
         exp = _with_samples(exp, args.samples)
@@ -135,8 +139,11 @@ def _executor_options(p) -> None:
 
 def add_subcommand(sub) -> None:
     s = sub.add_parser("sweep", help="run every condition of an experiment into a results store (resumable)")
-    s.add_argument("experiment")
+    s.add_argument("experiment", help="an experiment file, a shipped experiment, or a shipped set: "
+                                      + ", ".join(f"{k} ({' + '.join(v)})" for k, v in SUITES.items()))
     s.add_argument("--runs", type=at_least(1), help="runs per condition (default: the file's)")
+    s.add_argument("--scale", type=fraction, default=1.0,
+                   help="fraction of the runs per condition (at least 2), e.g. 0.125 for a quick check")
     s.add_argument("--seed", type=seed_value, help="master seed (default: the file's)")
     s.add_argument("--samples", type=at_least(1), metavar="N",
                    help="base samples of a [sweep.sample] design (default: the file's), e.g. 16 for a quick look")

@@ -1,0 +1,140 @@
+"""The open-questions section (analysis.future): answers from synthetic sweeps whose answers are known.
+
+Swarm items per run are set directly (robot 0 carries the remainder), so each question's answer
+follows from numbers chosen here, not from the code under test."""
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from infomarket.analysis import future
+from infomarket.analysis.frames import Frames
+from infomarket.analysis.report import build_report
+
+from .synthetic import _runs, write_store
+
+ANGLES = (5.0, 10.0, 20.0, 25.0, 40.0, 90.0)
+RUNS = 8
+
+
+def _run_rows(experiment, defence, byz, angle, run, total, rng):
+    per = np.full(25, total // 25)
+    per[0] += total - per.sum()
+    condition = f"byzantines={byz},defence={defence}" + ("" if angle is None else f",rotation_angle={angle}")
+    return pd.DataFrame({
+        "experiment": experiment, "condition": condition, "run": run, "seed": np.uint64(run + 1),
+        "robot": np.arange(25), "behaviour": ["sceptical"] * (25 - byz) + ["scaboteur"] * byz,
+        "honest": [True] * (25 - byz) + [False] * byz, "drift": rng.normal(0, 0.05, 25),
+        "items_collected": per.astype(int), "wealth": 1.0, "wealth_share": 0.04,
+        "byzantines": byz, "defence": defence, "rotation_angle": np.nan if angle is None else angle})
+
+
+def sweep(items) -> pd.DataFrame:
+    """``items(experiment, defence, byzantines, angle)`` -> the runs' swarm items around that value, with
+    the same spread (-3 .. +3) in every condition, so equal values give equal samples, never a p < 0.05."""
+    rng = np.random.default_rng(0)
+    rows = []
+    for d in future.DEFENCES:
+        for r in range(RUNS):
+            rows.append(_run_rows(future.HONEST, d, 0, None, r, items(future.HONEST, d, 0, None) + r % 7 - 3, rng))
+        for exp in future.ATTACKS:
+            for byz in (1, 3):
+                for a in ANGLES:
+                    for r in range(RUNS):
+                        total = items(exp, d, byz, a) + r % 7 - 3
+                        rows.append(_run_rows(exp, d, byz, a, r, total, rng))
+    return pd.concat(rows, ignore_index=True)
+
+
+def hopeless(exp, d, byz, a):
+    """Nothing helps: 330 without Byzantines, 230 under any attack and any defence."""
+    return 330 if byz == 0 else 230
+
+
+def rescued(exp, d, byz, a):
+    """Every new defence restores the swarm against liars (320 of 330), and costs nothing honest; the
+    farmer still drags the reputation sceptic down and the surfer adaptive Theta."""
+    if byz == 0:
+        return 330
+    if d == "paper":
+        return 230
+    if exp == "future_farmer" and d == "reputation_sceptic":
+        return 230
+    if exp == "future_surfer" and d == "adaptive_theta":
+        return 230
+    return 320
+
+
+def costly(exp, d, byz, a):
+    """Adaptive Theta costs an honest swarm 20 %, and is worse than the paper against liars above Theta."""
+    if byz == 0:
+        return 264 if d == "adaptive_theta" else 330
+    if d == "adaptive_theta" and exp == "future_liar" and a > 30:
+        return 200
+    return 300
+
+
+def _answers(items) -> dict[str, str]:
+    table = future.question_table(Frames(robots=sweep(items)))
+    return dict(zip(table["id"], table["answer"]))
+
+
+def test_every_declared_question_has_an_answer_function_and_back():
+    assert set(future.load_questions()) == set(future.ANSWERS)
+    for q in future.load_questions().values():
+        assert q.question.endswith("?") and q.rule
+
+
+def test_when_nothing_helps_every_answer_says_so():
+    a = _answers(hopeless)
+    assert a["liar_recovered"] == "no"
+    assert all(a[f"liar_improved_{d}"] == "no" for d in future.NEW)
+    assert a["farmer_beats_reputation_sceptic"] == "yes" and a["surfer_beats_adaptive_theta"] == "yes"
+    assert all(a[f"honest_cost_{d}"] == "no" for d in future.NEW)
+    assert a["above_theta_kept"] == "yes"
+
+
+def test_a_defence_that_rescues_the_swarm_is_seen():
+    a = _answers(rescued)
+    assert a["liar_recovered"] == "yes"  # 320 >= 0.9 x 330
+    assert all(a[f"liar_improved_{d}"] == "yes" for d in future.NEW)
+    # dropped to 230 (< 0.9 x 330) and never better than the paper (230): the attack beats its target
+    assert a["farmer_beats_reputation_sceptic"] == "yes" and a["surfer_beats_adaptive_theta"] == "yes"
+
+
+def test_costs_and_lost_protection_are_seen():
+    a = _answers(costly)
+    assert a["honest_cost_adaptive_theta"] == "yes" and a["honest_cost_both"] == "no"
+    assert a["above_theta_kept"] == "no"
+    # adaptive Theta never falls below 0.9 x its own honest median (300 > 0.9 x 264): not beaten
+    assert a["surfer_beats_adaptive_theta"] == "no"
+
+
+def test_missing_conditions_give_no_data_answers_not_errors():
+    robots = sweep(hopeless)
+    table = future.question_table(Frames(robots=robots[robots["experiment"] != future.HONEST]))
+    assert (table.set_index("id").loc[["liar_recovered", "honest_cost_both"], "answer"] == "no data").all()
+    empty = future.question_table(Frames())
+    assert (empty["answer"] == "no data").all()
+
+
+def test_figures_and_report_section_from_a_store(tmp_path):
+    robots = sweep(rescued)
+    store = write_store(tmp_path / "store", {"future": (robots, _runs(robots, 30000, 20000,
+                                                                       ("byzantines", "defence")), None)})
+    report = build_report(store, tmp_path / "out")
+    names = [f[0] for f in report.future.figures]
+    assert names == list(future.ATTACKS) and all(f[2] for f in report.future.figures)
+    for n in names:
+        assert (tmp_path / "out" / f"{n}.png").stat().st_size > 10_000
+    md = (tmp_path / "out" / "report.md").read_text()
+    assert "## The paper's open questions: reputation-aware defences" in md
+    assert "| Does the reputation farmer beat the reputation-aware sceptic? | yes |" in md
+    assert "open questions" in (tmp_path / "out" / "report.html").read_text()
+
+
+def test_a_paper_only_store_has_no_open_questions_section(paper_store, tmp_path):
+    report = build_report(paper_store, tmp_path)
+    assert report.future is None
+    assert "open questions" not in (tmp_path / "report.md").read_text()
