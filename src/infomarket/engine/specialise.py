@@ -93,8 +93,9 @@ def _header(behaviours: list[BehaviourSpec], payment: PaymentSpec) -> str:
 
 #: With ``terrain``, the loop's plane-only pieces are rebound to the terrain-aware ones before anything
 #: compiles (numba resolves a function's globals when it first compiles it).
-_TERRAIN = ("", "# ---- terrain: obstacles, several sites, line of sight, collisions (engine.terrain)",
-            "from infomarket.engine.terrain import behaviour_step, find_neighbours, forage, move  # noqa: F811")
+_TERRAIN = ("", "# ---- terrain: obstacles, several sites, line of sight, collisions, paths (engine.terrain)",
+            "from infomarket.engine.terrain import behaviour_step, find_neighbours, forage, move  # noqa: F811",
+            "from infomarket.engine.terrain import begin_communication, install_table  # noqa: F811")
 
 
 def generate_source(behaviours: list[BehaviourSpec], payment: PaymentSpec, terrain: bool = False) -> str:
@@ -124,6 +125,11 @@ def generate_source(behaviours: list[BehaviourSpec], payment: PaymentSpec, terra
               "from infomarket.engine.worldref import world_type as _world_type, borrow as _borrow, borrow_readonly as _borrow_readonly",
               "_WORLD_TYPE = _world_type()", "", "", constructor_source()]
     return "\n".join(lines)
+
+
+def uses_paths(behaviour_names: tuple[str, ...]) -> bool:
+    """Does any of these behaviours keep waypoint paths (so the run needs the terrain-aware step)?"""
+    return any(get_behaviour(b).paths for b in behaviour_names)
 
 
 def kernel_module(behaviour_names: tuple[str, ...], payment_name: str, terrain: bool = False) -> ModuleType:
