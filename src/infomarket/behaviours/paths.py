@@ -61,7 +61,7 @@ def shorten(pts, m, keep):
     """Drop interior points of the polyline (0, 0) -> pts[0] -> ... -> pts[m - 1] until at most
     ``keep`` remain: each time the one whose removal shortens the path least (the straightest corner).
     The last point (the site) always stays.  Works in place; returns the new count."""
-    while m > keep:
+    while m > keep and m > 1:
         best = 0
         best_d = np.inf
         for j in range(m - 1):
