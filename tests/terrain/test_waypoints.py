@@ -96,3 +96,21 @@ def test_a_blocked_robot_buys_and_installs_its_neighbours_path():
     # bought in the buyer's frame, installed, then dead-reckoned: the same world points
     np.testing.assert_allclose(_world_points(w, 0, FOOD), [(320.0, 300.0), (370.0, 300.0), (370.0, 360.0)],
                                atol=1e-9)
+
+
+def test_only_a_robot_that_bumped_turns_a_plain_vector_into_a_path():
+    sim = simulation(waypoint_config(4))
+    w = sim.world
+    for buyer, seller, y in ((0, 1, 300.0), (2, 3, 450.0)):  # two pairs, 150 apart: no trade across
+        place(sim, buyer, 300.0, y, 0.0)
+        w.tab_age[buyer, FOOD] = 100
+        place(sim, seller, 320.0, y, 0.0)
+        seek_food(sim, seller, 50.0, 0.0)  # a plain vector: food at (370, y)
+        w.tab_age[seller, FOOD] = 1
+    w.blocked[0, FOOD] = True
+    sim.step(1)
+    # the robot that bumped goes via the seller's position; the other averages the vector in (naive)
+    assert w.path_count[0, FOOD] == 1
+    np.testing.assert_allclose(_world_points(w, 0, FOOD), [(320.0, 300.0), (370.0, 300.0)], atol=1e-9)
+    assert w.path_count[2, FOOD] == 0
+    np.testing.assert_allclose(_world_points(w, 2, FOOD), [(370.0, 450.0)], atol=1e-9)
