@@ -150,8 +150,11 @@ def figure(a: dict, path: Path) -> Path:
         ax[0].set_xticks(range(1, 7), ["plane\nmarket", "plane\nno market", "corridor\nmarket",
                                        "corridor\nno market", "plane\nwaypoints", "corridor\nwaypoints"])
         ax[0].set_yscale("symlog", linthresh=10)
+        ax[0].set_ylim(bottom=0)
+        ax[0].set_title(f"corridor: 25 naive / 25 waypoint robots, {a['chain_blocked']['runs']} runs each")
     ax[0].set_ylabel("items per run (whole swarm)")
-    ax[0].set_title(f"corridor: 25 naive, {a['chain_blocked']['runs']} runs each")
+    if w["answer"] == "not run":
+        ax[0].set_title(f"corridor: 25 naive, {a['chain_blocked']['runs']} runs each")
     q3 = a["outlier_two_food"]["gaps_pct"]
     ax[1].boxplot([q3["one"], q3["two"]], tick_labels=["one food site", "two food sites"])
     ax[1].axhline(0, color="#999", lw=0.8)
