@@ -212,7 +212,8 @@ def _waypoint_line(q: dict, w: dict) -> str:
             f"{m['vector/plane']:g}, so waypoints keep {100 * w['share_of_plane']:.0f} % of it (needed ≥ "
             f"{100 * r['min_share_of_plane']:.0f} %: {'met' if w['keeps_half_of_plane'] else 'not met'}; two-sided p = "
             f"{_p(w['p_waypoint_corridor_vs_plane'])}).  Descriptive: waypoint robots on the open plane "
-            f"{m['waypoint/plane']:g} (vs naive {m['vector/plane']:g}, two-sided p = {_p(w['p_waypoint_vs_vector_plane'])}).")
+            f"{m['waypoint/plane']:g} (vs naive {m['vector/plane']:g}, two-sided p = "
+            f"{_p(w['p_waypoint_vs_vector_plane'])}).")
 
 
 def _p(p: float) -> str:
