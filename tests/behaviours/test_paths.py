@@ -85,14 +85,18 @@ def test_a_long_bought_path_is_shortened_to_path_points():
     np.testing.assert_allclose(pts, [(40.0, 0.0), (60.0, 0.0), (80.0, 0.0), (80.0, 80.0)], atol=1e-9)
 
 
-def test_path_behaviours_select_the_terrain_step_and_the_plane_kernel_stays_as_it_was():
+def test_only_path_behaviours_get_the_path_step():
     assert not specialise.uses_paths(("naive", "sceptical"))
     assert specialise.uses_paths(("naive", "waypoint"))
     from infomarket.registry import get_behaviour, get_payment
-    plane = specialise.generate_source([get_behaviour("naive")], get_payment("delayed"))
-    assert "begin_communication, install_table  # noqa" not in plane and "engine.paths" not in plane
-    terrain = specialise.generate_source([get_behaviour("waypoint")], get_payment("delayed"), terrain=True)
-    assert "from infomarket.engine.terrain import begin_communication, install_table" in terrain
+    naive, way, delayed = get_behaviour("naive"), get_behaviour("waypoint"), get_payment("delayed")
+    line = "from infomarket.engine.paths import behaviour_step, begin_communication, install_table"
+    plane = specialise.generate_source([naive], delayed)
+    assert "engine.terrain import" not in plane and "engine.paths" not in plane  # the paper's kernel
+    assert line not in specialise.generate_source([naive], delayed, terrain=True)  # terrain without paths
+    with_paths = specialise.generate_source([naive, way], delayed, paths=True)  # on the plane as well
+    assert "from infomarket.engine.terrain import behaviour_step" in with_paths and line in with_paths
+    assert with_paths.index("engine.terrain import") < with_paths.index(line)  # paths' step wins
 
 
 def test_detour_is_zero_on_the_segment():

@@ -17,12 +17,18 @@ is.  The engine only keeps paths consistent; what is bought and sold is up to ru
 * **Timing.**  As for the entry: sellers sell the start-of-step path, purchases go to ``new_path_*``
   and are installed when the robot moves.
 
-Only the terrain-aware step (``engine.terrain``) calls these, so the paper's kernel never pays for
-paths; a behaviour registered with ``paths=True`` selects that step even on the plane.
+The step below (``behaviour_step``, ``begin_communication``, ``install_table``) is the terrain-aware
+one with paths added; ``engine.specialise`` binds it only when a configured behaviour was registered
+with ``paths=True`` (on the plane too), so neither the paper's kernel nor a terrain run without path
+rules pays for paths.
 """
 from numba import njit
 
 from .geometry import norm
+from .kernels import begin_communication as _begin_plane
+from .kernels import install_table as _install_plane
+from .kernels import intended_move, odometry_update, update_state
+from .terrain import containing_site, sense_sites, sensors
 from .world import FOOD, NEST
 
 
@@ -102,3 +108,43 @@ def install_path(w, i):
         for j in range(m):
             w.path_vec[i, k, j, 0] = w.new_path_vec[i, k, j, 0]
             w.path_vec[i, k, j, 1] = w.new_path_vec[i, k, j, 1]
+
+
+@njit(inline="always")
+def behaviour_step(w, i, rng):
+    """The terrain-aware behaviour step (``terrain.behaviour_step``) with paths: a site sensed clears
+    that kind's path and mark, the legs are followed, a bump marks the site, waypoints are dead-reckoned."""
+    front, right, back, left = sensors(w, i)
+    sense_sites(w, i)
+    for k in range(2):
+        if containing_site(w, w.pos[i, 0], w.pos[i, 1], k) >= 0:
+            at_site(w, i, k)
+    advance(w, i)
+    was_food = w.tab_valid[i, FOOD]
+    was_nest = w.tab_valid[i, NEST]
+    update_state(w, i, front)
+    bumped(w, i, front, was_food, was_nest)
+    drop_invalid(w, i)
+    dx, dy = intended_move(w, i, rng)
+    if (front and dx >= 0.0) or (back and dx <= 0.0):
+        dx = -dx
+    if (right and dy <= 0.0) or (left and dy >= 0.0):
+        dy = -dy
+    if dx != 0.0 or dy != 0.0:
+        odometry_update(w, i, dx, dy)
+        path_odometry(w, i, dx, dy)
+    return dx, dy
+
+
+@njit
+def begin_communication(w):
+    """The plane's start-of-phase copy, and the same for waypoint paths."""
+    _begin_plane(w)
+    begin_paths(w)
+
+
+@njit(inline="always")
+def install_table(w, i):
+    """The plane's install of the bought table, and of the bought path."""
+    _install_plane(w, i)
+    install_path(w, i)

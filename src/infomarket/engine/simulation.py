@@ -62,8 +62,7 @@ class Simulation:
         self.world, self.behaviour_names = build_world(config, self.rng, record_events=record_events,
                                                        history_every=hist)
         t0 = time.perf_counter()
-        self._kernel = specialise.kernel_module(self.kinds, config.payment.scheme,
-                                                config.terrain or specialise.uses_paths(self.kinds))
+        self._kernel = specialise.kernel_module(self.kinds, config.payment.scheme, config.terrain)
         self._view = kernel_view(self.world, self._kernel)
         self._kernel.run_steps(self._view, self.rng, 0)  # compile or load from cache; runs no step
         self.compile_seconds = time.perf_counter() - t0

@@ -40,12 +40,9 @@ from numba import njit
 
 from ..errors import ConfigError
 from .geometry import norm, rotate
-from .kernels import begin_communication as _begin_plane
-from .kernels import install_table as _install_plane
 from .kernels import intended_move, odometry_update, outside, to_frame, to_world, update_state, within
 from .neighbours import find_neighbours as _find_all
 from .obstacles import nearest, sight_blocked
-from .paths import advance, at_site, begin_paths, bumped, drop_invalid, install_path, path_odometry
 from .world import FOOD, NEST
 
 #: Tries per robot to draw a clear initial position before the setup is refused.
@@ -171,7 +168,6 @@ def sense_sites(w, i):
         w.tab_age[i, k] = 0
         w.tab_valid[i, k] = True
         w.last_site[i] = k
-        at_site(w, i, k)
 
 
 @njit(inline="always")
@@ -207,16 +203,10 @@ def sensors(w, i):
 
 @njit(inline="always")
 def behaviour_step(w, i, rng):
-    """The plane's behaviour step (kernels.behaviour_step) with obstacle-aware sensors, every site and
-    waypoint paths (engine.paths: follow the legs, mark a bump, dead-reckon the waypoints)."""
+    """The plane's behaviour step (kernels.behaviour_step) with obstacle-aware sensors and every site."""
     front, right, back, left = sensors(w, i)
     sense_sites(w, i)
-    advance(w, i)
-    was_food = w.tab_valid[i, FOOD]
-    was_nest = w.tab_valid[i, NEST]
     update_state(w, i, front)
-    bumped(w, i, front, was_food, was_nest)
-    drop_invalid(w, i)
     dx, dy = intended_move(w, i, rng)
     if (front and dx >= 0.0) or (back and dx <= 0.0):
         dx = -dx
@@ -224,22 +214,7 @@ def behaviour_step(w, i, rng):
         dy = -dy
     if dx != 0.0 or dy != 0.0:
         odometry_update(w, i, dx, dy)
-        path_odometry(w, i, dx, dy)
     return dx, dy
-
-
-@njit
-def begin_communication(w):
-    """The plane's start-of-phase copy, and the same for waypoint paths."""
-    _begin_plane(w)
-    begin_paths(w)
-
-
-@njit(inline="always")
-def install_table(w, i):
-    """The plane's install of the bought table, and of the bought path."""
-    _install_plane(w, i)
-    install_path(w, i)
 
 
 @njit(inline="always")
