@@ -19,6 +19,7 @@ RUN = {
     "infomarket list",
     "infomarket check my.toml",
     "infomarket check corridor",
+    "infomarket check corridor_waypoints",
 }
 #: Parsed only, with the reason they are not run here.
 NOT_RUN = {
@@ -59,6 +60,8 @@ NOT_RUN = {
     "infomarket sweep crowd --out results/crowd": "128 full runs (100 robots); sweeps are tested in tests/runner",
     "infomarket terrain-report results --out results/terrain":
         "needs the three full stores; tests/terrain/test_report.py runs it on small ones",
+    "infomarket sweep corridor_waypoints --out results/corridor_waypoints":
+        "128 full runs; sweeps are tested in tests/runner, the waypoint rules in tests/terrain/test_waypoints.py",
     "infomarket view corridor": "a web server that runs until stopped; tests/viewer",
     "infomarket replay crowd --movie crowd.gif": "a full-length recording; movies: tests/viewer/test_terrain_view.py",
     "infomarket sweep sensitivity --out results/sensitivity --workers 1": "the full study, 5 120 runs (~25 min)",

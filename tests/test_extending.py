@@ -14,14 +14,14 @@ ROOT = Path(__file__).parents[1]
 
 @pytest.fixture(scope="module", autouse=True)
 def examples():
-    for name in ("age_liar.py", "equal_split.py", "reputation_outlier.py"):
+    for name in ("age_liar.py", "equal_split.py", "reputation_outlier.py", "path_follower.py"):
         plugins.load(str(ROOT / "examples" / name))
 
 
 def test_doc_code_is_the_example_code():
     doc = (ROOT / "docs" / "extending.md").read_text()
     blocks = re.findall(r"```python\n(.*?)```", doc, re.S)
-    for name in ("age_liar.py", "equal_split.py", "reputation_outlier.py"):
+    for name in ("age_liar.py", "equal_split.py", "reputation_outlier.py", "path_follower.py"):
         code = (ROOT / "examples" / name).read_text()
         assert code in blocks, f"docs/extending.md does not show examples/{name} as it is"
         assert len(code.strip().splitlines()) <= 20
@@ -76,3 +76,31 @@ def test_registering_twice_needs_replace():
     with pytest.raises(ValueError, match="already registered"):
         im.register_behaviour("tmp_silent", buy="naive", sell=sell, honest=False)
     im.register_behaviour("tmp_silent", buy="naive", sell=sell, honest=False, replace=True)
+
+
+def test_path_follower_takes_a_plain_vector_as_a_path_via_the_seller():
+    """Two robots on the plane, 20 apart, both facing +x: the seller believes food is 50 ahead; the
+    buyer (entry invalid, old) installs the path (seller's position, food) = (20, 0), (70, 0)."""
+    from infomarket.engine import Simulation
+    from infomarket.engine.world import FOOD
+
+    cfg = im.config.validate({"steps": 10, "swarm": {"robots": 2, "groups": [{"behaviour": "path_follower",
+                                                                              "count": 2}]},
+                              "robot": {"noise_sd": 0.0, "bias_mean": 0.0, "bias_sd": 0.0}})
+    sim = Simulation(cfg, seed=1)
+    w = sim.world
+    w.pos[:] = [(300.0, 300.0), (320.0, 300.0)]
+    w.hdir[:] = [(1.0, 0.0), (1.0, 0.0)]
+    w.tab_age[0, FOOD] = 100
+    w.tab_vec[1, FOOD] = (50.0, 0.0)
+    w.tab_valid[1, FOOD] = True
+    w.tab_age[1, FOOD] = 1
+    w.state[1] = 1  # seeking food
+    sim.step(1)
+    assert w.path_count[0, FOOD] == 1 and w.tab_valid[0, FOOD]
+    # world points: buyer position + (entry, waypoint) in its frame (heading unchanged: it moved along +x
+    # or not at all, after the purchase's stop)
+    c, s = w.hdir[0]
+    pts = [w.tab_vec[0, FOOD], w.path_vec[0, FOOD, 0]]
+    world = [(w.pos[0, 0] + c * x - s * y, w.pos[0, 1] + s * x + c * y) for x, y in pts]
+    np.testing.assert_allclose(world, [(320.0, 300.0), (370.0, 300.0)], atol=1e-9)

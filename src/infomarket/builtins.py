@@ -5,7 +5,7 @@ registry never imports it: ``infomarket/__init__.py`` does, so the built-ins exi
 is imported and there is no import circle between the registry and the rules.  The order below is the
 order ``infomarket list`` shows.
 """
-from .behaviours import byzantine, naive, sceptical
+from .behaviours import byzantine, naive, sceptical, waypoint
 from .payments import schemes
 from .registry import register_behaviour, register_payment
 
@@ -24,6 +24,8 @@ register_behaviour("free_rider", buy="naive", sell=byzantine.free_rider_sell, ho
                    description="naive buyer that never sells")
 register_behaviour("sceptical_free_rider", buy="sceptical", sell=byzantine.free_rider_sell, honest=False,
                    description="sceptical buyer that never sells (the original's FreeRiderBehavior)")
+register_behaviour("waypoint", buy=waypoint.waypoint_buy, sell="naive", honest=True, paths=True,
+                   description="naive buyer that buys and follows waypoint paths once a straight line failed it")
 
 register_payment("delayed", schemes.delayed_weights,
                  description="sellers share information_share * reward per transaction")

@@ -52,6 +52,9 @@ class BehaviourSpec:
     params: tuple[str, ...] = field(default=())
     defaults: dict[str, float] = field(default_factory=dict)
     limits: dict[str, tuple[str, Callable[[float], bool]]] = field(default_factory=dict)
+    #: Its robots keep waypoint paths (``behaviours.paths``): runs with it compile the path-aware
+    #: terrain step (``engine.paths``), which dead-reckons and follows paths, even on the plane.
+    paths: bool = False
 
     def check(self, name: str, value: float) -> str | None:
         """Why ``value`` is not allowed for parameter ``name``, or None."""
@@ -116,7 +119,7 @@ def _rule(func: Callable, fixed: tuple[str, ...], what: str, market: bool = Fals
 
 def register_behaviour(name: str, *, buy: Callable | str, sell: Callable | str, honest: bool,
                        description: str = "", limits: dict | None = None,
-                       replace: bool = False) -> BehaviourSpec:
+                       replace: bool = False, paths: bool = False) -> BehaviourSpec:
     """Register a behaviour from a buy rule and a sell rule (functions, or names of registered behaviours
     whose rule to reuse).
 
@@ -126,6 +129,8 @@ def register_behaviour(name: str, *, buy: Callable | str, sell: Callable | str, 
     the run's numpy Generator there (so a random rule stays reproducible from the run's seed).  ``honest`` says whether robots of this behaviour count as honest in the
     metrics (Byzantine otherwise).  ``limits`` maps a parameter to ``(text, predicate)``, e.g.
     ``{"threshold": ("> 0", lambda v: v > 0)}``: configurations breaking it are rejected with the text.
+    ``paths=True`` says the rules buy or install waypoint paths (``behaviours.paths``); runs with such a
+    behaviour then compile the path-aware terrain step (``engine.paths``); other runs never pay for it.
     """
     if name in _BEHAVIOURS and not replace:
         raise ValueError(f"behaviour {name!r} is already registered (pass replace=True to override)")
@@ -146,7 +151,10 @@ def register_behaviour(name: str, *, buy: Callable | str, sell: Callable | str, 
         if isinstance(r, str):  # a reused rule brings its limits along
             limits = {**_BEHAVIOURS[r].limits, **limits}
     limits = {k: v for k, v in limits.items() if k in params}
-    spec = BehaviourSpec(name, buy_rule, sell_rule, bool(honest), description, tuple(params), defaults, limits)
+    if any(isinstance(r, str) and _BEHAVIOURS[r].paths for r in (buy, sell)):
+        paths = True  # a reused path rule needs the step that keeps paths
+    spec = BehaviourSpec(name, buy_rule, sell_rule, bool(honest), description, tuple(params), defaults, limits,
+                         bool(paths))
     _BEHAVIOURS[name] = spec
     return spec
 

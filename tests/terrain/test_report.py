@@ -59,3 +59,28 @@ def test_terrain_report_command_on_small_stores(tmp_path):
 def test_terrain_report_without_stores_is_a_usage_error(tmp_path, capsys):
     assert main(["terrain-report", str(tmp_path), "--out", str(tmp_path / "o")]) == 2
     assert "no results store" in capsys.readouterr().err
+
+
+WAY_RULE = {"p_below": 0.001, "min_ratio": 2.0, "min_share_of_plane": 0.5}
+
+
+def _on(corridor_items, plane_items):
+    rows = []
+    for world, items in (("corridor", corridor_items), ("plane", plane_items)):
+        rows += [{"world": world, "market": "on", "run": r, "items_collected": v} for r, v in enumerate(items)]
+    return pd.DataFrame(rows)
+
+
+def test_waypoints_restore_needs_a_doubling_over_the_vector_market_and_half_the_plane():
+    naive = _on(list(range(1, 9)), list(range(101, 109)))  # vector market: median 4.5 behind the wall, 104.5 open
+    # waypoints 11..18 behind the wall: separated (p = 1 / 12870), ratio 14.5 / 4.5 = 3.2, but
+    # 14.5 / 104.5 = 14 % of the plane: partly
+    a = terrain.waypoints_restore(naive, _on(list(range(11, 19)), [0] * 8), WAY_RULE)
+    assert abs(a["p_waypoint_gt_vector_corridor"] - 1 / 12870) < 1e-15
+    assert a["ratio_to_vector_corridor"] == 14.5 / 4.5 and a["share_of_plane"] == 14.5 / 104.5
+    assert a["answer"] == "partly"
+    # 51..58 behind the wall: median 54.5 >= 52.25 (half of 104.5): yes
+    assert terrain.waypoints_restore(naive, _on(list(range(51, 59)), [0] * 8), WAY_RULE)["answer"] == "yes"
+    # 6..13: median 9.5, ratio 2.1 but overlapping the vector market's runs: p > 0.001: no
+    b = terrain.waypoints_restore(naive, _on(list(range(6, 14)), [0] * 8), WAY_RULE)
+    assert b["p_waypoint_gt_vector_corridor"] > 0.001 and b["answer"] == "no"

@@ -60,6 +60,35 @@ def chain_blocked(robots: pd.DataFrame, rule: dict) -> dict:
             "per_run": {f"{w}/{m}": v.tolist() for (w, m), v in runs.items()}}
 
 
+def waypoints_restore(naive: pd.DataFrame, waypoint: pd.DataFrame, rule: dict) -> dict:
+    """Q2: per-run swarm items of waypoint robots behind the wall vs the naive vector market behind the
+    same wall (a) and vs the vector market on the open plane (b), as declared."""
+    def runs(robots, world):
+        sub = robots[(robots.world == world) & (robots.market == "on")]
+        return sub.groupby("run", observed=True).items_collected.sum().to_numpy()
+
+    way, vec, plane = runs(waypoint, "corridor"), runs(naive, "corridor"), runs(naive, "plane")
+    way_plane = runs(waypoint, "plane")
+    med = {k: float(np.median(v)) for k, v in (("waypoint/corridor", way), ("vector/corridor", vec),
+                                               ("vector/plane", plane), ("waypoint/plane", way_plane))}
+    test = mann_whitney(way, vec)
+    ratio = _ratio(med["waypoint/corridor"], med["vector/corridor"])
+    share = _ratio(med["waypoint/corridor"], med["vector/plane"])
+    a = test.pvalue < rule["p_below"] and ratio >= rule["min_ratio"]
+    b = share >= rule["min_share_of_plane"]
+    two = lambda x, y: float(sps.mannwhitneyu(x, y, alternative="two-sided").pvalue)  # noqa: E731
+    return {"answer": ("yes" if b else "partly") if a else "no", "beats_vector_market": bool(a),
+            "keeps_half_of_plane": bool(b), "runs": len(way),
+            "median_items": med,
+            "iqr_items": {k: [float(np.percentile(v, 25)), float(np.percentile(v, 75))]
+                          for k, v in (("waypoint/corridor", way), ("vector/corridor", vec),
+                                       ("vector/plane", plane), ("waypoint/plane", way_plane))},
+            "p_waypoint_gt_vector_corridor": test.pvalue, "ratio_to_vector_corridor": ratio,
+            "share_of_plane": share, "p_waypoint_corridor_vs_plane": two(way, plane),
+            "p_waypoint_vs_vector_plane": two(way_plane, plane),
+            "per_run": {"waypoint/corridor": way.tolist(), "waypoint/plane": way_plane.tolist()}}
+
+
 def _separation(sub: pd.DataFrame) -> dict:
     honest = sub[sub.honest].wealth_share.to_numpy()
     byz = sub[~sub.honest].wealth_share.to_numpy()
@@ -115,8 +144,17 @@ def figure(a: dict, path: Path) -> Path:
     keys = ["plane/on", "plane/off", "corridor/on", "corridor/off"]
     ax[0].boxplot([q1[k] for k in keys], tick_labels=["plane\nmarket", "plane\nno market", "corridor\nmarket",
                                                       "corridor\nno market"])
+    w = a["waypoints_restore"]
+    if w["answer"] != "not run":
+        ax[0].boxplot([w["per_run"]["waypoint/plane"], w["per_run"]["waypoint/corridor"]], positions=[5, 6])
+        ax[0].set_xticks(range(1, 7), ["plane\nmarket", "plane\nno market", "corridor\nmarket",
+                                       "corridor\nno market", "plane\nwaypoints", "corridor\nwaypoints"])
+        ax[0].set_yscale("symlog", linthresh=10)
+        ax[0].set_ylim(bottom=0)
+        ax[0].set_title(f"corridor: 25 naive / 25 waypoint robots, {a['chain_blocked']['runs']} runs each")
     ax[0].set_ylabel("items per run (whole swarm)")
-    ax[0].set_title(f"corridor: 25 naive, {a['chain_blocked']['runs']} runs each")
+    if w["answer"] == "not run":
+        ax[0].set_title(f"corridor: 25 naive, {a['chain_blocked']['runs']} runs each")
     q3 = a["outlier_two_food"]["gaps_pct"]
     ax[1].boxplot([q3["one"], q3["two"]], tick_labels=["one food site", "two food sites"])
     ax[1].axhline(0, color="#999", lw=0.8)
@@ -144,7 +182,10 @@ def answer(root: Path) -> dict:
     sites_path = root / "two_food_sites" / "sites.parquet"
     sites = pd.read_parquet(sites_path) if sites_path.exists() else None
     return {"chain_blocked": chain_blocked(_robots(root, "corridor"), q["chain_blocked"]),
-            "waypoints_restore": {"answer": "not run", "why": q["waypoints_restore"].get("status", "")},
+            "waypoints_restore": (waypoints_restore(_robots(root, "corridor"), _robots(root, "corridor_waypoints"),
+                                                    q["waypoints_restore"])
+                                  if (root / "corridor_waypoints").exists() else
+                                  {"answer": "not run", "why": "no corridor_waypoints store"}),
             "outlier_two_food": outlier_two_food(_robots(root, "two_food"), q["outlier_two_food"], sites),
             "crowd_collisions": crowd_collisions(_robots(root, "crowd"), q["crowd_collisions"]),
             **({"crowd_sensing": exploratory(crowd_collisions(_robots(root, "crowd_sensing"), q["crowd_collisions"]))}
@@ -156,6 +197,23 @@ def exploratory(a: dict) -> dict:
     a.pop("answer", None)
     a["exploratory"] = True
     return a
+
+
+def _waypoint_line(q: dict, w: dict) -> str:
+    head = f"2. **{q['waypoints_restore']['question']}** — "
+    if w["answer"] == "not run":
+        return head + "**not run**: no `corridor_waypoints` store (`infomarket sweep corridor_waypoints`)."
+    m, r = w["median_items"], q["waypoints_restore"]
+    return (head + f"**{w['answer']}**.  Median items per run ({w['runs']} runs each, market on): waypoint robots "
+            f"behind the wall {m['waypoint/corridor']:g} vs the vector market behind the same wall "
+            f"{m['vector/corridor']:g} (ratio {w['ratio_to_vector_corridor']:.2f}, one-sided Mann–Whitney p = "
+            f"{_p(w['p_waypoint_gt_vector_corridor'])}; needed p < {r['p_below']:g} and ratio ≥ {r['min_ratio']:g}: "
+            f"{'met' if w['beats_vector_market'] else 'not met'}); the open plane with the vector market "
+            f"{m['vector/plane']:g}, so waypoints keep {100 * w['share_of_plane']:.0f} % of it (needed ≥ "
+            f"{100 * r['min_share_of_plane']:.0f} %: {'met' if w['keeps_half_of_plane'] else 'not met'}; two-sided p = "
+            f"{_p(w['p_waypoint_corridor_vs_plane'])}).  Descriptive: waypoint robots on the open plane "
+            f"{m['waypoint/plane']:g} (vs naive {m['vector/plane']:g}, two-sided p = "
+            f"{_p(w['p_waypoint_vs_vector_plane'])}).")
 
 
 def _p(p: float) -> str:
@@ -172,8 +230,7 @@ def markdown(a: dict) -> str:
         f"(ratio {c['ratio_corridor']:.2f}, one-sided Mann–Whitney p = {_p(c['p_corridor_on_gt_off'])}); "
         f"plane with market {m['plane/on']:g}, without {m['plane/off']:g} (ratio {c['ratio_plane']:.1f}).  "
         f"Behind the wall the market keeps {100 * c['corridor_share_of_plane']:.0f} % of the plane's throughput.",
-        f"2. **{q['waypoints_restore']['question']}** — **not run**: {q['waypoints_restore'].get('status')}; "
-        "the waypoint behaviour is not part of this branch.",
+        _waypoint_line(q, a["waypoints_restore"]),
     ]
     two, one = t["two_sites"], t["one_site"]
     text = (f"3. **{q['outlier_two_food']['question']}** — **{t['answer']}**.  Two food sites: median wealth "

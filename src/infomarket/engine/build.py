@@ -11,7 +11,7 @@ from .kernels import turn_tables
 from . import obstacles
 from .neighbours import grid_shape
 from .terrain import place_clear, site_arrays
-from .world import LOG, TX_POOL, World
+from .world import LOG, PATH_POINTS, TX_POOL, World
 
 #: First capacities; the host grows each when the kernel asks for room (``make_room``).
 NEIGHBOUR_CAPACITY = 8
@@ -124,6 +124,8 @@ def build_world(cfg: Experiment, rng: np.random.Generator, *, record_events: boo
         items=z(n, np.int64), stop_timer=z(n, np.int64), cool_timer=z(n, np.int64),
         nbr=z((n, kn), np.int64), nbr_count=z(n, np.int64),
         cell_start=z(nx * ny + 1, np.int64), cell_items=z(n, np.int64), spot_site=z((n, 2), np.int64),
+        blocked=z((n, 2), np.bool_), path_vec=z((n, 2, PATH_POINTS - 1, 2)), path_count=z((n, 2), np.int64),
+        new_path_vec=z((n, 2, PATH_POINTS - 1, 2)), new_path_count=z((n, 2), np.int64),
         balance=np.full(n, float(cfg.payment.initial_wealth)), pot=z(n), burned=z(1),
         tx_off=np.arange(n, dtype=np.int64) * kt, tx_cap=np.full(n, kt, np.int64), tx_count=z(n, np.int64),
         tx_seller=z(n * kt, np.int64), tx_site=z(n * kt, np.int64), tx_dir=z(n * kt),

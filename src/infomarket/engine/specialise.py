@@ -95,12 +95,18 @@ def _header(behaviours: list[BehaviourSpec], payment: PaymentSpec) -> str:
 #: compiles (numba resolves a function's globals when it first compiles it).
 _TERRAIN = ("", "# ---- terrain: obstacles, several sites, line of sight, collisions (engine.terrain)",
             "from infomarket.engine.terrain import behaviour_step, find_neighbours, forage, move  # noqa: F811")
+#: With ``paths`` (a behaviour registered with paths=True), on top of the terrain: waypoint paths.
+_PATHS = ("# ---- waypoint paths (engine.paths)",
+          "from infomarket.engine.paths import behaviour_step, begin_communication, install_table  # noqa: F811")
 
 
-def generate_source(behaviours: list[BehaviourSpec], payment: PaymentSpec, terrain: bool = False) -> str:
+def generate_source(behaviours: list[BehaviourSpec], payment: PaymentSpec, terrain: bool = False,
+                    paths: bool = False) -> str:
     """Source of the specialised module (template + dispatch) for these behaviours, in kind order;
-    ``terrain`` selects the terrain-aware step (engine.terrain)."""
-    lines = [_header(behaviours, payment), _TEMPLATE.read_text(), *(_TERRAIN if terrain else ()),
+    ``terrain`` selects the terrain-aware step (engine.terrain), ``paths`` adds waypoint paths to it
+    (engine.paths; implies the terrain step)."""
+    lines = [_header(behaviours, payment), _TEMPLATE.read_text(), *(_TERRAIN if terrain or paths else ()),
+             *(_PATHS if paths else ()),
              "", "# ---- generated dispatch " + "-" * 60,
              "from infomarket.registry import rule_function as _rule_function", ""]
     for k, b in enumerate(behaviours):
@@ -126,12 +132,18 @@ def generate_source(behaviours: list[BehaviourSpec], payment: PaymentSpec, terra
     return "\n".join(lines)
 
 
+def uses_paths(behaviour_names: tuple[str, ...]) -> bool:
+    """Does any of these behaviours keep waypoint paths (so the run needs the terrain-aware step)?"""
+    return any(get_behaviour(b).paths for b in behaviour_names)
+
+
 def kernel_module(behaviour_names: tuple[str, ...], payment_name: str, terrain: bool = False) -> ModuleType:
     """The specialised kernel module (``run_steps``) for these behaviours (kind order) and scheme, on
-    the paper's plane or (``terrain``) with obstacles, several sites, line of sight and collisions."""
+    the paper's plane or (``terrain``) with obstacles, several sites, line of sight and collisions;
+    behaviours registered with ``paths=True`` add waypoint paths (engine.paths) to the terrain step."""
     behaviours = [get_behaviour(b) for b in behaviour_names]
     payment = get_payment(payment_name)
-    source = generate_source(behaviours, payment, terrain)
+    source = generate_source(behaviours, payment, terrain, any(b.paths for b in behaviours))
     digest = hashlib.sha256(source.encode())
     digest.update(f"{__version__} {numba.__version__} {sys.version} {_package_digest()}".encode())
     cacheable = True

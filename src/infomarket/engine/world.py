@@ -47,6 +47,12 @@ ROBOTS:
     nbr [n, kn], nbr_count [n]: neighbours in increasing id order (a count above kn asks for room)
     cell_start [grid_nx * grid_ny + 1], cell_items [n]: the neighbour grid, rebuilt every step
     spot_site [n, 2]: which site (index into sites_*) each spot lies in
+    blocked [n, 2] bool: the robot bumped into something while seeking that site (its straight line
+        failed) and has not been at such a site since (set by the path-aware step, engine.paths; rules read it)
+    path_vec [n, 2, PATH_POINTS - 1, 2], path_count [n, 2]: waypoint paths (engine.paths).  When
+        path_count > 0 the table entry tab_vec is the first waypoint and path_vec[:path_count] the
+        further ones, the last being the site, all positions in the robot's frame (start-of-step
+        copy, what sellers sell);  new_path_vec, new_path_count: the path being bought into
 
 LEDGER:
     balance [n], pot [n] stakes locked by the robot's open purchases, burned [1] fuel burned
@@ -97,6 +103,8 @@ ROBOTS = (
     "spot", "has_spot", "last_site", "items", "stop_timer", "cool_timer",
     "nbr", "nbr_count", "cell_start", "cell_items",
     "spot_site",
+    # waypoint paths (engine.paths; only the path-aware step moves them)
+    "blocked", "path_vec", "path_count", "new_path_vec", "new_path_count",
 )
 #: The fields of one transaction in the pool (moved together when a block moves or is compacted).
 TX_POOL = ("tx_seller", "tx_site", "tx_dir", "tx_step", "tx_stake")
@@ -114,6 +122,9 @@ LOG = (
 STATE = ROBOTS + LEDGER + LOG
 
 World = namedtuple("World", PARAMS + STATE)
+
+#: Most points a waypoint path holds, the first one (the table entry itself) included.
+PATH_POINTS = 4
 
 # Robot states.
 EXPLORING = 0

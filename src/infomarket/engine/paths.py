@@ -1,0 +1,150 @@
+"""Waypoint paths in the terrain-aware step: a table entry of several legs (issue 14, item 4).
+
+A robot's entry for a site is normally one vector (``tab_vec``).  With a path (``path_count > 0``) the
+entry is the *first waypoint* and ``path_vec[:path_count]`` holds the further ones, the last being the
+site; every point is a position in the robot's own frame, kept by dead reckoning exactly as the entry
+is.  The engine only keeps paths consistent; what is bought and sold is up to rules
+(``behaviours.paths`` has the public helpers, ``behaviours.waypoint`` the built-in rule):
+
+* **Dead reckoning.**  Each waypoint moves by ``-dr`` and turns by ``-heading(dr)`` like the entry
+  (the same arithmetic as ``kernels.odometry_update``).
+* **Following the legs.**  A seeking robot that reaches its first waypoint (closer than its radius:
+  where the model would declare the entry wrong) takes the next waypoint as its entry and goes on;
+  the entry's age does not change.
+* **Bumps.**  When FRONT fires while seeking (the model then drops the entry and explores), the robot
+  marks the site ``blocked`` and drops its path with the entry.  Being at a site of that kind clears
+  both: the sensed vector is exact and straight.
+* **Timing.**  As for the entry: sellers sell the start-of-step path, purchases go to ``new_path_*``
+  and are installed when the robot moves.
+
+The step below (``behaviour_step``, ``begin_communication``, ``install_table``) is the terrain-aware
+one with paths added; ``engine.specialise`` binds it only when a configured behaviour was registered
+with ``paths=True`` (on the plane too), so neither the paper's kernel nor a terrain run without path
+rules pays for paths.
+"""
+from numba import njit
+
+from .geometry import norm
+from .kernels import begin_communication as _begin_plane
+from .kernels import install_table as _install_plane
+from .kernels import intended_move, odometry_update, update_state
+from .terrain import containing_site, sense_sites, sensors
+from .world import FOOD, NEST
+
+
+@njit(inline="always")
+def path_odometry(w, i, dx, dy):
+    """Move robot i's waypoints by its intended move (dx, dy) in its frame, as ``odometry_update``
+    moves its table entries."""
+    length = norm(dx, dy)
+    c = dx / length
+    s = -dy / length
+    for k in range(2):
+        for j in range(w.path_count[i, k]):
+            x = w.path_vec[i, k, j, 0] - dx
+            y = w.path_vec[i, k, j, 1] - dy
+            w.path_vec[i, k, j, 0] = c * x - s * y
+            w.path_vec[i, k, j, 1] = s * x + c * y
+
+
+@njit(inline="always")
+def advance(w, i):
+    """A robot at its first waypoint (closer than its radius) of a valid path takes the next one."""
+    for k in range(2):
+        m = w.path_count[i, k]
+        if m > 0 and w.tab_valid[i, k] and norm(w.tab_vec[i, k, 0], w.tab_vec[i, k, 1]) < w.radius:
+            w.tab_vec[i, k, 0] = w.path_vec[i, k, 0, 0]
+            w.tab_vec[i, k, 1] = w.path_vec[i, k, 0, 1]
+            for j in range(m - 1):
+                w.path_vec[i, k, j, 0] = w.path_vec[i, k, j + 1, 0]
+                w.path_vec[i, k, j, 1] = w.path_vec[i, k, j + 1, 1]
+            w.path_count[i, k] = m - 1
+
+
+@njit(inline="always")
+def at_site(w, i, k):
+    """Robot i senses a site of kind k: its entry is now one exact vector."""
+    w.path_count[i, k] = 0
+    w.blocked[i, k] = False
+
+
+@njit(inline="always")
+def bumped(w, i, front, was_food, was_nest):
+    """After the state machine: an entry it dropped while FRONT fired (the model's "blocked while
+    seeking") marks that site blocked.  ``was_*``: the entries' validity before the state machine."""
+    if front:
+        if was_food and not w.tab_valid[i, FOOD]:
+            w.blocked[i, FOOD] = True
+        if was_nest and not w.tab_valid[i, NEST]:
+            w.blocked[i, NEST] = True
+
+
+@njit(inline="always")
+def drop_invalid(w, i):
+    """A path lives only as long as its entry is valid (arrival at a final point empties it too)."""
+    for k in range(2):
+        if not w.tab_valid[i, k]:
+            w.path_count[i, k] = 0
+
+
+@njit(inline="always")
+def begin_paths(w):
+    """Start of the communication phase: purchases go to the new path; sellers keep the old one."""
+    for i in range(w.path_count.shape[0]):
+        for k in range(2):
+            m = w.path_count[i, k]
+            w.new_path_count[i, k] = m
+            for j in range(m):
+                w.new_path_vec[i, k, j, 0] = w.path_vec[i, k, j, 0]
+                w.new_path_vec[i, k, j, 1] = w.path_vec[i, k, j, 1]
+
+
+@njit(inline="always")
+def install_path(w, i):
+    """The robot moves: what it bought becomes its path (with ``install_table`` for the entry)."""
+    for k in range(2):
+        m = w.new_path_count[i, k]
+        w.path_count[i, k] = m
+        for j in range(m):
+            w.path_vec[i, k, j, 0] = w.new_path_vec[i, k, j, 0]
+            w.path_vec[i, k, j, 1] = w.new_path_vec[i, k, j, 1]
+
+
+@njit(inline="always")
+def behaviour_step(w, i, rng):
+    """The terrain-aware behaviour step (``terrain.behaviour_step``) with paths: a site sensed clears
+    that kind's path and mark, the legs are followed, a bump marks the site, waypoints are dead-reckoned."""
+    front, right, back, left = sensors(w, i)
+    sense_sites(w, i)
+    for k in range(2):
+        if containing_site(w, w.pos[i, 0], w.pos[i, 1], k) >= 0:
+            at_site(w, i, k)
+    advance(w, i)
+    was_food = w.tab_valid[i, FOOD]
+    was_nest = w.tab_valid[i, NEST]
+    update_state(w, i, front)
+    bumped(w, i, front, was_food, was_nest)
+    drop_invalid(w, i)
+    dx, dy = intended_move(w, i, rng)
+    if (front and dx >= 0.0) or (back and dx <= 0.0):
+        dx = -dx
+    if (right and dy <= 0.0) or (left and dy >= 0.0):
+        dy = -dy
+    if dx != 0.0 or dy != 0.0:
+        odometry_update(w, i, dx, dy)
+        path_odometry(w, i, dx, dy)
+    return dx, dy
+
+
+@njit
+def begin_communication(w):
+    """The plane's start-of-phase copy, and the same for waypoint paths."""
+    _begin_plane(w)
+    begin_paths(w)
+
+
+@njit(inline="always")
+def install_table(w, i):
+    """The plane's install of the bought table, and of the bought path."""
+    _install_plane(w, i)
+    install_path(w, i)
