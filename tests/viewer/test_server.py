@@ -284,7 +284,7 @@ def test_view_command_prints_the_url_and_stops_cleanly_on_a_signal(sig):
         with socket.create_connection((host, int(port)), timeout=5):
             pass  # it listens, on loopback
         proc.send_signal(sig)
-        rest = proc.communicate(timeout=60)  # a hang guard: a cold kernel compile may be finishing[1]
+        rest = proc.communicate(timeout=60)[1]  # a hang guard: a cold kernel compile may still be finishing
         assert proc.returncode == 0, rest
         assert "viewer stopped" in rest and "Traceback" not in rest
     finally:
