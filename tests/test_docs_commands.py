@@ -65,7 +65,7 @@ NOT_RUN = {
         "128 full runs; sweeps are tested in tests/runner, the waypoint rules in tests/terrain/test_waypoints.py",
     "infomarket view corridor": "a web server that runs until stopped; tests/viewer",
     "infomarket replay crowd --movie crowd.gif": "a full-length recording; movies: tests/viewer/test_terrain_view.py",
-    "infomarket sweep sensitivity --out results/sensitivity --workers 1": "the full study, 5 120 runs (~25 min)",
+    "infomarket sweep sensitivity --out results/sensitivity --workers 1": "the full study, 20 480 runs (~35 min on 2 cores)",
     "infomarket sweep sensitivity --samples 16 --out /tmp/sens-quick":
         "160 runs; tests/analysis/test_sensitivity.py runs the study with --samples 2",
     "infomarket sensitivity /tmp/sens-quick --out /tmp/sens-quick-report":
