@@ -161,3 +161,19 @@ def pending_add(w, me, site, seller, x, y, age):
 @njit(inline="always")
 def pending_clear(w, me, site):
     w.pend_count[me, site] = 0
+
+
+@njit(inline="always")
+def confirm_or_wait(w, me, site, seller, x, y, age, threshold):
+    """The sceptic's second chance for a purchase that disagrees with its own entry: if a pending
+    purchase agrees with it (diff < threshold), install their age-weighted average and clear the
+    pending list (True); otherwise keep it pending, unconfirmed (False)."""
+    for j in range(pending_count(w, me, site)):
+        _, px, py, page = pending_get(w, me, site, j)
+        if diff(px, py, x, y) < threshold:
+            cx, cy, cage = weighted(px, py, page, x, y, age)
+            install(w, me, site, cx, cy, cage)
+            pending_clear(w, me, site)
+            return True
+    pending_add(w, me, site, seller, x, y, age)
+    return False

@@ -2,8 +2,8 @@
 filtered by reputation, and two attacks aimed at reputation-based defences.  (Registered by
 ``infomarket.builtins``; docs/research.md explains them and what the ``future`` sweep found.)"""
 from ..engine.geometry import rotate
-from .api import (buy, combine, current, diff, install, next_candidate, own_entry, pending_add, pending_clear,
-                  pending_count, pending_get, pending_has, weighted)
+from .api import (buy, combine, confirm_or_wait, current, diff, next_candidate, own_entry, pending_clear,
+                  pending_has)
 from .market import sales_settled, seller_reputation, wealth_share
 
 
@@ -38,18 +38,7 @@ def reputation_sceptic_buy(w, me, nbrs, threshold=0.25, trust_reputation=0.85, t
                 combine(w, me, site, x, y, age)
                 pending_clear(w, me, site)
                 continue
-            confirmed = False
-            for j in range(pending_count(w, me, site)):
-                _, px, py, page = pending_get(w, me, site, j)
-                if diff(px, py, x, y) < threshold:
-                    cx, cy, cage = weighted(px, py, page, x, y, age)
-                    install(w, me, site, cx, cy, cage)
-                    confirmed = True
-                    break
-            if confirmed:
-                pending_clear(w, me, site)
-            else:
-                pending_add(w, me, site, s, x, y, age)
+            confirm_or_wait(w, me, site, s, x, y, age, threshold)
 
 
 def reputation_farmer_sell(w, me, site, rotation_angle=90.0, farm_reputation=0.8, farm_record=10.0,

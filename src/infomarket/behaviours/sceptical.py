@@ -1,7 +1,6 @@
 """Sceptical robots: use bought information only when something confirms it (eq. 6, pending list).
 (Registered as ``sceptical`` by ``infomarket.builtins``.)"""
-from .api import (buy, combine, current, diff, install, next_candidate, pending_add, pending_clear,
-                  pending_count, pending_get, pending_has, weighted)
+from .api import buy, combine, confirm_or_wait, current, diff, next_candidate, pending_clear, pending_has
 
 
 def sceptical_buy(w, me, nbrs, threshold=0.25):
@@ -27,16 +26,5 @@ def sceptical_buy(w, me, nbrs, threshold=0.25):
                 combine(w, me, site, x, y, age)
                 pending_clear(w, me, site)
                 continue
-            confirmed = False
-            for j in range(pending_count(w, me, site)):
-                _, px, py, page = pending_get(w, me, site, j)
-                if diff(px, py, x, y) < threshold:
-                    cx, cy, cage = weighted(px, py, page, x, y, age)
-                    install(w, me, site, cx, cy, cage)
-                    confirmed = True
-                    break
-            if confirmed:
-                pending_clear(w, me, site)
-            else:
-                pending_add(w, me, site, s, x, y, age)
+            confirm_or_wait(w, me, site, s, x, y, age, threshold)
 
