@@ -81,10 +81,8 @@ def _one(cfg: Experiment, run: int, seed: int, steps: int | None, history_every:
         sites.insert(0, "run", np.int64(run))
         sites.insert(1, "seed", np.uint64(seed))
         sites.insert(2, "site", np.arange(len(sites), dtype=np.int64))
-    empty = pd.DataFrame()
-    return RunOutput(run, seed, robots, hist, events if record_events else empty,
-                     payments if record_events else empty, r.compile_seconds, r.run_seconds, r.steps,
-                     sites=sites)
+    return RunOutput(run, seed, robots, hist, events, payments, r.compile_seconds, r.run_seconds, r.steps,
+                     sites=sites)  # events and payments are empty unless recorded
 
 
 def _failed(run: int, seed: int, exc: BaseException) -> RunOutput:
