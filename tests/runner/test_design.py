@@ -3,6 +3,7 @@ integers, the design seeded from the experiment's seed, kept in the store and re
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 
 import infomarket as im
@@ -170,10 +171,53 @@ def test_a_design_is_kept_in_the_store_resumed_and_not_mixed_with_another(tmp_pa
     assert {"point", "noise_sd", "byzantines"} <= set(robots.columns)
     # another design of the same experiment into the same store is refused, the store untouched
     before = sorted(p.name for p in (out / "runs").iterdir())
-    assert main(["sweep", str(path), "--samples", "8", "--out", str(out), "--quiet"]) == 2
+    assert main(["sweep", str(path), "--samples", "2", "--out", str(out), "--quiet"]) == 2
     assert "design" in capsys.readouterr().err
     assert sorted(p.name for p in (out / "runs").iterdir()) == before
     assert load(out, "design").points == 24
+
+
+def test_a_sobol_design_grows_in_its_store_and_runs_only_its_new_points(tmp_path):
+    path = write(tmp_path, method="sobol", samples=4)
+    out = tmp_path / "store"
+    assert main(["sweep", str(path), "--out", str(out), "--quiet"]) == 0
+    parts = {p.name: p.stat().st_mtime_ns for p in (out / "runs").iterdir()}
+    small = Store(out).runs().set_index("point").sort_index()
+    assert main(["sweep", str(path), "--samples", "8", "--out", str(out), "--quiet"]) == 0
+    runs = Store(out).runs().set_index("point").sort_index()
+    # (2 x 2 keys + 2) x 8 points (second order), each once; the first 24 are the runs made before, untouched
+    assert list(runs.index) == list(range(48))
+    assert {p.name: p.stat().st_mtime_ns for p in (out / "runs").iterdir() if p.name in parts} == parts
+    assert list(runs.loc[:23, "duration_s"]) == list(small["duration_s"])
+    grown = load(out, "design")
+    assert grown.samples == 8 and grown.points == 48
+    np.testing.assert_array_equal(grown.X, make_design(im.load_experiment(write(tmp_path, samples=8))).X)
+    # the new points are the grown design's: the same seeds and values as a store made at 8 at once
+    fresh = tmp_path / "fresh"
+    assert main(["sweep", str(path), "--samples", "8", "--out", str(fresh), "--quiet"]) == 0
+    once = Store(fresh).runs().set_index("point").sort_index()
+    assert list(once.seed) == list(runs.seed) and list(once.noise_sd) == list(runs.noise_sd)
+    pd.testing.assert_frame_equal(Store(fresh).robots().sort_values(["point", "robot"]).reset_index(drop=True)
+                                  .drop(columns="duration_s", errors="ignore"),
+                                  Store(out).robots().sort_values(["point", "robot"]).reset_index(drop=True)
+                                  .drop(columns="duration_s", errors="ignore"))
+
+
+def test_a_growth_cut_short_between_its_writes_reads_as_the_old_design(tmp_path):
+    from infomarket.runner.design import _paths, save
+    from infomarket.store.files import write_parquet_atomic
+
+    store = Store(tmp_path / "s").create()
+    small = make_design(im.load_experiment(write(tmp_path, samples=4)))
+    big = make_design(im.load_experiment(write(tmp_path, samples=8)))
+    save(store, small)
+    write_parquet_atomic(big.frame(), _paths(store.root, "design")[1])  # the matrix written, not the settings
+    kept = load(store.root, "design")
+    assert kept.samples == 4 and kept.points == 24
+    np.testing.assert_array_equal(kept.X, small.X)
+    save(store, big)
+    assert load(store.root, "design").points == 48
+
 
 
 def test_the_store_keeps_one_design_per_experiment_but_outputs_may_change(tmp_path):
@@ -184,7 +228,9 @@ def test_the_store_keeps_one_design_per_experiment_but_outputs_may_change(tmp_pa
     first = make_design(exp)
     save(store, first)
     with pytest.raises(StoreError, match="other settings.*samples"):
-        save(store, make_design(im.load_experiment(write(tmp_path, samples=8))))
+        save(store, make_design(im.load_experiment(write(tmp_path, samples=2))))  # fewer: refused
+    with pytest.raises(StoreError, match="other settings.*seed"):
+        save(store, make_design(im.load_experiment(write(tmp_path, samples=8)), seed=6))  # grown, other seed
     body = SAMPLE.format(method="sobol", samples=4).replace('["items"]', '["items", "share_gap"]')
     save(store, make_design(im.load_experiment(write(tmp_path, body=body))))  # the analysis may change
     assert load(store.root, "design").outputs == ["items", "share_gap"]

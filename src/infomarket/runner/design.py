@@ -11,7 +11,9 @@ Everything that can make a design unusable is refused before anything runs: unkn
 keys, non-integer bounds of an integer key, two keys named alike, and any corner of the bounds at which
 the experiment is invalid (every corner is validated like a file of its own).  The design's matrix and
 settings are kept in the store (``STORE/designs/EXPERIMENT.parquet`` and ``.json``) so the analysis can
-be redone from the store alone and a resumed sweep is checked against the design it started.
+be redone from the store alone and a resumed sweep is checked against the design it started.  A Sobol'
+design may grow in its store (``--samples`` doubled): its first points are the stored ones, so only the
+new points run.
 """
 from __future__ import annotations
 
@@ -113,6 +115,17 @@ class Design:
         for k in ("outputs", "custom", "salib"):
             s.pop(k)
         return s
+
+    def extends(self, old: "Design") -> bool:
+        """Whether this design is ``old`` grown: the same settings but more base samples, and ``old``'s
+        points first.  Saltelli's scheme on a Sobol' sequence has that property, so a study whose
+        intervals came out too wide grows in place and reruns none of its points (their seeds follow
+        the point's number); the matrices are compared, so a method without it is simply refused."""
+        mine, theirs = self._matrix_spec(), old._matrix_spec()
+        for s in (mine, theirs):
+            s.pop("samples"), s.pop("points")
+        return (mine == theirs and self.points > old.points
+                and np.array_equal(self.X[:old.points], old.X))
 
 
 # -------------------------------------------------------------------------------------- key paths
@@ -308,13 +321,17 @@ def save(store, design: Design) -> None:
     spec_path, matrix_path = _paths(store.root, design.experiment)
     if spec_path.exists():
         old = load(store.root, design.experiment)
-        if old._matrix_spec() != design._matrix_spec() or not np.array_equal(old.X, design.X):
+        grown = design.extends(old)
+        if not grown and (old._matrix_spec() != design._matrix_spec() or not np.array_equal(old.X, design.X)):
             diff = sorted(k for k, v in design._matrix_spec().items() if old._matrix_spec().get(k) != v)
             raise StoreError(f"{store.root}: holds a {old.method} design of {design.experiment} with other "
                              f"settings ({', '.join(diff) or 'another matrix'}); its runs would not fit this "
-                             f"design: use another --out")
+                             f"design (only a design whose first points are the stored ones, such as a Sobol' "
+                             f"design with more samples, grows a store): use another --out")
         if old.spec() == design.spec():
             return
+        if grown:  # the matrix first: a growth cut short before the settings is read as the old design
+            write_parquet_atomic(design.frame(), matrix_path)
     else:
         spec_path.parent.mkdir(exist_ok=True)
         write_parquet_atomic(design.frame(), matrix_path)
@@ -338,4 +355,7 @@ def load(root, experiment: str) -> Design:
     except (OSError, ValueError) as exc:
         raise StoreError(f"{root}: the design of {experiment} is unreadable ({exc})") from None
     X = frame[[f"{n}_raw" for n in spec["names"]]].to_numpy(dtype=float)
-    return Design.from_spec(spec, X)
+    if len(X) < spec["points"]:
+        raise StoreError(f"{root}: the design of {experiment} has {len(X)} of its {spec['points']} points")
+    # more rows than the settings name: a growth (``save``) stopped between its two writes
+    return Design.from_spec(spec, X[:spec["points"]])
