@@ -68,7 +68,7 @@ def _execute(experiments, args, label: str) -> int:
         total = sum(c.runs for c in conds)
         with progress(label, total, enabled=not args.quiet) as bar:
             done = run_sweep(conds, store, workers=workers, client=client, on_done=bar.advance,
-                             on_plan=lambda todo: bar.advance(total - todo) if total - todo else None,
+                             on_plan=lambda todo: bar.skip(total - todo) if total - todo else None,
                              record_events=args.events, retry_failed=args.retry_failed)
     finally:
         if client is not None:

@@ -14,14 +14,19 @@ class _Lines:
 
     def __init__(self, label: str, total: int, stream, every: float = 10.0):
         self.label, self.total, self.stream, self.every = label, total, stream, every
-        self.done = 0
+        self.done = self.skipped = 0
         self.t0 = self.last = time.monotonic()
+
+    def skip(self, k: int) -> None:
+        """Count ``k`` runs done before this process (a resumed sweep) without counting them in the rate."""
+        self.done += k
+        self.skipped += k
 
     def advance(self, k: int = 1) -> None:
         self.done += k
         now = time.monotonic()
         if now - self.last >= self.every or self.done == self.total:
-            rate = self.done / max(now - self.t0, 1e-9)
+            rate = (self.done - self.skipped) / max(now - self.t0, 1e-9)
             left = (self.total - self.done) / rate if rate > 0 else float("inf")
             print(f"{self.label}: {self.done}/{self.total} runs, {rate:.1f} runs/s, ~{left:.0f} s left",
                   file=self.stream, flush=True)
@@ -34,6 +39,11 @@ class _Bar:
         self.t0 = time.monotonic()
         self.done = 0
 
+    def skip(self, k: int) -> None:
+        # a reset forgets rich's speed samples, so the runs already done do not inflate the time left
+        task = next(t for t in self.progress.tasks if t.id == self.task)
+        self.progress.reset(self.task, total=task.total, completed=task.completed + k, rate="")
+
     def advance(self, k: int = 1) -> None:
         self.done += k
         rate = self.done / max(time.monotonic() - self.t0, 1e-9)
@@ -41,13 +51,17 @@ class _Bar:
 
 
 class _Silent:
+    def skip(self, k: int) -> None:
+        pass
+
     def advance(self, k: int = 1) -> None:
         pass
 
 
 @contextmanager
 def progress(label: str, total: int, *, enabled: bool = True, stream=None):
-    """Context manager yielding an object with ``advance(k)``; prints nothing when not ``enabled``."""
+    """Context manager yielding an object with ``advance(k)`` (runs made) and ``skip(k)`` (runs found done);
+    prints nothing when not ``enabled``."""
     stream = stream or sys.stderr
     if not enabled:
         yield _Silent()
