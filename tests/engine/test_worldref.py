@@ -1,0 +1,74 @@
+"""The kernel's view of the world counts no references: numba keeps NRT_incref / NRT_decref out of
+line (an atomic add behind a call), so reading a field or passing the handle to a rule must emit none;
+and the one reference the host holds is not leaked by calls."""
+import re
+
+from numba import njit
+
+from infomarket.engine.kernels import begin_communication, behaviour_step, forage, install_table, move
+from infomarket.engine.neighbours import find_neighbours
+from infomarket.engine.worldref import BorrowedArray, WorldType
+
+from ..conftest import Handle, make_config
+
+
+@njit
+def _steps(w, rng, k):
+    """The engine's per-robot pieces, inlined as the step loop inlines them."""
+    for _ in range(k):
+        find_neighbours(w)
+        begin_communication(w)
+        for i in range(w.pos.shape[0]):
+            forage(w, i, rng)
+            install_table(w, i)
+            dx, dy = behaviour_step(w, i, rng)
+            move(w, i, dx, dy, rng)
+            w.items[i] += 1
+
+
+def _nrt_calls(dispatcher) -> list[str]:
+    """Operands of the reference-counting calls in the compiled function itself (not in the wrapper
+    that unboxes the arguments from Python, which takes and gives back the host's reference once per
+    call, nor in the definitions of the NRT functions)."""
+    ir = "\n".join(dispatcher.inspect_llvm().values())
+    native = [f for f in ir.split("\ndefine ")[1:]
+              if "@_ZN7cpython" not in f.split("(")[0] and "@NRT_" not in f.split("(")[0]]
+    return [c for f in native for c in re.findall(r"call void @NRT_(?:incref|decref)\(ptr ([^)]*)\)", f)]
+
+
+def test_fields_and_the_handle_emit_no_reference_counting():
+    h = Handle(make_config(3))
+    assert isinstance(h.kernel._WORLD_TYPE, WorldType)
+    _steps(h.view, h.rng, 2)
+    calls = _nrt_calls(_steps)
+    # numba's random Generator is still counted (what is left: a few calls per robot)
+    assert calls and [c for c in calls if "rng" not in c] == []
+
+
+def test_world_arrays_are_borrowed_and_params_read_only():
+    from infomarket.engine.worldref import world_type
+
+    fields = world_type().field_dict
+    assert isinstance(fields["pos"], BorrowedArray) and fields["pos"].mutable
+    assert isinstance(fields["site_pos"], BorrowedArray) and not fields["site_pos"].mutable
+
+
+def test_calls_leave_the_hosts_one_reference():
+    h = Handle(make_config(3))
+    assert h.view._meminfo.refcount == 1
+    _steps(h.view, h.rng, 50)
+    h.kernel.run_steps(h.view, h.rng, 20)
+    assert h.view._meminfo.refcount == 1
+    assert h.world.items.sum() == 150  # the writes went to the host's arrays
+
+
+def test_a_slice_of_a_borrowed_array_is_an_ordinary_view():
+    @njit
+    def neighbours_sum(w, i):
+        return w.nbr[i, :w.nbr_count[i]].sum()
+
+    h = Handle(make_config(3))
+    h.world.nbr[0, :3] = (7, 1, 2)
+    h.world.nbr_count[0] = 2
+    assert neighbours_sum(h.view, 0) == 8
+    assert h.view._meminfo.refcount == 1
