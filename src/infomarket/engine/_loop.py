@@ -75,6 +75,7 @@ def run_steps(w, rng, t_end):
     off_valid, off_vec, off_age = w.off_valid, w.off_vec, w.off_age
     nbr, nbr_count = w.nbr, w.nbr_count
     fuel = w.fuel_cost
+    bits = rng.bit_generator  # the engine's own draws (engine.draws); rules get the Generator
     while clock[0] < t_end:
         find_neighbours(w)
         if not has_room(w):
@@ -98,7 +99,7 @@ def run_steps(w, rng, t_end):
             if cool[i] == 0:
                 buy_dispatch(kind[i], w, i, nbr[i, :nbr_count[i]], rng)
         for i in range(n):
-            if forage(w, i, rng):
+            if forage(w, i, bits):
                 settle(w, i, rng)
             install_table(w, i)
             if stop[i] > 0:
@@ -110,8 +111,8 @@ def run_steps(w, rng, t_end):
                     balance[i] -= fuel
                     w.burned[0] += fuel
                     w.money[0] -= fuel
-                dx, dy = behaviour_step(w, i, rng)
-                move(w, i, dx, dy, rng)
+                dx, dy = behaviour_step(w, i, bits)
+                move(w, i, dx, dy, bits)
             if cool[i] > 0:
                 cool[i] -= 1
         record_history(w)

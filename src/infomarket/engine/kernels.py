@@ -8,6 +8,7 @@ import math
 import numpy as np
 from numba import njit
 
+from .draws import normal, uniform
 from .geometry import DEG, norm, rotate
 from .world import EXPLORING, FOOD, NEST, SEEKING_FOOD, SEEKING_NEST
 
@@ -45,8 +46,8 @@ def within(x, y, cx, cy, r):
 @njit(inline="always")
 def draw_spot(w, i, site, rng):
     """A pick-up / drop point uniform in the site's disc."""
-    a = rng.random() * 2.0 * math.pi
-    r = w.site_r[site] * math.sqrt(rng.random())
+    a = uniform(rng) * 2.0 * math.pi
+    r = w.site_r[site] * math.sqrt(uniform(rng))
     w.spot[i, site, 0] = w.site_pos[site, 0] + r * math.cos(a)
     w.spot[i, site, 1] = w.site_pos[site, 1] + r * math.sin(a)
     w.has_spot[i, site] = True
@@ -181,10 +182,10 @@ def intended_move(w, i, rng):
         return x, y
     turn = 0
     if w.levy[i] <= 1:
-        turn = draw_index(w.cauchy_cdf, w.cauchy_guide, rng.random())
+        turn = draw_index(w.cauchy_cdf, w.cauchy_guide, uniform(rng))
     w.levy[i] -= 1
     if w.levy[i] <= 0:
-        w.levy[i] = draw_index(w.levy_cdf, w.levy_guide, rng.random()) + 1
+        w.levy[i] = draw_index(w.levy_cdf, w.levy_guide, uniform(rng)) + 1
     if turn == 0:
         return w.speed, 0.0
     return w.speed * w.turn_cos[turn], w.speed * w.turn_sin[turn]
@@ -236,7 +237,7 @@ def move(w, i, dx, dy, rng):
     if dx == 0.0 and dy == 0.0:
         return
     mx, my = to_world(w, i, dx, dy)
-    mx, my = rotate(mx, my, rng.normal(w.bias[i], w.noise_sd))
+    mx, my = rotate(mx, my, normal(rng, w.bias[i], w.noise_sd))
     length = norm(mx, my)
     w.hdir[i, 0] = mx / length
     w.hdir[i, 1] = my / length

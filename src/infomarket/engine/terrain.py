@@ -39,6 +39,7 @@ import numpy as np
 from numba import njit
 
 from ..errors import ConfigError
+from .draws import normal, uniform
 from .geometry import norm, rotate
 from .kernels import intended_move, odometry_update, outside, to_frame, to_world, update_state, within
 from .neighbours import find_neighbours as _find_all
@@ -125,8 +126,8 @@ def forage(w, i, rng):
     kind = NEST if w.carrying[i] else FOOD
     s = containing_site(w, x, y, kind)
     if s >= 0 and not (w.has_spot[i, kind] and w.spot_site[i, kind] == s):
-        a = rng.random() * 2.0 * math.pi
-        rr = w.sites_r[s] * math.sqrt(rng.random())
+        a = uniform(rng) * 2.0 * math.pi
+        rr = w.sites_r[s] * math.sqrt(uniform(rng))
         w.spot[i, kind, 0] = w.sites_xy[s, 0] + rr * math.cos(a)
         w.spot[i, kind, 1] = w.sites_xy[s, 1] + rr * math.sin(a)
         w.has_spot[i, kind] = True
@@ -241,7 +242,7 @@ def move(w, i, dx, dy, rng):
     if dx == 0.0 and dy == 0.0:
         return
     mx, my = to_world(w, i, dx, dy)
-    mx, my = rotate(mx, my, rng.normal(w.bias[i], w.noise_sd))
+    mx, my = rotate(mx, my, normal(rng, w.bias[i], w.noise_sd))
     length = norm(mx, my)
     w.hdir[i, 0] = mx / length
     w.hdir[i, 1] = my / length
