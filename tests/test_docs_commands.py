@@ -65,7 +65,9 @@ NOT_RUN = {
         "128 full runs; sweeps are tested in tests/runner, the waypoint rules in tests/terrain/test_waypoints.py",
     "infomarket view corridor": "a web server that runs until stopped; tests/viewer",
     "infomarket replay crowd --movie crowd.gif": "a full-length recording; movies: tests/viewer/test_terrain_view.py",
-    "infomarket sweep sensitivity --out results/sensitivity --workers 1": "the full study, 20 480 runs (~35 min on 2 cores)",
+    "infomarket sweep sensitivity --out results/sensitivity --workers 2": "the full study, 40 960 runs (~63 min on 2 cores)",
+    "infomarket sweep sensitivity --samples 8192 --out results/sensitivity":
+        "needs the full study's store; growing a design is tested in tests/runner/test_design.py",
     "infomarket sweep sensitivity --samples 16 --out /tmp/sens-quick":
         "160 runs; tests/analysis/test_sensitivity.py runs the study with --samples 2",
     "infomarket sensitivity /tmp/sens-quick --out /tmp/sens-quick-report":
