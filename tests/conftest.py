@@ -29,7 +29,7 @@ class Handle:
         self.rng = np.random.default_rng(seed)
         self.world, self.names = build_world(cfg, self.rng, record_events=record_events)
         self.kernel = specialise.kernel_module(behaviour_kinds(cfg), cfg.payment.scheme)
-        self.view = kernel_view(self.world, self.kernel)
+        self.view = kernel_view(self.world)
 
     def place(self, i: int, x: float, y: float, heading: float) -> None:
         w = self.world

@@ -63,7 +63,7 @@ class Simulation:
                                                        history_every=hist)
         t0 = time.perf_counter()
         self._kernel = specialise.kernel_module(self.kinds, config.payment.scheme, config.terrain)
-        self._view = kernel_view(self.world, self._kernel)
+        self._view = kernel_view(self.world)
         self._kernel.run_steps(self._view, self.rng, 0)  # compile or load from cache; runs no step
         self.compile_seconds = time.perf_counter() - t0
         self.run_seconds = 0.0
@@ -88,7 +88,7 @@ class Simulation:
             if status == self._kernel.DONE:
                 break
             self.world = make_room(self.world)
-            self._view = kernel_view(self.world, self._kernel)
+            self._view = kernel_view(self.world)
         self.run_seconds += time.perf_counter() - t0
 
     def run(self, steps: int | None = None) -> Result:

@@ -21,7 +21,6 @@ import numba
 
 from .. import __version__
 from ..registry import BehaviourSpec, PaymentSpec, Rule, get_behaviour, get_payment
-from .worldref import constructor_source
 
 _TEMPLATE = Path(__file__).with_name("_loop.py")
 _PACKAGE = Path(__file__).resolve().parents[1]
@@ -126,9 +125,8 @@ def generate_source(behaviours: list[BehaviourSpec], payment: PaymentSpec, terra
                   f"        _b{k}_buy(w, i, nbrs{_args(b.buy, b.params, 'w.bparams[i]')})"]
     lines += ["", "", "@njit(cache=True)", "def pay_dispatch(w, buyer, sellers, sites, directions, weights, rng):",
               f"    _pay(buyer, sellers, sites, directions, weights{_args(payment.weights, payment.params, 'w.pparams')})",
-              "", "", "from numba.experimental.structref import new as _structref_new",
-              "from infomarket.engine.worldref import world_type as _world_type, borrow as _borrow, borrow_readonly as _borrow_readonly",
-              "_WORLD_TYPE = _world_type()", "", "", constructor_source()]
+              "", "", "from infomarket.engine.worldref import world_type as _world_type",
+              "_WORLD_TYPE = _world_type()  # what make_view (engine.worldref.view_module) builds", ""]
     return "\n".join(lines)
 
 
@@ -144,8 +142,7 @@ def kernel_module(behaviour_names: tuple[str, ...], payment_name: str, terrain: 
     behaviours = [get_behaviour(b) for b in behaviour_names]
     payment = get_payment(payment_name)
     source = generate_source(behaviours, payment, terrain, any(b.paths for b in behaviours))
-    digest = hashlib.sha256(source.encode())
-    digest.update(f"{__version__} {numba.__version__} {sys.version} {_package_digest()}".encode())
+    digest = generated_digest(source)
     cacheable = True
     for rule in [r for b in behaviours for r in (b.buy, b.sell)] + [payment.weights]:
         text = _rule_source(rule)
@@ -153,21 +150,34 @@ def kernel_module(behaviour_names: tuple[str, ...], payment_name: str, terrain: 
             cacheable = False
             text = repr(id(rule.func))
         digest.update(text.encode())
-    key = digest.hexdigest()[:20]
-    if key in _LOADED:
-        return _LOADED[key]
+    return load_generated("kernel", digest.hexdigest()[:20], source, cacheable)
+
+
+def load_generated(prefix: str, key: str, source: str, cacheable: bool = True) -> ModuleType:
+    """Import generated ``source`` as the module ``infomarket_PREFIX_KEY`` from ``cache_dir()/PREFIX_KEY.py``
+    (written once, atomically), so numba caches what it compiles there; ``key`` must hash everything
+    the source and its machine code depend on.  Not ``cacheable``: a fresh temporary folder."""
+    name = f"{prefix}_{key}"
+    if name in _LOADED:
+        return _LOADED[name]
     folder = cache_dir() if cacheable else Path(tempfile.mkdtemp(prefix="infomarket-kernel-"))
     folder.mkdir(parents=True, exist_ok=True)
-    path = folder / f"kernel_{key}.py"
+    path = folder / f"{name}.py"
     if not path.exists():  # never rewrite: numba's cache index is stamped with the file's mtime
         fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
         with os.fdopen(fd, "w") as fh:
             fh.write(source)
         os.replace(tmp, path)
-    name = f"infomarket_kernel_{key}"
-    spec = importlib.util.spec_from_file_location(name, path)
+    spec = importlib.util.spec_from_file_location(f"infomarket_{name}", path)
     module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module
+    sys.modules[f"infomarket_{name}"] = module
     spec.loader.exec_module(module)
-    _LOADED[key] = module
+    _LOADED[name] = module
     return module
+
+
+def generated_digest(source: str):
+    """sha256 of ``source`` with the versions and the compiled package's own source mixed in."""
+    digest = hashlib.sha256(source.encode())
+    digest.update(f"{__version__} {numba.__version__} {sys.version} {_package_digest()}".encode())
+    return digest

@@ -63,7 +63,7 @@ def replay_events(events: Iterable, robots: int, *, scheme: str = "delayed", ini
     rng = np.random.default_rng(0)  # only a rule that asks for one uses it
     world, _ = build_world(cfg, rng)
     kernel = specialise.kernel_module(("naive",), scheme)
-    view = kernel_view(world, kernel)
+    view = kernel_view(world)
     accepted: list[bool] = []
     step = None
     for ev in events:
@@ -80,7 +80,7 @@ def replay_events(events: Iterable, robots: int, *, scheme: str = "delayed", ini
             buyer = int(get("buyer"))
             while not reserve(view, buyer, int(world.tx_count[buyer]) + 1):
                 world = make_room(world, tx_need=world.tx_count + 1)
-                view = kernel_view(world, kernel)
+                view = kernel_view(world)
             accepted.append(bool(open_transaction(view, buyer, int(get("seller")), int(get("site")),
                                                   float(get("direction_deg")))))
         elif kind == "deposit":
