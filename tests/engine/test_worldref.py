@@ -3,6 +3,7 @@ line (an atomic add behind a call), so reading a field or passing the handle to 
 and the one reference the host holds is not leaked by calls."""
 import re
 
+import numba
 from numba import njit
 
 from infomarket.engine.kernels import begin_communication, behaviour_step, forage, install_table, move
@@ -39,7 +40,7 @@ def _nrt_calls(dispatcher) -> list[str]:
 
 def test_fields_and_the_handle_emit_no_reference_counting():
     h = Handle(make_config(3))
-    assert isinstance(h.kernel._WORLD_TYPE, WorldType)
+    assert isinstance(numba.typeof(h.view), WorldType)
     _steps(h.view, h.rng, 2)
     assert _nrt_calls(_steps) == []  # the engine draws from the bit generator (engine.draws)
 

@@ -125,8 +125,7 @@ def generate_source(behaviours: list[BehaviourSpec], payment: PaymentSpec, terra
                   f"        _b{k}_buy(w, i, nbrs{_args(b.buy, b.params, 'w.bparams[i]')})"]
     lines += ["", "", "@njit(cache=True)", "def pay_dispatch(w, buyer, sellers, sites, directions, weights, rng):",
               f"    _pay(buyer, sellers, sites, directions, weights{_args(payment.weights, payment.params, 'w.pparams')})",
-              "", "", "from infomarket.engine.worldref import world_type as _world_type",
-              "_WORLD_TYPE = _world_type()  # what make_view (engine.worldref.view_module) builds", ""]
+              ""]
     return "\n".join(lines)
 
 
