@@ -168,5 +168,13 @@ def _checked_seed(seed) -> int:
 def simulate(config: Experiment | str | Path, seed: int | None = None, *, steps: int | None = None,
              record_events: bool = False, history_every: int | None = None) -> Result:
     """Run one experiment (an Experiment, a shipped name like ``"fig2D"`` or a file path) once.
-    The same configuration and seed give identical results."""
-    return Simulation(config, seed, record_events=record_events, history_every=history_every).run(steps)
+    The same configuration and seed give identical results.  ``steps`` is the run's length, exactly as
+    the experiment's ``steps`` (it shapes the Lévy step-length table), so ``simulate(cfg, seed, steps=N)``
+    reproduces a run stored with ``steps = N``."""
+    if not isinstance(config, Experiment):
+        config = load_experiment(config)
+    if steps is not None:
+        if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1:
+            raise ConfigError(f"steps must be a positive integer number of steps, got {steps!r}")
+        config = config.model_copy(update={"steps": int(steps)})
+    return Simulation(config, seed, record_events=record_events, history_every=history_every).run()

@@ -134,10 +134,9 @@ def uses_paths(behaviour_names: tuple[str, ...]) -> bool:
     return any(get_behaviour(b).paths for b in behaviour_names)
 
 
-def kernel_module(behaviour_names: tuple[str, ...], payment_name: str, terrain: bool = False) -> ModuleType:
-    """The specialised kernel module (``run_steps``) for these behaviours (kind order) and scheme, on
-    the paper's plane or (``terrain``) with obstacles, several sites, line of sight and collisions;
-    behaviours registered with ``paths=True`` add waypoint paths (engine.paths) to the terrain step."""
+def _kernel_parts(behaviour_names: tuple[str, ...], payment_name: str, terrain: bool) -> tuple[str, str, bool]:
+    """(source, key, cacheable) of the kernel for these rules: the key hashes everything its machine code
+    depends on (template, engine source, every rule's source, versions)."""
     behaviours = [get_behaviour(b) for b in behaviour_names]
     payment = get_payment(payment_name)
     source = generate_source(behaviours, payment, terrain, any(b.paths for b in behaviours))
@@ -149,7 +148,24 @@ def kernel_module(behaviour_names: tuple[str, ...], payment_name: str, terrain: 
             cacheable = False
             text = repr(id(rule.func))
         digest.update(text.encode())
-    return load_generated("kernel", digest.hexdigest()[:20], source, cacheable)
+    return source, digest.hexdigest()[:20], cacheable
+
+
+def kernel_module(behaviour_names: tuple[str, ...], payment_name: str, terrain: bool = False) -> ModuleType:
+    """The specialised kernel module (``run_steps``) for these behaviours (kind order) and scheme, on
+    the paper's plane or (``terrain``) with obstacles, several sites, line of sight and collisions;
+    behaviours registered with ``paths=True`` add waypoint paths (engine.paths) to the terrain step."""
+    source, key, cacheable = _kernel_parts(behaviour_names, payment_name, terrain)
+    return load_generated("kernel", key, source, cacheable)
+
+
+def kernel_id(cfg) -> str:
+    """The digest that names the compiled kernel an experiment runs on (``kernel_<id>.py`` in
+    ``cache_dir()``): two experiments with the same id share one kernel, so a warm-up before forking
+    workers is needed once per id.  Computes no code."""
+    from .build import behaviour_kinds
+
+    return _kernel_parts(behaviour_kinds(cfg), cfg.payment.scheme, cfg.terrain)[1]
 
 
 def load_generated(prefix: str, key: str, source: str, cacheable: bool = True) -> ModuleType:
