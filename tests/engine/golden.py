@@ -10,8 +10,9 @@ commit, and list the affected cases::
     python -m tests.engine.golden --write            # the fast set (make test)
     python -m tests.engine.golden --write --full     # also the full-length set (-m slow)
 
-Runs are shortened with ``simulate(..., steps=N)`` of the unchanged configuration, never with a
-changed ``steps`` key: the Lévy step-length table is sized by the configured step count.
+Runs are stopped early with ``Simulation(cfg, seed).run(N)`` on the unchanged configuration, never with a
+changed ``steps`` key (nor ``simulate(..., steps=N)``, which sets it): the Lévy step-length table is
+sized by the configured step count.
 """
 from __future__ import annotations
 
@@ -80,8 +81,7 @@ def _hash_frame(h, frame) -> None:
 
 def digest(case: Case) -> str:
     cfg, seed = _config(case)
-    r = im.simulate(cfg, seed, steps=case.steps, record_events=True,
-                    history_every=cfg.history_every or 500)
+    r = im.Simulation(cfg, seed, record_events=True, history_every=cfg.history_every or 500).run(case.steps)
     h = hashlib.sha256()
     for frame in (r.robots, r.events, r.history):
         _hash_frame(h, frame)
