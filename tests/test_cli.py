@@ -5,7 +5,7 @@ import pandas as pd
 import pytest
 
 from infomarket.cli import main
-from infomarket.engine.seeds import run_seed
+from infomarket.seeds import run_seed
 
 COLUMNS = ["run", "seed", "robot", "behaviour", "honest", "drift", "items_collected", "wealth"]
 

@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 import infomarket as im
-from infomarket.engine.seeds import run_seed
+from infomarket.seeds import run_seed
 from infomarket.runner.plan import conditions
 
 FILE = Path(__file__).with_name("golden_digests.json")

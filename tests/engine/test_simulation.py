@@ -10,7 +10,7 @@ import pytest
 
 import infomarket as im
 from infomarket.config import validate
-from infomarket.engine.seeds import run_seed
+from infomarket.seeds import run_seed
 from infomarket.engine.world import open_transactions
 
 

@@ -7,7 +7,7 @@ import time
 
 from .. import __version__
 from ..config import load_experiment
-from ..engine.seeds import run_seed
+from ..seeds import run_seed
 from ..engine.simulation import Simulation
 from .floor import floor_steps_per_second
 

@@ -20,7 +20,7 @@ from . import sizes, terrain
 from .sample import Sample
 
 #: Seeds are 63-bit everywhere (files, the command line, the Python API, the store's int64 columns).
-MAX_SEED = 2**63 - 1
+from ..seeds import MAX_SEED  # noqa: E402  (one definition, infomarket.seeds)
 
 PosFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 NonNegFloat = Annotated[float, Field(ge=0, allow_inf_nan=False)]

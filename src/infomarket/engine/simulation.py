@@ -20,7 +20,7 @@ from ..registry import behaviours
 from . import specialise
 from .build import behaviour_kinds, build_world, make_room
 from .flags import ErrorFlags
-from .seeds import MAX_SEED
+from ..seeds import MAX_SEED
 from .world import EVENT_NAMES, SITE_NAMES, STATE_NAMES, headings
 from .worldref import kernel_view
 

@@ -18,7 +18,7 @@ import pandas as pd
 
 from .. import plugins
 from ..config.schema import Experiment
-from ..engine.seeds import run_seed
+from ..seeds import run_seed
 from ..engine.simulation import Simulation, simulate
 
 

@@ -17,7 +17,7 @@ from typing import Any
 
 from ..config.load import validate
 from ..config.schema import Experiment
-from ..engine.seeds import run_seed
+from ..seeds import run_seed
 from ..errors import ConfigError
 
 BASE = "base"

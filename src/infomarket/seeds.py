@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..config.schema import MAX_SEED  # noqa: F401  (one definition; re-exported for the engine)
+#: The largest seed anywhere (experiment files, the command line, the API, the viewer): numpy's
+#: SeedSequence takes any non-negative integer, and 63 bits keep every seed a signed 64-bit integer in
+#: Parquet and in DuckDB.
+MAX_SEED = 2**63 - 1
 
 
 def run_seed(master: int, run: int, condition: int = 0) -> int:
