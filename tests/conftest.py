@@ -7,7 +7,7 @@ import pytest
 from infomarket.config import validate
 from infomarket.engine import specialise
 from infomarket.engine.build import behaviour_kinds, build_world
-from infomarket.engine.worldref import kernel_view
+from infomarket.engine.world import kernel_view
 
 
 def make_config(robots: int = 2, behaviour: str = "naive", scheme: str = "delayed", **top):

@@ -25,7 +25,7 @@ class UsageError(InfomarketError, ValueError):
 
 
 class SimulationError(InfomarketError, RuntimeError):
-    """The compiled kernel reported a condition it cannot recover from (see engine.flags)."""
+    """The compiled kernel reported a condition it cannot recover from (see state.flags)."""
 
 
 def exit_code(exc: BaseException) -> int:

@@ -8,7 +8,7 @@ cos/sin of angles, the engine with stored unit vectors, so the last bits differ.
 the reference's floats are set to the engine's, so rounding differences cannot accumulate over the run
 and any real difference shows in the step where it is made.  Discrete state must match exactly.
 
-Checked to fail when the engine is broken: one sign flipped in ``engine.kernels.to_frame`` (step 1),
+Checked to fail when the engine is broken: one sign flipped in ``engine.geometry.to_frame`` (step 1),
 the age of eqs. 4-5 changed, or the weights of eqs. 4-5 swapped (``behaviours.api.weighted``).
 """
 from __future__ import annotations

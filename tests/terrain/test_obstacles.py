@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from infomarket.engine.obstacles import CIRCLE, RECT, SEGMENT, cuts, distance
+from infomarket.space.obstacles import CIRCLE, RECT, SEGMENT, cuts, distance
 from infomarket.engine.world import EXPLORING, FOOD, SEEKING_FOOD, headings
 
 from .conftest import place, seek_food, simulation, terrain_config
@@ -140,7 +140,7 @@ def test_without_the_obstacle_the_same_move_is_made():
 def test_positions_never_enter_an_obstacle_in_a_long_noisy_run():
     from infomarket.config import validate
     from infomarket.engine import Simulation
-    from infomarket.engine.obstacles import nearest
+    from infomarket.space.obstacles import nearest
 
     obstacles = [{"shape": "rect", "x0": 300.0, "y0": 100.0, "x1": 420.0, "y1": 500.0},
                  {"shape": "circle", "x": 700.0, "y": 300.0, "radius": 60.0},

@@ -11,7 +11,7 @@ of the step (``own_entry``), while a buyer's purchases go into its new table (``
 from numba import njit
 
 from ..engine.geometry import direction, norm
-from ..engine.kernels import to_frame, to_world
+from ..engine.geometry import to_frame, to_world
 from ..ledger.kernels import open_transaction, purchase_events
 
 #: ``diff`` of a zero vector (eq. 6 divides by its norm).

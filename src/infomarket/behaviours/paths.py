@@ -18,7 +18,7 @@ import numpy as np
 from numba import njit
 
 from ..engine.geometry import norm
-from ..engine.kernels import to_frame, to_world
+from ..engine.geometry import to_frame, to_world
 from ..engine.world import PATH_POINTS
 from .api import buy
 

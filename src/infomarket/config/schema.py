@@ -278,7 +278,7 @@ class Experiment(_Strict):
     @property
     def terrain(self) -> bool:
         """Does this setup leave the paper's plane (obstacles, several sites of a kind, line of sight,
-        collisions)?  Only then does the engine compile the terrain-aware step (engine.terrain)."""
+        collisions)?  Only then does the engine compile the terrain variant of the step (engine.step, engine.terrain)."""
         return bool(self.obstacles or self.robot.line_of_sight or self.robot.collisions or self.robot.sense_robots
                     or len(self.sites("food")) > 1 or len(self.sites("nest")) > 1)
 

@@ -1,4 +1,5 @@
-"""Small compiled geometry helpers; angles in degrees throughout, as in the model."""
+"""Small compiled geometry helpers: angles (in degrees throughout, as in the model), discs, the arena,
+and a robot's own frame."""
 import math
 
 from numba import njit
@@ -59,3 +60,33 @@ def angular_distance(a, b):
     if d > 180.0:
         d = 360.0 - d
     return d
+
+
+@njit(inline="always")
+def within(x, y, cx, cy, r):
+    """Strictly inside the circle of centre (cx, cy) and radius r."""
+    dx = x - cx
+    dy = y - cy
+    return dx * dx + dy * dy < r * r
+
+
+@njit(inline="always")
+def outside(x, y, r, width, height):
+    """Would a robot disc centred at (x, y) leave the arena?"""
+    return x + r >= width or x - r < 0.0 or y + r >= height or y - r < 0.0
+
+
+@njit(inline="always")
+def to_frame(w, i, x, y):
+    """A world-frame vector in robot i's frame (rotated by -heading)."""
+    c = w.hdir[i, 0]
+    s = w.hdir[i, 1]
+    return c * x + s * y, c * y - s * x
+
+
+@njit(inline="always")
+def to_world(w, i, x, y):
+    """A vector in robot i's frame in the world frame (rotated by +heading)."""
+    c = w.hdir[i, 0]
+    s = w.hdir[i, 1]
+    return c * x - s * y, s * x + c * y

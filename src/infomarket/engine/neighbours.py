@@ -9,9 +9,9 @@ they find exactly the same neighbours.
 A robot may have more neighbours than ``nbr`` has columns: the count is still exact, nothing beyond
 the capacity is written, and ``has_room`` sends the host to grow the table before the step goes on.
 """
-import math
-
 from numba import njit
+
+from ..space.grid import grid_shape  # noqa: F401  (the grid's geometry; re-exported for the engine)
 
 #: Up to this many robots, all pairs are tested.
 ALL_PAIRS_UP_TO = 48
@@ -95,7 +95,7 @@ def _grid(pos, rc2, nbr, nbr_count, cap, size, nx, ny, start, items):
 
 
 @njit
-def find_neighbours(w):
+def find_all_neighbours(w):
     """Fill ``nbr`` / ``nbr_count`` for the current positions (idempotent: depends on positions only)."""
     nbr = w.nbr
     nbr_count = w.nbr_count
@@ -110,10 +110,3 @@ def find_neighbours(w):
     else:
         _grid(w.pos, rc * rc, nbr, nbr_count, nbr.shape[1], w.grid_cell, w.grid_nx, w.grid_ny,
               w.cell_start, w.cell_items)
-
-
-def grid_shape(width: float, height: float, comm_range: float, robots: int) -> tuple[float, int, int]:
-    """Cell side and counts: at least one communication range wide (so neighbours are in adjacent
-    cells), and no more than about 4 cells per robot (so memory stays O(n) in a sparse arena)."""
-    side = max(comm_range, math.sqrt(width * height / max(4 * robots, 64)), 1e-9)
-    return side, max(1, math.ceil(width / side)), max(1, math.ceil(height / side))

@@ -1,4 +1,4 @@
-"""Waypoint paths in the terrain-aware step: a table entry of several legs (issue 14, item 4).
+"""Waypoint paths: a table entry of several legs, and the helpers of the step's ``paths`` variant.
 
 A robot's entry for a site is normally one vector (``tab_vec``).  With a path (``path_count > 0``) the
 entry is the *first waypoint* and ``path_vec[:path_count]`` holds the further ones, the last being the
@@ -7,7 +7,7 @@ is.  The engine only keeps paths consistent; what is bought and sold is up to ru
 (``behaviours.paths`` has the public helpers, ``behaviours.waypoint`` the built-in rule):
 
 * **Dead reckoning.**  Each waypoint moves by ``-dr`` and turns by ``-heading(dr)`` like the entry
-  (the same arithmetic as ``kernels.odometry_update``).
+  (the same arithmetic as ``step.odometry_update``).
 * **Following the legs.**  A seeking robot that reaches its first waypoint (closer than its radius:
   where the model would declare the entry wrong) takes the next waypoint as its entry and goes on;
   the entry's age does not change.
@@ -17,19 +17,14 @@ is.  The engine only keeps paths consistent; what is bought and sold is up to ru
 * **Timing.**  As for the entry: sellers sell the start-of-step path, purchases go to ``new_path_*``
   and are installed when the robot moves.
 
-The step below (``behaviour_step``, ``begin_communication``, ``install_table``) is the terrain-aware
-one with paths added; ``engine.specialise`` binds it only when a configured behaviour was registered
-with ``paths=True`` (on the plane too), so neither the paper's kernel nor a terrain run without path
-rules pays for paths.
+``engine.step`` calls these helpers when its ``paths`` option is on, which ``engine.specialise`` sets only
+when a configured behaviour was registered with ``paths=True`` (on the plane too, with the terrain
+variant), so neither the paper's kernel nor a terrain run without path rules pays for paths.
 """
 from numba import njit
 
 from .geometry import norm
-from .kernels import begin_communication as _begin_plane
-from .kernels import install_table as _install_plane
-from .kernels import intended_move, odometry_update, update_state
-from .terrain import containing_site, sense_sites, sensors
-from .world import FOOD, NEST
+from .params import FOOD, NEST
 
 
 @njit(inline="always")
@@ -108,43 +103,3 @@ def install_path(w, i):
         for j in range(m):
             w.path_vec[i, k, j, 0] = w.new_path_vec[i, k, j, 0]
             w.path_vec[i, k, j, 1] = w.new_path_vec[i, k, j, 1]
-
-
-@njit(inline="always")
-def behaviour_step(w, i, rng):
-    """The terrain-aware behaviour step (``terrain.behaviour_step``) with paths: a site sensed clears
-    that kind's path and mark, the legs are followed, a bump marks the site, waypoints are dead-reckoned."""
-    front, right, back, left = sensors(w, i)
-    sense_sites(w, i)
-    for k in range(2):
-        if containing_site(w, w.pos[i, 0], w.pos[i, 1], k) >= 0:
-            at_site(w, i, k)
-    advance(w, i)
-    was_food = w.tab_valid[i, FOOD]
-    was_nest = w.tab_valid[i, NEST]
-    update_state(w, i, front)
-    bumped(w, i, front, was_food, was_nest)
-    drop_invalid(w, i)
-    dx, dy = intended_move(w, i, rng)
-    if (front and dx >= 0.0) or (back and dx <= 0.0):
-        dx = -dx
-    if (right and dy <= 0.0) or (left and dy >= 0.0):
-        dy = -dy
-    if dx != 0.0 or dy != 0.0:
-        odometry_update(w, i, dx, dy)
-        path_odometry(w, i, dx, dy)
-    return dx, dy
-
-
-@njit
-def begin_communication(w):
-    """The plane's start-of-phase copy, and the same for waypoint paths."""
-    _begin_plane(w)
-    begin_paths(w)
-
-
-@njit(inline="always")
-def install_table(w, i):
-    """The plane's install of the bought table, and of the bought path."""
-    _install_plane(w, i)
-    install_path(w, i)

@@ -18,11 +18,11 @@ from ..config.load import load_experiment
 from ..errors import ConfigError, SimulationError
 from ..registry import behaviours
 from . import specialise
-from .build import behaviour_kinds, build_world, make_room
-from .flags import ErrorFlags
 from ..seeds import MAX_SEED
-from .world import EVENT_NAMES, SITE_NAMES, STATE_NAMES, headings
-from .worldref import kernel_view
+from ..state.flags import ErrorFlags
+from .build import build_world, make_room
+from .params import behaviour_kinds
+from .world import EVENT_NAMES, SITE_NAMES, STATE_NAMES, headings, kernel_view
 
 
 @dataclass
@@ -48,7 +48,12 @@ class Result:
 
 
 class Simulation:
-    """One simulated swarm.  ``Simulation(cfg, seed).run()`` → Result; ``step(k)`` advances k steps."""
+    """One simulated swarm.  ``Simulation(cfg, seed).run()`` → Result; ``step(k)`` advances k steps.
+
+    The step it runs: ``engine/loop_template.py`` (the loop, in the order of docs/model.md §3), whose
+    pieces are all in ``engine/step.py``; ``self.kernel_source`` is the generated module the loop was
+    compiled from (the template specialised to this experiment's rules and step options).  The state
+    it steps is ``self.world`` (``engine.world``: parameters, swarm, ledger and log side by side)."""
 
     def __init__(self, config: Experiment | str | Path, seed: int | None = None, *, record_events: bool = False,
                  history_every: int | None = None):
@@ -67,6 +72,11 @@ class Simulation:
         self._kernel.run_steps(self._view, self.rng, 0)  # compile or load from cache; runs no step
         self.compile_seconds = time.perf_counter() - t0
         self.run_seconds = 0.0
+
+    @property
+    def kernel_source(self) -> Path:
+        """The generated module this simulation's loop was compiled from (its header names every source)."""
+        return Path(self._kernel.__file__)
 
     @property
     def clock(self) -> int:

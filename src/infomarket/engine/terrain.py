@@ -1,15 +1,15 @@
-"""The terrain-aware step: obstacles, several sites of a kind, line of sight and collisions.
+"""Terrain: obstacles, several sites of a kind, line of sight and collisions: the rules, and the helpers
+the step's ``terrain`` variant calls (``engine.step``).
 
-Setups on the paper's plane never run this code: ``engine.specialise`` rebinds the step loop's
-``find_neighbours``, ``forage``, ``behaviour_step`` and ``move`` to the functions below only when the
-experiment has ``cfg.terrain`` (a separate compiled kernel), so the paper's kernel is the one it always was.
+Setups on the paper's plane never run this code: their kernel is compiled with ``terrain`` off, so the
+branches that call these helpers are folded away and the paper's kernel is the one it always was.
 
 Rules (docs/terrain.md says the same for users):
 
 * **Sensing and reflection.**  The four proximity sensors fire when a move of ``v`` towards heading,
   heading - 90, heading + 180, heading + 90 would put the robot's disc outside the arena *or* touching
   an obstacle (distance from the probed centre to it at most ``r``); the reflection rule and the
-  "FRONT while seeking invalidates the entry" rule are the model's, unchanged (MODEL.md §3).
+  "FRONT while seeking invalidates the entry" rule are the model's, unchanged (docs/model.md §3).
 * **Never inside.**  A move whose end point (after noise and the arena clamp) would make the disc
   overlap an obstacle (distance below ``r``) is not made: the robot stays where it is.
 * **Collisions** (``robot.collisions``).  Robots move one at a time in id order (as always); a move
@@ -35,30 +35,17 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import njit
 
 from ..errors import ConfigError
-from .draws import normal, uniform
-from .geometry import norm, rotate
-from .kernels import intended_move, odometry_update, outside, to_frame, to_world, update_state, within
-from .neighbours import find_neighbours as _find_all
-from .obstacles import nearest, sight_blocked
-from .world import FOOD, NEST
+from ..space.obstacles import nearest, sight_blocked
+from .geometry import outside, within
 
 #: Tries per robot to draw a clear initial position before the setup is refused.
 PLACEMENT_TRIES = 10_000
 
 
-def site_arrays(cfg) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Every site as (centres [S, 2], radii [S], kinds [S]): food sites first, then nests, file order."""
-    sites = [(s, FOOD) for s in cfg.sites("food")] + [(s, NEST) for s in cfg.sites("nest")]
-    return (np.array([[s.x, s.y] for s, _ in sites], dtype=np.float64),
-            np.array([s.radius for s, _ in sites], dtype=np.float64),
-            np.array([k for _, k in sites], dtype=np.int64))
-
-
-def place_clear(world, rng: np.random.Generator) -> None:
+def place_clear(world, rng) -> None:
     """Redraw (uniform whole numbers, as the first draw) the initial position of every robot whose disc
     overlaps an obstacle or, with collisions, a robot placed before it; in id order, after all other
     initial draws, so nothing else about the initial state changes."""
@@ -82,11 +69,10 @@ def place_clear(world, rng: np.random.Generator) -> None:
 
 
 @njit
-def find_neighbours(w):
-    """Neighbours as on the plane, then, with line of sight, pairs whose straight line an obstacle cuts
-    are dropped (lists stay in increasing id order).  Lists that overflowed are left alone: the step
-    does not begin (``has_room``) and runs this again after the host grows them."""
-    _find_all(w)
+def drop_hidden_pairs(w):
+    """With line of sight, drop the neighbour pairs whose straight line an obstacle cuts (lists stay in
+    increasing id order).  Lists that overflowed are left alone: the step does not begin (``has_room``)
+    and runs this again after the host grows them."""
     if not w.line_of_sight or w.obs_kind.shape[0] == 0:
         return
     nbr = w.nbr
@@ -118,61 +104,7 @@ def containing_site(w, x, y, kind):
 
 
 @njit(inline="always")
-def forage(w, i, rng):
-    """Pick-up and drop spots at whichever site of the needed kind the robot is in (MODEL.md §6, per
-    site).  Returns True when robot i deposits an item this step."""
-    x = w.pos[i, 0]
-    y = w.pos[i, 1]
-    kind = NEST if w.carrying[i] else FOOD
-    s = containing_site(w, x, y, kind)
-    if s >= 0 and not (w.has_spot[i, kind] and w.spot_site[i, kind] == s):
-        a = uniform(rng) * 2.0 * math.pi
-        rr = w.sites_r[s] * math.sqrt(uniform(rng))
-        w.spot[i, kind, 0] = w.sites_xy[s, 0] + rr * math.cos(a)
-        w.spot[i, kind, 1] = w.sites_xy[s, 1] + rr * math.sin(a)
-        w.has_spot[i, kind] = True
-        w.spot_site[i, kind] = s
-    if not (w.has_spot[i, kind] and within(x, y, w.spot[i, kind, 0], w.spot[i, kind, 1], w.radius)):
-        return False
-    w.has_spot[i, kind] = False
-    counted = w.clock[0] >= w.transitory
-    if counted:
-        w.site_items[w.spot_site[i, kind]] += 1
-    if kind == FOOD:
-        w.carrying[i] = True
-        return False
-    w.carrying[i] = False
-    if counted:
-        w.items[i] += 1
-    return True
-
-
-@njit(inline="always")
-def sense_sites(w, i):
-    """Like the plane's: for each kind, the first site containing the robot sets that kind's entry to
-    its target point there (its spot if the spot lies in that site, else the centre)."""
-    x = w.pos[i, 0]
-    y = w.pos[i, 1]
-    for k in range(2):
-        s = containing_site(w, x, y, k)
-        if s < 0:
-            continue
-        if w.has_spot[i, k] and w.spot_site[i, k] == s:
-            tx = w.spot[i, k, 0]
-            ty = w.spot[i, k, 1]
-        else:
-            tx = w.sites_xy[s, 0]
-            ty = w.sites_xy[s, 1]
-        vx, vy = to_frame(w, i, tx - x, ty - y)
-        w.tab_vec[i, k, 0] = vx
-        w.tab_vec[i, k, 1] = vy
-        w.tab_age[i, k] = 0
-        w.tab_valid[i, k] = True
-        w.last_site[i] = k
-
-
-@njit(inline="always")
-def probe(w, i, x, y):
+def obstructed(w, i, x, y):
     """A proximity sensor of robot i: would a disc centred at (x, y) leave the arena or touch an
     obstacle (or, with ``sense_robots``, another robot's disc: centres at most 2 r apart)?"""
     if outside(x, y, w.radius, w.width, w.height):
@@ -192,33 +124,6 @@ def probe(w, i, x, y):
 
 
 @njit(inline="always")
-def sensors(w, i):
-    """FRONT, RIGHT, BACK, LEFT (MODEL.md §3) with obstacles sensed like the arena's walls."""
-    x = w.pos[i, 0]
-    y = w.pos[i, 1]
-    c = w.speed * w.hdir[i, 0]
-    s = w.speed * w.hdir[i, 1]
-    return (probe(w, i, x + c, y + s), probe(w, i, x + s, y - c), probe(w, i, x - c, y - s),
-            probe(w, i, x - s, y + c))
-
-
-@njit(inline="always")
-def behaviour_step(w, i, rng):
-    """The plane's behaviour step (kernels.behaviour_step) with obstacle-aware sensors and every site."""
-    front, right, back, left = sensors(w, i)
-    sense_sites(w, i)
-    update_state(w, i, front)
-    dx, dy = intended_move(w, i, rng)
-    if (front and dx >= 0.0) or (back and dx <= 0.0):
-        dx = -dx
-    if (right and dy <= 0.0) or (left and dy >= 0.0):
-        dy = -dy
-    if dx != 0.0 or dy != 0.0:
-        odometry_update(w, i, dx, dy)
-    return dx, dy
-
-
-@njit(inline="always")
 def blocked(w, i, x, y):
     """Would robot i's disc at (x, y) overlap an obstacle or (with collisions) another robot?"""
     r = w.radius
@@ -234,21 +139,3 @@ def blocked(w, i, x, y):
                 if ex * ex + ey * ey < d2:
                     return True
     return False
-
-
-@njit(inline="always")
-def move(w, i, dx, dy, rng):
-    """The plane's noisy move (kernels.move), not made when its end point is blocked (see above)."""
-    if dx == 0.0 and dy == 0.0:
-        return
-    mx, my = to_world(w, i, dx, dy)
-    mx, my = rotate(mx, my, normal(rng, w.bias[i], w.noise_sd))
-    length = norm(mx, my)
-    w.hdir[i, 0] = mx / length
-    w.hdir[i, 1] = my / length
-    r = w.radius
-    x = min(max(w.pos[i, 0] + mx, r), w.width - r)
-    y = min(max(w.pos[i, 1] + my, r), w.height - r)
-    if not blocked(w, i, x, y):
-        w.pos[i, 0] = x
-        w.pos[i, 1] = y

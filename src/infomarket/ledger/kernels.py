@@ -1,4 +1,8 @@
-"""Compiled ledger operations over the world's arrays (see engine.world for the fields).
+"""Compiled ledger operations: the only code that changes the ledger's arrays (``ledger.state``).
+
+They run on anything with the ledger's fields, its log and a clock: inside the engine on the flat world,
+or alone on a ``ledger.state.Book`` (``ledger.replay``).  Everywhere else those arrays are read-only in
+compiled code (``state.view``); each operation here ``unlock``s the arrays it writes.
 
 Money is conserved by construction: the only operations are transfers between balances and pots,
 the reward issued on a deposit, and (optionally) fuel burned by moving robots.
@@ -7,8 +11,9 @@ import math
 
 from numba import njit
 
-from ..engine import flags
-from ..engine.world import EV_DEPOSIT, EV_PURCHASE, EV_REFUSED
+from ..state import flags
+from ..state.log import EV_DEPOSIT, EV_PURCHASE, EV_REFUSED
+from ..state.view import unlock
 
 
 #: A seller whose balance falls short of the stake by less than this (float rounding of sums of
@@ -28,21 +33,21 @@ def log_event(w, kind, buyer, seller, site, direction, x, y, age, stake, sx=0.0,
         return
     k = w.ev_count[0]
     if k >= w.ev_step.shape[0]:
-        w.flags[0] |= flags.EVENT_OVERFLOW
+        unlock(w.flags)[0] |= flags.EVENT_OVERFLOW
         return
-    w.ev_step[k] = w.clock[0]
-    w.ev_kind[k] = kind
-    w.ev_buyer[k] = buyer
-    w.ev_seller[k] = seller
-    w.ev_site[k] = site
-    w.ev_dir[k] = direction
-    w.ev_x[k] = x
-    w.ev_y[k] = y
-    w.ev_age[k] = age
-    w.ev_stake[k] = stake
-    w.ev_sx[k] = sx
-    w.ev_sy[k] = sy
-    w.ev_count[0] = k + 1
+    unlock(w.ev_step)[k] = w.clock[0]
+    unlock(w.ev_kind)[k] = kind
+    unlock(w.ev_buyer)[k] = buyer
+    unlock(w.ev_seller)[k] = seller
+    unlock(w.ev_site)[k] = site
+    unlock(w.ev_dir)[k] = direction
+    unlock(w.ev_x)[k] = x
+    unlock(w.ev_y)[k] = y
+    unlock(w.ev_age)[k] = age
+    unlock(w.ev_stake)[k] = stake
+    unlock(w.ev_sx)[k] = sx
+    unlock(w.ev_sy)[k] = sy
+    unlock(w.ev_count)[0] = k + 1
 
 
 @njit
@@ -50,25 +55,25 @@ def log_payment(w, buyer, tx, weight, amount):
     """Append one row to the payments log: what the seller of pool transaction ``tx`` received."""
     k = w.pay_count[0]
     if k >= w.pay_step.shape[0]:
-        w.flags[0] |= flags.EVENT_OVERFLOW
+        unlock(w.flags)[0] |= flags.EVENT_OVERFLOW
         return
-    w.pay_step[k] = w.clock[0]
-    w.pay_buyer[k] = buyer
-    w.pay_seller[k] = w.tx_seller[tx]
-    w.pay_site[k] = w.tx_site[tx]
-    w.pay_weight[k] = weight
-    w.pay_amount[k] = amount
-    w.pay_count[0] = k + 1
+    unlock(w.pay_step)[k] = w.clock[0]
+    unlock(w.pay_buyer)[k] = buyer
+    unlock(w.pay_seller)[k] = w.tx_seller[tx]
+    unlock(w.pay_site)[k] = w.tx_site[tx]
+    unlock(w.pay_weight)[k] = weight
+    unlock(w.pay_amount)[k] = amount
+    unlock(w.pay_count)[0] = k + 1
 
 
 @njit(inline="always")
 def _move_transaction(w, src, dst):
     """Copy pool entry ``src`` (every field of a transaction) to ``dst``."""
-    w.tx_seller[dst] = w.tx_seller[src]
-    w.tx_site[dst] = w.tx_site[src]
-    w.tx_dir[dst] = w.tx_dir[src]
-    w.tx_step[dst] = w.tx_step[src]
-    w.tx_stake[dst] = w.tx_stake[src]
+    unlock(w.tx_seller)[dst] = w.tx_seller[src]
+    unlock(w.tx_site)[dst] = w.tx_site[src]
+    unlock(w.tx_dir)[dst] = w.tx_dir[src]
+    unlock(w.tx_step)[dst] = w.tx_step[src]
+    unlock(w.tx_stake)[dst] = w.tx_stake[src]
 
 
 @njit
@@ -85,9 +90,9 @@ def reserve(w, buyer, need):
     a = w.tx_off[buyer]
     for x in range(w.tx_count[buyer]):
         _move_transaction(w, a + x, top + x)
-    w.tx_off[buyer] = top
-    w.tx_cap[buyer] = cap
-    w.pool_top[0] = top + cap
+    unlock(w.tx_off)[buyer] = top
+    unlock(w.tx_cap)[buyer] = cap
+    unlock(w.pool_top)[0] = top + cap
     return True
 
 
@@ -96,23 +101,24 @@ def open_transaction(w, buyer, seller, site, direction):
     """Lock the seller's stake and record the transaction; False (nothing recorded) when refused."""
     k = w.tx_count[buyer]
     if k >= w.tx_cap[buyer]:
-        w.flags[0] |= flags.TX_OVERFLOW
+        unlock(w.flags)[0] |= flags.TX_OVERFLOW
         return False
     lock = 0.0
     if w.stake > 0.0:
-        if w.balance[seller] < w.stake - STAKE_TOLERANCE:
+        balance = unlock(w.balance)
+        if balance[seller] < w.stake - STAKE_TOLERANCE:
             return False
-        lock = min(w.stake, w.balance[seller])  # never below zero, even within the tolerance
-        w.balance[seller] -= lock
-        w.money[0] -= lock
-        w.pot[buyer] += lock
+        lock = min(w.stake, balance[seller])  # never below zero, even within the tolerance
+        balance[seller] -= lock
+        unlock(w.money)[0] -= lock
+        unlock(w.pot)[buyer] += lock
     x = w.tx_off[buyer] + k
-    w.tx_seller[x] = seller
-    w.tx_site[x] = site
-    w.tx_dir[x] = direction
-    w.tx_step[x] = w.clock[0]
-    w.tx_stake[x] = lock
-    w.tx_count[buyer] = k + 1
+    unlock(w.tx_seller)[x] = seller
+    unlock(w.tx_site)[x] = site
+    unlock(w.tx_dir)[x] = direction
+    unlock(w.tx_step)[x] = w.clock[0]
+    unlock(w.tx_stake)[x] = lock
+    unlock(w.tx_count)[buyer] = k + 1
     return True
 
 
@@ -129,13 +135,14 @@ def expire_stakes(w, buyer):
         m += 1
     if m == 0:
         return
+    balance, money, pot = unlock(w.balance), unlock(w.money), unlock(w.pot)
     for x in range(m):
-        w.balance[w.tx_seller[a + x]] += w.tx_stake[a + x]
-        w.money[0] += w.tx_stake[a + x]
-        w.pot[buyer] -= w.tx_stake[a + x]
+        balance[w.tx_seller[a + x]] += w.tx_stake[a + x]
+        money[0] += w.tx_stake[a + x]
+        pot[buyer] -= w.tx_stake[a + x]
     for x in range(k - m):
         _move_transaction(w, a + m + x, a + x)
-    w.tx_count[buyer] = k - m
+    unlock(w.tx_count)[buyer] = k - m
 
 
 @njit
@@ -155,12 +162,12 @@ def purchase_events(w, ok, buyer, seller, site, direction, x, y, age, sx, sy):
 @njit(inline="always")
 def _record_sale(w, seller, weight, top, pay, stake):
     """The seller's reputation record for one settled transaction (engine.world, REPUTATION): O(1)."""
-    w.rep_settled[seller] += 1
+    unlock(w.rep_settled)[seller] += 1
     if weight <= 0.0 or weight < OUTLIER_FRACTION * top:
-        w.rep_reduced[seller] += 1
-    w.rep_earned[seller] += pay
+        unlock(w.rep_reduced)[seller] += 1
+    unlock(w.rep_earned)[seller] += pay
     if stake > pay:
-        w.rep_stake_lost[seller] += stake - pay
+        unlock(w.rep_stake_lost)[seller] += stake - pay
 
 
 @njit
@@ -170,12 +177,13 @@ def distribute(w, buyer, weights):
     Each seller's reputation record is updated from its weight (an outlier when below half the best
     weight of its site in this settlement), so rules can read how the market has judged it."""
     k = w.tx_count[buyer]
-    w.balance[buyer] += w.reward
+    balance, tx_count = unlock(w.balance), unlock(w.tx_count)
+    balance[buyer] += w.reward
     pot = w.pot[buyer]
-    w.balance[buyer] += pot
-    w.pot[buyer] = 0.0
-    w.money[0] += w.reward + pot
-    w.rep_deposits[buyer] += 1
+    balance[buyer] += pot
+    unlock(w.pot)[buyer] = 0.0
+    unlock(w.money)[0] += w.reward + pot
+    unlock(w.rep_deposits)[buyer] += 1
     total = 0.0
     top0 = 0.0
     top1 = 0.0
@@ -183,8 +191,8 @@ def distribute(w, buyer, weights):
     for x in range(k):
         wx = weights[x]
         if not (wx >= 0.0) or math.isinf(wx):
-            w.flags[0] |= flags.BAD_WEIGHTS
-            w.tx_count[buyer] = 0
+            unlock(w.flags)[0] |= flags.BAD_WEIGHTS
+            tx_count[buyer] = 0
             return
         total += wx
         if w.tx_site[a + x] == 0:
@@ -197,15 +205,24 @@ def distribute(w, buyer, weights):
         seller = w.tx_seller[a + x]
         pay = amount * (weights[x] / total) if paid else 0.0
         if paid:
-            w.balance[seller] += pay
+            balance[seller] += pay
         _record_sale(w, seller, weights[x], top0 if w.tx_site[a + x] == 0 else top1, pay, w.tx_stake[a + x])
     if paid:
-        w.balance[buyer] -= amount
+        balance[buyer] -= amount
         if w.record:
             for x in range(k):
                 log_payment(w, buyer, a + x, weights[x] / total, amount * (weights[x] / total))
     elif w.record:
         for x in range(k):
             log_payment(w, buyer, a + x, 0.0, 0.0)
-    w.tx_count[buyer] = 0
+    tx_count[buyer] = 0
     log_event(w, EV_DEPOSIT, buyer, -1, -1, 0.0, 0.0, 0.0, 0, 0.0, 0.0, 0.0)
+
+
+@njit(inline="always")
+def burn_fuel(w, i):
+    """Robot i pays the fuel cost of one move (the caller checked it can): burned, not paid to anyone."""
+    fuel = w.fuel_cost
+    unlock(w.balance)[i] -= fuel
+    unlock(w.burned)[0] += fuel
+    unlock(w.money)[0] -= fuel

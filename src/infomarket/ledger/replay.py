@@ -1,7 +1,8 @@
-"""Replay a ledger event sequence through the engine's own compiled ledger code.
+"""Replay a ledger event sequence through the ledger's own compiled operations, on a ledger alone.
 
-Used by the conformance tests (``payment_vectors.json``) and to check the EVM contract against the
-simulation: both feed the same purchases and deposits and compare balances.
+No swarm is built and no engine code runs: a ``ledger.state.Book`` (the ledger, its log and a clock) is
+all the operations need.  Used by the conformance tests (``payment_vectors.json``) and to check the EVM
+contract against the simulation: both feed the same purchases and deposits and compare balances.
 """
 from __future__ import annotations
 
@@ -10,14 +11,12 @@ from typing import Iterable
 
 import numpy as np
 
-from ..config.schema import Experiment
-from ..engine import specialise
-from ..engine.build import build_world, make_room
-from ..engine.flags import ErrorFlags
-from ..errors import SimulationError
-from ..engine.world import REPUTATION
-from ..engine.worldref import kernel_view
-from .kernels import expire_stakes, open_transaction, reserve
+from ..errors import ConfigError, SimulationError
+from ..registry import get_payment
+from ..state.flags import ErrorFlags
+from ..state.view import make_view
+from .kernels import distribute, expire_stakes, open_transaction, reserve
+from .state import REPUTATION, grow_book, new_book
 
 
 @dataclass(frozen=True)
@@ -27,7 +26,7 @@ class Replayed:
     balances: np.ndarray
     pots: np.ndarray
     accepted: list[bool]
-    #: the ledger's reputation record after the replay (``engine.world.REPUTATION``: field -> copy)
+    #: the ledger's reputation record after the replay (``ledger.state.REPUTATION``: field -> copy)
     record: dict = field(default_factory=dict)
 
 
@@ -44,6 +43,66 @@ class LedgerEvent:
     step: int = 0
 
 
+class Ledger:
+    """A ledger on its own: purchases, deposits (weighed by a payment scheme) and stake expiry, with
+    the same compiled operations the engine runs inside a simulation."""
+
+    def __init__(self, robots: int, *, scheme: str = "delayed", initial_wealth: float = 1.0,
+                 reward: float = 1.0, information_share: float = 0.5, stake: float = 0.0,
+                 params: dict | None = None, stake_expiry: int = 0, record_events: bool = False):
+        spec = get_payment(scheme)
+        values = {**spec.defaults, **(params or {})}
+        unknown = sorted(set(values) - set(spec.params))
+        if unknown:
+            raise ConfigError(f"payment {scheme!r} has no parameter {', '.join(map(repr, unknown))}; "
+                              f"it takes {', '.join(spec.params) or 'none'}")
+        self.scheme = spec
+        self.book = new_book(robots, record_events=record_events, initial_wealth=initial_wealth, reward=reward,
+                             information_share=information_share, stake=stake, stake_expiry=int(stake_expiry),
+                             pparams=[float(values.get(p, 0.0)) for p in spec.params])
+        self.view = make_view("book", self.book)
+        self.rng = np.random.default_rng(0)  # only a scheme that asks for one uses it
+
+    def _check(self) -> None:
+        flags = ErrorFlags(int(self.book.flags[0]))
+        if flags:
+            raise SimulationError(flags.describe())
+
+    def begin_step(self, step: int) -> None:
+        """Step ``step`` begins: the clock moves there and, with stake expiry, expired stakes go back."""
+        self.book.clock[0] = step
+        if self.book.stake_expiry > 0:
+            for buyer in range(self.book.balance.shape[0]):
+                expire_stakes(self.view, buyer)
+
+    def purchase(self, buyer: int, seller: int, site: int, direction_deg: float) -> bool:
+        """Open a transaction (locking the seller's stake); False when the seller cannot stake."""
+        book = self.book
+        while not reserve(self.view, buyer, int(book.tx_count[buyer]) + 1):
+            self.book = book = grow_book(book, book.tx_count + 1, int(book.ev_count[0]) + 1, 0)
+            self.view = make_view("book", book)
+        ok = bool(open_transaction(self.view, buyer, seller, site, float(direction_deg)))
+        self._check()
+        return ok
+
+    def deposit(self, buyer: int) -> None:
+        """The buyer deposits an item: the scheme weighs its open transactions and the round trip is paid."""
+        book = self.book
+        if book.record:
+            self.book = book = grow_book(book, book.tx_count, int(book.ev_count[0]) + 1,
+                                         int(book.pay_count[0]) + int(book.tx_count[buyer]))
+            self.view = make_view("book", book)
+        a = int(book.tx_off[buyer])
+        b = a + int(book.tx_count[buyer])
+        weights = np.zeros(b - a)
+        rule = self.scheme.weights
+        extra = ([self.view] if rule.wants_market else []) + ([self.rng] if rule.wants_rng else [])
+        rule.func(buyer, book.tx_seller[a:b].copy(), book.tx_site[a:b].copy(), book.tx_dir[a:b].copy(), weights,
+                  *extra, *book.pparams[:len(rule.params)])
+        distribute(self.view, buyer, weights)
+        self._check()
+
+
 def replay_events(events: Iterable, robots: int, *, scheme: str = "delayed", initial_wealth: float = 1.0,
                   reward: float = 1.0, information_share: float = 0.5, stake: float = 0.0,
                   params: dict | None = None, stake_expiry: int = 0) -> Replayed:
@@ -54,16 +113,8 @@ def replay_events(events: Iterable, robots: int, *, scheme: str = "delayed", ini
     ``stake_expiry`` = T > 0 applies the stake-expiry rule (docs/chain.md): at the start of each step
     s (before its first event), every open transaction opened at a step t with t + T <= s expires:
     its stake goes back to its seller and it leaves the buyer's round trip."""
-    cfg = Experiment.model_validate({
-        "swarm": {"robots": robots, "groups": [{"behaviour": "naive", "count": robots}]},
-        "payment": {"scheme": scheme, "initial_wealth": initial_wealth, "reward": reward,
-                    "information_share": information_share, "stake": stake, "params": params or {},
-                    "stake_expiry": int(stake_expiry)},
-    })
-    rng = np.random.default_rng(0)  # only a rule that asks for one uses it
-    world, _ = build_world(cfg, rng)
-    kernel = specialise.kernel_module(("naive",), scheme)
-    view = kernel_view(world)
+    ledger = Ledger(robots, scheme=scheme, initial_wealth=initial_wealth, reward=reward,
+                    information_share=information_share, stake=stake, params=params, stake_expiry=stake_expiry)
     accepted: list[bool] = []
     step = None
     for ev in events:
@@ -73,22 +124,13 @@ def replay_events(events: Iterable, robots: int, *, scheme: str = "delayed", ini
             now = int(get("step"))
             if step is None or now > step:  # a new step begins: the engine's expiry, then the event
                 step = now
-                world.clock[0] = step
-                for buyer in range(robots):
-                    expire_stakes(view, buyer)
+                ledger.begin_step(step)
         if kind in ("purchase", "refused"):
-            buyer = int(get("buyer"))
-            while not reserve(view, buyer, int(world.tx_count[buyer]) + 1):
-                world = make_room(world, tx_need=world.tx_count + 1)
-                view = kernel_view(world)
-            accepted.append(bool(open_transaction(view, buyer, int(get("seller")), int(get("site")),
-                                                  float(get("direction_deg")))))
+            accepted.append(ledger.purchase(int(get("buyer")), int(get("seller")), int(get("site")),
+                                            float(get("direction_deg"))))
         elif kind == "deposit":
-            kernel.settle(view, int(get("buyer")), rng)
+            ledger.deposit(int(get("buyer")))
         else:
-            raise ValueError(f"unknown ledger event kind {kind!r}")
-        flags = ErrorFlags(int(world.flags[0]))
-        if flags:
-            raise SimulationError(flags.describe())
-    return Replayed(world.balance.copy(), world.pot.copy(), accepted,
-                    {f: getattr(world, f).copy() for f in REPUTATION})
+            raise ConfigError(f"unknown ledger event kind {kind!r} (purchase, refused or deposit)")
+    book = ledger.book
+    return Replayed(book.balance.copy(), book.pot.copy(), accepted, {f: getattr(book, f).copy() for f in REPUTATION})

@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..engine import kernels
+from ..engine import geometry as kernels  # to_world: the robot-frame rotation the engine uses
 from ..engine.world import EVENT_NAMES, FOOD, NEST, SITE_NAMES, STATE_NAMES, headings, open_transactions
 from ..registry import behaviours
 

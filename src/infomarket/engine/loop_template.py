@@ -1,8 +1,11 @@
 """Template of the compiled step loop.  Never imported as is: ``engine.specialise`` writes a module made of
-this source plus the three dispatch functions for the configured rules (below, declared and left to
-the generator), so each rule call is a direct, inlinable call and the whole kernel is cached on disk.
+the step options (``TERRAIN``, ``PATHS``), this source, and the three dispatch functions for the
+configured rules (below, declared and left to the generator), so each rule call is a direct, inlinable
+call and the whole kernel is cached on disk.  Every step piece it calls is in ``engine.step``, written
+once; ``TERRAIN`` and ``PATHS`` are constants of the generated module, so the variants a kernel does not
+use are folded away.
 
-Order of operations per step (MODEL.md §3): neighbours; communication (offers from start-of-step
+Order of operations per step (docs/model.md §3): neighbours; communication (offers from start-of-step
 tables, then every robot buys in id order); move (foraging and payment, install the new table,
 behaviour step, noisy motion), robots in id order.
 
@@ -13,15 +16,16 @@ with the step not begun, the host grows the arrays (``build.make_room``) and cal
 import numpy as np
 from numba import njit
 
-from infomarket.engine.kernels import (begin_communication, behaviour_step, forage, install_table, move,
-                                       record_history)
-from infomarket.engine.neighbours import find_neighbours
-from infomarket.ledger.kernels import distribute, expire_stakes, reserve, settlement
+from infomarket.engine.step import (begin_communication, behaviour_step, find_neighbours, forage, install_table,
+                                    move, record_history)
+from infomarket.ledger.kernels import burn_fuel, distribute, expire_stakes, reserve, settlement
+from infomarket.state.view import unlock
 
 DONE = 0
 NEED_ROOM = 1
 
-# ---- provided by the generator (engine.specialise), one branch per configured rule -----------------
+# ---- provided by the generator (engine.specialise) --------------------------------------------------
+#: TERRAIN, PATHS: the step options (bools), written above this template
 #: sell_dispatch(kind, w, i, site, rng) -> (valid, x, y, age): robot i's offer for ``site``
 #: buy_dispatch(kind, w, i, nbrs, rng): robot i buys from its neighbours
 #: pay_dispatch(w, buyer, sellers, sites, directions, weights, rng): the scheme's weights
@@ -70,21 +74,21 @@ def settle(w, i, rng):
 def run_steps(w, rng, t_end):
     """Advance the world until step ``t_end`` (or until the host must grow an array): DONE or NEED_ROOM."""
     n = w.pos.shape[0]
-    clock, kind, balance = w.clock, w.kind, w.balance
+    clock, kind, balance = unlock(w.clock), w.kind, w.balance
     cool, stop = w.cool_timer, w.stop_timer
     off_valid, off_vec, off_age = w.off_valid, w.off_vec, w.off_age
     nbr, nbr_count = w.nbr, w.nbr_count
     fuel = w.fuel_cost
     bits = rng.bit_generator  # the engine's own draws (engine.draws); rules get the Generator
     while clock[0] < t_end:
-        find_neighbours(w)
+        find_neighbours(w, TERRAIN)
         if not has_room(w):
             return NEED_ROOM
         clock[0] += 1
         if w.stake_expiry > 0:
             for i in range(n):
                 expire_stakes(w, i)
-        begin_communication(w)
+        begin_communication(w, PATHS)
         for i in range(n):
             for site in range(2):
                 if cool[i] == 0:
@@ -99,20 +103,18 @@ def run_steps(w, rng, t_end):
             if cool[i] == 0:
                 buy_dispatch(kind[i], w, i, nbr[i, :nbr_count[i]], rng)
         for i in range(n):
-            if forage(w, i, bits):
+            if forage(w, i, bits, TERRAIN):
                 settle(w, i, rng)
-            install_table(w, i)
+            install_table(w, i, PATHS)
             if stop[i] > 0:
                 stop[i] -= 1
             elif fuel > 0.0 and balance[i] < fuel:
                 pass
             else:
                 if fuel > 0.0:
-                    balance[i] -= fuel
-                    w.burned[0] += fuel
-                    w.money[0] -= fuel
-                dx, dy = behaviour_step(w, i, bits)
-                move(w, i, dx, dy, bits)
+                    burn_fuel(w, i)
+                dx, dy = behaviour_step(w, i, bits, TERRAIN, PATHS)
+                move(w, i, dx, dy, bits, TERRAIN)
             if cool[i] > 0:
                 cool[i] -= 1
         record_history(w)

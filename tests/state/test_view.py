@@ -6,9 +6,8 @@ import re
 import numba
 from numba import njit
 
-from infomarket.engine.kernels import begin_communication, behaviour_step, forage, install_table, move
-from infomarket.engine.neighbours import find_neighbours
-from infomarket.engine.worldref import BorrowedArray, WorldType
+from infomarket.engine.step import begin_communication, behaviour_step, find_neighbours, forage, install_table, move
+from infomarket.state.view import BorrowedArray, GuardedArray, WorldType, layout_type
 
 from ..conftest import Handle, make_config
 
@@ -18,13 +17,13 @@ def _steps(w, rng, k):
     """The engine's per-robot pieces, inlined as the step loop inlines them (with the bit generator)."""
     bits = rng.bit_generator
     for _ in range(k):
-        find_neighbours(w)
-        begin_communication(w)
+        find_neighbours(w, False)
+        begin_communication(w, False)
         for i in range(w.pos.shape[0]):
-            forage(w, i, bits)
-            install_table(w, i)
-            dx, dy = behaviour_step(w, i, bits)
-            move(w, i, dx, dy, bits)
+            forage(w, i, bits, False)
+            install_table(w, i, False)
+            dx, dy = behaviour_step(w, i, bits, False, False)
+            move(w, i, dx, dy, bits, False)
             w.items[i] += 1
 
 
@@ -45,12 +44,13 @@ def test_fields_and_the_handle_emit_no_reference_counting():
     assert _nrt_calls(_steps) == []  # the engine draws from the bit generator (engine.draws)
 
 
-def test_world_arrays_are_borrowed_and_params_read_only():
-    from infomarket.engine.worldref import world_type
-
-    fields = world_type().field_dict
+def test_world_arrays_are_borrowed_params_read_only_and_books_guarded():
+    fields = layout_type("world").field_dict
     assert isinstance(fields["pos"], BorrowedArray) and fields["pos"].mutable
-    assert isinstance(fields["site_pos"], BorrowedArray) and not fields["site_pos"].mutable
+    assert isinstance(fields["sites_xy"], BorrowedArray) and not fields["sites_xy"].mutable
+    assert not isinstance(fields["sites_xy"], GuardedArray)  # a parameter can never be unlocked
+    for name in ("balance", "pot", "money", "tx_seller", "rep_settled", "ev_step", "pay_amount", "hist", "clock"):
+        assert isinstance(fields[name], GuardedArray) and not fields[name].mutable, name
 
 
 def test_calls_leave_the_hosts_one_reference():
