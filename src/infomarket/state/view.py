@@ -33,7 +33,7 @@ import numpy as np
 from numba import config, types
 from numba.core.datamodel.models import StructModel
 from numba.experimental import structref
-from numba.core import cgutils
+from numba.core import cgutils, ir_utils
 from numba.extending import NativeValue, box, intrinsic, register_model, unbox
 
 from .spec import Spec
@@ -98,13 +98,23 @@ def _unlock(typingctx, array):
     return out(array), lambda context, builder, sig, args: args[0]
 
 
+def _unlock_aliases(lhs, args, alias_map, arg_aliases):
+    """Tell numba's alias analysis that ``unlock(a)`` *is* ``a``.  Without it, a function that inlines an
+    ``@overload(inline="always")`` (the engine's draws) runs numba's dead-code elimination, which sees a
+    write into a fresh, unused call result and deletes it: ``unlock(w.site_items)[k] += 1`` next to a
+    draw was silently lost (tests/state/test_view.py keeps that case)."""
+    ir_utils._add_alias(lhs, args[0].name, alias_map, arg_aliases)
+
+
+ir_utils.alias_func_extensions[("_unlock", __name__)] = _unlock_aliases
+
+
 def _identity(array):
     return array
 
 
-#: ``unlock(array)``: an intrinsic (numba inlines it as the same array, typed writable).  An ``@overload``
-#: returning the same intrinsic lost the writes made through it (the stores were missing from the
-#: compiled code; tests/state/test_view.py checks they land).  With ``NUMBA_DISABLE_JIT=1``, the array itself.
+#: ``unlock(array)``: an intrinsic, which numba inlines as the same array typed writable (with
+#: ``NUMBA_DISABLE_JIT=1``, the array itself).
 unlock = _identity if config.DISABLE_JIT else _unlock
 
 
