@@ -72,3 +72,82 @@ def test_a_slice_of_a_borrowed_array_is_an_ordinary_view():
     h.world.nbr_count[0] = 2
     assert neighbours_sum(h.view, 0) == 8
     assert h.view._meminfo.refcount == 1
+
+
+def _compiles(fn, *args) -> bool:
+    try:
+        fn(*args)
+    except numba.core.errors.TypingError as e:
+        assert "readonly" in str(e) or "read-only" in str(e) or "unlock" in str(e) or "No implementation" in str(e)
+        return False
+    return True
+
+
+def test_only_unlock_writes_the_books_and_nothing_writes_a_parameter():
+    from infomarket.state.view import unlock
+
+    h = Handle(make_config(2))
+
+    @njit
+    def write_balance(w):
+        w.balance[0] = 5.0
+
+    @njit
+    def write_log(w):
+        w.ev_count[0] = 3
+
+    @njit
+    def write_parameter(w):
+        w.sites_r[0] = 1.0
+
+    @njit
+    def unlock_parameter(w):
+        unlock(w.sites_r)[0] = 1.0
+
+    @njit
+    def ledger_operation(w):
+        unlock(w.balance)[0] = 5.0
+
+    assert not _compiles(write_balance, h.view)
+    assert not _compiles(write_log, h.view)
+    assert not _compiles(write_parameter, h.view)
+    assert not _compiles(unlock_parameter, h.view)
+    assert _compiles(ledger_operation, h.view) and h.world.balance[0] == 5.0
+
+
+def test_a_rule_that_writes_a_balance_does_not_compile():
+    import pytest
+
+    import infomarket as im
+
+    def thief_buy(w, me, nbrs):
+        w.balance[me] += 1.0
+
+    def honest_sell(w, me, site):
+        return False, 0.0, 0.0, 0
+
+    im.register_behaviour("test_thief", buy=thief_buy, sell=honest_sell, honest=False)
+    cfg = make_config(2, behaviour="test_thief")
+    with pytest.raises(numba.core.errors.TypingError, match="readonly"):
+        im.simulate(cfg, seed=1, steps=5)
+
+
+def test_writes_through_unlock_survive_numbas_dead_code_elimination():
+    """An inlined overload (the engine's draws) makes numba eliminate dead code; a write through
+    ``unlock`` there was deleted until the alias analysis learnt that unlock(a) is a."""
+    import numpy as np
+
+    from infomarket.engine.draws import uniform
+    from infomarket.state.view import unlock
+
+    @njit
+    def count_with_a_draw(w, rng):
+        bits = rng.bit_generator
+        u = uniform(bits)
+        if u >= 0.0:
+            unlock(w.site_items)[0] += 1
+
+    h = Handle(make_config(2))
+    count_with_a_draw(h.view, np.random.default_rng(0))
+    count_with_a_draw(h.view, np.random.default_rng(1))
+    assert h.world.site_items[0] == 2

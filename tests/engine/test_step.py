@@ -7,7 +7,7 @@ from scipy import stats
 
 from infomarket.engine import step as K
 from infomarket.engine.params import cauchy_cdf, guide_table, levy_cdf
-from infomarket.engine.neighbours import find_neighbours
+from infomarket.engine.neighbours import find_all_neighbours as find_neighbours
 from infomarket.engine.world import EXPLORING, FOOD, NEST, SEEKING_FOOD, headings
 
 from ..conftest import Handle, make_config
