@@ -130,24 +130,3 @@ def test_a_rule_that_writes_a_balance_does_not_compile():
     cfg = make_config(2, behaviour="test_thief")
     with pytest.raises(numba.core.errors.TypingError, match="readonly"):
         im.simulate(cfg, seed=1, steps=5)
-
-
-def test_writes_through_unlock_survive_numbas_dead_code_elimination():
-    """An inlined overload (the engine's draws) makes numba eliminate dead code; a write through
-    ``unlock`` there was deleted until the alias analysis learnt that unlock(a) is a."""
-    import numpy as np
-
-    from infomarket.engine.draws import uniform
-    from infomarket.state.view import unlock
-
-    @njit
-    def count_with_a_draw(w, rng):
-        bits = rng.bit_generator
-        u = uniform(bits)
-        if u >= 0.0:
-            unlock(w.site_items)[0] += 1
-
-    h = Handle(make_config(2))
-    count_with_a_draw(h.view, np.random.default_rng(0))
-    count_with_a_draw(h.view, np.random.default_rng(1))
-    assert h.world.site_items[0] == 2

@@ -143,3 +143,20 @@ def test_without_sensing_robots_the_same_pair_is_blocked_not_reflected():
     w = sim.world
     assert w.state.tolist() == [SEEKING_FOOD, SEEKING_FOOD]
     assert w.pos[:, 0].tolist() == [100.0, 117.0]  # each would end 14.5 from the other
+
+
+def test_items_per_site_add_up_to_the_items_deposited():
+    """Every deposit is counted at its nest and every pick-up at its food site (after the transitory
+    period).  The per-site count is written through ``unlock`` next to the spot's random draws, where
+    numba's dead-code elimination once deleted it (state.view._unlock_aliases): the counts stayed 0."""
+    import infomarket as im
+    from infomarket.runner.plan import conditions
+
+    cond = next(c for c in conditions(im.load_experiment("two_food")) if c.id == "food_sites=2")
+    res = im.Simulation(cond.config, seed=1).run(1500)
+    sites = res.totals["sites"]
+    deposits = sum(s["items"] for s in sites if s["kind"] == "nest")
+    pickups = sum(s["items"] for s in sites if s["kind"] == "food")
+    assert deposits == int(res.robots.items_collected.sum()) > 0
+    assert pickups >= deposits
+    assert all(s["items"] > 0 for s in sites if s["kind"] == "food")  # both food sites were used

@@ -102,7 +102,7 @@ def _unlock_aliases(lhs, args, alias_map, arg_aliases):
     """Tell numba's alias analysis that ``unlock(a)`` *is* ``a``.  Without it, a function that inlines an
     ``@overload(inline="always")`` (the engine's draws) runs numba's dead-code elimination, which sees a
     write into a fresh, unused call result and deletes it: ``unlock(w.site_items)[k] += 1`` next to a
-    draw was silently lost (tests/state/test_view.py keeps that case)."""
+    draw was silently lost (tests/terrain/test_sites_and_collisions.py keeps that case)."""
     ir_utils._add_alias(lhs, args[0].name, alias_map, arg_aliases)
 
 
