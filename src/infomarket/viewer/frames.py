@@ -62,6 +62,7 @@ def scene(sim) -> dict:
         "name": cfg.name,
         "description": cfg.description,
         "seed": sim.seed,
+        "seed_text": str(sim.seed),  # exact in the page (a JavaScript number rounds a seed above 2**53)
         "steps": cfg.steps,
         "scheme": cfg.payment.scheme,
         "arena": {"width": cfg.arena.width, "height": cfg.arena.height},

@@ -81,9 +81,9 @@
     if (obstacles.length) terrain.push(`${obstacles.length} obstacle${obstacles.length > 1 ? "s" : ""}`);
     if (scene.robot.collisions) terrain.push("collisions");
     if (scene.robot.line_of_sight) terrain.push("line of sight");
-    $("subtitle").textContent = `${groups} · ${scene.scheme} payment · seed ${scene.seed}` +
+    $("subtitle").textContent = `${groups} · ${scene.scheme} payment · seed ${scene.seed_text ?? scene.seed}` +
       terrain.map((t) => ` · ${t}`).join("");
-    if (V.mode === "live") $("seed").placeholder = `random (now ${scene.seed})`;
+    if (V.mode === "live") $("seed").placeholder = `random (now ${scene.seed_text ?? scene.seed})`;
     fit();
   }
 
@@ -528,7 +528,7 @@
     $("speed").onchange = () => V.source && V.source.speed(Number($("speed").value));
     $("restart").onclick = () => {
       const text = $("seed").value.trim();
-      if (V.source && V.source.restart) V.source.restart(text === "" ? null : Number(text));
+      if (V.source && V.source.restart) V.source.restart(text === "" ? null : text);  // as text: seeds go up to 2**63 - 1
     };
     $("comm").onchange = () => { V.showComm = $("comm").checked; V.dirty = true; };
     arena.addEventListener("click", (ev) => {
