@@ -86,7 +86,7 @@ def run_demo(args: argparse.Namespace) -> int:
         if args.rpc:
             connect(args.rpc)  # fail before simulating if the node is not there
         if config.payment.scheme == "outlier" and config.payment_params()["theta"] > 180:
-            raise ValueError("the contract needs theta in [0, 180] degrees")
+            raise ConfigError("the contract needs theta in [0, 180] degrees")
     except (ConfigError, ValueError, ChainError) as exc:
         return report_error(exc, 2)
     composition = ", ".join(f"{g.count} {g.behaviour}" for g in config.swarm.groups if g.count)

@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from statistics import mean
 
 from ..engine.world import SITE_NAMES
+from ..errors import ArgumentError
 from ..payments import default_theta
 from .errors import ChainError, ContractRevert
 from .market import SCHEMES, ChainMarket, MarketParams, connect, derived_account
@@ -88,7 +89,7 @@ class ReplayReport:
     def compare(self, expected: Sequence[float]) -> list[BalanceRow]:
         """Each robot's on-chain balance against ``expected`` (the simulated ledger's, in tokens)."""
         if len(expected) != self.robots:
-            raise ValueError(f"expected {self.robots} balances, got {len(expected)}")
+            raise ArgumentError(f"expected {self.robots} balances, got {len(expected)}")
         return [BalanceRow(i, self.balances[i], float(expected[i]), self.rounding_bound[i])
                 for i in range(self.robots)]
 

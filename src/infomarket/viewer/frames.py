@@ -18,6 +18,7 @@ import numpy as np
 
 from ..engine import kernels
 from ..engine.world import EVENT_NAMES, FOOD, NEST, SITE_NAMES, STATE_NAMES, headings, open_transactions
+from ..errors import FormatError
 from ..registry import behaviours
 
 #: The engine's own robot-frame -> world rotation, as plain Python (it also takes arrays of robots).
@@ -130,7 +131,7 @@ class Frame:
 def decode(data: bytes, n: int) -> Frame:
     """Inverse of ``encode`` for a swarm of ``n`` robots (what the page does, in Python)."""
     if len(data) != frame_size(n):
-        raise ValueError(f"a frame of {n} robots has {frame_size(n)} bytes, got {len(data)}")
+        raise FormatError(f"a frame of {n} robots has {frame_size(n)} bytes, got {len(data)}")
     head = np.frombuffer(data, "<f8", len(HEADER))
     offset, cols = 8 * len(HEADER), {}
     for c, t in COLUMNS:

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 
 from ..config.schema import Experiment
 from ..engine import Simulation
+from ..errors import InfomarketError
 from ..seeds import MAX_SEED
 from .frames import encode, honest_mask, robot_detail, scene
 
@@ -34,7 +35,7 @@ MAX_SPEED = 1000
 MAX_STEP = 10_000  # one command stays short, so Ctrl-C never waits long for a worker thread
 
 
-class CommandError(ValueError):
+class CommandError(InfomarketError, ValueError):
     """A message from the page that cannot be carried out; its text goes back to the page."""
 
 
