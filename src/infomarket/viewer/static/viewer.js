@@ -1,7 +1,7 @@
 /* infomarket viewer: draws frames that the Python engine computed; it simulates nothing itself.
  *
  * Two sources feed the same drawing code: a live server (WebSocket at ./ws, see viewer/server.py) and
- * a replay whose frames are embedded in the page (<script id="infomarket-replay">, see viewer/replay.py).
+ * a replay whose frames are embedded in the page (<script id="infomarket-replay">, see viewer/recording.py).
  * A frame is binary: float64 header numbers, then one little-endian column per robot attribute, laid
  * out as the scene's "columns" say (viewer/frames.py); we wrap each column in a typed-array view.
  * Tests and curious users read the page's state through window.infomarketViewer.

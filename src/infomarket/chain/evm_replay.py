@@ -1,4 +1,4 @@
-"""Replay a simulator's event log through the contract, and compare the two ledgers.
+"""Replay a simulated swarm's event log on the EVM, through the contract, and compare the two ledgers.
 
 The simulator's ledger and the contract implement the same rules (MODEL.md section 5) in floats and
 in fixed point. Feeding the contract the same events (every purchase as a real light contract
