@@ -1,4 +1,4 @@
-"""The information market on an Ethereum chain (MODEL.md section 9).
+"""The information market on an Ethereum chain (docs/model.md §9).
 
 ``contracts/InformationMarket.sol`` enforces the market's rules; this package is its client side:
 

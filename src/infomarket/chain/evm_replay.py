@@ -1,6 +1,6 @@
 """Replay a simulated swarm's event log on the EVM, through the contract, and compare the two ledgers.
 
-The simulator's ledger and the contract implement the same rules (MODEL.md section 5) in floats and
+The simulator's ledger and the contract implement the same rules (docs/model.md §5) in floats and
 in fixed point. Feeding the contract the same events (every purchase as a real light contract
 revealed by its seller, every deposit as the market's ``buyItem``) and comparing every robot's final
 balance is the conformance check between the two backends.

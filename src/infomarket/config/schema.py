@@ -3,7 +3,7 @@
 Validation happens here, before anything runs: unknown keys, wrong types and impossible values are
 all reported with the key's path (``swarm.groups[0].count``) and what is allowed (``config.load`` turns
 them into one ``errors.ConfigError``), and so is a configuration whose memory need exceeds the limit
-(``config.sizes``).  Defaults are the values of MODEL.md §1 that produced the paper's figures; ``swarm``
+(``config.sizes``).  Defaults are the values of docs/model.md §1 that produced the paper's figures; ``swarm``
 has none and is required.
 """
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """How much memory a configuration needs, checked before any of it is spent.
 
-The estimate follows the engine's O(n) layout (MODEL.md §9): per robot, a few hundred bytes of O(1) state
+The estimate follows the engine's O(n) layout (``engine.world``): per robot, a few hundred bytes of O(1) state
 and O(k) buffers (neighbours, pending transactions, offers), with k bounded by how many robots fit in
 communication range; a neighbour grid; the Lévy step-length table, 16 bytes × (steps + 1); the wealth
 history, 8 bytes × robots × steps / history_every (and its long table); the event log when recorded.
