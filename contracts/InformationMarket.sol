@@ -2,7 +2,7 @@
 pragma solidity 0.8.28;
 
 /// @title InformationMarket
-/// @notice On-chain half of the robot swarm's information market (MODEL.md sections 5 and 9): sellers
+/// @notice On-chain half of the robot swarm's information market (docs/model.md §5 and §9): sellers
 /// reveal path information under a light contract the buyer signed off-chain, and the market account
 /// pays every deposited item and shares part of the reward among the robot's information sellers.
 /// @dev Balances live in an internal ledger of this contract's own token (9 decimals), not in an
@@ -15,7 +15,7 @@ pragma solidity 0.8.28;
 ///
 /// The contract trusts no seller's word about its information: the direction each record is weighed
 /// by is that of the vector the seller committed to, minus the seller's position the buyer signed
-/// (MODEL.md section 4), and "within theta" is decided on those integer vectors with dot products
+/// (docs/model.md §4), and "within theta" is decided on those integer vectors with dot products
 /// against a fixed cos(theta), exactly. A stake never stays locked for ever: records older than
 /// `stakeExpiry` blocks give their stake back to their seller (anyone may trigger it). A round trip
 /// of any length settles in bounded gas per transaction: `buyItem` settles what fits in one batch and
@@ -28,7 +28,7 @@ contract InformationMarket {
     // Types
     // ------------------------------------------------------------------------------------------------
 
-    /// @notice How a deposit's reward share is split among the robot's sellers (MODEL.md section 5).
+    /// @notice How a deposit's reward share is split among the robot's sellers (docs/model.md §5).
     /// @dev Delayed: in proportion to each seller's number of transactions; no stakes allowed.
     /// Outlier: in proportion to the number of same-site transactions within theta of each transaction,
     /// with the locked stakes added to the shared amount (staking is on when `stake() > 0`).
@@ -701,7 +701,7 @@ contract InformationMarket {
         if (recovered == address(0) || recovered != lc.buyer) revert InfoMarketInvalidBuyerSignature(lc.buyer, recovered);
     }
 
-    /// @dev The seller's rotated vector (MODEL.md section 4: purchased vector minus seller position),
+    /// @dev The seller's rotated vector (docs/model.md §4: purchased vector minus seller position),
     /// range-checked, a zero vector replaced by (1, 0).
     function _sellerVector(int64 x, int64 y, int64 sx, int64 sy) private pure returns (int64, int64) {
         int256 dx = int256(x) - sx;

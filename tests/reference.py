@@ -1,6 +1,6 @@
-"""A plain, slow, deliberately obvious Python implementation of one environment step (MODEL.md §2-6).
+"""A plain, slow, deliberately obvious Python implementation of one environment step (docs/model.md §2-6).
 
-Written from MODEL.md, not from the engine: no numba, no numpy arithmetic, no infomarket imports.
+Written from docs/model.md, not from the engine: no numba, no numpy arithmetic, no infomarket imports.
 Robots are ``Robot`` objects holding floats and lists; angles are kept in degrees and turned with
 ``math.cos``/``math.sin`` at each use.  The only things shared with the engine are the start state
 (positions, headings, biases, behaviours) and a copy of the run's random ``Generator``, which this
@@ -165,7 +165,7 @@ class Reference:
         return own.copy()
 
     def buy(self, b: int, s: int, site: int, offers) -> Entry | None:
-        """Buyer b buys seller s's offer (MODEL.md §4); None when the seller cannot lock the stake."""
+        """Buyer b buys seller s's offer (docs/model.md §4); None when the seller cannot lock the stake."""
         buyer, seller = self.robots[b], self.robots[s]
         off = offers[s][site]
         rx, ry = buyer.to_frame(*seller.to_world(*off.vec))
@@ -266,7 +266,7 @@ class Reference:
         self.pay(i)
 
     def pay(self, i: int) -> None:
-        """Deposit by robot i (MODEL.md §5)."""
+        """Deposit by robot i (docs/model.md §5)."""
         r, p = self.robots[i], self.p
         r.balance += p.reward
         pot, r.pot = r.pot, 0.0

@@ -115,9 +115,9 @@ def read_only_folder(tmp_path) -> Path:
 
 
 def test_replay_into_a_read_only_folder_fails_before_simulating(tmp_path, capsys, monkeypatch):
-    from infomarket.viewer import replay
+    from infomarket.viewer import recording
 
-    monkeypatch.setattr(replay, "record", lambda *a, **k: pytest.fail("simulated before checking --out"))
+    monkeypatch.setattr(recording, "record", lambda *a, **k: pytest.fail("simulated before checking --out"))
     out = read_only_folder(tmp_path) / "run.html"
     assert main(["replay", "fig2B", "--steps", "50", "--out", str(out)]) == 2
     err = capsys.readouterr().err

@@ -1,4 +1,4 @@
-"""Reduced-size statistical checks of the paper's headline results (MODEL.md §8), 12 runs per panel.
+"""Reduced-size statistical checks of the paper's headline results (docs/model.md §8), 12 runs per panel.
 
 The full-size check is ``infomarket reproduce paper`` followed by ``infomarket figures``; these use fewer
 runs and fixed seeds.  The bounds are not restated here: each check reads its rule from

@@ -1,4 +1,4 @@
-"""The original simulator's classes are mapped to what they did there (MODEL.md §10)."""
+"""The original simulator's classes are mapped to what they did there (docs/model.md §10)."""
 import json
 
 import pytest

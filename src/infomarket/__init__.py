@@ -9,6 +9,8 @@ Quick use::
 
 New behaviours and payment schemes: ``im.register_behaviour`` / ``im.register_payment`` (docs/extending.md).
 """
+#: The package version, written only here: pyproject.toml reads it (``[tool.hatch.version]``), and the
+#: compiled-kernel cache, stores and the command line take it from here, so it holds in a fresh clone too.
 __version__ = "0.1.0"
 
 from .config import Experiment, load_experiment  # noqa: E402

@@ -25,7 +25,36 @@ class UsageError(InfomarketError, ValueError):
 
 
 class SimulationError(InfomarketError, RuntimeError):
-    """The compiled kernel reported a condition it cannot recover from (see state.flags)."""
+    """The compiled kernel reported a condition it cannot recover from (see state.flags), or a run in
+    another process failed."""
+
+
+class ArgumentError(InfomarketError, ValueError):
+    """A function of the Python API was called with a value it cannot take (out of range, wrong length)."""
+
+
+class InputTypeError(InfomarketError, TypeError):
+    """A function of the Python API was given an object of a kind it cannot read."""
+
+
+class RuleError(InfomarketError, TypeError):
+    """A function handed to the registration API cannot be a rule (not a function, wrong arguments)."""
+
+
+class RegistrationError(InfomarketError, ValueError):
+    """A registration clashes with what is registered (a name taken, rules disagreeing on a default)."""
+
+
+class PluginError(InfomarketError, ImportError):
+    """A plugin (a module or a ``.py`` file of rules) cannot be imported."""
+
+
+class FormatError(InfomarketError, ValueError):
+    """Bytes do not have the layout infomarket writes (e.g. a viewer frame of the wrong size)."""
+
+
+class InternalError(InfomarketError, RuntimeError):
+    """A defect of infomarket itself (a damaged package, an impossible state), never the user's to fix."""
 
 
 def exit_code(exc: BaseException) -> int:

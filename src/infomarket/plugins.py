@@ -12,6 +12,8 @@ import os
 import sys
 from pathlib import Path
 
+from .errors import PluginError
+
 
 def resolve(entry: str, base: Path | None) -> str:
     """The canonical form of an entry: an absolute path for files, the module name otherwise."""
@@ -28,7 +30,7 @@ def load(entry: str) -> None:
     if entry.endswith(".py"):
         path = Path(entry)
         if not path.exists():
-            raise ImportError(f"no such file {entry}")
+            raise PluginError(f"no such file {entry}")
         name = "infomarket_plugin_" + hashlib.sha1(str(path).encode()).hexdigest()[:12] + "_" + path.stem
         if name in sys.modules:
             return

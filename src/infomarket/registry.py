@@ -16,7 +16,7 @@ from typing import Callable
 
 import numba
 
-from .errors import ConfigError
+from .errors import ConfigError, RegistrationError, RuleError
 
 #: Fixed leading arguments of each kind of rule (everything after them is a parameter).
 BUY_ARGS = ("w", "me", "nbrs")
@@ -93,7 +93,7 @@ def _jit(func: Callable) -> Callable:
     if isinstance(func, numba.core.registry.CPUDispatcher):
         return func
     if not callable(func):
-        raise TypeError(f"a rule must be a function, got {func!r}")
+        raise RuleError(f"a rule must be a function, got {func!r}")
     return numba.njit(func)
 
 
@@ -102,7 +102,7 @@ def _rule(func: Callable, fixed: tuple[str, ...], what: str, market: bool = Fals
     py = getattr(jitted, "py_func", jitted)
     sig = list(inspect.signature(py).parameters.values())
     if len(sig) < len(fixed):
-        raise TypeError(f"{what} {py.__name__} must take the arguments {', '.join(fixed)} first")
+        raise RuleError(f"{what} {py.__name__} must take the arguments {', '.join(fixed)} first")
     extra = sig[len(fixed):]
     wants_market = market and bool(extra) and extra[0].name == "market"
     if wants_market:
@@ -112,7 +112,7 @@ def _rule(func: Callable, fixed: tuple[str, ...], what: str, market: bool = Fals
         extra = extra[1:]
     for p in extra:
         if p.kind not in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD):
-            raise TypeError(f"{what} {py.__name__}: parameter {p.name} must be a plain positional argument")
+            raise RuleError(f"{what} {py.__name__}: parameter {p.name} must be a plain positional argument")
     defaults = {p.name: float(p.default) for p in extra if p.default is not p.empty}
     return Rule(jitted, tuple(p.name for p in extra), defaults, wants_rng, wants_market)
 
@@ -133,7 +133,7 @@ def register_behaviour(name: str, *, buy: Callable | str, sell: Callable | str, 
     behaviour then compile the path-aware terrain step (``engine.paths``); other runs never pay for it.
     """
     if name in _BEHAVIOURS and not replace:
-        raise ValueError(f"behaviour {name!r} is already registered (pass replace=True to override)")
+        raise RegistrationError(f"behaviour {name!r} is already registered (pass replace=True to override)")
     buy_rule = _BEHAVIOURS[buy].buy if isinstance(buy, str) else _rule(buy, BUY_ARGS, "buy rule")
     sell_rule = _BEHAVIOURS[sell].sell if isinstance(sell, str) else _rule(sell, SELL_ARGS, "sell rule")
     params: list[str] = []
@@ -144,7 +144,7 @@ def register_behaviour(name: str, *, buy: Callable | str, sell: Callable | str, 
                 params.append(p)
         for k, v in r.defaults.items():
             if k in defaults and defaults[k] != v:
-                raise ValueError(f"behaviour {name!r}: rules disagree on the default of {k!r}")
+                raise RegistrationError(f"behaviour {name!r}: rules disagree on the default of {k!r}")
             defaults[k] = v
     limits = dict(limits or {})
     for r in (buy, sell):
@@ -185,7 +185,7 @@ def register_payment(name: str, weights: Callable, *, description: str = "", lim
     ``rng``, if wanted, comes next.
     """
     if name in _PAYMENTS and not replace:
-        raise ValueError(f"payment scheme {name!r} is already registered (pass replace=True to override)")
+        raise RegistrationError(f"payment scheme {name!r} is already registered (pass replace=True to override)")
     spec = PaymentSpec(name, _rule(weights, PAY_ARGS, "payment rule", market=True), description,
                        dict(limits or {}))
     _PAYMENTS[name] = spec

@@ -1,4 +1,4 @@
-"""A slow, exact reference of the payment rules (MODEL.md section 5) in rational arithmetic.
+"""A slow, exact reference of the payment rules (docs/model.md §5) in rational arithmetic.
 
 The contract floors every share to a whole unit; this model does not round at all, so the tests can
 check the contract against the rules themselves (within the rounding bound), not against a copy of

@@ -66,7 +66,7 @@ def test_on_chain_balances_equal_the_simulated_ledger(capsys):
     """The issue's acceptance check, in short: a staking swarm with deposits, purchases and refusals,
     every one through the contract; every balance within its rounding bound of the simulation's."""
     load_experiment, simulate = _simulator()
-    from infomarket.chain.replay import replay_result
+    from infomarket.chain.evm_replay import replay_result
 
     result = simulate(demo_config(load_experiment("fig4C"), 5, 4000, "staking"), seed=2, record_events=True)
     kinds = result.events["kind"].value_counts()

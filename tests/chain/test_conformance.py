@@ -22,7 +22,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from infomarket.chain.market import MarketParams
-from infomarket.chain.replay import FLOAT_SLACK_UNITS, replay_on_chain
+from infomarket.chain.evm_replay import FLOAT_SLACK_UNITS, replay_on_chain
 from infomarket.chain.units import TOKEN_UNIT
 from infomarket.ledger.replay import replay_events
 

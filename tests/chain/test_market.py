@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 from infomarket.chain.errors import ContractRevert
 from infomarket.chain.protocol import FOOD, NEST, PathInfo
-from infomarket.chain.replay import FLOAT_SLACK_UNITS
+from infomarket.chain.evm_replay import FLOAT_SLACK_UNITS
 from infomarket.chain.units import TOKEN_UNIT, to_units
 
 from .exact_ledger import SELLER_POSITION, ExactLedger, vector_for

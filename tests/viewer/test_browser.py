@@ -19,7 +19,7 @@ from selenium.webdriver.chrome.service import Service
 from selenium.webdriver.common.action_chains import ActionChains
 from selenium.webdriver.common.by import By
 
-from infomarket.viewer.replay import record, write_html
+from infomarket.viewer.recording import record, write_html
 
 from .conftest import ServerThread, thousand_robots
 

@@ -7,7 +7,7 @@ from PIL import Image
 
 from infomarket.errors import ConfigError
 from infomarket.viewer import movie
-from infomarket.viewer.replay import record
+from infomarket.viewer.recording import record
 
 
 @pytest.fixture(scope="module")

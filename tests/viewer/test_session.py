@@ -5,6 +5,7 @@ import json
 
 import pytest
 
+from infomarket.seeds import MAX_SEED
 from infomarket.viewer.frames import decode
 from infomarket.viewer.session import MAX_SPEED, Command, CommandError, Session, parse_command
 
@@ -18,6 +19,8 @@ from infomarket.viewer.session import MAX_SPEED, Command, CommandError, Session,
     ({"cmd": "speed", "value": MAX_SPEED}, Command("speed", MAX_SPEED)),
     ({"cmd": "restart"}, Command("restart", None)),
     ({"cmd": "restart", "seed": 9}, Command("restart", 9)),
+    ({"cmd": "restart", "seed": MAX_SEED}, Command("restart", MAX_SEED)),
+    ({"cmd": "restart", "seed": str(MAX_SEED)}, Command("restart", MAX_SEED)),  # the page sends text
     ({"cmd": "select", "robot": 0}, Command("select", 0)),
     ({"cmd": "select", "robot": None}, Command("select", None)),
 ])
@@ -38,6 +41,9 @@ def test_valid_commands(msg, want):
     ('{"cmd": "select", "robot": -1}', "select: robot must be an integer in [0, 24], got -1"),
     ('{"cmd": "select", "robot": "3"}', "got '3'"),
     ('{"cmd": "restart", "seed": false}', "restart: seed must be an integer"),
+    (f'{{"cmd": "restart", "seed": {MAX_SEED + 1}}}', f"restart: seed must be an integer in [0, {MAX_SEED}]"),
+    ('{"cmd": "restart", "seed": "-3"}', "restart: seed must be an integer in [0, "),
+    ('{"cmd": "restart", "seed": "7a"}', "got '7a'"),
 ])
 def test_invalid_commands_say_why(text, why):
     with pytest.raises(CommandError) as err:
@@ -58,3 +64,12 @@ def test_session_steps_restarts_and_reports(fig2b):
     assert s.sim.clock == 0 and s.seed != 4 and s.scene()["seed"] == s.seed
     s.restart(4)
     assert s.seed == 4
+
+
+def test_a_random_seed_spans_the_whole_seed_range(fig2b, monkeypatch):
+    """The viewer draws its seeds from [0, MAX_SEED] (infomarket.seeds), the range of every other seed."""
+    import infomarket.viewer.session as session
+    drawn = []
+    monkeypatch.setattr(session.secrets, "randbelow", lambda n: drawn.append(n) or n - 1)
+    s = Session(fig2b)
+    assert drawn == [MAX_SEED + 1] and s.seed == MAX_SEED and s.scene()["seed_text"] == str(MAX_SEED)

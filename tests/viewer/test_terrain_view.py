@@ -9,7 +9,7 @@ import infomarket as im
 from infomarket.engine import Simulation
 from infomarket.viewer import movie
 from infomarket.viewer.frames import scene
-from infomarket.viewer.replay import record, write_html
+from infomarket.viewer.recording import record, write_html
 
 OBSTACLES = [{"shape": "rect", "x0": 400.0, "y0": 350.0, "x1": 500.0, "y1": 550.0},
              {"shape": "circle", "x": 850.0, "y": 150.0, "radius": 40.0},

@@ -4,7 +4,7 @@ All helpers are compiled functions over the world tuple ``w`` (fields in ``engin
 written with them runs inside the compiled step loop.  Sites are 0 (food) and 1 (nest); vectors are in
 the calling robot's own frame (x axis along its heading).
 
-Timing (MODEL.md §3): during the communication phase sellers sell from the table they had at the start
+Timing (docs/model.md §3): during the communication phase sellers sell from the table they had at the start
 of the step (``own_entry``), while a buyer's purchases go into its new table (``current`` / ``install``
 / ``combine``), which it starts using when it moves.  Stakes and the pending list change at once.
 """

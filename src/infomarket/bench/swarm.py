@@ -14,6 +14,7 @@ import sys
 
 from ..config import load_experiment
 from ..config.schema import Experiment
+from ..errors import SimulationError
 
 
 def scaled_config(robots: int, steps: int, base: str = "fig2A") -> Experiment:
@@ -65,7 +66,7 @@ def run_swarm_sizes(sizes: list[int], steps: int, on_done=None) -> dict:
         proc = subprocess.run([sys.executable, "-m", "infomarket.bench.swarm", str(n), str(steps)],
                               capture_output=True, text=True)
         if proc.returncode != 0:
-            raise RuntimeError(f"bench of {n} robots failed:\n{proc.stderr.strip()[-2000:]}")
+            raise SimulationError(f"bench of {n} robots failed:\n{proc.stderr.strip()[-2000:]}")
         out[n] = json.loads(proc.stdout.strip().splitlines()[-1])
         if on_done:
             on_done(n, out[n])

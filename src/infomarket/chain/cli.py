@@ -5,7 +5,7 @@ contract (the seller's offer and the buyer's acceptance signed with their own ke
 by its seller, each refused purchase is checked to be refused by the contract too, and each deposit
 is a ``buyItem`` by the market account. The command prints the gas and blocks this took and compares
 every robot's on-chain balance with its wealth in the simulation (exit status 1 if any differs by more
-than the fixed-point rounding allows, see ``replay``).
+than the fixed-point rounding allows, see ``evm_replay``).
 
 ``add_subcommand(subparsers)`` hangs ``chain demo`` under the main ``infomarket`` parser; the chosen
 handler is stored as ``func`` (``args.func(args)`` returns the exit status). Heavy imports (the
@@ -78,7 +78,7 @@ def run_demo(args: argparse.Namespace) -> int:
         from ..errors import ConfigError
         from .errors import ChainError
         from .market import connect
-        from .replay import replay_result
+        from .evm_replay import replay_result
     except ImportError as exc:
         return report_error(f"infomarket chain needs the chain extra (pip install 'infomarket[chain]'): {exc}", 1)
     try:
@@ -86,7 +86,7 @@ def run_demo(args: argparse.Namespace) -> int:
         if args.rpc:
             connect(args.rpc)  # fail before simulating if the node is not there
         if config.payment.scheme == "outlier" and config.payment_params()["theta"] > 180:
-            raise ValueError("the contract needs theta in [0, 180] degrees")
+            raise ConfigError("the contract needs theta in [0, 180] degrees")
     except (ConfigError, ValueError, ChainError) as exc:
         return report_error(exc, 2)
     composition = ", ".join(f"{g.count} {g.behaviour}" for g in config.swarm.groups if g.count)

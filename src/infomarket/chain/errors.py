@@ -14,6 +14,10 @@ class ChainError(InfomarketError, RuntimeError):
     """Something went wrong talking to the chain (no node, no funded account, bad artifact...)."""
 
 
+class UnitsError(ChainError, ValueError):
+    """A value does not fit the contract's fixed-point integer units (e.g. a coordinate beyond int64)."""
+
+
 class ContractRevert(ChainError):
     """The contract refused a call with one of its custom errors (``name``, ``args``)."""
 

@@ -26,6 +26,7 @@ from eth_account.signers.local import LocalAccount
 from eth_utils import keccak, to_checksum_address
 from eth_utils.abi import event_abi_to_log_topic, function_abi_to_4byte_selector, get_abi_input_types, get_abi_output_types
 
+from ..errors import ConfigError
 from ..payments import default_theta
 from .backends import Receipt, RevertedCall, make_backend
 from .errors import ChainError, ContractRevert
@@ -52,7 +53,7 @@ def load_artifact() -> dict:
 def cos_theta(theta_deg: float) -> int:
     """cos(theta) in the contract's fixed point (1e-9), nearest."""
     if not 0.0 <= theta_deg <= 180.0:
-        raise ValueError(f"theta must be in [0, 180] degrees, not {theta_deg}")
+        raise ConfigError(f"theta must be in [0, 180] degrees, not {theta_deg}")
     return round(math.cos(math.radians(theta_deg)) * COS_SCALE)
 
 
@@ -76,7 +77,7 @@ class MarketParams:
                     max_records_per_seller: int = DEFAULT_MAX_RECORDS_PER_SELLER,
                     max_validity: int = DEFAULT_MAX_VALIDITY, settle_batch: int = DEFAULT_SETTLE_BATCH) -> MarketParams:
         if scheme not in SCHEMES:
-            raise ValueError(f"scheme must be one of {sorted(SCHEMES)}, not {scheme!r}")
+            raise ConfigError(f"scheme must be one of {sorted(SCHEMES)}, not {scheme!r}")
         theta = default_theta() if theta_deg is None else theta_deg  # the outlier rule's own default
         return cls(scheme, to_units(reward), share_to_wad(information_share), to_units(stake),
                    cos_theta(theta), stake_expiry, max_records_per_seller, max_validity, settle_batch)

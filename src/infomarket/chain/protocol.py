@@ -1,4 +1,4 @@
-"""The off-chain half of a sale: the light contract (paper, Methods, last section; MODEL.md section 9).
+"""The off-chain half of a sale: the light contract (paper, Methods, last section; docs/model.md §9).
 
 1. The seller, having sensed the buyer's relative pose, computes the path information in the buyer's
    frame (``path_in_buyer_frame``), commits to it with a salted hash, and signs an ``Offer`` (site,
@@ -218,7 +218,7 @@ def accept_offer(buyer_key: bytes, domain: Domain, offer: Offer, offer_signature
 
 def path_in_buyer_frame(vector: tuple[float, float], heading_offset_deg: float,
                         seller_position: tuple[float, float]) -> tuple[float, float]:
-    """What the seller reveals (MODEL.md section 4): its vector rotated into the buyer's frame by
+    """What the seller reveals (docs/model.md §4): its vector rotated into the buyer's frame by
     ``heading_seller - heading_buyer``, plus its own position in the buyer's frame, as ``(x, y)``.
     The contract subtracts the position again to get the rotated vector the outlier rule compares.
     """

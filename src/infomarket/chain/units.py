@@ -19,6 +19,8 @@ from __future__ import annotations
 
 from decimal import Decimal
 
+from .errors import UnitsError
+
 TOKEN_UNIT = 10**9
 WAD = 10**18
 MICRO = 10**6
@@ -56,5 +58,5 @@ def to_micro(coordinate: float) -> int:
     """Position coordinate -> signed micro units; refuses what does not fit the contract's int64."""
     value = int((_exact(coordinate) * MICRO).to_integral_value())
     if not -_INT64 <= value < _INT64:
-        raise ValueError(f"coordinate {coordinate} does not fit in int64 micro units")
+        raise UnitsError(f"coordinate {coordinate} does not fit in int64 micro units")
     return value

@@ -1,4 +1,4 @@
-"""The original simulator's JSON configuration format (MODEL.md §10), translated to ours.
+"""The original simulator's JSON configuration format (docs/model.md §10), translated to ours.
 
 Users of the original bring their files unchanged; every key is mapped or knowingly ignored, and an
 unknown key is an error like in our own format.

@@ -12,6 +12,8 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
+from ..errors import ConfigError
+
 #: Outputs every design can name without defining them (one value per run; ``runner.design`` says how).
 BUILTIN_OUTPUTS = {
     "items": "items collected by the whole swarm after the transitory period",
@@ -62,29 +64,29 @@ class Sample(_Strict):
         for key in self.bounds:
             r = self.bound(key).range
             if len(r) != 2:
-                raise ValueError(f"bounds.{key}: a range is [low, high], got {len(r)} number(s)")
+                raise ConfigError(f"bounds.{key}: a range is [low, high], got {len(r)} number(s)")
             if not r[0] < r[1]:
-                raise ValueError(f"bounds.{key}: empty or inverted range [{r[0]}, {r[1]}]; "
+                raise ConfigError(f"bounds.{key}: empty or inverted range [{r[0]}, {r[1]}]; "
                                  f"the low end must be below the high end")
         n, d = self.samples, len(self.bounds)
         if self.method == "sobol" and (n < 2 or n & (n - 1)):
             lower = 2 ** max(1, int(math.log2(n)))
-            raise ValueError(f"samples = {n}: Sobol' designs need a power of 2 (at least 2), e.g. {lower} or "
+            raise ConfigError(f"samples = {n}: Sobol' designs need a power of 2 (at least 2), e.g. {lower} or "
                              f"{2 * lower}")
         if self.method == "morris":
             if n < 2:
-                raise ValueError(f"samples = {n}: Morris needs at least 2 trajectories")
+                raise ConfigError(f"samples = {n}: Morris needs at least 2 trajectories")
             if self.levels % 2:
-                raise ValueError(f"levels = {self.levels}: Morris needs an even number of levels")
+                raise ConfigError(f"levels = {self.levels}: Morris needs an even number of levels")
         if self.method == "lhs" and n <= 2 * RBD_HARMONICS:
-            raise ValueError(f"samples = {n}: a Latin hypercube is analysed with RBD-FAST "
+            raise ConfigError(f"samples = {n}: a Latin hypercube is analysed with RBD-FAST "
                              f"({RBD_HARMONICS} harmonics), which needs more than {2 * RBD_HARMONICS} samples")
         if self.method == "sobol" and d < 2:
-            raise ValueError("Sobol' indices need at least 2 sampled keys")
+            raise ConfigError("Sobol' indices need at least 2 sampled keys")
         for name in self.outputs:
             if name not in BUILTIN_OUTPUTS and name not in self.custom:
-                raise ValueError(f"outputs: unknown output {name!r}; built in: {', '.join(BUILTIN_OUTPUTS)}; "
+                raise ConfigError(f"outputs: unknown output {name!r}; built in: {', '.join(BUILTIN_OUTPUTS)}; "
                                  f"or define it under [sweep.sample.custom.{name}]")
         if len(set(self.outputs)) != len(self.outputs):
-            raise ValueError("outputs: an output is named twice")
+            raise ConfigError("outputs: an output is named twice")
         return self

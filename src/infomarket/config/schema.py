@@ -3,7 +3,7 @@
 Validation happens here, before anything runs: unknown keys, wrong types and impossible values are
 all reported with the key's path (``swarm.groups[0].count``) and what is allowed (``config.load`` turns
 them into one ``errors.ConfigError``), and so is a configuration whose memory need exceeds the limit
-(``config.sizes``).  Defaults are the values of MODEL.md §1 that produced the paper's figures; ``swarm``
+(``config.sizes``).  Defaults are the values of docs/model.md §1 that produced the paper's figures; ``swarm``
 has none and is required.
 """
 from __future__ import annotations
@@ -15,6 +15,7 @@ from typing import Annotated, Any, Literal, Union
 from pydantic import BaseModel, StrictBool, ConfigDict, Field, ValidationInfo, field_validator, model_validator
 
 from .. import plugins
+from ..errors import ConfigError
 from ..registry import behaviours, payments
 from . import sizes, terrain
 from .sample import Sample
@@ -56,7 +57,7 @@ class Rect(_Strict):
     @model_validator(mode="after")
     def _ordered(self) -> "Rect":
         if not (self.x0 < self.x1 and self.y0 < self.y1):
-            raise ValueError(f"a rect needs x0 < x1 and y0 < y1, got ({self.x0}, {self.y0}) - ({self.x1}, {self.y1})")
+            raise ConfigError(f"a rect needs x0 < x1 and y0 < y1, got ({self.x0}, {self.y0}) - ({self.x1}, {self.y1})")
         return self
 
 
@@ -81,7 +82,7 @@ class Segment(_Strict):
     @model_validator(mode="after")
     def _long(self) -> "Segment":
         if self.x0 == self.x1 and self.y0 == self.y1:
-            raise ValueError(f"a segment needs two different end points, got ({self.x0}, {self.y0}) twice")
+            raise ConfigError(f"a segment needs two different end points, got ({self.x0}, {self.y0}) twice")
         return self
 
 
@@ -126,11 +127,11 @@ class Swarm(_Strict):
     def _counts(self) -> "Swarm":
         for k, g in enumerate(self.groups):
             if g.count > self.robots:
-                raise ValueError(f"groups[{k}].count = {g.count} is more robots of {g.behaviour!r} than "
+                raise ConfigError(f"groups[{k}].count = {g.count} is more robots of {g.behaviour!r} than "
                                  f"the swarm has (robots = {self.robots})")
         total = sum(g.count for g in self.groups)
         if total != self.robots:
-            raise ValueError(f"the group counts add up to {total} but robots = {self.robots}; they must be equal")
+            raise ConfigError(f"the group counts add up to {total} but robots = {self.robots}; they must be equal")
         return self
 
 
@@ -165,15 +166,15 @@ class Sweep(_Strict):
     @model_validator(mode="after")
     def _not_empty(self) -> "Sweep":
         if self.sample is not None and (self.grid or self.axes):
-            raise ValueError("a sweep has either a grid and axes or a sample design, not both")
+            raise ConfigError("a sweep has either a grid and axes or a sample design, not both")
         if not self.grid and not self.axes and self.sample is None:
-            raise ValueError("a sweep needs a grid or axes with at least one key, or a [sweep.sample] design")
+            raise ConfigError("a sweep needs a grid or axes with at least one key, or a [sweep.sample] design")
         for key, values in self.grid.items():
             if not values:
-                raise ValueError(f"grid.{key}: empty list of values")
+                raise ConfigError(f"grid.{key}: empty list of values")
         for name, values in self.axes.items():
             if not values:
-                raise ValueError(f"axes.{name}: empty list of values")
+                raise ConfigError(f"axes.{name}: empty list of values")
         return self
 
 
@@ -207,60 +208,60 @@ class Experiment(_Strict):
             try:
                 plugins.load(e)
             except Exception as exc:  # a plugin's own error is the user's to see, in one line
-                raise ValueError(f"cannot load plugin {e!r}: {type(exc).__name__}: {exc}") from None
+                raise ConfigError(f"cannot load plugin {e!r}: {type(exc).__name__}: {exc}") from None
         return resolved
 
     @model_validator(mode="after")
     def _coherent(self) -> "Experiment":
         if self.transitory >= self.steps:
-            raise ValueError(f"transitory = {self.transitory} must be smaller than steps = {self.steps}")
+            raise ConfigError(f"transitory = {self.transitory} must be smaller than steps = {self.steps}")
         w, h, r = self.arena.width, self.arena.height, self.robot.radius
         if w - 1 - 2 * r < 0 or h - 1 - 2 * r < 0:
-            raise ValueError(f"the arena ({w} x {h}) is too small for robots of radius {r}")
+            raise ConfigError(f"the arena ({w} x {h}) is too small for robots of radius {r}")
         for key in ("food", "nest"):
             for label, s in self._labelled_sites(key):
                 if s.x - s.radius < 0 or s.x + s.radius > w or s.y - s.radius < 0 or s.y + s.radius > h:
-                    raise ValueError(f"{label} site at ({s.x}, {s.y}) with radius {s.radius} lies outside the "
+                    raise ConfigError(f"{label} site at ({s.x}, {s.y}) with radius {s.radius} lies outside the "
                                      f"arena [0, {w}] x [0, {h}]")
         why = terrain.site_overlap(self)
         if why:
-            raise ValueError(why)
+            raise ConfigError(why)
         if self.history_every > self.steps:
-            raise ValueError(f"history_every = {self.history_every} must be at most steps = {self.steps}")
+            raise ConfigError(f"history_every = {self.history_every} must be at most steps = {self.steps}")
         known = behaviours()
         for k, g in enumerate(self.swarm.groups):
             if g.behaviour not in known:
-                raise ValueError(f"swarm.groups[{k}].behaviour: unknown behaviour {g.behaviour!r}; "
+                raise ConfigError(f"swarm.groups[{k}].behaviour: unknown behaviour {g.behaviour!r}; "
                                  f"allowed: {', '.join(sorted(known))}")
             allowed = known[g.behaviour].params
             for p, v in g.params.items():
                 if p not in allowed:
-                    raise ValueError(f"swarm.groups[{k}].params: {g.behaviour!r} has no parameter {p!r}; "
+                    raise ConfigError(f"swarm.groups[{k}].params: {g.behaviour!r} has no parameter {p!r}; "
                                      f"allowed: {', '.join(allowed) or 'none'}")
                 why = known[g.behaviour].check(p, v)
                 if why:
-                    raise ValueError(f"swarm.groups[{k}].params.{p} = {v}: {why}")
+                    raise ConfigError(f"swarm.groups[{k}].params.{p} = {v}: {why}")
             missing = [p for p in allowed if p not in g.params and p not in known[g.behaviour].defaults]
             if missing:
-                raise ValueError(f"swarm.groups[{k}].params: {g.behaviour!r} needs {', '.join(missing)}")
+                raise ConfigError(f"swarm.groups[{k}].params: {g.behaviour!r} needs {', '.join(missing)}")
         schemes = payments()
         if self.payment.scheme not in schemes:
-            raise ValueError(f"payment.scheme: unknown scheme {self.payment.scheme!r}; "
+            raise ConfigError(f"payment.scheme: unknown scheme {self.payment.scheme!r}; "
                              f"allowed: {', '.join(sorted(schemes))}")
         spec = schemes[self.payment.scheme]
         for p, v in self.payment.params.items():
             if p not in spec.params:
-                raise ValueError(f"payment.params: scheme {spec.name!r} has no parameter {p!r}; "
+                raise ConfigError(f"payment.params: scheme {spec.name!r} has no parameter {p!r}; "
                                  f"allowed: {', '.join(spec.params) or 'none'}")
             why = spec.check(p, v)
             if why:
-                raise ValueError(f"payment.params.{p} = {v}: {why}")
+                raise ConfigError(f"payment.params.{p} = {v}: {why}")
         missing = [p for p in spec.params if p not in self.payment.params and p not in spec.defaults]
         if missing:
-            raise ValueError(f"payment.params: scheme {spec.name!r} needs {', '.join(missing)}")
+            raise ConfigError(f"payment.params: scheme {spec.name!r} needs {', '.join(missing)}")
         too_big = sizes.run_too_big(self)
         if too_big:
-            raise ValueError(too_big)
+            raise ConfigError(too_big)
         return self
 
     # ------------------------------------------------------------------ derived views

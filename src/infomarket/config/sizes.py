@@ -1,6 +1,6 @@
 """How much memory a configuration needs, checked before any of it is spent.
 
-The estimate follows the engine's O(n) layout (MODEL.md §9): per robot, a few hundred bytes of O(1) state
+The estimate follows the engine's O(n) layout (``engine.world``): per robot, a few hundred bytes of O(1) state
 and O(k) buffers (neighbours, pending transactions, offers), with k bounded by how many robots fit in
 communication range; a neighbour grid; the Lévy step-length table, 16 bytes × (steps + 1); the wealth
 history, 8 bytes × robots × steps / history_every (and its long table); the event log when recorded.
@@ -15,6 +15,8 @@ from __future__ import annotations
 import math
 import os
 import re
+
+from ..errors import ConfigError
 
 ENV = "INFOMARKET_MEMORY_LIMIT"
 ROBOT_BYTES = 1200           # O(1) per-robot state (~480 B: engine.world) + its first 16-entry transaction block (40 B each)
@@ -32,17 +34,19 @@ _UNITS = {"": 1, "b": 1, "k": 10**3, "kb": 10**3, "m": 10**6, "mb": 10**6, "g": 
 
 def human(n: float) -> str:
     """Bytes in binary units, e.g. ``7.3 TiB``."""
-    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB"):
-        if abs(n) < 1024 or unit == "PiB":
-            return f"{n:.0f} {unit}" if unit == "B" else f"{n:.1f} {unit}"
+    if abs(n) < 1024:
+        return f"{n:.0f} B"
+    for unit in ("KiB", "MiB", "GiB", "TiB"):
         n /= 1024
-    raise AssertionError  # pragma: no cover
+        if abs(n) < 1024:
+            return f"{n:.1f} {unit}"
+    return f"{n / 1024:.1f} PiB"
 
 
 def parse_bytes(text: str) -> int:
     m = re.fullmatch(r"\s*([0-9]+(?:\.[0-9]+)?)\s*([a-zA-Z]*)\s*", text)
     if not m or m.group(2).lower() not in _UNITS:
-        raise ValueError(f"{ENV}={text!r}: expected a size like 64GiB, 500MB or a number of bytes")
+        raise ConfigError(f"{ENV}={text!r}: expected a size like 64GiB, 500MB or a number of bytes")
     return int(float(m.group(1)) * _UNITS[m.group(2).lower()])
 
 

@@ -1,7 +1,7 @@
 """Payment schemes: weight rules over a buyer's open transactions (registered by ``infomarket.builtins``
 through the public ``register_payment``)."""
 
-#: The paper's stake (MODEL.md §5).
+#: The paper's stake (docs/model.md §5).
 PAPER_STAKE = 0.04
 #: The paper's three markets by name: (scheme, stake).
 MARKETS = {"delayed": ("delayed", 0.0), "outlier": ("outlier", 0.0), "staking": ("outlier", PAPER_STAKE)}

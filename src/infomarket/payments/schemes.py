@@ -1,4 +1,4 @@
-"""Built-in payment schemes (MODEL.md §5), registered through the public ``register_payment``.
+"""Built-in payment schemes (docs/model.md §5), registered through the public ``register_payment``.
 
 A scheme only weighs the buyer's transactions; the ledger moves the money (``ledger.kernels.distribute``).
 Staking is a ledger setting (``payment.stake``), so any scheme can be run with or without it.

@@ -2,7 +2,7 @@
 
 The model never runs in the browser.  The server (``server``) steps an ``infomarket.Simulation`` in
 Python, one per browser connection (``session``), and streams compact binary frames (``frames``) over a
-WebSocket; the page (``static/``) only draws them.  A replay (``replay``) is the same page with the
+WebSocket; the page (``static/``) only draws them.  A replay (``recording``) is the same page with the
 frames of a finished run embedded in one HTML file, and a movie (``movie``) draws those frames with
 matplotlib.  Nothing here writes to the simulation: the viewer is read-only.
 """

@@ -91,7 +91,7 @@ class _Ticker:
 
 
 def cmd_replay(args) -> int:
-    from .replay import record, write_html
+    from .recording import record, write_html
 
     if not args.out and not args.movie:
         raise UsageError("replay: say what to write: --out FILE.html, --movie FILE.mp4 (or .gif), or both")

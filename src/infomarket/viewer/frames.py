@@ -18,6 +18,7 @@ import numpy as np
 
 from ..engine import geometry as kernels  # to_world: the robot-frame rotation the engine uses
 from ..engine.world import EVENT_NAMES, FOOD, NEST, SITE_NAMES, STATE_NAMES, headings, open_transactions
+from ..errors import FormatError
 from ..registry import behaviours
 
 #: The engine's own robot-frame -> world rotation, as plain Python (it also takes arrays of robots).
@@ -62,6 +63,7 @@ def scene(sim) -> dict:
         "name": cfg.name,
         "description": cfg.description,
         "seed": sim.seed,
+        "seed_text": str(sim.seed),  # exact in the page (a JavaScript number rounds a seed above 2**53)
         "steps": cfg.steps,
         "scheme": cfg.payment.scheme,
         "arena": {"width": cfg.arena.width, "height": cfg.arena.height},
@@ -129,7 +131,7 @@ class Frame:
 def decode(data: bytes, n: int) -> Frame:
     """Inverse of ``encode`` for a swarm of ``n`` robots (what the page does, in Python)."""
     if len(data) != frame_size(n):
-        raise ValueError(f"a frame of {n} robots has {frame_size(n)} bytes, got {len(data)}")
+        raise FormatError(f"a frame of {n} robots has {frame_size(n)} bytes, got {len(data)}")
     head = np.frombuffer(data, "<f8", len(HEADER))
     offset, cols = 8 * len(HEADER), {}
     for c, t in COLUMNS:

@@ -15,7 +15,7 @@ import numpy as np
 
 from ..errors import ConfigError
 from .frames import CARRYING, LAST_FOOD, LAST_NEST
-from .replay import Recording
+from .recording import Recording
 
 HONEST, BYZANTINE = "#2f6fd6", "#d62f2f"
 SITE_COLOURS = {"food": "#2ca02c", "nest": "#e8b100"}

@@ -29,7 +29,7 @@ from aiohttp import WSCloseCode, WSMsgType, web
 
 from .. import __version__
 from ..config.schema import Experiment
-from ..errors import InfomarketError
+from ..errors import InfomarketError, InternalError
 from . import DEFAULT_PORT, STATIC
 from .session import CommandError, Session, parse_command
 
@@ -223,7 +223,7 @@ def bind(host: str, port: int) -> tuple[socket.socket, bool]:
             continue
         sock.listen(128)
         return sock, bool(port) and p != port
-    raise AssertionError("unreachable")
+    raise InternalError("bind: the last try (port 0) either binds or raises")  # unreachable
 
 
 async def serve(config: Experiment, seed: int | None = None, *, port: int = DEFAULT_PORT,

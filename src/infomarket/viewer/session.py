@@ -26,15 +26,16 @@ from dataclasses import dataclass, field
 
 from ..config.schema import Experiment
 from ..engine import Simulation
+from ..errors import InfomarketError
+from ..seeds import MAX_SEED
 from .frames import encode, honest_mask, robot_detail, scene
 
 DEFAULT_SPEED = 10
 MAX_SPEED = 1000
 MAX_STEP = 10_000  # one command stays short, so Ctrl-C never waits long for a worker thread
-MAX_SEED = 2**32 - 1
 
 
-class CommandError(ValueError):
+class CommandError(InfomarketError, ValueError):
     """A message from the page that cannot be carried out; its text goes back to the page."""
 
 
@@ -69,6 +70,8 @@ def parse_command(text: str | bytes, robots: int) -> Command:
     if cmd == "speed":
         return Command(cmd, _int(msg, "value", 1, MAX_SPEED))
     if cmd == "restart":
+        if isinstance(msg.get("seed"), str) and msg["seed"].isascii() and msg["seed"].isdigit():
+            msg = {**msg, "seed": int(msg["seed"])}  # the page sends seeds as text: JavaScript numbers stop at 2**53
         return Command(cmd, _int(msg, "seed", 0, MAX_SEED, optional=True))
     if cmd == "select":
         return Command(cmd, _int(msg, "robot", 0, robots - 1, optional=True))
@@ -95,7 +98,7 @@ class Session:
 
     def restart(self, seed: int | None = None) -> None:
         """A fresh swarm from step 0; a random seed unless one is given."""
-        self.seed = secrets.randbelow(MAX_SEED) if seed is None else int(seed)
+        self.seed = secrets.randbelow(MAX_SEED + 1) if seed is None else int(seed)
         self.sim = Simulation(self.config, self.seed, record_events=True)
         self._honest = honest_mask(self.sim)
 

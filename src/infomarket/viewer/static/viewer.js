@@ -1,7 +1,7 @@
 /* infomarket viewer: draws frames that the Python engine computed; it simulates nothing itself.
  *
  * Two sources feed the same drawing code: a live server (WebSocket at ./ws, see viewer/server.py) and
- * a replay whose frames are embedded in the page (<script id="infomarket-replay">, see viewer/replay.py).
+ * a replay whose frames are embedded in the page (<script id="infomarket-replay">, see viewer/recording.py).
  * A frame is binary: float64 header numbers, then one little-endian column per robot attribute, laid
  * out as the scene's "columns" say (viewer/frames.py); we wrap each column in a typed-array view.
  * Tests and curious users read the page's state through window.infomarketViewer.
@@ -81,9 +81,9 @@
     if (obstacles.length) terrain.push(`${obstacles.length} obstacle${obstacles.length > 1 ? "s" : ""}`);
     if (scene.robot.collisions) terrain.push("collisions");
     if (scene.robot.line_of_sight) terrain.push("line of sight");
-    $("subtitle").textContent = `${groups} · ${scene.scheme} payment · seed ${scene.seed}` +
+    $("subtitle").textContent = `${groups} · ${scene.scheme} payment · seed ${scene.seed_text ?? scene.seed}` +
       terrain.map((t) => ` · ${t}`).join("");
-    if (V.mode === "live") $("seed").placeholder = `random (now ${scene.seed})`;
+    if (V.mode === "live") $("seed").placeholder = `random (now ${scene.seed_text ?? scene.seed})`;
     fit();
   }
 
@@ -528,7 +528,7 @@
     $("speed").onchange = () => V.source && V.source.speed(Number($("speed").value));
     $("restart").onclick = () => {
       const text = $("seed").value.trim();
-      if (V.source && V.source.restart) V.source.restart(text === "" ? null : Number(text));
+      if (V.source && V.source.restart) V.source.restart(text === "" ? null : text);  // as text: seeds go up to 2**63 - 1
     };
     $("comm").onchange = () => { V.showComm = $("comm").checked; V.dirty = true; };
     arena.addEventListener("click", (ev) => {

@@ -21,6 +21,7 @@ import numpy as np
 from .. import __version__
 from ..config.schema import Experiment
 from ..engine import Simulation
+from ..errors import InternalError
 from . import STATIC
 from .frames import Frame, decode, encode, event_columns, frame_size, honest_mask, scene
 
@@ -71,7 +72,7 @@ def _pack(data: bytes) -> str:
 
 def _inline(page: str, old: str, new: str) -> str:
     if page.count(old) != 1:
-        raise RuntimeError(f"viewer page template changed: expected one {old!r}")  # a packaging defect
+        raise InternalError(f"viewer page template changed: expected one {old!r}")  # a packaging defect
     return page.replace(old, new)
 
 

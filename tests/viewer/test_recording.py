@@ -11,7 +11,7 @@ import pytest
 
 import infomarket as im
 from infomarket.viewer.frames import encode, frame_size
-from infomarket.viewer.replay import default_every, record, write_html
+from infomarket.viewer.recording import default_every, record, write_html
 
 
 @pytest.fixture(scope="module")

@@ -9,7 +9,7 @@ import pytest
 
 from infomarket.chain.errors import ChainError
 from infomarket.chain.market import MarketParams
-from infomarket.chain.replay import BalanceRow, replay_on_chain
+from infomarket.chain.evm_replay import BalanceRow, replay_on_chain
 
 from .exact_ledger import SELLER_POSITION, ExactLedger, vector_for
 

@@ -1,6 +1,6 @@
-"""Replay a simulator's event log through the contract, and compare the two ledgers.
+"""Replay a simulated swarm's event log on the EVM, through the contract, and compare the two ledgers.
 
-The simulator's ledger and the contract implement the same rules (MODEL.md section 5) in floats and
+The simulator's ledger and the contract implement the same rules (docs/model.md §5) in floats and
 in fixed point. Feeding the contract the same events (every purchase as a real light contract
 revealed by its seller, every deposit as the market's ``buyItem``) and comparing every robot's final
 balance is the conformance check between the two backends.
@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 from statistics import mean
 
 from ..engine.world import SITE_NAMES
+from ..errors import ArgumentError
 from ..payments import default_theta
 from .errors import ChainError, ContractRevert
 from .market import SCHEMES, ChainMarket, MarketParams, connect, derived_account
@@ -88,7 +89,7 @@ class ReplayReport:
     def compare(self, expected: Sequence[float]) -> list[BalanceRow]:
         """Each robot's on-chain balance against ``expected`` (the simulated ledger's, in tokens)."""
         if len(expected) != self.robots:
-            raise ValueError(f"expected {self.robots} balances, got {len(expected)}")
+            raise ArgumentError(f"expected {self.robots} balances, got {len(expected)}")
         return [BalanceRow(i, self.balances[i], float(expected[i]), self.rounding_bound[i])
                 for i in range(self.robots)]
 
