@@ -156,10 +156,13 @@ class Store:
                 (self.root / t).mkdir(exist_ok=True)
             return self
         self.refuse_foreign()
-        for t in TABLES:
-            (self.root / t).mkdir(parents=True, exist_ok=True)
+        self.root.mkdir(parents=True, exist_ok=True)
+        # store.json first: a folder holding only it (and the lock) reads as a store being created, so a
+        # second writer racing this one is refused by the lock, not taken for a foreign folder
         self._write_meta({"format": FORMAT, "package_version": __version__,
                           "created": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "seeds": {}})
+        for t in TABLES:
+            (self.root / t).mkdir(exist_ok=True)
         return self
 
     def foreign(self) -> list[Path]:
