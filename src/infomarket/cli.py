@@ -64,9 +64,8 @@ def cmd_run(args) -> int:
         kept = f", {done.skipped} already there" if done.skipped else ""
         print(f"wrote the results store {out}: {done.done} run(s) of {cfg.name}{kept} "
               f"(`infomarket figures {out}`, `infomarket store verify {out}`)")
-        seconds = float(res.store.runs().query("experiment == @cfg.name and condition == 'base'").duration_s.sum())
-        if done.done and seconds > 0:
-            print(f"{done.env_steps / seconds:,.0f} env-steps/s per core "
+        if done.done and done.run_seconds > 0:
+            print(f"{done.env_steps / done.run_seconds:,.0f} env-steps/s per core "
                   f"(compile/load {done.compile_seconds:.2f} s)")
     if done.failed:
         return report(f"{done.failed} of {done.done} runs failed (the first: {done.first_error}); every error "

@@ -139,3 +139,29 @@ def test_bad_input_writes_nothing(tmp_path, capsys):
     assert main(["run", "fig2B", "--runs", "1", "--steps", "10", "--out", str(f)]) == 2
     assert "exists and is not a directory" in capsys.readouterr().err and f.read_text() == "x"
     assert not out.exists()
+
+
+def test_ctrl_c_stops_a_process_pool_run_at_once(tmp_path):
+    """Ctrl-C reaches the run and its pool workers (one process group, as from a terminal): the workers
+    are ended at once rather than after the tasks already queued to them, finished runs are kept."""
+    out = tmp_path / "D"
+    proc = subprocess.Popen([sys.executable, "-m", "infomarket.cli", "run", "fig2B", "--runs", "2000", "--steps",
+                             "60000", "--workers", "2", "--out", str(out)],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True,
+                            env={**os.environ, "PYTHONPATH": str(Path(im.__file__).parents[1])})
+    deadline = time.monotonic() + 180
+    while not (out / "store.json").exists() and time.monotonic() < deadline:
+        time.sleep(0.05)
+    time.sleep(3)  # the workers are busy with their first tasks of 16 runs, and one more is queued to each
+    assert proc.poll() is None, proc.communicate()
+    t0 = time.monotonic()
+    err = _interrupt(proc)
+    stopped = time.monotonic() - t0
+    assert err.startswith("infomarket: error: interrupted") and err.count("\n") == 1
+    with pytest.raises(ProcessLookupError):
+        os.killpg(proc.pid, 0)  # no worker left behind
+    kept = Store(out).runs()
+    assert kept.empty or not kept.run.duplicated().any()
+    # a task is 16 runs of 60 000 steps (over 5 s): stopping must not wait for the running and queued ones
+    assert stopped < 8, f"took {stopped:.1f} s to stop"
+    assert main(["store", "verify", str(out)]) == 0

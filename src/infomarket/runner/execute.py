@@ -192,15 +192,32 @@ def process_pool(workers: int) -> ProcessPoolExecutor:
 
 @contextmanager
 def local_executor(workers: int):
-    """``InlineExecutor`` for one worker, else a local ``process_pool`` (shut down on leaving)."""
+    """``InlineExecutor`` for one worker, else a local ``process_pool``, shut down on leaving; on Ctrl-C or
+    an error the pool's workers are stopped at once instead of first finishing the tasks already queued
+    to them (their results could no longer be kept)."""
     if workers <= 1:
         yield InlineExecutor()
         return
     pool = process_pool(workers)
     try:
         yield pool
-    finally:
-        pool.shutdown(wait=True, cancel_futures=True)
+    except BaseException:
+        stop_pool(pool)
+        raise
+    pool.shutdown(wait=True)
+
+
+def stop_pool(pool: ProcessPoolExecutor) -> None:
+    """Cancel what has not started and end the workers now (``terminate_workers`` from Python 3.14)."""
+    if hasattr(pool, "terminate_workers"):
+        pool.terminate_workers()
+        return
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for proc in processes:
+        proc.terminate()
+    for proc in processes:
+        proc.join(timeout=10)
 
 
 # ---------------------------------------------------------------------------------------- warm-up

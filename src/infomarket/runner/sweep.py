@@ -43,6 +43,8 @@ class SweepReport:
     retried: int = 0
     #: seconds spent compiling or loading kernels: the warm-up, or the longest a run spent on it
     compile_seconds: float = 0.0
+    #: seconds the runs made now spent running (summed over workers: per-core speed is env_steps / this)
+    run_seconds: float = 0.0
 
     @property
     def env_steps_per_second(self) -> float:
@@ -178,14 +180,15 @@ def _run(conds, store, workers, executor, on_done, on_plan, record_events) -> Sw
     if on_plan:
         on_plan(todo)
     t0 = time.perf_counter()
-    env_steps, compile_seconds = 0, 0.0
+    env_steps, compile_seconds, run_seconds = 0, 0.0, 0.0
     failed: list[RunOutput] = []
 
     def finished(task: Task, outputs: list[RunOutput]) -> None:
-        nonlocal env_steps, compile_seconds
+        nonlocal env_steps, compile_seconds, run_seconds
         tables = _frames(task, outputs)
         store.write_part(task.part_id, **tables)
         env_steps += int(tables["runs"].steps.sum())
+        run_seconds += float(tables["runs"].duration_s.sum())
         compile_seconds = max([compile_seconds] + [o.compile_seconds for o in outputs])
         failed.extend(o for o in outputs if o.error is not None)
         if on_done:
@@ -198,6 +201,6 @@ def _run(conds, store, workers, executor, on_done, on_plan, record_events) -> Sw
             warm = execute(tasks, finished, executor=pool, record_events=record_events)
     first = failed[0].error.strip().splitlines()[-1] if failed else ""
     return SweepReport(planned, planned - todo, todo, env_steps, time.perf_counter() - t0, len(failed), first,
-                       compile_seconds=max(warm, compile_seconds))
+                       compile_seconds=max(warm, compile_seconds), run_seconds=run_seconds)
 
 
