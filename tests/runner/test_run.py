@@ -132,6 +132,10 @@ def test_bad_input_writes_nothing(tmp_path, capsys):
         with pytest.raises(SystemExit) as exc:
             main(["run", "fig2B", "--out", str(out), *argv])
         assert exc.value.code == 2 and message in capsys.readouterr().err
+    every = tomllib.loads((SHIPPED / "fig5.toml").read_text())["history_every"]  # 100
+    assert main(["run", "fig5", "--steps", "10", "--out", str(out)]) == 2  # shorter than its history period
+    err = capsys.readouterr().err
+    assert err == f"infomarket: error: --steps 10: history_every = {every} must be at most steps = 10\n"
     assert main(["run", "no_such_experiment", "--out", str(out)]) == 2
     assert capsys.readouterr().err.startswith("infomarket: error: ")
     f = tmp_path / "file"

@@ -22,6 +22,7 @@ from pathlib import Path
 import pandas as pd
 
 from ..config import load_experiment, sizes
+from ..config.load import validate
 from ..errors import ConfigError, UsageError
 from ..store import Store
 from .plan import BASE, Condition
@@ -63,10 +64,13 @@ def prepare(experiment: str, *, runs: int | None = None, seed: int | None = None
     changes = {k: v for k, v in (("steps", steps), ("history_every", history_every)) if v is not None}
     runs = runs or cfg.runs
     seed = cfg.seed if seed is None else seed
+    data = cfg.model_dump()
+    data.update(changes, sweep=None, runs=runs, seed=seed)
+    options = " ".join(f"--{'history' if k == 'history_every' else k} {v}" for k, v in changes.items())
     try:
-        cfg = cfg.with_overrides(**changes, sweep=None, runs=runs, seed=seed)
-    except ConfigError as exc:
-        raise UsageError(str(exc).replace("configuration: invalid experiment\n  ", "")) from None
+        cfg = validate(data, options or "configuration")
+    except ConfigError as exc:  # e.g. --steps below the file's transitory or history_every
+        raise UsageError(str(exc).replace(" invalid experiment\n  ", " ").replace("\n  ", "; ")) from None
     too_big = sizes.runs_too_big(cfg, runs)
     if too_big:
         raise UsageError(f"--runs {runs}: {too_big}")
