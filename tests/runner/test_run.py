@@ -169,3 +169,22 @@ def test_ctrl_c_stops_a_process_pool_run_at_once(tmp_path):
     # a task is 16 runs of 60 000 steps (over 5 s): stopping must not wait for the running and queued ones
     assert stopped < 8, f"took {stopped:.1f} s to stop"
     assert main(["store", "verify", str(out)]) == 0
+
+
+def test_run_batch_is_the_same_runs_kept_in_memory(tmp_path):
+    """``run_batch`` (the Python API the headline tests use) and ``infomarket run`` make the same tasks with
+    the same seeds: the in-memory rows equal the store's, on any executor."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from infomarket.runner import run_batch
+
+    out = tmp_path / "D"
+    assert main(["run", "fig2D", "--runs", "3", "--steps", "400", "--seed", "21", "--out", str(out),
+                 "--workers", "1", "--quiet"]) == 0
+    stored = Store(out).robots().drop(columns=["experiment", "condition"])
+    cfg = im.load_experiment("fig2D")
+    for kw in ({"workers": 1}, {"workers": 2}, {"executor": ThreadPoolExecutor(2)}):
+        got = run_batch(cfg, 3, 21, steps=400, **kw).robots
+        assert got.seed.astype(int).tolist() == [run_seed(21, r, 0) for r in (0, 1, 2) for _ in range(25)]
+        for col in COLUMNS:
+            assert np.array_equal(got[col].to_numpy(), stored[col].to_numpy()), (kw, col)
