@@ -262,17 +262,15 @@ def execute(tasks: list[Task], finished: Callable[[Task, list[RunOutput]], None]
     Returns the seconds spent warming up."""
     if not tasks:
         return 0.0
-    inline = executor is None or isinstance(executor, InlineExecutor)
-    warm_seconds = 0.0
-    if not inline:
-        configs = (c.config for t in tasks for c, _ in t.members)
-        warm_seconds = sum(warm_up(configs).values())
-    if inline:
+    if executor is None or isinstance(executor, InlineExecutor):  # no other process: nothing to warm
         for t in tasks:
             finished(t, run_calls(_calls(t, record_events)))
-        return warm_seconds
-    futures = {executor.submit(run_calls, _calls(t, record_events)): t for t in tasks}
+        return 0.0
+    warm_seconds = sum(warm_up(c.config for t in tasks for c, _ in t.members).values())
+    futures: dict[Future, Task] = {}
     try:
+        for t in tasks:
+            futures[executor.submit(run_calls, _calls(t, record_events))] = t
         for fut in as_completed(futures):
             finished(futures[fut], fut.result())
     except BaseException:
