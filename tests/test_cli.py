@@ -6,6 +6,7 @@ import pytest
 
 from infomarket.cli import main
 from infomarket.seeds import run_seed
+from infomarket.store import Store
 
 COLUMNS = ["run", "seed", "robot", "behaviour", "honest", "drift", "items_collected", "wealth"]
 
@@ -14,40 +15,47 @@ def test_run_writes_robots_table_and_summary(tmp_path, capsys):
     out = tmp_path / "o"
     assert main(["run", "fig2B", "--runs", "3", "--steps", "600", "--seed", "5", "--out", str(out),
                  "--workers", "1"]) == 0
-    df = pd.read_parquet(out / "robots.parquet")
+    df = Store(out).robots()
     assert all(c in df.columns for c in COLUMNS)
+    assert set(df.experiment) == {"fig2B"} and set(df.condition) == {"base"}
     assert len(df) == 3 * 25 and sorted(df.run.unique()) == [0, 1, 2]
     assert list(df.seed.unique()) == [run_seed(5, i) for i in range(3)]
     assert df.groupby("run").honest.sum().tolist() == [24, 24, 24]
     assert df.groupby("run").wealth_share.sum().round(12).tolist() == [1.0, 1.0, 1.0]
     text = capsys.readouterr().out
-    assert "saboteur" in text and "median items" in text and "robots.parquet" in text
-    assert not (out / "wealth_history.parquet").exists()
+    assert "saboteur" in text and "median items" in text and f"wrote the results store {out}" in text
+    assert "3 runs x 600 steps, master seed 5" in text
+    assert Store(out).history().empty
 
 
-def test_same_seed_gives_identical_parquet(tmp_path):
-    paths = []
+def test_same_seed_gives_identical_tables(tmp_path):
+    tables = []
     for k, workers in enumerate(("1", "2")):
         out = tmp_path / f"o{k}"
         assert main(["run", "fig2D", "--runs", "2", "--steps", "2000", "--seed", "11", "--out", str(out),
                      "--workers", workers, "--quiet"]) == 0
-        paths.append(out / "robots.parquet")
-    assert paths[0].read_bytes() == paths[1].read_bytes()
+        tables.append(Store(out).robots())
+        parts = sorted(p.name for p in (out / "robots").glob("*.parquet"))
+        assert parts == ["part-fig2D-base-00000-00000.parquet", "part-fig2D-base-00001-00001.parquet"]
+    pd.testing.assert_frame_equal(tables[0], tables[1], check_exact=True)
+    for run in (0, 1):  # the part files themselves are byte for byte the same
+        name = f"part-fig2D-base-{run:05d}-{run:05d}.parquet"
+        assert (tmp_path / "o0" / "robots" / name).read_bytes() == (tmp_path / "o1" / "robots" / name).read_bytes()
     out = tmp_path / "other"
     main(["run", "fig2D", "--runs", "2", "--steps", "2000", "--seed", "12", "--out", str(out), "--quiet"])
-    assert not pd.read_parquet(out / "robots.parquet").equals(pd.read_parquet(paths[0]))
+    assert not Store(out).robots().wealth.equals(tables[0].wealth)
 
 
 def test_history_every_k_steps(tmp_path):
     out = tmp_path / "h"
     assert main(["run", "fig4A", "--runs", "2", "--steps", "1000", "--history", "100", "--out", str(out),
                  "--workers", "1", "--quiet"]) == 0
-    h = pd.read_parquet(out / "wealth_history.parquet")
+    h = Store(out).history()
     assert set(h.columns) >= {"run", "seed", "step", "robot", "wealth"}
     assert sorted(h.step.unique()) == list(range(100, 1001, 100))
     assert len(h) == 2 * 10 * 25
     last = h[h.step == 1000].sort_values(["run", "robot"]).wealth.to_numpy()
-    robots = pd.read_parquet(out / "robots.parquet").sort_values(["run", "robot"]).wealth.to_numpy()
+    robots = Store(out).robots().sort_values(["run", "robot"]).wealth.to_numpy()
     assert (last == robots).all()
 
 

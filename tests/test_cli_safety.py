@@ -48,11 +48,11 @@ def test_too_many_robots_or_steps_are_refused_by_check_with_the_estimate(tmp_pat
 
 
 def test_run_and_sweep_refuse_too_many_runs_at_once_and_write_nothing(tmp_path, capsys, monkeypatch):
-    import infomarket.runner
+    import infomarket.runner.run
     import infomarket.runner.sweep
 
     never = lambda *a, **k: pytest.fail("started running instead of refusing")  # noqa: E731
-    monkeypatch.setattr(infomarket.runner, "run_batch", never)
+    monkeypatch.setattr(infomarket.runner.run, "run_experiment", never)
     monkeypatch.setattr(infomarket.runner.sweep, "run_sweep", never)
     exp = write(tmp_path)
     out = tmp_path / "o"
@@ -64,34 +64,74 @@ def test_run_and_sweep_refuse_too_many_runs_at_once_and_write_nothing(tmp_path, 
     assert not out.exists()
 
 
-def test_run_refuses_to_overwrite_without_force(tmp_path, capsys):
+def _files(folder: Path) -> dict[str, bytes]:
+    return {str(p.relative_to(folder)): p.read_bytes() for p in sorted(folder.rglob("*")) if p.is_file()}
+
+
+def test_run_refuses_to_replace_other_runs_without_force(tmp_path, capsys):
+    from infomarket.store import Store
+
     exp, out = write(tmp_path), tmp_path / "o"
     assert main(["run", str(exp), "--runs", "1", "--out", str(out), "--quiet"]) == 0
-    first = (out / "robots.parquet").read_bytes()
-    assert main(["run", str(exp), "--runs", "2", "--out", str(out), "--quiet"]) == 2
-    err = capsys.readouterr().err
-    assert "robots.parquet exists" in err and "--force replaces it" in err
-    assert (out / "robots.parquet").read_bytes() == first
-    assert main(["run", str(exp), "--runs", "2", "--out", str(out), "--quiet", "--force"]) == 0
-    assert pd.read_parquet(out / "robots.parquet").run.nunique() == 2
+    first = _files(out)
+    # another configuration (300 -> 400 steps) or another master seed: refused, the store untouched
+    for extra in (["--steps", "400"], ["--seed", "9"]):
+        assert main(["run", str(exp), "--runs", "2", "--out", str(out), "--quiet", *extra]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith(f"infomarket: error: --out {out}: holds runs of small made with ") and "--force" in err
+        assert err.count("\n") == 1 and _files(out) == first
+    assert "another configuration" in err or "master seed 1 (now 9)" in err
+    assert main(["run", str(exp), "--runs", "2", "--out", str(out), "--quiet", "--steps", "400", "--force"]) == 0
+    runs = Store(out).runs()
+    assert sorted(runs.run) == [0, 1] and set(runs.steps) == {400}  # replaced, not mixed
+    # the same request with more runs adds the missing runs and keeps the others byte for byte
+    before = _files(out)
+    assert main(["run", str(exp), "--runs", "3", "--out", str(out), "--quiet", "--steps", "400"]) == 0
+    after = _files(out)
+    assert {k: after[k] for k in before if k != "store.json"} == {k: v for k, v in before.items() if k != "store.json"}
+    assert sorted(Store(out).runs().run) == [0, 1, 2]
 
 
-def test_an_interrupted_run_keeps_the_runs_it_finished(tmp_path, capsys, monkeypatch):
-    from infomarket.runner import batch
+def test_run_replaces_an_earlier_versions_flat_files_only_with_force(tmp_path, capsys):
+    exp, out = write(tmp_path), tmp_path / "old"
+    out.mkdir()
+    (out / "robots.parquet").write_bytes(b"an earlier run's table")
+    assert main(["run", str(exp), "--runs", "1", "--out", str(out), "--quiet"]) == 2
+    assert "robots.parquet exists" in capsys.readouterr().err
+    assert _files(out) == {"robots.parquet": b"an earlier run's table"}
+    assert main(["run", str(exp), "--runs", "1", "--out", str(out), "--quiet", "--force"]) == 0
+    assert not (out / "robots.parquet").exists() and (out / "store.json").exists()
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "notes.txt").write_text("keep")  # anything else is never removed, even with --force
+    assert main(["run", str(exp), "--runs", "1", "--out", str(tmp_path / "mine"), "--quiet", "--force"]) == 2
+    assert "not an infomarket results store" in capsys.readouterr().err
+    assert _files(tmp_path / "mine") == {"notes.txt": b"keep"}
 
-    real = batch._one
+
+def test_an_interrupted_run_keeps_the_runs_it_finished_and_resumes(tmp_path, capsys, monkeypatch):
+    from infomarket.runner import execute
+    from infomarket.store import Store
+
+    real = execute.run_one
 
     def one(cfg, run, *args, **kw):
         if run == 2:
             raise KeyboardInterrupt  # Ctrl-C during the third run
         return real(cfg, run, *args, **kw)
 
-    monkeypatch.setattr(batch, "_one", one)
+    monkeypatch.setattr(execute, "run_one", one)
     out = tmp_path / "o"
-    assert main(["run", str(write(tmp_path)), "--runs", "3", "--workers", "1", "--out", str(out),
-                 "--quiet"]) == 130
+    argv = ["run", str(write(tmp_path)), "--runs", "3", "--workers", "1", "--out", str(out), "--quiet"]
+    assert main(argv) == 130
     assert "kept the 2 of 3 runs that had finished" in capsys.readouterr().err
-    assert sorted(pd.read_parquet(out / "robots.parquet").run.unique()) == [0, 1]
+    kept = Store(out).robots()
+    assert sorted(kept.run.unique()) == [0, 1]
+    assert main(["store", "verify", str(out)]) == 0
+    monkeypatch.setattr(execute, "run_one", real)
+    assert main(argv) == 0  # resumes: runs only run 2
+    robots = Store(out).robots()
+    assert sorted(robots.run.unique()) == [0, 1, 2]
+    pd.testing.assert_frame_equal(robots[robots.run < 2].reset_index(drop=True), kept, check_exact=True)
 
 
 def test_quiet_prints_nothing(tmp_path, capsys):

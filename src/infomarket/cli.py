@@ -14,8 +14,8 @@ from pathlib import Path
 
 from . import __version__
 from .bench import cli as bench_cli
-from .cliargs import Parser, UsageError, at_least, seed_value, writable_dir
-from .errors import ConfigError, InfomarketError, report
+from .cliargs import Parser, at_least, seed_value
+from .errors import EXIT_FAILED, InfomarketError, report
 
 SUBCOMMAND_MODULES = ("infomarket.runner.cli", "infomarket.analysis.cli", "infomarket.viewer.cli",
                       "infomarket.chain.cli", "infomarket.analysis.sensitivity_cli")
@@ -40,61 +40,37 @@ def _print_summary(robots, title: str) -> None:
 
 # ---------------------------------------------------------------------------------------------- run
 def cmd_run(args) -> int:
-    from .config import load_experiment, sizes
-    from .runner import run_batch
-    from .runner.batch import BatchInterrupted, default_workers
+    from .runner.execute import default_workers
     from .runner.progress import progress
+    from .runner.run import RunInterrupted, prepare, run_experiment
 
-    cfg = load_experiment(args.experiment)
-    changes = {}
-    if args.steps is not None:
-        changes["steps"] = args.steps
-    if args.history is not None:
-        changes["history_every"] = args.history
-    if changes:
-        try:
-            cfg = cfg.with_overrides(**changes)
-        except ConfigError as exc:
-            raise UsageError(str(exc).replace("configuration: invalid experiment\n  ", "")) from None
-    runs = args.runs or cfg.runs
-    too_big = sizes.runs_too_big(cfg, runs)
-    if too_big:
-        raise UsageError(f"--runs {runs}: {too_big}")
-    seed = cfg.seed if args.seed is None else args.seed
+    cond = prepare(args.experiment, runs=args.runs, seed=args.seed, steps=args.steps, history_every=args.history)
+    cfg, runs, seed = cond.config, cond.runs, cond.master_seed
     out = Path(args.out or Path("results") / cfg.name)
-    names = ["robots.parquet"] + (["wealth_history.parquet"] if cfg.history_every else [])
-    names += ["sites.parquet"] if cfg.terrain else []  # items per site per run (docs/terrain.md)
-    existing = [n for n in names if (out / n).exists()]
-    if existing and not args.force:
-        raise UsageError(f"--out {out}: {existing[0]} exists (an earlier run's results); --force replaces it, "
-                         f"or choose another --out")
-    out = writable_dir(out)
     workers = args.workers or min(default_workers(), runs)
     try:
-        with progress(f"{cfg.name}", runs, enabled=not args.quiet) as bar:
-            res = run_batch(cfg, runs, seed, workers=workers, on_done=bar.advance)
-    except BatchInterrupted as stop:
-        if stop.result is None:
-            report(f"interrupted before any of the {runs} runs finished; nothing written", EXIT_INTERRUPTED)
-        else:
-            done = stop.result.robots["run"].nunique()
-            written = _write_run_tables(stop.result, out, names)
-            report(f"interrupted: kept the {done} of {runs} runs that had finished (their run numbers are in "
-                   f"the run column): wrote {', '.join(map(str, written))}", EXIT_INTERRUPTED)
-        return EXIT_INTERRUPTED
-    written = _write_run_tables(res, out, names)
+        with progress(cfg.name, runs, enabled=not args.quiet) as bar:
+            res = run_experiment(cond, out, workers=workers, force=args.force, on_done=bar.advance,
+                                 on_plan=lambda todo: bar.skip(runs - todo) if runs - todo else None)
+    except RunInterrupted as stop:
+        if not stop.kept:
+            return report(f"interrupted before any of the {runs} runs finished; nothing kept", EXIT_INTERRUPTED)
+        return report(f"interrupted: kept the {stop.kept} of {runs} runs that had finished in the store {out}; "
+                      f"the same command again runs only the others", EXIT_INTERRUPTED)
+    done = res.sweep
+    if not args.quiet and len(res.robots):
+        _print_summary(res.robots, f"{cfg.name}: {res.runs_done} runs x {cfg.steps} steps, master seed {seed}")
     if not args.quiet:
-        _print_summary(res.robots, f"{cfg.name}: {runs} runs x {res.steps} steps, master seed {seed}")
-        print(f"wrote {', '.join(map(str, written))}")
-        print(f"{res.env_steps_per_second:,.0f} env-steps/s per core (compile/load {res.compile_seconds:.2f} s)")
+        kept = f", {done.skipped} already there" if done.skipped else ""
+        print(f"wrote the results store {out}: {done.done} run(s) of {cfg.name}{kept} "
+              f"(`infomarket figures {out}`, `infomarket store verify {out}`)")
+        if done.done and done.run_seconds > 0:
+            print(f"{done.env_steps / done.run_seconds:,.0f} env-steps/s per core "
+                  f"(compile/load {done.compile_seconds:.2f} s)")
+    if done.failed:
+        return report(f"{done.failed} of {done.done} runs failed (the first: {done.first_error}); every error "
+                      f"is listed by `infomarket store failed {out}`", EXIT_FAILED)
     return 0
-
-
-def _write_run_tables(res, out: Path, names: list[str]) -> list[Path]:
-    from .store import write_parquet_atomic
-
-    tables = {"robots.parquet": res.robots, "wealth_history.parquet": res.history, "sites.parquet": res.sites}
-    return [write_parquet_atomic(tables[n], out / n) for n in names]
 
 
 # --------------------------------------------------------------------------------------------- demo
@@ -148,16 +124,17 @@ def build_parser() -> Parser:
     p.add_argument("--version", action="version", version=f"infomarket {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
-    r = sub.add_parser("run", help="run an experiment N times and write robots.parquet")
+    r = sub.add_parser("run", help="run an experiment N times into a results store (robots, runs, ...; resumable)")
     r.add_argument("experiment", help="a .toml file, an original .json file, or a shipped name (e.g. fig2B)")
     r.add_argument("--runs", type=at_least(1), help="number of runs (default: the file's)")
     r.add_argument("--seed", type=seed_value, help="master seed (default: the file's)")
     r.add_argument("--steps", type=at_least(1), help="steps per run (default: the file's)")
     r.add_argument("--history", type=at_least(0), metavar="K",
-                   help="also write wealth_history.parquet: every robot's wealth every K steps")
-    r.add_argument("--out", help="output folder (default: results/NAME)")
+                   help="also store the history table: every robot's wealth every K steps")
+    r.add_argument("--out", help="results store folder (default: results/NAME); resumed if it holds these runs")
     r.add_argument("--workers", type=at_least(1), help="processes (default: one per core)")
-    r.add_argument("--force", action="store_true", help="replace the results of an earlier run in --out")
+    r.add_argument("--force", action="store_true",
+                   help="replace this experiment's earlier runs in --out (made with another configuration or seed)")
     r.add_argument("--quiet", action="store_true", help="print nothing but errors")
     r.set_defaults(func=cmd_run)
 

@@ -11,8 +11,9 @@ from rich.console import Console
 from rich.table import Table
 
 from .config import load_experiment
-from .runner import run_batch
-from .runner.batch import default_workers, process_pool, warm
+from .runner.batch import run_conditions
+from .runner.execute import default_workers
+from .runner.plan import conditions
 from .runner.progress import progress
 
 SETUPS = (("fig2A", "25 naive"), ("fig2B", "24 naive + 1 saboteur"),
@@ -28,18 +29,16 @@ def run_demo(runs: int = 8, workers: int | None = None) -> int:
     paper = {"fig2A": "20", "fig2B": "~10 (halves)", "fig2C": "below 2A", "fig2D": "~2C, ~2x 2B"}
     t0 = time.perf_counter()
     steps = 0
-    configs = [load_experiment(name) for name, _ in SETUPS]
-    for cfg in configs:  # compile (first time only) before forking, so every worker shares the kernels
-        warm(cfg)
-    with progress("demo", runs * len(SETUPS)) as bar, process_pool(workers) as pool:
-        for (name, swarm), cfg in zip(SETUPS, configs):
-            res = run_batch(cfg, runs, cfg.seed, workers=workers, executor=pool, on_done=bar.advance)
-            steps += runs * res.steps
-            d = res.robots
-            honest = d[d.honest].items_collected.median()
-            byz = d[~d.honest].items_collected
-            table.add_row(name.removeprefix("fig"), swarm, f"{honest:g}",
-                          f"{byz.median():g}" if len(byz) else "-", paper[name])
+    conds = [c for name, _ in SETUPS for c in conditions(load_experiment(name), runs=runs)]
+    with progress("demo", runs * len(SETUPS)) as bar:  # one pool, one warm-up for the four kernels
+        results = run_conditions(conds, workers=workers, on_done=bar.advance)
+    for (name, swarm), res in zip(SETUPS, results):
+        steps += runs * res.steps
+        d = res.robots
+        honest = d[d.honest].items_collected.median()
+        byz = d[~d.honest].items_collected
+        table.add_row(name.removeprefix("fig"), swarm, f"{honest:g}",
+                      f"{byz.median():g}" if len(byz) else "-", paper[name])
     wall = time.perf_counter() - t0
     console.print(table)
     console.print(f"{len(SETUPS) * runs} runs, {steps:,} env-steps in {wall:.1f} s wall "

@@ -101,7 +101,7 @@ def test_every_executor_gives_the_same_store(tmp_path):
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cluster, distributed.Client(cluster) as client:
         s = Store(tmp_path / "dask")
-        run_sweep(plan([exp]), s, client=client)
+        run_sweep(plan([exp]), s, executor=client.get_executor(pure=False))
         tables.append(s.robots())
     for t in tables[1:]:
         pd.testing.assert_frame_equal(tables[0], t, check_exact=True)

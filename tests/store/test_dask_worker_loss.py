@@ -32,7 +32,7 @@ def test_a_worker_killed_mid_sweep_loses_and_duplicates_nothing(tiny, tmp_path):
                 killed.append(sum(finished))
 
         store = Store(tmp_path / "dask")
-        report = run_sweep(plan([exp]), store, client=client, on_done=kill_one)
+        report = run_sweep(plan([exp]), store, executor=client.get_executor(pure=False), on_done=kill_one)
         victim = next(iter(pids.values()))
         assert victim not in client.run(os.getpid).values()  # the worker really died (its nanny restarted it)
     assert killed and killed[0] < 2 * 12 and report.failed == 0  # killed with runs still to do

@@ -12,7 +12,7 @@ def run_scaling(experiment: str = "fig2A", runs: int = 32, steps: int = 15000) -
     local pool's forked workers inherit it from the parent; Dask workers load it from the disk cache)."""
     import tempfile
 
-    from ..runner.batch import warm
+    from ..runner.execute import warm
     from ..runner.sweep import plan, run_sweep
     from ..store import Store
 
@@ -29,7 +29,7 @@ def run_scaling(experiment: str = "fig2A", runs: int = 32, steps: int = 15000) -
                                   dashboard_address=None) as cluster, Client(cluster) as client:
                     client.run(warm, cfg)  # workers up, kernel loaded, before the clock starts
                     t0 = time.perf_counter()
-                    run_sweep(conds, Store(tmp), client=client)
+                    run_sweep(conds, Store(tmp), executor=client.get_executor(pure=False))
                     wall = time.perf_counter() - t0
             else:
                 t0 = time.perf_counter()

@@ -1,25 +1,23 @@
-"""Run one experiment many times, in this process or a local process pool.
+"""One experiment run many times, its tables kept in memory: a sweep of one condition without a store.
 
-Run ``i`` uses ``seeds.run_seed(master, i, condition)``: rerunning any single run alone with that seed
-gives exactly its rows here, whichever executor ran it.
+``run_batch`` plans the condition, makes the tasks and runs them with ``execute.execute`` exactly as a
+sweep does (same tasks, same warm-up, same seeds: run ``i`` uses ``seeds.run_seed(master, i, condition)``);
+only what happens to a finished task differs.  ``infomarket run`` uses ``runner.run`` (a results store).
 """
 from __future__ import annotations
 
-import multiprocessing
-import os
-import sys
-import time
-import traceback
-from concurrent.futures import Executor, ProcessPoolExecutor
+from concurrent.futures import Executor
 from dataclasses import dataclass, field
 
-import numpy as np
 import pandas as pd
 
-from .. import plugins
 from ..config.schema import Experiment
-from ..seeds import run_seed
-from ..engine.simulation import Simulation, simulate
+from .execute import (RunFailed, RunOutput, Task, default_workers, execute, local_executor, make_tasks,
+                      process_pool, warm)
+from .plan import BASE, Condition
+
+__all__ = ["BatchInterrupted", "BatchResult", "RunFailed", "RunOutput", "default_workers", "process_pool", "run_batch",
+           "run_conditions", "warm"]
 
 
 @dataclass
@@ -46,126 +44,54 @@ class BatchInterrupted(KeyboardInterrupt):
         self.result, self.planned = result, planned
 
 
-@dataclass
-class RunOutput:
-    """What one run of a batch produced; ``error`` (a traceback's text) when it raised instead."""
-
-    run: int
-    seed: int
-    robots: pd.DataFrame
-    history: pd.DataFrame
-    events: pd.DataFrame
-    payments: pd.DataFrame = field(default_factory=pd.DataFrame)
-    compile_seconds: float = 0.0
-    run_seconds: float = 0.0
-    steps: int = 0
-    error: str | None = None
-    sites: pd.DataFrame = field(default_factory=pd.DataFrame)
-
-
-MAX_ERROR_CHARS = 4000
-
-
-def _one(cfg: Experiment, run: int, seed: int, steps: int | None, history_every: int | None,
-         record_events: bool = False) -> RunOutput:
-    r = simulate(cfg, seed, steps=steps, history_every=history_every, record_events=record_events)
-    robots = r.robots
-    robots.insert(0, "run", np.int64(run))
-    hist, events, payments = r.history, r.events, r.payments
-    for table in (hist, events, payments):
-        if len(table):
-            table.insert(0, "run", np.int64(run))
-            table.insert(1, "seed", np.uint64(seed))
-    sites = pd.DataFrame(r.totals.get("sites", []))
-    if len(sites):
-        sites.insert(0, "run", np.int64(run))
-        sites.insert(1, "seed", np.uint64(seed))
-        sites.insert(2, "site", np.arange(len(sites), dtype=np.int64))
-    return RunOutput(run, seed, robots, hist, events, payments, r.compile_seconds, r.run_seconds, r.steps,
-                     sites=sites)  # events and payments are empty unless recorded
-
-
-def _failed(run: int, seed: int, exc: BaseException) -> RunOutput:
-    text = "".join(traceback.format_exception(exc))[-MAX_ERROR_CHARS:]
-    empty = pd.DataFrame()
-    return RunOutput(run, seed, empty, empty, empty, empty, error=text)
-
-
-def _chunk(cfg: Experiment, items: list[tuple[int, int]], steps, history_every, record_events=False,
-           isolate=False) -> list[RunOutput]:
-    """Run ``items`` (run, seed) in this process.  ``isolate``: a run that raises becomes a RunOutput
-    with its error text, and the others still run (sweeps); otherwise the exception propagates."""
-    try:
-        for entry in cfg.plugins:  # rules registered by plugins must exist in this worker too
-            plugins.load(entry)
-    except Exception as exc:
-        if not isolate:
-            raise
-        return [_failed(run, seed, exc) for run, seed in items]
-    out = []
-    for run, seed in items:
-        try:
-            out.append(_one(cfg, run, seed, steps, history_every, record_events))
-        except Exception as exc:
-            if not isolate:
-                raise
-            out.append(_failed(run, seed, exc))
-    return out
-
-
-def default_workers() -> int:
-    return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
-
-
-def warm(cfg: Experiment) -> None:
-    """Compile (or load) the configuration's kernel in this process, so forked workers inherit it."""
-    Simulation(cfg, 0)  # loads every compiled entry point (view constructor, step loop)
-
-
-def process_pool(workers: int) -> ProcessPoolExecutor:
-    """A local pool.  On Linux workers are forked, so kernels already loaded here cost them nothing."""
-    ctx = multiprocessing.get_context("fork") if sys.platform.startswith("linux") else None
-    return ProcessPoolExecutor(max_workers=workers, mp_context=ctx)
-
-
 def run_batch(cfg: Experiment, runs: int, master_seed: int, *, steps: int | None = None,
               history_every: int | None = None, workers: int = 1, condition: int = 0,
               on_done=None, executor: Executor | None = None) -> BatchResult:
-    """Run ``runs`` independent runs; ``on_done(k)`` is called as runs complete (for progress).
-    ``executor`` (any concurrent.futures Executor) is used if given, else a local pool of ``workers``."""
-    items = [(i, run_seed(master_seed, i, condition)) for i in range(runs)]
-    outputs: list[RunOutput] = []
+    """Run ``runs`` independent runs of ``cfg`` (``steps``/``history_every`` replace the file's); returns
+    their tables.  ``on_done(k)`` is called as runs complete (for progress).  ``executor`` (any
+    concurrent.futures Executor) is used if given, else inline for one worker, else a local pool.
+    A run that raises stops the batch with ``RunFailed`` (holding the run's traceback text)."""
+    changes = {k: v for k, v in (("steps", steps), ("history_every", history_every)) if v is not None}
+    if changes:
+        cfg = cfg.model_copy(update=changes)
+    cond = Condition(cfg.name, BASE, {}, cfg, runs, master_seed, condition)
+    return run_conditions([cond], workers=workers if runs > 1 else 1, on_done=on_done, executor=executor)[0]
+
+
+def run_conditions(conds: list[Condition], *, workers: int = 1, on_done=None,
+                   executor: Executor | None = None) -> list[BatchResult]:
+    """Every run of each condition, on one executor with one warm-up; a BatchResult per condition, in
+    order.  Ctrl-C raises ``BatchInterrupted`` holding the first condition's finished runs."""
+    tasks = make_tasks(conds, set(), workers if executor is None else max(workers, 2))
+    outputs: dict[tuple[str, str], list[RunOutput]] = {(c.experiment, c.id): [] for c in conds}
     warm_seconds = 0.0
+
+    def finished(task: Task, out: list[RunOutput]) -> None:
+        k = 0
+        for c, runs in task.members:
+            mine = out[k:k + len(runs)]
+            k += len(runs)
+            for o in mine:
+                if o.error is not None:
+                    raise RunFailed(f"{c.experiment} [{c.id}]: run {o.run} (seed {o.seed}) failed:\n{o.error}")
+            outputs[(c.experiment, c.id)].extend(mine)
+        if on_done:
+            on_done(len(out))
+
     try:
-        if executor is None and (workers <= 1 or runs == 1):
-            for it in items:
-                outputs.append(_one(cfg, *it, steps, history_every))
-                if on_done:
-                    on_done(1)
+        if executor is not None:
+            warm_seconds = execute(tasks, finished, executor=executor)
         else:
-            t0 = time.perf_counter()
-            warm(cfg)
-            warm_seconds = time.perf_counter() - t0
-            n_workers = workers if executor is None else max(workers, 1)
-            size = max(1, min(8, runs // (n_workers * 4) or 1))  # batch runs per task: little overhead
-            chunks = [items[k:k + size] for k in range(0, runs, size)]
-            pool = executor or process_pool(workers)
-            try:
-                futures = [pool.submit(_chunk, cfg, c, steps, history_every) for c in chunks]
-                for f in futures:
-                    res = f.result()
-                    outputs.extend(res)
-                    if on_done:
-                        on_done(len(res))
-            finally:
-                if executor is None:
-                    pool.shutdown(cancel_futures=True)
+            with local_executor(workers) as pool:
+                warm_seconds = execute(tasks, finished, executor=pool)
     except KeyboardInterrupt:
-        raise BatchInterrupted(_collect(outputs, warm_seconds) if outputs else None, runs) from None
-    return _collect(outputs, warm_seconds)
+        first = outputs[(conds[0].experiment, conds[0].id)]
+        raise BatchInterrupted(_collect(first, warm_seconds) if first else None, conds[0].runs) from None
+    return [_collect(outputs[(c.experiment, c.id)], warm_seconds) for c in conds]
 
 
 def _collect(outputs: list[RunOutput], warm_seconds: float) -> BatchResult:
+    outputs = sorted(outputs, key=lambda o: o.run)  # tasks finish in any order; rows are by run
     robots = pd.concat([o.robots for o in outputs], ignore_index=True)
     hists = [o.history for o in outputs if len(o.history)]
     history = pd.concat(hists, ignore_index=True) if hists else pd.DataFrame()

@@ -33,7 +33,7 @@ def _client(args):
 def _execute(experiments, args, label: str) -> int:
     import time
 
-    from ..runner.batch import default_workers
+    from ..runner.execute import default_workers
     from ..runner.progress import progress
     from ..runner.sweep import plan, run_sweep
     from ..store import Store
@@ -53,21 +53,20 @@ def _execute(experiments, args, label: str) -> int:
             why = sizes.run_too_big(c.config, record_events=True)
             if why:
                 raise UsageError(f"--events: {c.experiment} [{c.id}]: {why}")
-    store = Store(args.out)
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {out}: exists and is not a directory")
+    store = Store(out)
+    store.refuse_foreign()  # a file, or a folder of something else: refused before anything starts
     client, cluster = _client(args)  # before creating anything: a scheduler that does not answer writes nothing
     workers = args.workers or default_workers()
     t0 = time.perf_counter()
     try:
-        try:
-            store.create()
-        except OSError as exc:
-            raise UsageError(f"--out {out}: cannot write there ({exc.strerror or exc})") from None
         total = sum(c.runs for c in conds)
         with progress(label, total, enabled=not args.quiet) as bar:
-            done = run_sweep(conds, store, workers=workers, client=client, on_done=bar.advance,
+            done = run_sweep(conds, store, workers=workers,
+                             executor=client.get_executor(pure=False) if client is not None else None,
+                             on_done=bar.advance,
                              on_plan=lambda todo: bar.skip(total - todo) if total - todo else None,
                              record_events=args.events, retry_failed=args.retry_failed)
     finally:

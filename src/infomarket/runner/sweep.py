@@ -12,11 +12,10 @@ committed as ``failed`` with its error text; the others go on (``retry_failed`` 
 """
 from __future__ import annotations
 
-import hashlib
-import math
+import json
 import time
 from collections.abc import Callable, Iterable
-from concurrent.futures import as_completed as futures_completed
+from concurrent.futures import Executor
 from dataclasses import dataclass
 
 import numpy as np
@@ -24,37 +23,12 @@ import pandas as pd
 
 from .. import __version__
 from ..config.schema import Experiment
-from ..engine.build import behaviour_kinds
 from ..store import Store, StoreError
 from ..store.results import FAILED, OK
-from .batch import RunOutput, _chunk, process_pool, warm
+from .execute import RunOutput, Task, execute, local_executor, make_tasks
 from .plan import Condition, conditions
 
-
-@dataclass(frozen=True)
-class Task:
-    condition: Condition
-    runs: tuple[int, ...]
-    #: further (condition, runs) committed in the same part: the points of a sampled design, which have
-    #: a run or two each, are grouped so that a study of thousands of points is not thousands of parts
-    more: tuple[tuple[Condition, tuple[int, ...]], ...] = ()
-
-    @property
-    def members(self) -> list[tuple[Condition, tuple[int, ...]]]:
-        return [(self.condition, self.runs), *self.more]
-
-    @property
-    def size(self) -> int:
-        return sum(len(r) for _, r in self.members)
-
-    @property
-    def part_id(self) -> str:
-        c = self.condition
-        if self.more:  # named by its members, so a resumed sweep's regrouped parts never collide
-            ids = ";".join(f"{m.id}:{','.join(map(str, r))}" for m, r in self.members)
-            return f"{c.experiment}-set-{hashlib.sha256(ids.encode()).hexdigest()[:16]}"
-        tag = "base" if c.id == "base" else format(c.number, "x")[:12]
-        return f"{c.experiment}-{tag}-{self.runs[0]:05d}-{self.runs[-1]:05d}"
+__all__ = ["SweepReport", "Task", "check_compatible", "make_tasks", "plan", "run_sweep", "sweep_locked"]
 
 
 @dataclass
@@ -67,6 +41,10 @@ class SweepReport:
     failed: int = 0
     first_error: str = ""
     retried: int = 0
+    #: seconds spent compiling or loading kernels: the warm-up, or the longest a run spent on it
+    compile_seconds: float = 0.0
+    #: seconds the runs made now spent running (summed over workers: per-core speed is env_steps / this)
+    run_seconds: float = 0.0
 
     @property
     def env_steps_per_second(self) -> float:
@@ -106,53 +84,20 @@ def check_compatible(store: Store, conds: list[Condition]) -> None:
     store.claim_seeds(seeds)
 
 
-def make_tasks(conds: list[Condition], done: set, workers: int) -> list[Task]:
-    """Missing runs, grouped per condition into tasks of a few runs each."""
-    todo = [(c, [r for r in range(c.runs) if (c.experiment, c.id, r) not in done]) for c in conds]
-    total = sum(len(r) for _, r in todo)
-    size = max(1, min(16, math.ceil(total / max(1, workers * 8))))
-    tasks = []
-    group: list[tuple[Condition, tuple[int, ...]]] = []  # points of a sampled design, filled up to ``size``
-
-    def flush() -> None:
-        if group:
-            tasks.append(Task(group[0][0], group[0][1], tuple(group[1:])))
-            group.clear()
-
-    for c, runs in todo:
-        if c.design is not None and 0 < len(runs) < size:
-            if group and (group[0][0].experiment != c.experiment
-                          or sum(len(r) for _, r in group) + len(runs) > size):
-                flush()
-            group.append((c, tuple(runs)))
-            continue
-        for k in range(0, len(runs), size):
-            tasks.append(Task(c, tuple(runs[k:k + size])))
-    flush()
-    # longest first, so the long runs (Figs. 5-6) do not finish alone at the end on one worker
-    tasks.sort(key=lambda t: -t.condition.config.steps * t.size)
-    return tasks
-
-
-def _chunks(calls: list[tuple]) -> list[RunOutput]:
-    """``batch._chunk`` for each (configuration, runs, ...) of one task, outputs in order."""
-    return [o for call in calls for o in _chunk(*call)]
-
-
 def _concat(frames: list[pd.DataFrame]) -> pd.DataFrame | None:
     frames = [f for f in frames if len(f)]
     return pd.concat(frames, ignore_index=True) if frames else None
 
 
 def _frames(task: Task, outputs: list[RunOutput]) -> dict[str, pd.DataFrame | None]:
-    """The part's tables: robots, history, events, payments (None when empty) and the runs record."""
+    """The part's tables (None when empty): robots, history, events, payments, sites, the configurations
+    the runs used (one row per condition: ``Store.config`` rebuilds them) and the runs record."""
     if task.more:
         parts, k = [], 0
         for c, runs in task.members:
             parts.append(_frames(Task(c, runs), outputs[k:k + len(runs)]))
             k += len(runs)
-        return {t: _concat([p[t] for p in parts if p[t] is not None])
-                for t in ("robots", "history", "events", "payments", "runs")}
+        return {t: _concat([p[t] for p in parts if p[t] is not None]) for t in parts[0]}
     c = task.condition
 
     def label(df: pd.DataFrame, keys: bool) -> pd.DataFrame:
@@ -163,7 +108,7 @@ def _frames(task: Task, outputs: list[RunOutput]) -> dict[str, pd.DataFrame | No
                 df[k] = v
         return df
 
-    robots, hists, events, payments, rows = [], [], [], [], []
+    robots, hists, events, payments, sites, rows = [], [], [], [], [], []
     for o, run in zip(outputs, task.runs):
         if o.error is None:
             robots.append(label(o.robots, True))
@@ -174,29 +119,48 @@ def _frames(task: Task, outputs: list[RunOutput]) -> dict[str, pd.DataFrame | No
                 events.append(label(o.events, True))
             if len(o.payments):
                 payments.append(label(o.payments, True))
+            if len(o.sites):
+                sites.append(label(o.sites, True))
         rows.append({"experiment": c.experiment, "condition": c.id, "run": np.int64(run),
                      "seed": np.uint64(c.seed(run)), "master_seed": np.int64(c.master_seed),
                      "config_hash": c.config.config_hash(), "package_version": __version__,
                      "duration_s": o.run_seconds, "steps": o.steps, "transitory": c.config.transitory,
                      "status": OK if o.error is None else FAILED, "error": o.error or "", **c.keys})
+    configs = pd.DataFrame([{"experiment": c.experiment, "condition": c.id, "config_hash": c.config.config_hash(),
+                             "config": config_json(c.config)}])
     return {"robots": _concat(robots), "history": _concat(hists), "events": _concat(events),
-            "payments": _concat(payments), "runs": pd.DataFrame(rows)}
+            "payments": _concat(payments), "sites": _concat(sites), "configs": configs, "runs": pd.DataFrame(rows)}
 
 
-def run_sweep(conds: list[Condition], store: Store, *, workers: int = 1, client=None,
+def config_json(cfg: Experiment) -> str:
+    """The configuration as JSON text, as ``Store.config`` reads it back (``config.load.validate``)."""
+    return json.dumps(cfg.model_dump(mode="json"), sort_keys=True)
+
+
+def run_sweep(conds: list[Condition], store: Store, *, workers: int = 1, executor: Executor | None = None,
               on_done: Callable[[int], None] | None = None, on_plan: Callable[[int], None] | None = None,
               record_events: bool = False, retry_failed: bool = False) -> SweepReport:
-    """Run every missing run of ``conds`` into ``store``.  ``client``: a dask.distributed Client
-    (never created here); otherwise a local pool of ``workers`` processes (inline when 1).
-    ``record_events``: also store each run's event log; ``retry_failed``: rerun the failed runs."""
-    store.create()
-    with store.lock():
-        store.check()  # a damaged store is refused until repaired
-        check_compatible(store, conds)  # first: a refused store is left exactly as it was
-        _save_designs(store, conds)  # refuses a store holding another design of the same experiment
-        retried = store.uncommit_failed() if retry_failed else 0
-        store.remove_orphans()
-        report = _run(conds, store, workers, client, on_done, on_plan, record_events)
+    """Run every missing run of ``conds`` into ``store``: on ``executor`` (any ``concurrent.futures``
+    Executor, e.g. ``process_pool(n)`` or a Dask ``client.get_executor(pure=False)``; never shut down
+    here), else inline when ``workers`` is 1, else on a local pool of ``workers`` processes made here.
+    ``record_events``: also store each run's event log; ``retry_failed``: rerun the failed runs.
+    The store is locked throughout (a second writer gets StoreError at once, before writing anything)."""
+    with store.writing():
+        return sweep_locked(conds, store, workers=workers, executor=executor, on_done=on_done, on_plan=on_plan,
+                            record_events=record_events, retry_failed=retry_failed)
+
+
+def sweep_locked(conds: list[Condition], store: Store, *, workers: int = 1, executor: Executor | None = None,
+                 on_done: Callable[[int], None] | None = None, on_plan: Callable[[int], None] | None = None,
+                 record_events: bool = False, retry_failed: bool = False) -> SweepReport:
+    """``run_sweep`` for a caller already inside ``store.writing()`` (``runner.run`` decides what to keep
+    under the same lock)."""
+    store.check()  # a damaged store is refused until repaired
+    check_compatible(store, conds)  # first: a refused store is left exactly as it was
+    _save_designs(store, conds)  # refuses a store holding another design of the same experiment
+    retried = store.uncommit_failed() if retry_failed else 0
+    store.remove_orphans()
+    report = _run(conds, store, workers, executor, on_done, on_plan, record_events)
     report.retried = retried
     return report
 
@@ -209,60 +173,34 @@ def _save_designs(store: Store, conds: list[Condition]) -> None:
         save(store, design)
 
 
-def _run(conds, store, workers, client, on_done, on_plan, record_events) -> SweepReport:
-    done = store.completed_runs()
-    tasks = make_tasks(conds, done, workers)
+def _run(conds, store, workers, executor, on_done, on_plan, record_events) -> SweepReport:
+    tasks = make_tasks(conds, store.completed_runs(), workers)
     planned = sum(c.runs for c in conds)
     todo = sum(t.size for t in tasks)
     if on_plan:
         on_plan(todo)
     t0 = time.perf_counter()
-    env_steps = 0
+    env_steps, compile_seconds, run_seconds = 0, 0.0, 0.0
     failed: list[RunOutput] = []
 
     def finished(task: Task, outputs: list[RunOutput]) -> None:
-        nonlocal env_steps
+        nonlocal env_steps, compile_seconds, run_seconds
         tables = _frames(task, outputs)
         store.write_part(task.part_id, **tables)
         env_steps += int(tables["runs"].steps.sum())
+        run_seconds += float(tables["runs"].duration_s.sum())
+        compile_seconds = max([compile_seconds] + [o.compile_seconds for o in outputs])
         failed.extend(o for o in outputs if o.error is not None)
         if on_done:
             on_done(task.size)
 
-    def args(t: Task):
-        return ([(c.config, [(r, c.seed(r)) for r in runs], None, None, record_events, True)
-                 for c, runs in t.members],)
-
-    if tasks and client is None and workers > 1:
-        seen = set()
-        for c in (c for t in tasks for c, _ in t.members):  # every kernel loaded once here: forked workers
-            key = (behaviour_kinds(c.config), c.config.payment.scheme)  # inherit them compiled
-            if key not in seen:
-                seen.add(key)
-                warm(c.config)
-    if not tasks:
-        pass
-    elif client is not None:
-        from distributed import as_completed as dask_completed
-
-        for cfg in {(behaviour_kinds(c.config), c.config.payment.scheme): c.config
-                    for t in tasks for c, _ in t.members}.values():
-            warm(cfg)  # fills the disk cache once instead of in every worker at once
-        futures = {client.submit(_chunks, *args(t), pure=False): t for t in tasks}
-        for fut in dask_completed(futures):
-            finished(futures[fut], fut.result())
-    elif workers <= 1:
-        for t in tasks:
-            finished(t, _chunks(*args(t)))
+    if executor is not None:
+        warm = execute(tasks, finished, executor=executor, record_events=record_events)
     else:
-        with process_pool(workers) as pool:
-            futures = {pool.submit(_chunks, *args(t)): t for t in tasks}
-            try:
-                for fut in futures_completed(futures):
-                    finished(futures[fut], fut.result())
-            except BaseException:
-                for f in futures:
-                    f.cancel()
-                raise
+        with local_executor(workers) as pool:
+            warm = execute(tasks, finished, executor=pool, record_events=record_events)
     first = failed[0].error.strip().splitlines()[-1] if failed else ""
-    return SweepReport(planned, planned - todo, todo, env_steps, time.perf_counter() - t0, len(failed), first)
+    return SweepReport(planned, planned - todo, todo, env_steps, time.perf_counter() - t0, len(failed), first,
+                       compile_seconds=max(warm, compile_seconds), run_seconds=run_seconds)
+
+

@@ -8,6 +8,8 @@ Layout (each part file written atomically, see ``files``)::
     STORE/history/part-ID.parquet  wealth of every robot every K steps (when asked)
     STORE/events/part-ID.parquet   the ledger's event log: purchases, refusals, deposits (``--events``)
     STORE/payments/part-ID.parquet what each seller received at each deposit (``--events``)
+    STORE/sites/part-ID.parquet    items per site per run (setups with terrain, docs/terrain.md)
+    STORE/configs/part-ID.parquet  the configuration each condition ran (JSON text), see ``config``
     STORE/runs/part-ID.parquet     one row per run: the commit record of its part
     STORE/damaged/...              parts that ``repair`` moved aside
 
@@ -34,6 +36,7 @@ import json
 import os
 import shutil
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -45,7 +48,7 @@ from ..errors import InfomarketError
 from .files import sha256_file, write_atomic, write_text_atomic
 
 FORMAT = 1
-DATA_TABLES = ("robots", "history", "events", "payments")
+DATA_TABLES = ("robots", "history", "events", "payments", "sites", "configs")
 TABLES = DATA_TABLES + ("runs",)
 KEY = ["experiment", "condition", "run"]
 OK, FAILED = "ok", "failed"
@@ -98,7 +101,10 @@ class StoreLock:
         key = self.path.resolve()
         if key in _HELD:
             raise StoreError(f"{self.path.parent}: this process is already writing this store")
-        fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o666)
+        try:
+            fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o666)
+        except OSError as exc:
+            raise StoreError(f"{self.path.parent}: cannot write there ({exc.strerror or exc})") from None
         try:
             fcntl.lockf(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:
@@ -149,13 +155,42 @@ class Store:
             for t in TABLES:
                 (self.root / t).mkdir(exist_ok=True)
             return self
-        if self.root.exists() and any(self.root.iterdir()):
-            raise StoreError(f"{self.root}: exists, is not empty and is not an infomarket results store")
-        for t in TABLES:
-            (self.root / t).mkdir(parents=True, exist_ok=True)
+        self.refuse_foreign()
+        self.root.mkdir(parents=True, exist_ok=True)
+        # store.json first: a folder holding only it (and the lock) reads as a store being created, so a
+        # second writer racing this one is refused by the lock, not taken for a foreign folder
         self._write_meta({"format": FORMAT, "package_version": __version__,
                           "created": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "seeds": {}})
+        for t in TABLES:
+            (self.root / t).mkdir(exist_ok=True)
         return self
+
+    def foreign(self) -> list[Path]:
+        """What the folder holds that is not a store's (empty for a store, a new or an empty folder)."""
+        if self.exists() or not self.root.is_dir():
+            return []
+        return sorted(p for p in self.root.iterdir() if p.name != "store.lock")
+
+    def refuse_foreign(self) -> None:
+        """StoreError if the folder exists and holds anything but a results store (writes nothing)."""
+        if self.root.exists() and not self.root.is_dir():
+            raise StoreError(f"{self.root}: exists and is not a directory")
+        if self.foreign():
+            raise StoreError(f"{self.root}: exists, is not empty and is not an infomarket results store")
+
+    @contextmanager
+    def writing(self):
+        """``with store.writing(): ...``: refuse a folder holding something else (before writing anything),
+        take the store's lock (a second writer gets StoreError at once, having written nothing), then
+        create the layout if new.  Everything written under it comes from the one lock holder."""
+        self.refuse_foreign()
+        try:
+            self.root.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise StoreError(f"{self.root}: cannot write there ({exc.strerror or exc})") from None
+        with self.lock():
+            self.create()
+            yield self
 
     def _write_meta(self, meta: dict) -> None:
         write_text_atomic(json.dumps(meta, indent=2) + "\n", self.meta_path)
@@ -211,13 +246,15 @@ class Store:
     # ------------------------------------------------------------------ writing
     def write_part(self, part_id: str, robots: pd.DataFrame | None, runs: pd.DataFrame,
                    history: pd.DataFrame | None = None, events: pd.DataFrame | None = None,
-                   payments: pd.DataFrame | None = None) -> None:
-        """Write one part: the data tables (robots, history, events, payments) first, then the runs
-        record with their checksums and row counts, last."""
+                   payments: pd.DataFrame | None = None, sites: pd.DataFrame | None = None,
+                   configs: pd.DataFrame | None = None) -> None:
+        """Write one part: the data tables (robots, history, events, payments, sites, configs) first, then
+        the runs record with their checksums and row counts, last."""
         if self.part_path("runs", part_id).exists():
             raise StoreError(f"{self.root}: part {part_id} is already committed")
         runs = runs.copy()
-        tables = {"robots": robots, "history": history, "events": events, "payments": payments}
+        tables = {"robots": robots, "history": history, "events": events, "payments": payments,
+                  "sites": sites, "configs": configs}
         for t in DATA_TABLES:
             df = tables[t]
             sha, rows = "", 0
@@ -369,6 +406,45 @@ class Store:
     def payments(self) -> pd.DataFrame:
         """What each seller received at each deposit (one row per settled transaction), ``--events`` runs."""
         return self._read("payments")
+
+    def sites(self) -> pd.DataFrame:
+        """Items per site per run (setups with terrain: food sites and nests, docs/terrain.md)."""
+        return self._read("sites")
+
+    def configs(self) -> pd.DataFrame:
+        """One row per (experiment, condition, config_hash): the configuration its runs used, as JSON."""
+        df = self._read("configs")
+        return df.drop_duplicates(["experiment", "condition", "config_hash"]).reset_index(drop=True) if len(df) else df
+
+    def config(self, experiment: str, condition: str = "base"):
+        """The configuration (an ``Experiment``) the runs of ``experiment`` [``condition``] used, steps and
+        all: ``simulate(store.config(name), seed=row.seed)`` gives exactly the rows of the run ``row`` of
+        the runs table."""
+        from ..config.load import validate
+
+        df = self.configs()
+        rows = df[(df.experiment == experiment) & (df.condition == condition)] if len(df) else df
+        if rows.empty:
+            raise StoreError(f"{self.root}: no recorded configuration of {experiment} [{condition}]")
+        return validate(json.loads(rows.config.iloc[-1]), f"{self.root}: {experiment} [{condition}]")
+
+    def drop_experiment(self, name: str) -> int:
+        """Remove every part holding runs of experiment ``name`` (commit record first, so a crash leaves
+        orphans, not damage) and its recorded master seed; other experiments are kept.  Returns how many
+        parts were removed.  Call with the lock held."""
+        n = 0
+        for pid, record in self._records().items():
+            if "experiment" not in record.columns or not (record.experiment == name).any():
+                continue
+            self.part_path("runs", pid).unlink()
+            for t in DATA_TABLES:
+                self.part_path(t, pid).unlink(missing_ok=True)
+            n += 1
+        meta = self.meta()
+        if name in meta.get("seeds", {}):
+            del meta["seeds"][name]
+            self._write_meta(meta)
+        return n
 
     def failed(self) -> pd.DataFrame:
         """The committed runs that raised, with their error text."""

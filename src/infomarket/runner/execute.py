@@ -1,0 +1,284 @@
+"""The one way infomarket runs many simulations: tasks of runs handed to any ``concurrent.futures.Executor``.
+
+A task is some runs of one condition (or of a few points of a sampled design); ``execute`` submits every
+task to the executor, hands each finished task's outputs to ``finished`` in this process (which writes
+them to a results store, or keeps them in memory for ``run_batch``), and stops cleanly on Ctrl-C.  The
+executor may be ``InlineExecutor`` (this process, one task at a time), a local ``process_pool``, or a
+Dask client's ``client.get_executor(pure=False)``.
+
+Before any task is submitted to another process, ``warm_up`` compiles (or loads from the disk cache)
+each distinct kernel once, keyed on ``engine.specialise.kernel_id``: forked pool workers inherit the
+loaded kernels, and Dask workers find them in the disk cache instead of all compiling at once.
+
+Run ``r`` of a condition uses ``seeds.run_seed(master, r, condition_number)``: rerunning it alone with
+that seed gives exactly its rows, whichever executor ran it.
+"""
+from __future__ import annotations
+
+import math
+import multiprocessing
+import os
+import sys
+import time
+import traceback
+from collections.abc import Callable, Iterable
+from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from .. import plugins
+from ..config.schema import Experiment
+from ..engine.simulation import Simulation, simulate
+from ..errors import InfomarketError
+from .plan import Condition
+
+MAX_ERROR_CHARS = 4000
+
+
+class RunFailed(InfomarketError, RuntimeError):
+    """A run raised where its caller cannot go on without it (``run_batch``); the message holds its
+    traceback's text."""
+
+
+# ---------------------------------------------------------------------------------------- one run
+@dataclass
+class RunOutput:
+    """What one run produced; ``error`` (a traceback's text) when it raised instead."""
+
+    run: int
+    seed: int
+    robots: pd.DataFrame
+    history: pd.DataFrame
+    events: pd.DataFrame
+    payments: pd.DataFrame = field(default_factory=pd.DataFrame)
+    compile_seconds: float = 0.0
+    run_seconds: float = 0.0
+    steps: int = 0
+    error: str | None = None
+    sites: pd.DataFrame = field(default_factory=pd.DataFrame)
+
+
+def run_one(cfg: Experiment, run: int, seed: int, record_events: bool = False) -> RunOutput:
+    """Run ``cfg`` once with ``seed`` (its own ``steps`` and ``history_every``); tables get ``run``/``seed``."""
+    r = simulate(cfg, seed, record_events=record_events)
+    robots = r.robots
+    robots.insert(0, "run", np.int64(run))
+    hist, events, payments = r.history, r.events, r.payments
+    for table in (hist, events, payments):
+        if len(table):
+            table.insert(0, "run", np.int64(run))
+            table.insert(1, "seed", np.uint64(seed))
+    sites = pd.DataFrame(r.totals.get("sites", []))
+    if len(sites):
+        sites.insert(0, "run", np.int64(run))
+        sites.insert(1, "seed", np.uint64(seed))
+        sites.insert(2, "site", np.arange(len(sites), dtype=np.int64))
+    return RunOutput(run, seed, robots, hist, events, payments, r.compile_seconds, r.run_seconds, r.steps,
+                     sites=sites)  # events and payments are empty unless recorded
+
+
+def _failed(run: int, seed: int, exc: BaseException) -> RunOutput:
+    text = "".join(traceback.format_exception(exc))[-MAX_ERROR_CHARS:]
+    empty = pd.DataFrame()
+    return RunOutput(run, seed, empty, empty, empty, empty, error=text)
+
+
+def run_chunk(cfg: Experiment, items: list[tuple[int, int]], record_events: bool = False) -> list[RunOutput]:
+    """Run ``items`` (run, seed) of ``cfg`` in this process; a run that raises becomes a RunOutput with its
+    error text and the others still run.  Ctrl-C (KeyboardInterrupt) is not caught."""
+    try:
+        for entry in cfg.plugins:  # rules registered by plugins must exist in this worker too
+            plugins.load(entry)
+    except Exception as exc:
+        return [_failed(run, seed, exc) for run, seed in items]
+    out = []
+    for run, seed in items:
+        try:
+            out.append(run_one(cfg, run, seed, record_events))
+        except Exception as exc:
+            out.append(_failed(run, seed, exc))
+    return out
+
+
+def run_calls(calls: list[tuple]) -> list[RunOutput]:
+    """``run_chunk`` for each (configuration, items, record_events) of one task, outputs in order."""
+    return [o for call in calls for o in run_chunk(*call)]
+
+
+# ------------------------------------------------------------------------------------------ tasks
+@dataclass(frozen=True)
+class Task:
+    condition: Condition
+    runs: tuple[int, ...]
+    #: further (condition, runs) in the same task: the points of a sampled design, which have a run or
+    #: two each, are grouped so that a study of thousands of points is not thousands of tasks (and parts)
+    more: tuple[tuple[Condition, tuple[int, ...]], ...] = ()
+
+    @property
+    def members(self) -> list[tuple[Condition, tuple[int, ...]]]:
+        return [(self.condition, self.runs), *self.more]
+
+    @property
+    def size(self) -> int:
+        return sum(len(r) for _, r in self.members)
+
+    @property
+    def part_id(self) -> str:
+        import hashlib
+
+        c = self.condition
+        if self.more:  # named by its members, so a resumed sweep's regrouped parts never collide
+            ids = ";".join(f"{m.id}:{','.join(map(str, r))}" for m, r in self.members)
+            return f"{c.experiment}-set-{hashlib.sha256(ids.encode()).hexdigest()[:16]}"
+        tag = "base" if c.id == "base" else format(c.number, "x")[:12]
+        return f"{c.experiment}-{tag}-{self.runs[0]:05d}-{self.runs[-1]:05d}"
+
+
+def make_tasks(conds: list[Condition], done: set, workers: int) -> list[Task]:
+    """The runs of ``conds`` not in ``done`` ((experiment, condition, run) keys), grouped per condition
+    into tasks of a few runs each, longest first."""
+    todo = [(c, [r for r in range(c.runs) if (c.experiment, c.id, r) not in done]) for c in conds]
+    total = sum(len(r) for _, r in todo)
+    size = max(1, min(16, math.ceil(total / max(1, workers * 8))))
+    tasks = []
+    group: list[tuple[Condition, tuple[int, ...]]] = []  # points of a sampled design, filled up to ``size``
+
+    def flush() -> None:
+        if group:
+            tasks.append(Task(group[0][0], group[0][1], tuple(group[1:])))
+            group.clear()
+
+    for c, runs in todo:
+        if c.design is not None and 0 < len(runs) < size:
+            if group and (group[0][0].experiment != c.experiment
+                          or sum(len(r) for _, r in group) + len(runs) > size):
+                flush()
+            group.append((c, tuple(runs)))
+            continue
+        for k in range(0, len(runs), size):
+            tasks.append(Task(c, tuple(runs[k:k + size])))
+    flush()
+    # longest first, so the long runs (Figs. 5-6) do not finish alone at the end on one worker
+    tasks.sort(key=lambda t: -t.condition.config.steps * t.size)
+    return tasks
+
+
+# -------------------------------------------------------------------------------------- executors
+class InlineExecutor(Executor):
+    """Runs each submitted call at once, in this process (``workers = 1``): no pickling, no warm-up."""
+
+    def submit(self, fn, /, *args, **kwargs) -> Future:
+        future: Future = Future()
+        future.set_running_or_notify_cancel()
+        try:
+            future.set_result(fn(*args, **kwargs))
+        except Exception as exc:  # Ctrl-C (KeyboardInterrupt) propagates to the caller at once
+            future.set_exception(exc)
+        return future
+
+
+def default_workers() -> int:
+    return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
+
+
+def process_pool(workers: int) -> ProcessPoolExecutor:
+    """A local pool.  On Linux workers are forked, so kernels already loaded here cost them nothing."""
+    ctx = multiprocessing.get_context("fork") if sys.platform.startswith("linux") else None
+    return ProcessPoolExecutor(max_workers=workers, mp_context=ctx)
+
+
+@contextmanager
+def local_executor(workers: int):
+    """``InlineExecutor`` for one worker, else a local ``process_pool``, shut down on leaving; on Ctrl-C or
+    an error the pool's workers are stopped at once instead of first finishing the tasks already queued
+    to them (their results could no longer be kept)."""
+    if workers <= 1:
+        yield InlineExecutor()
+        return
+    pool = process_pool(workers)
+    try:
+        yield pool
+    except BaseException:
+        stop_pool(pool)
+        raise
+    pool.shutdown(wait=True)
+
+
+def stop_pool(pool: ProcessPoolExecutor) -> None:
+    """Cancel what has not started and end the workers now (``terminate_workers`` from Python 3.14)."""
+    if hasattr(pool, "terminate_workers"):
+        pool.terminate_workers()
+        return
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for proc in processes:
+        proc.terminate()
+    for proc in processes:
+        proc.join(timeout=10)
+
+
+# ---------------------------------------------------------------------------------------- warm-up
+def warm(cfg: Experiment) -> None:
+    """Compile (or load) the configuration's kernel in this process, so forked workers inherit it."""
+    Simulation(cfg, 0)  # loads every compiled entry point (view constructor, step loop)
+
+
+def warm_up(configs: Iterable[Experiment]) -> dict[str, float]:
+    """Load the kernel of each configuration in this process, once per distinct
+    ``engine.specialise.kernel_id`` (behaviours, scheme and terrain: the kernel's real key); returns the
+    seconds spent per kernel id.  A configuration whose warm-up raises is left to its runs, which record
+    the error as failed runs."""
+    from ..engine.specialise import kernel_id
+
+    seconds: dict[str, float] = {}
+    for cfg in configs:
+        try:
+            key = kernel_id(cfg)
+        except Exception:  # noqa: BLE001 - the runs themselves report it
+            continue
+        if key in seconds:
+            continue
+        t0 = time.perf_counter()
+        try:
+            for entry in cfg.plugins:
+                plugins.load(entry)
+            warm(cfg)
+        except Exception:  # noqa: BLE001 - the runs themselves report it, as failed runs
+            pass
+        seconds[key] = time.perf_counter() - t0
+    return seconds
+
+
+# ---------------------------------------------------------------------------------------- execute
+def execute(tasks: list[Task], finished: Callable[[Task, list[RunOutput]], None], *,
+            executor: Executor | None = None, record_events: bool = False) -> float:
+    """Run every task on ``executor`` (None: inline, in this process), calling ``finished(task, outputs)``
+    here as each completes (in completion order).  Kernels are warmed up once per kernel id before the
+    first task goes to another process.  On any exception, Ctrl-C included, tasks not yet started are
+    cancelled and the exception propagates; tasks already finished have been handed to ``finished``.
+    Returns the seconds spent warming up."""
+    if not tasks:
+        return 0.0
+    if executor is None or isinstance(executor, InlineExecutor):  # no other process: nothing to warm
+        for t in tasks:
+            finished(t, run_calls(_calls(t, record_events)))
+        return 0.0
+    warm_seconds = sum(warm_up(c.config for t in tasks for c, _ in t.members).values())
+    futures: dict[Future, Task] = {}
+    try:
+        for t in tasks:
+            futures[executor.submit(run_calls, _calls(t, record_events))] = t
+        for fut in as_completed(futures):
+            finished(futures[fut], fut.result())
+    except BaseException:
+        for f in futures:
+            f.cancel()
+        raise
+    return warm_seconds
+
+
+def _calls(task: Task, record_events: bool) -> list[tuple]:
+    return [(c.config, [(r, c.seed(r)) for r in runs], record_events) for c, runs in task.members]
