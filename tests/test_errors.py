@@ -33,9 +33,6 @@ STILL_ALLOWED = frozenset({
     "analysis/future.py",
     "analysis/headline.py",
     "analysis/stats.py",
-    "cliargs.py",
-    "engine/simulation.py",
-    "ledger/replay.py",
 })
 
 

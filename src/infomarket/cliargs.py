@@ -47,10 +47,10 @@ def writable_file(path: str | Path, option: str = "--out") -> Path:
     try:
         with tempfile.TemporaryFile(dir=folder):
             pass
-        if path.exists() and not os.access(path, os.W_OK):
-            raise PermissionError(13, "Permission denied")
     except OSError as exc:
         raise UsageError(f"{option} {path}: cannot write there ({exc.strerror or exc})") from None
+    if path.exists() and not os.access(path, os.W_OK):
+        raise UsageError(f"{option} {path}: cannot write there (Permission denied)")
     return path
 
 

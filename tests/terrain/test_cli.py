@@ -1,6 +1,7 @@
 """Terrain setups from the command line: bad files exit 2 with one message, `run` writes per-site counts."""
-import pandas as pd
 import pytest
+
+from infomarket.store.results import Store
 
 from infomarket.cli import main
 
@@ -47,9 +48,10 @@ def test_run_writes_items_per_site(tmp_path):
     path.write_text(GOOD.replace("steps = 400", "steps = 3000"))
     out = tmp_path / "out"
     assert main(["run", str(path), "--runs", "2", "--out", str(out), "--workers", "1", "--quiet"]) == 0
-    sites = pd.read_parquet(out / "sites.parquet")
-    robots = pd.read_parquet(out / "robots.parquet")
-    assert sites.columns.tolist() == ["run", "seed", "site", "kind", "x", "y", "radius", "items"]
+    store = Store(out)
+    sites, robots = store.sites(), store.robots()
+    assert sites.columns.tolist() == ["experiment", "condition", "run", "seed", "site", "kind", "x", "y", "radius",
+                                      "items"]
     assert sites.groupby("run").kind.apply(list).tolist() == [["food", "food", "nest"]] * 2
     # every deposit is counted at the one nest and in some robot's items (two independent counters)
     nest = sites[sites.kind == "nest"].set_index("run")["items"]
@@ -60,4 +62,4 @@ def test_run_writes_items_per_site(tmp_path):
 def test_plane_run_writes_no_sites_table(tmp_path):
     out = tmp_path / "p"
     assert main(["run", "fig2A", "--runs", "1", "--steps", "200", "--out", str(out), "--quiet"]) == 0
-    assert not (out / "sites.parquet").exists()
+    assert Store(out).sites().empty and len(Store(out).robots()) == 25

@@ -293,9 +293,11 @@ class Experiment(_Strict):
 
     def with_overrides(self, **changes) -> "Experiment":
         """A re-validated copy with top-level fields replaced (e.g. steps, runs, seed)."""
+        from .load import validate  # (load imports this module)
+
         data = self.model_dump()
         data.update(changes)
-        return Experiment.model_validate(data)  # plugins are absolute paths or module names by now
+        return validate(data)  # one ConfigError naming the key; plugins are absolute paths or module names by now
 
     def config_hash(self) -> str:
         """Hash of everything that determines results (not name, description, runs or seed)."""

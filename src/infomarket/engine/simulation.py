@@ -15,7 +15,7 @@ import pandas as pd
 
 from ..config.schema import Experiment
 from ..config.load import load_experiment
-from ..errors import ConfigError, SimulationError
+from ..errors import ArgumentError, ConfigError, SimulationError
 from ..registry import behaviours
 from . import specialise
 from ..seeds import MAX_SEED
@@ -85,7 +85,7 @@ class Simulation:
     def step(self, k: int = 1) -> None:
         """Advance ``k`` steps (a positive integer)."""
         if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
-            raise ValueError(f"step(k): k must be a positive integer number of steps, got {k!r}")
+            raise ArgumentError(f"step(k): k must be a positive integer number of steps, got {k!r}")
         self.advance_to(self.clock + int(k))
 
     def advance_to(self, t_end: int) -> None:

@@ -24,6 +24,8 @@ from typing import Iterable, Mapping
 
 import numpy as np
 
+from ..errors import InternalError
+
 WRITERS = ("host", "engine", "ledger", "log")
 
 
@@ -50,7 +52,7 @@ class Spec:
         self.fields = tuple(fields)
         for f in self.fields:
             if f.writer not in WRITERS:
-                raise AssertionError(f"{domain}.{f.name}: unknown writer {f.writer!r}")
+                raise InternalError(f"{domain}.{f.name}: unknown writer {f.writer!r}")
         self.names = tuple(f.name for f in self.fields)
         self.tuple = namedtuple(domain.capitalize(), self.names)
 
@@ -67,16 +69,16 @@ class Spec:
         """Every field present, with its dtype and number of dimensions (a builder's contract)."""
         missing = [n for n in self.names if n not in values]
         if missing:
-            raise AssertionError(f"{self.domain}: missing {', '.join(missing)}")
+            raise InternalError(f"{self.domain}: missing {', '.join(missing)}")
         for f in self.fields:
             v = values[f.name]
             if f.ndim == 0:
                 kind = {"float": float, "int": int, "bool": bool}[f.dtype]
                 if type(v) is not kind:
-                    raise AssertionError(f"{self.domain}.{f.name}: {type(v).__name__}, spec says {f.dtype}")
+                    raise InternalError(f"{self.domain}.{f.name}: {type(v).__name__}, spec says {f.dtype}")
             elif not isinstance(v, np.ndarray) or v.dtype != np.dtype(f.dtype) or v.ndim != f.ndim:
                 got = f"{v.dtype} {v.ndim}-d" if isinstance(v, np.ndarray) else type(v).__name__
-                raise AssertionError(f"{self.domain}.{f.name}: {got}, spec says {f.dtype} {f.ndim}-d")
+                raise InternalError(f"{self.domain}.{f.name}: {got}, spec says {f.dtype} {f.ndim}-d")
 
     def build(self, values: Mapping):
         """The domain's named tuple from a mapping, checked against the spec."""
