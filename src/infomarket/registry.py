@@ -52,8 +52,8 @@ class BehaviourSpec:
     params: tuple[str, ...] = field(default=())
     defaults: dict[str, float] = field(default_factory=dict)
     limits: dict[str, tuple[str, Callable[[float], bool]]] = field(default_factory=dict)
-    #: Its robots keep waypoint paths (``behaviours.paths``): runs with it compile the path-aware
-    #: terrain step (``engine.paths``), which dead-reckons and follows paths, even on the plane.
+    #: Its robots keep waypoint paths (``behaviours.paths``): runs with it compile the step's paths
+    #: variant (``engine.step``, ``engine.paths``), which dead-reckons and follows paths, even on the plane.
     paths: bool = False
 
     def check(self, name: str, value: float) -> str | None:
@@ -130,7 +130,7 @@ def register_behaviour(name: str, *, buy: Callable | str, sell: Callable | str, 
     metrics (Byzantine otherwise).  ``limits`` maps a parameter to ``(text, predicate)``, e.g.
     ``{"threshold": ("> 0", lambda v: v > 0)}``: configurations breaking it are rejected with the text.
     ``paths=True`` says the rules buy or install waypoint paths (``behaviours.paths``); runs with such a
-    behaviour then compile the path-aware terrain step (``engine.paths``); other runs never pay for it.
+    behaviour then compile the step's paths variant (``engine.step``, ``engine.paths``); other runs never pay for it.
     """
     if name in _BEHAVIOURS and not replace:
         raise RegistrationError(f"behaviour {name!r} is already registered (pass replace=True to override)")

@@ -2,7 +2,7 @@
 
 A robot's entry for a site may be a short polyline (``engine.paths``): the entry itself is the first
 waypoint and up to ``PATH_POINTS - 1`` further waypoints follow, the last being the site, all positions
-in the robot's own frame.  The path-aware step (``engine.paths``) follows the legs in order and
+in the robot's own frame.  The step's paths variant (``engine.step``, ``engine.paths``) follows the legs in order and
 dead-reckons every waypoint; a behaviour whose rules use these helpers must be registered with
 ``paths=True`` so that its runs compile that step (``register_behaviour(..., paths=True)``).
 

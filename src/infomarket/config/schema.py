@@ -86,7 +86,7 @@ class Segment(_Strict):
         return self
 
 
-#: ``[[obstacles]]`` entries, told apart by ``shape`` (engine.obstacles has the geometry).
+#: ``[[obstacles]]`` entries, told apart by ``shape`` (space.obstacles has the geometry).
 Obstacle = Annotated[Union[Rect, CircleObstacle, Segment], Field(discriminator="shape")]
 
 
@@ -100,7 +100,7 @@ class Robot(_Strict):
     stop_time: NonNegInt = 0
     cooldown: NonNegInt = 0
     fuel_cost: NonNegFloat = 0.0
-    #: Two robots communicate only if no obstacle cuts the segment between them (engine.obstacles).
+    #: Two robots communicate only if no obstacle cuts the segment between them (space.obstacles).
     line_of_sight: StrictBool = False
     #: Robots are discs that cannot overlap: a move that would overlap another robot is not made.
     collisions: StrictBool = False

@@ -151,7 +151,7 @@ class Simulation:
 
     def site_counts(self) -> list[dict]:
         """Every site (food first, file order) with the items picked up there (food) or deposited
-        there (nest) after the transitory period; counted only by the terrain-aware step."""
+        there (nest) after the transitory period; counted only by the step's terrain variant."""
         w = self.world
         return [{"kind": SITE_NAMES[int(k)], "x": float(xy[0]), "y": float(xy[1]), "radius": float(r),
                  "items": int(c)} for xy, r, k, c in zip(w.sites_xy, w.sites_r, w.sites_kind, w.site_items)]

@@ -92,7 +92,7 @@ def generate_source(behaviours: list[BehaviourSpec], payment: PaymentSpec, terra
 
 
 def uses_paths(behaviour_names: tuple[str, ...]) -> bool:
-    """Does any of these behaviours keep waypoint paths (so the run needs the terrain-aware step)?"""
+    """Does any of these behaviours keep waypoint paths (so the run needs the step's paths variant)?"""
     return any(get_behaviour(b).paths for b in behaviour_names)
 
 
@@ -116,7 +116,7 @@ def _kernel_parts(behaviour_names: tuple[str, ...], payment_name: str, terrain: 
 def kernel_module(behaviour_names: tuple[str, ...], payment_name: str, terrain: bool = False) -> ModuleType:
     """The specialised kernel module (``run_steps``) for these behaviours (kind order) and scheme, on
     the paper's plane or (``terrain``) with obstacles, several sites, line of sight and collisions;
-    behaviours registered with ``paths=True`` add waypoint paths (engine.paths) to the terrain step."""
+    behaviours registered with ``paths=True`` add the paths variant (waypoint paths, engine.paths) to the terrain one."""
     source, key, cacheable = _kernel_parts(behaviour_names, payment_name, terrain)
     return load_generated("kernel", key, source, cacheable)
 

@@ -161,7 +161,7 @@ def purchase_events(w, ok, buyer, seller, site, direction, x, y, age, sx, sy):
 
 @njit(inline="always")
 def _record_sale(w, seller, weight, top, pay, stake):
-    """The seller's reputation record for one settled transaction (engine.world, REPUTATION): O(1)."""
+    """The seller's reputation record for one settled transaction (ledger.state, REPUTATION): O(1)."""
     unlock(w.rep_settled)[seller] += 1
     if weight <= 0.0 or weight < OUTLIER_FRACTION * top:
         unlock(w.rep_reduced)[seller] += 1

@@ -1,6 +1,6 @@
 """Obstacle geometry, compiled: distances from a point, and whether a segment is cut (line of sight).
 
-Obstacles are rows of ``w.obs_kind`` / ``w.obs_geom`` (engine.world): a rectangle is (x0, y0, x1, y1)
+Obstacles are rows of ``w.obs_kind`` / ``w.obs_geom`` (engine.params): a rectangle is (x0, y0, x1, y1)
 with x0 < x1 and y0 < y1, a circle (x, y, radius, 0), a segment (x0, y0, x1, y1).  A robot is a disc of
 radius ``r``: its disc *overlaps* an obstacle when the centre's distance to it is below ``r`` (so
 positions may touch an obstacle, as they may touch the arena's edge), and a proximity sensor *fires*
