@@ -188,3 +188,26 @@ def test_an_underpowered_question_is_inconclusive_never_no():
 def test_answer_needs_evidence_for_either_side():
     assert stats.answer(True, False) == "yes" and stats.answer(False, True) == "no"
     assert stats.answer(False, False) == "inconclusive" and stats.answer(True, True) == "inconclusive"
+
+
+def test_walsh_median_and_the_signed_rank_test_by_hand():
+    # d = 1, 2, 4: Walsh averages 1, 1.5, 2.5, 2, 3, 4 -> sorted 1 1.5 2 2.5 3 4 -> median 2.25
+    assert stats.walsh_median([1.0, 2.0, 4.0]) == 2.25
+    # 5 runs, all positive and distinct: exact one-sided signed-rank p = 1 / 2^5
+    pr = stats.paired([0.5, 1.0, 2.0, 3.0, 4.0])
+    assert pr.p == pytest.approx(1 / 32) and pr.min_p == 1 / 32 and pr.positive == 1.0
+    assert pr.hl_low <= pr.hl <= pr.hl_high
+
+
+def test_a_ratio_answer_needs_its_whole_interval_on_one_side():
+    rng = np.random.default_rng(12)
+    y = rng.normal(100, 5, 32)
+    assert stats.answer_interval(stats.median_ratio(y * 0.8, y), 0.5) == stats.YES
+    assert stats.answer_interval(stats.median_ratio(y * 0.3, y), 0.5) == stats.NO
+    assert stats.median_ratio([1.0, 3.0], [2.0, 2.0]).value == 1.0  # medians 2 / 2, by hand
+    wide = stats.median_ratio(rng.uniform(0, 100, 4), rng.uniform(50, 150, 4))
+    assert stats.answer_interval(wide, 0.5) == stats.INCONCLUSIVE
+    # point estimate below the bound (32.5 / 100), but resampled medians reach 0.9: inconclusive, not no
+    below = stats.median_ratio([10.0, 20.0, 45.0, 90.0], [100.0, 100.0, 100.0, 100.0])
+    assert below.value == 0.325 and below.high >= 0.5
+    assert stats.answer_interval(below, 0.5) == stats.INCONCLUSIVE

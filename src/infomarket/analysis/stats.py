@@ -309,3 +309,89 @@ def answer_superiority(comparisons: list[Comparison], min_hits: int = 1, target:
     if hits >= min_hits:
         return YES
     return NO if powered >= min_hits else INCONCLUSIVE
+
+
+@dataclass(frozen=True)
+class Paired:
+    """Within-run differences (e.g. honest minus Byzantine mean wealth share of each run): the run is
+    the sample, so honest and Byzantine values of one run are paired.  Wilcoxon signed-rank test
+    (``scipy.stats.wilcoxon``), the Hodges-Lehmann pseudo-median (median of the Walsh averages) with a
+    seeded percentile bootstrap interval."""
+
+    n: int
+    median: float
+    hl: float
+    hl_low: float
+    hl_high: float
+    p: float
+    min_p: float       # 1 / 2^n one-sided: every difference of one sign
+    alpha: float
+    positive: float    # share of runs with a positive difference
+
+    @property
+    def significant(self) -> bool:
+        return self.p < self.alpha
+
+    def describe(self, unit: str = "") -> str:
+        return (f"{self.n} runs, median difference {self.median:+.3g}{unit}, HL pseudo-median {self.hl:+.3g}{unit} "
+                f"[{self.hl_low:.3g}, {self.hl_high:.3g}], positive in {100 * self.positive:.0f} % of runs; "
+                f"Wilcoxon signed-rank (run-level) p = {_fmt_p(self.p)} (smallest possible {_fmt_p(self.min_p)})")
+
+
+def walsh_median(d, axis: int = -1):
+    """Hodges-Lehmann one-sample estimate: the median of the Walsh averages (d_i + d_j) / 2, i <= j."""
+    d = np.moveaxis(np.asarray(d, float), axis, -1)
+    i, j = np.triu_indices(d.shape[-1])
+    return np.median((d[..., i] + d[..., j]) / 2.0, axis=-1)
+
+
+def paired(d, alpha: float = ALPHA, alternative: str = "greater", confidence: float = CONFIDENCE,
+           resamples: int = RESAMPLES, seed: int = SEED) -> Paired:
+    """Run-level test of within-run differences ``d`` (one per run) being above zero ("greater")."""
+    d = np.asarray(d, float)
+    if len(d) == 0:
+        raise ValueError("a paired test needs at least one run")
+    p = float(stats.wilcoxon(d, alternative=alternative).pvalue) if np.any(d != 0) else 1.0
+    lo = hi = math.nan
+    if len(d) >= 2:
+        res = stats.bootstrap((d,), walsh_median, vectorized=True, n_resamples=resamples, batch=BATCH * 5,
+                              confidence_level=confidence, method="percentile", rng=np.random.default_rng(seed))
+        lo, hi = float(res.confidence_interval.low), float(res.confidence_interval.high)
+    return Paired(len(d), float(np.median(d)), float(walsh_median(d)), lo, hi, p,
+                  0.5 ** len(d) * (2.0 if alternative == "two-sided" else 1.0), alpha, float(np.mean(d > 0)))
+
+
+@dataclass(frozen=True)
+class Ratio:
+    """Ratio of medians x / y with a seeded percentile bootstrap interval (groups resampled apart)."""
+
+    value: float
+    low: float
+    high: float
+    confidence: float
+
+
+def median_ratio(x, y, confidence: float = CONFIDENCE, resamples: int = RESAMPLES, seed: int = SEED) -> Ratio:
+    x, y = np.asarray(x, float), np.asarray(y, float)
+
+    def ratio(a, b, axis=-1):
+        mb = np.median(b, axis=axis)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(mb == 0, np.inf, np.median(a, axis=axis) / mb)
+
+    value = float(ratio(x, y))
+    if len(x) < 2 or len(y) < 2:
+        return Ratio(value, math.nan, math.nan, confidence)
+    res = stats.bootstrap((x, y), ratio, vectorized=True, paired=False, n_resamples=resamples, batch=BATCH * 5,
+                          confidence_level=confidence, method="percentile", rng=np.random.default_rng(seed))
+    return Ratio(value, float(res.confidence_interval.low), float(res.confidence_interval.high), confidence)
+
+
+def answer_interval(r: Ratio, bound: float) -> str:
+    """"Is the ratio at least ``bound``?" from its interval: yes when the whole interval is at or
+    above it, no when the whole interval is below it, inconclusive when it straddles (or is undefined)."""
+    if r.low >= bound:
+        return YES
+    if r.high < bound:
+        return NO
+    return INCONCLUSIVE
