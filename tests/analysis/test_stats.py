@@ -211,3 +211,6 @@ def test_a_ratio_answer_needs_its_whole_interval_on_one_side():
     below = stats.median_ratio([10.0, 20.0, 45.0, 90.0], [100.0, 100.0, 100.0, 100.0])
     assert below.value == 0.325 and below.high >= 0.5
     assert stats.answer_interval(below, 0.5) == stats.INCONCLUSIVE
+    # nothing collected in either condition: the ratio 0 / 0 is undefined, so no answer
+    zero = stats.median_ratio([0.0, 0.0], [0.0, 0.0])
+    assert np.isnan(zero.value) and stats.answer_interval(zero, 0.5) == stats.INCONCLUSIVE

@@ -374,10 +374,10 @@ class Ratio:
 def median_ratio(x, y, confidence: float = CONFIDENCE, resamples: int = RESAMPLES, seed: int = SEED) -> Ratio:
     x, y = np.asarray(x, float), np.asarray(y, float)
 
-    def ratio(a, b, axis=-1):
-        mb = np.median(b, axis=axis)
+    def ratio(a, b, axis=-1):  # 0 / 0 is undefined (NaN: no answer can rest on it), x / 0 infinite
+        ma, mb = np.median(a, axis=axis), np.median(b, axis=axis)
         with np.errstate(divide="ignore", invalid="ignore"):
-            return np.where(mb == 0, np.inf, np.median(a, axis=axis) / mb)
+            return np.where(mb == 0, np.where(ma == 0, np.nan, np.inf), ma / np.where(mb == 0, 1.0, mb))
 
     value = float(ratio(x, y))
     if len(x) < 2 or len(y) < 2:
