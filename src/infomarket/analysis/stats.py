@@ -286,11 +286,6 @@ def tost(x, y, margin: float, alpha: float = ALPHA, seed: int = SEED) -> tuple[f
     return max(lo.p, hi.p), lo, hi
 
 
-def underpowered(c: Comparison, target: float = POWER) -> bool:
-    """The run counts cannot reach alpha, or give less than ``target`` power for the declared effect."""
-    return not (c.power >= target)  # power is 0 where alpha / family is out of reach
-
-
 def answer(yes: bool, no: bool) -> str:
     """yes / no from the evidence for each; neither (or, impossibly, both) is "inconclusive"."""
     if yes and not no:
