@@ -1,4 +1,6 @@
-"""The statistics the paper reports, each a thin wrapper over scipy so no test or CI is hand-rolled.
+"""The statistics the reports use: tests and intervals come from scipy; the few pieces scipy lacks (the
+Hodges-Lehmann shift, Cliff's delta, Holm's adjustment, simulated power) are short and tested against
+hand calculations.
 
 - Mann-Whitney U (Figs. 3-4): one-sided, honest > Byzantine, because the paper's claim is that the
   honest distribution is higher, not merely different.
