@@ -134,6 +134,7 @@ def test_holm_turns_a_single_marginal_angle_into_a_no():
     comps[0] = dataclasses.replace(comps[0], p=0.03, p_adjusted=0.03)
     assert comps[0].significant
     assert not stats.adjust(comps)[0].significant
+    assert stats.adjust(comps)[0].family == 4 and "Holm-adjusted over 4" in stats.adjust(comps)[0].describe()
 
 
 def test_tost_shows_equivalence_of_equal_samples_and_refuses_a_shifted_one():

@@ -220,6 +220,7 @@ class Comparison:
     declared: float
     power: float
     alpha: float
+    family: int = 1     # how many comparisons the Holm adjustment spans
 
     @property
     def significant(self) -> bool:
@@ -227,7 +228,8 @@ class Comparison:
 
     def describe(self, unit: str = "") -> str:
         e = self.effect
-        adj = f", Holm-adjusted {_fmt_p(self.p_adjusted)}" if self.p_adjusted != self.p else ""
+        adj = (f", Holm-adjusted over {self.family} {_fmt_p(self.p_adjusted)}"
+               if self.family > 1 or self.p_adjusted != self.p else "")
         pw = "" if math.isnan(self.power) else f", power {self.power:.2f} if the true shift is {self.declared:+.3g}{unit}"
         return (f"{self.label}: medians {self.median_x:.4g} vs {self.median_y:.4g} (n = {self.n_x}, {self.n_y}), "
                 f"HL shift {e.hl:+.3g}{unit} [{e.hl_low:.3g}, {e.hl_high:.3g}], Cliff's delta {e.delta:+.2f} "
@@ -277,7 +279,7 @@ def holm(pvalues) -> np.ndarray:
 def adjust(comparisons: list[Comparison]) -> list[Comparison]:
     """The comparisons of one question with Holm-adjusted p-values (unchanged for a single one)."""
     adj = holm([c.p for c in comparisons])
-    return [replace(c, p_adjusted=float(a)) for c, a in zip(comparisons, adj)]
+    return [replace(c, p_adjusted=float(a), family=len(comparisons)) for c, a in zip(comparisons, adj)]
 
 
 def tost(x, y, margin: float, alpha: float = ALPHA, seed: int = SEED) -> tuple[float, Comparison, Comparison]:
