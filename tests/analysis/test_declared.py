@@ -88,3 +88,13 @@ def test_answering_with_another_run_count_says_so():
     assert declared.size_note(32, [32, 32]) == ""
     assert declared.size_note(32, [2, 2]) == "answered with 2 runs per condition, not the 32 declared"
     assert declared.size_note(None, [2, 2]) == ""
+
+
+def test_a_paper_rule_edited_after_the_first_run_is_flagged_in_the_paper_report(tmp_path, files):
+    from .synthetic import paper_like
+
+    store = write_store(tmp_path / "store", paper_like(), only=("fig2",))
+    _edit(files["tolerances.toml"], "min = 18\nmax = 22", "min = 17\nmax = 22")  # rows.fig2A_median
+    build_report(store, tmp_path / "out")
+    md = (tmp_path / "out" / "report.md").read_text()
+    assert "EDITED after its first run: rows.fig2A_median" in md
