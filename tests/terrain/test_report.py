@@ -52,6 +52,7 @@ def test_terrain_report_command_on_small_stores(tmp_path):
     text = (out / "terrain.md").read_text()
     assert [line[:3] for line in text.splitlines() if line[:1].isdigit()] == ["1. ", "2. ", "3. ", "4. "]
     assert "store crowd: terrain_questions.toml: 4 of 4 declarations unchanged" in text
+    assert "- NOTE: crowd_collisions: answered with 2 runs per condition, not the 32 declared." in text
     # 2 runs per condition cannot decide a rule: inconclusive, never yes or no (issue 24)
     assert all("— **inconclusive**" in line for line in text.splitlines() if line[:2] in ("1.", "3.", "4."))
     assert "not run" in text.splitlines()[1]

@@ -25,7 +25,7 @@ from scipy import stats as sps
 
 from ..cliargs import UsageError
 from . import stats as st
-from .declared import check, summary
+from .declared import check, size_note, summary
 from .stats import mann_whitney
 
 QUESTIONS = Path(__file__).with_name("terrain_questions.toml")
@@ -328,6 +328,18 @@ def markdown(a: dict) -> str:
             f"collisions vs {e[100]['median_off']:.2f} without (ratio {e[100]['ratio']:.2f}, p = "
             f"{_p(e[100]['p_two_sided'])}); 25 robots: {e[25]['median_on']:.2f} vs {e[25]['median_off']:.2f} "
             f"(ratio {e[25]['ratio']:.2f}, p = {_p(e[25]['p_two_sided'])}).")
+    notes = []
+    for qid, key in (("chain_blocked", "runs"), ("waypoints_restore", "runs"), ("outlier_two_food", None),
+                     ("crowd_collisions", None)):
+        ans = a[qid]
+        runs = (ans.get(key) if key else (ans["two_sites"]["runs"] if qid == "outlier_two_food" else ans[100]["runs"])) \
+            if ans.get("answer") != "not run" else None
+        note = size_note(q[qid].get("runs"), [runs] if runs else [])
+        if note:
+            notes.append(f"{qid}: {note}")
+    if notes:
+        lines.append("")
+        lines += [f"- NOTE: {n}." for n in notes]
     if "declarations" in a:
         lines.append("")
         lines += [f"- {line}" for line in a["declarations"]]
