@@ -9,7 +9,7 @@ def test_figures_command_writes_the_report_with_a_line_per_figure(tmp_path, caps
     out = capsys.readouterr().out.splitlines()
     assert "fig2: wrote fig2.png, fig2.svg" in out and "fig6: wrote fig6.png, fig6.svg" in out
     assert "fig5: skipped (no fig5 rows in the store)" in out
-    assert "paper vs this store: 9 pass, 0 fail, 16 no data" in out
+    assert "paper vs this store: 9 pass, 0 fail, 0 inconclusive, 16 no data" in out
     assert (tmp_path / "out" / "report.html").exists()
 
 

@@ -33,6 +33,7 @@ def test_fig3_annotates_the_mann_whitney_p_value_on_each_panel(paper_frames):
     fig = analysis.fig3(paper_frames.robots)
     for ax in fig.axes:
         assert any("Mann-Whitney" in t.get_text() and "p = " in t.get_text() for t in ax.texts)
+        assert any("run-level signed-rank, 12 runs" in t.get_text() for t in ax.texts)
 
 
 def test_fig6_shows_pearson_r(paper_frames):

@@ -30,18 +30,18 @@ def _run_rows(experiment, defence, byz, angle, run, total, rng):
         "byzantines": byz, "defence": defence, "rotation_angle": np.nan if angle is None else angle})
 
 
-def sweep(items) -> pd.DataFrame:
+def sweep(items, runs: int = RUNS) -> pd.DataFrame:
     """``items(experiment, defence, byzantines, angle)`` -> the runs' swarm items around that value, with
     the same spread (-3 .. +3) in every condition, so equal values give equal samples, never a p < 0.05."""
     rng = np.random.default_rng(0)
     rows = []
     for d in future.DEFENCES:
-        for r in range(RUNS):
+        for r in range(runs):
             rows.append(_run_rows(future.HONEST, d, 0, None, r, items(future.HONEST, d, 0, None) + r % 7 - 3, rng))
         for exp in future.ATTACKS:
             for byz in (1, 3):
                 for a in ANGLES:
-                    for r in range(RUNS):
+                    for r in range(runs):
                         total = items(exp, d, byz, a) + r % 7 - 3
                         rows.append(_run_rows(exp, d, byz, a, r, total, rng))
     return pd.concat(rows, ignore_index=True)
@@ -138,3 +138,51 @@ def test_a_paper_only_store_has_no_open_questions_section(paper_store, tmp_path)
     report = build_report(paper_store, tmp_path)
     assert report.future is None
     assert "open questions" not in (tmp_path / "report.md").read_text()
+
+
+@pytest.mark.parametrize("items", [hopeless, rescued, costly])
+def test_a_reduced_sweep_answers_inconclusive_never_yes_or_no(items):
+    """``sweep future --scale 0.02`` gives 2 runs per condition: the smallest one-sided Mann-Whitney p is
+    1/6, so no test can reach alpha and every answer must be inconclusive.  (The rules before issue 24
+    answered these with yes or no: e.g. "the farmer beats the sceptic" was yes for ``hopeless``, because
+    its second clause, "at no angle significantly better", holds whenever nothing can be significant.)"""
+    table = future.question_table(Frames(robots=sweep(items, runs=2)))
+    assert set(table["answer"]) == {future.INCONCLUSIVE}
+    assert table["statistics"].str.contains("answered with 2 runs per condition, not the 32 declared").all()
+
+
+def test_answers_state_effects_with_intervals_holm_and_power():
+    table = future.question_table(Frames(robots=sweep(rescued))).set_index("id")
+    text = table.loc["liar_improved_reputation_sceptic", "statistics"]
+    assert "HL shift +90 items" in text and "Cliff's delta +1.00" in text and "Holm-adjusted" in text
+    assert "power 1.00 if the true shift is +33 items" in text  # margin: 10 % of the reference median 330
+    # Holm over the 4 angles: equal p-values are each multiplied by 4
+    q = future.load_questions()["liar_improved_reputation_sceptic"]
+    comps = future.ANSWERS[q.id](future.swarm_items(sweep(rescued)), q.params).comparisons
+    assert len(comps) == 4 and all(c.p_adjusted == pytest.approx(4 * c.p) for c in comps)
+
+
+def test_an_attack_does_not_beat_a_defence_just_because_nothing_is_significant():
+    """The farmer drags the sceptic far below its own honest median (shown), but the paper's defence
+    against the farmer is so variable that "the sceptic is no better than the paper" cannot be shown:
+    inconclusive, where the rule before issue 24 ("at no angle significantly better") said yes."""
+    robots = sweep(hopeless)
+    sel = (robots["experiment"] == "future_farmer") & (robots["defence"] == "paper") & (robots["robot"] == 0)
+    wild = np.tile([-200, 200, -150, 150, -100, 100, 0, 60], sel.sum() // RUNS)
+    robots.loc[sel, "items_collected"] += wild
+    a = dict(zip(*future.question_table(Frames(robots=robots))[["id", "answer"]].T.values))
+    assert a["farmer_beats_reputation_sceptic"] == future.INCONCLUSIVE
+    assert a["surfer_beats_adaptive_theta"] == future.YES  # the surfer's paper runs are untouched
+
+
+def test_no_cost_needs_a_shown_margin_not_a_missing_difference():
+    """Equal honest swarms but a spread as wide as the margin: no cost is not shown, so the answer is
+    inconclusive (the rule before issue 24 said "no" because the difference was not significant)."""
+    rng = np.random.default_rng(3)
+    robots = sweep(hopeless)
+    honest = robots["experiment"] == future.HONEST
+    noise = {key: rng.integers(-80, 80) for key in robots.loc[honest, ["defence", "run"]].itertuples(index=False)}
+    robots.loc[honest & (robots["robot"] == 0), "items_collected"] += [
+        noise[(d, r)] for d, r in robots.loc[honest & (robots["robot"] == 0), ["defence", "run"]].itertuples(index=False)]
+    a = dict(zip(*future.question_table(Frames(robots=robots))[["id", "answer"]].T.values))
+    assert a["honest_cost_reputation_sceptic"] == future.INCONCLUSIVE

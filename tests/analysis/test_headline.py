@@ -1,9 +1,11 @@
 import math
 
+import numpy as np
+
 import pytest
 
 from infomarket.analysis import headline
-from infomarket.analysis.headline import FAIL, NO_DATA, PASS, Rule, headline_table, load_rules
+from infomarket.analysis.headline import FAIL, INCONCLUSIVE, NO_DATA, PASS, Rule, headline_table, load_rules
 
 from .synthetic import paper_like, write_store
 
@@ -149,3 +151,41 @@ def test_headline_table_takes_frames_dicts_and_paths(paper_store, paper_frames):
     a = headline_table(paper_store.root)
     b = headline_table({"robots": paper_frames.robots, "history": paper_frames.history})
     assert list(a["verdict"]) == list(b["verdict"])
+
+
+# ------------------------------------------------------------------------------- issue 24: run level
+def test_fig3_4_rows_are_run_level_and_too_few_runs_are_inconclusive(paper_frames):
+    """Honest robots far richer in every run, but only 6 runs of fig3A: the robot-level p (pooled robots)
+    is tiny, the run-level signed-rank p can be no smaller than 1/64 > 0.001: inconclusive, not pass."""
+    robots = paper_frames.robots
+    robots = robots[(robots.experiment != "fig3A") | (robots.run < 6)]
+    table = headline_table({"robots": robots, "history": paper_frames.history}).set_index("id")
+    assert table.loc["fig3A_mannwhitney", "value"] == pytest.approx(1 / 64)
+    assert table.loc["fig3A_mannwhitney", "verdict"] == INCONCLUSIVE
+    assert "robot-level" in table.loc["fig3A_mannwhitney", "store"]
+    assert table.loc["fig3B_mannwhitney", "verdict"] == PASS  # 12 runs: 1 / 4096 < 0.001
+
+
+def test_fig7b_needs_a_significant_gain_not_just_a_higher_median(paper_frames):
+    """No staking one item lower per run than staking's distribution: staking's median stays higher
+    at every angle above Theta (the old rule's pass), but the gain is no test's evidence: fail."""
+    robots = paper_frames.robots.copy()
+    rng = np.random.default_rng(5)
+    sel = (robots.experiment == "fig7") & (robots.byzantines == 3) & (robots.rotation_angle > 30)
+    robots.loc[sel, "items_collected"] = rng.integers(12, 14, sel.sum())
+    lower = sel & (robots.market == "no_staking") & (robots.robot == 0)
+    robots.loc[lower, "items_collected"] -= 1
+    runs = robots[sel].groupby(["rotation_angle", "market", "run"])["items_collected"].sum()
+    med = runs.groupby(["rotation_angle", "market"]).median().unstack()
+    if not (med["staking"] > med["no_staking"]).all():
+        pytest.skip("the draw did not give higher staking medians everywhere")
+    table = headline_table({"robots": robots}).set_index("id")
+    assert table.loc["fig7B_staking_helps", "value"] < 1.0
+    assert table.loc["fig7B_staking_helps", "verdict"] in (FAIL, INCONCLUSIVE)
+    assert "Holm" in table.loc["fig7B_staking_helps", "store"]
+
+
+def test_fig7b_with_two_runs_per_condition_is_inconclusive(paper_frames):
+    robots = paper_frames.robots
+    robots = robots[(robots.experiment != "fig7") | (robots.run < 2)]
+    assert verdicts(headline_table({"robots": robots}))["fig7B_staking_helps"] == INCONCLUSIVE

@@ -59,6 +59,6 @@ def test_same_store_gives_identical_figures(paper_frames, tmp_path):
 
 def test_provenance_counts_runs_per_experiment(paper_frames):
     p = collect_provenance(paper_frames).experiments.set_index("experiment")
-    assert p.loc["fig7", "runs"] == 2 * 2 * 10 * 4 and p.loc["fig7", "conditions"] == 40
+    assert p.loc["fig7", "runs"] == 2 * 2 * 10 * 8 and p.loc["fig7", "conditions"] == 40
     assert p.loc["fig7", "config hashes"] == "cafefig7"
     assert p.loc["fig5", "status"] == "ok: 4"

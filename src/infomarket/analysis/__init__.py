@@ -18,6 +18,8 @@ _LAZY = {
     "build_report": "report", "collect_provenance": "provenance",
     "Frames": "frames", "MissingDataError": "frames",
     "mann_whitney": "stats", "pearson": "stats", "mean_band": "stats", "regression_band": "stats",
+    "compare": "stats", "holm": "stats", "tost": "stats", "paired": "stats", "median_ratio": "stats",
+    "hodges_lehmann": "stats", "cliffs_delta": "stats",
     "swarm_throughput": "metrics", "wealth_curves": "metrics",
 }
 

@@ -23,7 +23,7 @@ from . import metrics, stats
 from .boxplots import BYZANTINE, HONEST, draw_boxes, honest_vs_byzantine, legend_handles
 from .frames import Frames, MissingDataError, composition, experiment
 
-EQUAL_SHARE_PCT = 100.0 / 25  # every robot's wealth share when wealth is equal (MODEL.md §7)
+EQUAL_SHARE_PCT = 100.0 / 25  # every robot's wealth share when wealth is equal (docs/model.md §7)
 THETA_DEG = get_payment("outlier").defaults["theta"]  # outlier threshold (paper, Fig. 7): the scheme's default
 STAKING, NO_STAKING = "#2ca02c", "#ff7f0e"
 
@@ -85,7 +85,12 @@ def _annotate_mann_whitney(ax: Axes, rows: pd.DataFrame) -> None:
     if honest.all() or not honest.any():
         return
     mw = stats.mann_whitney(rows.loc[honest, "wealth_share"], rows.loc[~honest, "wealth_share"])
-    ax.text(0.03, 0.97, f"Mann-Whitney U, one-sided\np = {mw.pvalue:.2g}", transform=ax.transAxes, ha="left",
+    means = rows.groupby(["run", "honest"])["wealth_share"].mean().unstack().dropna()
+    text = f"robot-level Mann-Whitney U, one-sided\np = {mw.pvalue:.2g}"
+    if len(means):  # the run-level test the report judges (issue 24)
+        pr = stats.paired(100.0 * (means[True] - means[False]).to_numpy())
+        text = f"run-level signed-rank, {pr.n} runs\np = {pr.p:.2g}\n" + text
+    ax.text(0.03, 0.97, text, transform=ax.transAxes, ha="left",
             va="top", fontsize=8, bbox=dict(facecolor="white", edgecolor="none", alpha=0.8))
 
 

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from ..errors import InfomarketError
+from ..errors import InfomarketError, InputTypeError
 from ..store import Store, StoreError
 
 
@@ -38,13 +38,13 @@ class Frames:
         if isinstance(source, dict):
             unknown = set(source) - {"robots", "history", "runs", "meta"}
             if unknown:
-                raise TypeError(f"unknown tables {sorted(unknown)}; expected robots, history, runs")
+                raise InputTypeError(f"unknown tables {sorted(unknown)}; expected robots, history, runs")
             return cls(**{k: v for k, v in source.items() if v is not None})
         if isinstance(source, (str, Path)):
             source = Store(source)
         if isinstance(source, Store):
             return cls.from_store(source)
-        raise TypeError(f"cannot read tables from a {type(source).__name__}")
+        raise InputTypeError(f"cannot read tables from a {type(source).__name__}")
 
     @classmethod
     def from_store(cls, store: Store) -> "Frames":

@@ -3,9 +3,10 @@
 The sweep (``infomarket sweep future``) runs three attacks (``future_liar``, ``future_farmer``,
 ``future_surfer``) against four defences, plus every defence without Byzantines (``future_honest``).
 The sample is the run: its swarm items (every robot's items after the transitory period, as in Fig. 7).
-The questions, their decision rules and parameters are declared in ``tolerances.toml`` ([questions.*])
-before the full sweep ran; each answer here is computed from those parameters, yes or no, with the
-Mann-Whitney p-values and medians it used, whatever it is.
+The questions, their decision rules and parameters are declared in ``tolerances.toml`` ([statistics],
+[questions.*]); each answer here is computed from those parameters with ``analysis.stats`` (run-level
+effects with bootstrap intervals, one-sided Mann-Whitney, Holm over the question's family, simulated
+power, non-inferiority tests for "no cost" and "kept"): yes, no or inconclusive, whatever it is.
 """
 from __future__ import annotations
 
@@ -21,8 +22,11 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from scipy import stats as sps
 
+from . import stats as st
 from .boxplots import draw_boxes, legend_handles
+from .declared import check, size_note, status_of, summary
 from .frames import Frames, MissingDataError
+from ..errors import ConfigError
 
 TOLERANCES = Path(__file__).with_name("tolerances.toml")
 ATTACKS = {"future_liar": "constant liar (scaboteur)", "future_farmer": "reputation farmer",
@@ -35,7 +39,7 @@ LABELS = {"paper": "paper (sceptical + outlier, staking)", "reputation_sceptic":
           "adaptive_theta": "adaptive Theta", "both": "both"}
 BELOW = (5.0, 10.0, 20.0, 25.0)
 ABOVE = (40.0, 90.0)
-YES, NO, NO_DATA = "yes", "no", "no data"
+YES, NO, INCONCLUSIVE, NO_DATA = st.YES, st.NO, st.INCONCLUSIVE, "no data"
 
 
 def swarm_items(robots: pd.DataFrame) -> pd.DataFrame:
@@ -84,15 +88,27 @@ class Question:
 
 @dataclass(frozen=True)
 class Answer:
-    answer: str      # yes / no / no data
+    answer: str      # yes / no / inconclusive / no data
     statistics: str  # the numbers the answer rests on
+    comparisons: tuple = ()  # the stats.Comparison objects, for tests and JSON
+
+
+STATISTICS = {"alpha": st.ALPHA, "power": st.POWER, "margin_fraction": 0.10, "confidence": st.CONFIDENCE,
+              "runs": None}
+
+
+def load_statistics(path: str | Path = TOLERANCES) -> dict:
+    """The shared statistical declarations ([statistics]) of the questions, with defaults."""
+    return {**STATISTICS, **tomllib.loads(Path(path).read_text()).get("statistics", {})}
 
 
 def load_questions(path: str | Path = TOLERANCES) -> dict[str, Question]:
+    """The declared questions; each one's params include the shared [statistics] (its own win)."""
+    shared = load_statistics(path)
     data = tomllib.loads(Path(path).read_text()).get("questions", {})
     out = {}
     for qid, spec in data.items():
-        params = {k: v for k, v in spec.items() if k not in ("question", "rule")}
+        params = {**shared, **{k: v for k, v in spec.items() if k not in ("question", "rule")}}
         out[qid] = Question(qid, spec["question"], spec["rule"], params)
     return out
 
@@ -111,37 +127,64 @@ def _med(x: np.ndarray) -> float:
     return float(np.median(x))
 
 
+def _reference(runs: pd.DataFrame, p: dict) -> tuple[np.ndarray, float]:
+    """The paper defence's swarm without Byzantines, and the margin (a fraction of its median)."""
+    ref = _need(values(runs, HONEST, "paper", 0), "future_honest, paper defence")
+    return ref, p.get("fraction", p["margin_fraction"]) * _med(ref)
+
+
+def _cmp(x, y, label, p, *, alternative="greater", shift=0.0, declared=None, family=1) -> st.Comparison:
+    return st.compare(x, y, alternative=alternative, shift=shift, declared=declared, alpha=p["alpha"],
+                      family=family, label=label)
+
+
+def _lines(comps: list[st.Comparison]) -> str:
+    return "; ".join(c.describe(" items") for c in comps)
+
+
+def _size(p: dict, comps: list[st.Comparison]) -> str:
+    note = size_note(p.get("runs"), [n for c in comps for n in (c.n_x, c.n_y)])
+    return f"NOTE: {note}. " if note else ""
+
+
+def _power_line(comps: list[st.Comparison], p: dict) -> str:
+    low = [c.label for c in comps if not c.power >= p["power"]]
+    return (f"power >= {p['power']:g} at {len(comps) - len(low)} of {len(comps)} comparisons"
+            + (f" (below at {', '.join(low)})" if low else ""))
+
+
 @answers("liar_recovered")
 def _liar_recovered(runs: pd.DataFrame, p: dict) -> Answer:
-    ref = _need(values(runs, HONEST, "paper", 0), "future_honest, paper defence")
-    target = (1.0 - p["fraction"]) * _med(ref)
-    parts, any_yes = [], False
-    for d in NEW:
-        ratios = []
-        for a in BELOW:
-            x = _need(values(runs, "future_liar", d, 3, a), f"future_liar {d} at {a:g} deg")
-            ratios.append((_med(x) / _med(ref), a, greater(x, values(runs, "future_liar", "paper", 3, a))))
-        worst = min(ratios)
-        ok = all(r * _med(ref) >= target for r, _, _ in ratios)
-        any_yes |= ok
-        parts.append(f"{d}: worst median ratio {worst[0]:.2f} at {worst[1]:g} deg "
-                     f"(p vs paper, one-sided: {', '.join(f'{a:g}: {q:.2g}' for _, a, q in ratios)})")
-    return Answer(YES if any_yes else NO, f"reference median {_med(ref):g} items (paper, 0 Byzantines, "
-                  f"n = {len(ref)}), target >= {target:g}; " + "; ".join(parts))
+    ref, m = _reference(runs, p)
+    keys = [(d, a) for d in NEW for a in BELOW]
+    xs = {k: _need(values(runs, "future_liar", k[0], 3, k[1]), f"future_liar {k[0]} at {k[1]:g} deg") for k in keys}
+    ni = st.adjust([_cmp(xs[k], ref, f"{k[0]} {k[1]:g} deg within", p, shift=m, declared=0.0, family=len(keys))
+                    for k in keys])
+    below = st.adjust([_cmp(xs[k], ref, f"{k[0]} {k[1]:g} deg below", p, alternative="less", shift=m)
+                       for k in keys])
+    yes = [d for d in NEW if all(c.significant for c, k in zip(ni, keys) if k[0] == d)]
+    no = all(any(c.significant for c, k in zip(below, keys) if k[0] == d) for d in NEW)
+    return Answer(st.answer(bool(yes), no),
+                  f"{_size(p, ni)}reference (paper, 0 Byzantines) median {_med(ref):g} items, n = {len(ref)}; "
+                  f"margin {m:.3g} items; shown within the margin at every angle: {', '.join(yes) or 'no defence'}; "
+                  f"shown below at some angle: {', '.join(d for d in NEW if any(c.significant for c, k in zip(below, keys) if k[0] == d)) or 'no defence'}; "
+                  f"{_power_line(ni, p)}. Non-inferiority (Holm over {len(keys)}): {_lines(ni)}", tuple(ni + below))
 
 
 def _improves(defence: str):
     def measure(runs: pd.DataFrame, p: dict) -> Answer:
-        hits, parts = 0, []
+        _, m = _reference(runs, p)
+        comps = []
         for a in BELOW:
             x = _need(values(runs, "future_liar", defence, 3, a), f"future_liar {defence} at {a:g} deg")
             y = _need(values(runs, "future_liar", "paper", 3, a), f"future_liar paper at {a:g} deg")
-            q = greater(x, y)
-            hits += q < p["alpha"]
-            parts.append(f"{a:g} deg: {_med(x):g} vs {_med(y):g}, p = {q:.2g}")
-        return Answer(YES if hits >= p["min_angles"] else NO,
-                      f"{hits} of {len(BELOW)} angles with p < {p['alpha']:g} (medians {defence} vs paper, "
-                      f"n = {len(x)} runs each): " + "; ".join(parts))
+            comps.append(_cmp(x, y, f"{a:g} deg", p, declared=m, family=len(BELOW)))
+        comps = st.adjust(comps)
+        hits = sum(c.significant for c in comps)
+        return Answer(st.answer_superiority(comps, p["min_angles"], p["power"]),
+                      f"{_size(p, comps)}{hits} of {len(BELOW)} angles with Holm-adjusted p < {p['alpha']:g} "
+                      f"(needed {p['min_angles']}); {_power_line(comps, p)} for a gain of the margin "
+                      f"({m:.3g} items). {defence} vs paper: {_lines(comps)}", tuple(comps))
     return measure
 
 
@@ -152,24 +195,27 @@ for _d in NEW:
 def _beats(experiment: str, defence: str):
     def measure(runs: pd.DataFrame, p: dict) -> Answer:
         own = _need(values(runs, HONEST, defence, 0), f"future_honest, {defence}")
-        floor = (1.0 - p["fraction"]) * _med(own)
-        dropped, helped, parts = [], [], []
-        for a in (*BELOW, *ABOVE):
-            x = _need(values(runs, experiment, defence, 3, a), f"{experiment} {defence} at {a:g} deg")
-            y = _need(values(runs, experiment, "paper", 3, a), f"{experiment} paper at {a:g} deg")
-            q = greater(x, y)
-            if _med(x) < floor:
-                dropped.append(a)
-            if q < p["alpha"]:
-                helped.append(a)
-            parts.append(f"{a:g} deg: {_med(x):g} (paper {_med(y):g}, p = {q:.2g})")
-        yes = bool(dropped) and not helped
-        def at(angles):
-            return f"{', '.join(f'{a:g}' for a in angles)} deg" if angles else "no angle"
+        m = p.get("fraction", p["margin_fraction"]) * _med(own)
+        angles = (*BELOW, *ABOVE)
+        x = {a: _need(values(runs, experiment, defence, 3, a), f"{experiment} {defence} at {a:g} deg") for a in angles}
+        y = {a: _need(values(runs, experiment, "paper", 3, a), f"{experiment} paper at {a:g} deg") for a in angles}
+        dropped = st.adjust([_cmp(x[a], own, f"{a:g} deg", p, alternative="less", shift=m) for a in angles])
+        kept = st.adjust([_cmp(x[a], own, f"{a:g} deg", p, shift=m) for a in angles])
+        not_better = st.adjust([_cmp(x[a], y[a], f"{a:g} deg", p, alternative="less", shift=-m) for a in angles])
+        helped = st.adjust([_cmp(x[a], y[a], f"{a:g} deg", p, declared=m, family=len(angles)) for a in angles])
 
-        return Answer(YES if yes else NO,
-                      f"{defence} without Byzantines: median {_med(own):g}, floor {floor:g}; below the floor at "
-                      f"{at(dropped)}; significantly better than the paper at {at(helped)}; " + "; ".join(parts))
+        def at(comps):
+            hit = [c.label for c in comps if c.significant]
+            return ", ".join(hit) if hit else "no angle"
+
+        yes = any(c.significant for c in dropped) and all(c.significant for c in not_better)
+        no = any(c.significant for c in helped) or all(c.significant for c in kept)
+        return Answer(st.answer(yes, no),
+                      f"{_size(p, helped)}{defence} without Byzantines: median {_med(own):g}, margin {m:.3g}; "
+                      f"shown below {_med(own):g} - margin at {at(dropped)}; shown above it at {at(kept)}; "
+                      f"shown no better than the paper + margin at {at(not_better)}; significantly better than "
+                      f"the paper at {at(helped)} (each set Holm over {len(angles)} angles). {defence} vs paper: "
+                      f"{_lines(helped)}", tuple(dropped + kept + not_better + helped))
     return measure
 
 
@@ -179,13 +225,14 @@ answers("surfer_beats_adaptive_theta")(_beats("future_surfer", "adaptive_theta")
 
 def _honest_cost(defence: str):
     def measure(runs: pd.DataFrame, p: dict) -> Answer:
-        x = _need(values(runs, HONEST, "paper", 0), "future_honest, paper")
+        x, m = _reference(runs, p)
         y = _need(values(runs, HONEST, defence, 0), f"future_honest, {defence}")
-        q = greater(x, y)
+        cost = _cmp(y, x, f"{defence} below paper", p, alternative="less", declared=-m)
+        ni = _cmp(y, x, f"{defence} within the margin of paper", p, shift=m, declared=0.0)
         rel = 100.0 * (_med(y) - _med(x)) / _med(x) if _med(x) else math.nan
-        return Answer(YES if q < p["alpha"] else NO,
-                      f"medians {_med(y):g} ({defence}) vs {_med(x):g} (paper), {rel:+.1f} %; Mann-Whitney "
-                      f"paper > {defence}: p = {q:.2g} (n = {len(x)}, {len(y)})")
+        return Answer(st.answer(cost.significant, ni.significant),
+                      f"{_size(p, [cost])}medians {_med(y):g} ({defence}) vs {_med(x):g} (paper), {rel:+.1f} %; "
+                      f"margin {m:.3g} items. {cost.describe(' items')}; {ni.describe(' items')}", (cost, ni))
     return measure
 
 
@@ -195,24 +242,28 @@ for _d in NEW:
 
 @answers("above_theta_kept")
 def _above_kept(runs: pd.DataFrame, p: dict) -> Answer:
-    worse, parts = [], []
-    for d in NEW:
-        for a in ABOVE:
-            x = _need(values(runs, "future_liar", "paper", 3, a), f"future_liar paper at {a:g} deg")
-            y = _need(values(runs, "future_liar", d, 3, a), f"future_liar {d} at {a:g} deg")
-            q = greater(x, y)
-            if q < p["alpha"]:
-                worse.append(f"{d} at {a:g} deg")
-            parts.append(f"{d} {a:g} deg: {_med(y):g} vs {_med(x):g}, p = {q:.2g}")
-    return Answer(NO if worse else YES, f"significantly worse than the paper: {', '.join(worse) or 'none'}; "
-                  + "; ".join(parts))
+    _, m = _reference(runs, p)
+    keys = [(d, a) for d in NEW for a in ABOVE]
+    x = {k: _need(values(runs, "future_liar", k[0], 3, k[1]), f"future_liar {k[0]} at {k[1]:g} deg") for k in keys}
+    y = {a: _need(values(runs, "future_liar", "paper", 3, a), f"future_liar paper at {a:g} deg") for a in ABOVE}
+    ni = st.adjust([_cmp(x[k], y[k[1]], f"{k[0]} {k[1]:g} deg", p, shift=m, declared=0.0, family=len(keys))
+                    for k in keys])
+    worse = st.adjust([_cmp(x[k], y[k[1]], f"{k[0]} {k[1]:g} deg", p, alternative="less") for k in keys])
+    shown = [c.label for c in worse if c.significant]
+    return Answer(st.answer(all(c.significant for c in ni), bool(shown)),
+                  f"{_size(p, ni)}margin {m:.3g} items; significantly worse than the paper: "
+                  f"{', '.join(shown) or 'none'}; non-inferiority shown at {sum(c.significant for c in ni)} of "
+                  f"{len(ni)}; {_power_line(ni, p)}. Non-inferiority (Holm over {len(keys)}): {_lines(ni)}",
+                  tuple(ni + worse))
 
 
 def question_table(source, questions: dict[str, Question] | None = None) -> pd.DataFrame:
-    """One row per declared question: the question, its rule, the answer and its statistics
-    (``no data`` when the store lacks a condition it needs)."""
+    """One row per declared question: the question, its rule, the answer (yes / no / inconclusive, or
+    ``no data`` when the store lacks a condition it needs), its statistics, and whether its declaration
+    predates the store's first run (``declared``: see ``analysis.declared``)."""
     frames = Frames.of(source)
     questions = load_questions() if questions is None else questions
+    locks = check(frames.meta.get("declarations") if frames.meta else None)
     try:
         runs = swarm_items(frames.robots)
     except MissingDataError as exc:
@@ -220,7 +271,7 @@ def question_table(source, questions: dict[str, Question] | None = None) -> pd.D
     rows = []
     for qid, q in questions.items():
         if qid not in ANSWERS:
-            raise KeyError(f"tolerances questions.{qid} has no answer function in future.py")
+            raise ConfigError(f"tolerances questions.{qid} has no answer function in future.py")
         if runs is None:
             a = Answer(NO_DATA, missing)
         else:
@@ -228,8 +279,9 @@ def question_table(source, questions: dict[str, Question] | None = None) -> pd.D
                 a = ANSWERS[qid](runs, q.params)
             except MissingDataError as exc:
                 a = Answer(NO_DATA, str(exc))
-        rows.append([qid, q.question, q.rule, a.answer, a.statistics])
-    return pd.DataFrame(rows, columns=["id", "question", "rule", "answer", "statistics"])
+        rows.append([qid, q.question, q.rule, a.answer, a.statistics,
+                     status_of(locks, "tolerances.toml", f"questions.{qid}")])
+    return pd.DataFrame(rows, columns=["id", "question", "rule", "answer", "statistics", "declared"])
 
 
 # ------------------------------------------------------------------------------------------- figures
@@ -293,6 +345,7 @@ class Section:
 
     figures: list[tuple[str, str, list[Path], str]]  # name, caption, files (empty if skipped), note
     table: pd.DataFrame
+    lock: str = ""  # whether the questions were declared before the store's first run
 
 
 def section(frames: Frames, out: Path, vector: str, echo: Callable[[str], None]) -> Section | None:
@@ -313,14 +366,20 @@ def section(frames: Frames, out: Path, vector: str, echo: Callable[[str], None])
             echo(f"{name}: skipped ({exc})")
     table = question_table(frames)
     counts = table["answer"].value_counts()
-    echo(f"open questions: {counts.get(YES, 0)} yes, {counts.get(NO, 0)} no, {counts.get(NO_DATA, 0)} no data")
-    return Section(figs, table)
+    echo(f"open questions: {counts.get(YES, 0)} yes, {counts.get(NO, 0)} no, {counts.get(INCONCLUSIVE, 0)} "
+         f"inconclusive, {counts.get(NO_DATA, 0)} no data")
+    lock = summary(check(frames.meta.get("declarations") if frames.meta else None), "tolerances.toml", "questions.")
+    return Section(figs, table, lock)
 
 
 INTRO = ("The paper's future work, run: reputation-aware scepticism and adaptive Theta against attacks aimed at "
-         "them (docs/research.md). Questions and decision rules were declared in "
-         "`src/infomarket/analysis/tolerances.toml` ([questions]) before the full sweep was run; the sample is "
-         "the run (swarm items in the last 10 000 steps), tests are one-sided Mann-Whitney U on per-run values.")
+         "them (docs/research.md). Questions and decision rules: `src/infomarket/analysis/tolerances.toml` "
+         "([statistics], [questions]); the rules were revised for issue 24 after the first full sweep (see the file). "
+         "The sample is the run (swarm items in the last 10 000 steps). Each comparison gives the Hodges-Lehmann "
+         "shift and Cliff's delta with 95 % bootstrap intervals, a one-sided Mann-Whitney U test (Holm-adjusted "
+         "over the angles or defences the question spans), and its simulated power for the declared margin; "
+         "an answer the runs cannot support either way is \"inconclusive\", never \"no\".")
+COLUMNS = ["question", "answer", "declared", "statistics", "rule"]
 
 
 def to_markdown(s: Section, md_table: Callable[[pd.DataFrame], str]) -> list[str]:
@@ -330,7 +389,7 @@ def to_markdown(s: Section, md_table: Callable[[pd.DataFrame], str]) -> list[str
         md += [f"![{name}]({files[0].name})", "", f"Vector: [{files[1].name}]({files[1].name})"] if files \
             else [f"*Skipped: {note}.*"]
         md.append("")
-    md += ["### Answers", "", md_table(s.table[["question", "answer", "statistics", "rule"]]), ""]
+    md += ["### Answers", "", f"Declarations: {s.lock}.", "", md_table(s.table[COLUMNS]), ""]
     return md
 
 
@@ -345,5 +404,5 @@ def to_html(s: Section, html_table: Callable[[pd.DataFrame], str]) -> list[str]:
             parts.append(f"<p><a href='{e(files[1].name)}'><img src='{e(files[0].name)}' alt='{e(name)}'></a></p>")
         else:
             parts.append(f"<p class='note'>Skipped: {e(note)}.</p>")
-    parts += ["<h3>Answers</h3>", html_table(s.table[["question", "answer", "statistics", "rule"]])]
+    parts += ["<h3>Answers</h3>", f"<p>Declarations: {e(s.lock)}.</p>", html_table(s.table[COLUMNS])]
     return parts

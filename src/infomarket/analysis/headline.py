@@ -1,4 +1,4 @@
-"""The "paper vs this store" table: one row per headline number of MODEL.md §8.
+"""The "paper vs this store" table: one row per headline number of docs/model.md §8.
 
 Each row is a metric (a function here, computing one number from the tables) judged by a rule declared
 in ``tolerances.toml`` (bounds and the reasoning behind them, written before any result was seen).
@@ -7,10 +7,11 @@ code, and a test can check that every rule has a metric and every metric a rule.
 """
 from __future__ import annotations
 
+import inspect
 import math
 import tomllib
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -19,9 +20,10 @@ import pandas as pd
 from . import metrics, stats
 from .figures import THETA_DEG
 from .frames import Frames, MissingDataError, require
+from ..errors import ConfigError
 
 TOLERANCES = Path(__file__).with_name("tolerances.toml")
-PASS, FAIL, NO_DATA = "pass", "fail", "no data"
+PASS, FAIL, NO_DATA, INCONCLUSIVE = "pass", "fail", "no data", "inconclusive"
 COLUMNS = ["id", "figure", "claim", "paper", "store", "value", "tolerance", "verdict"]
 
 
@@ -37,6 +39,7 @@ class Rule:
     max: float | None = None
     above: float | None = None
     below: float | None = None
+    params: dict = field(default_factory=dict, compare=False)  # other declared keys (e.g. alpha)
 
     def passes(self, value: float) -> bool:
         if value is None or math.isnan(value):
@@ -59,8 +62,9 @@ def load_rules(path: str | Path = TOLERANCES) -> dict[str, Rule]:
     for rid, spec in data["rows"].items():
         bounds = {k: float(spec[k]) for k in ("min", "max", "above", "below") if k in spec}
         if not bounds:
-            raise ValueError(f"{path}: rows.{rid} declares no bound")
-        rules[rid] = Rule(rid, spec["figure"], spec["claim"], spec["paper"], **bounds)
+            raise ConfigError(f"{path}: rows.{rid} declares no bound")
+        params = {k: v for k, v in spec.items() if k not in ("figure", "claim", "paper", *bounds)}
+        rules[rid] = Rule(rid, spec["figure"], spec["claim"], spec["paper"], **bounds, params=params)
     return rules
 
 
@@ -68,6 +72,8 @@ def load_rules(path: str | Path = TOLERANCES) -> dict[str, Rule]:
 class Measurement:
     value: float   # what the rule judges
     shown: str     # how the table shows it (with the numbers it was computed from)
+    floor: float | None = None  # the smallest value the store's run counts allow (a p-value's minimum)
+    undecided: bool = False     # the store's runs cannot decide the row (a failing row is "inconclusive")
 
 
 METRICS: dict[str, Callable[[Frames], Measurement]] = {}
@@ -159,13 +165,20 @@ def _fig3_shrinks(f: Frames) -> Measurement:
 
 
 def _mann_whitney(name: str) -> Callable[[Frames], Measurement]:
+    """Run-level (issue 24): each run's honest minus Byzantine mean wealth share (percentage points),
+    one-sided Wilcoxon signed-rank test; the paper's robot-level Mann-Whitney, which pools robots over
+    runs (pseudo-replicates), is shown beside it.  ``floor``: 1 / 2^runs, the smallest p the runs allow."""
     def measure(f: Frames) -> Measurement:
         rows = require(f.robots, name, ("wealth_share", "honest"))
         honest = rows["honest"].to_numpy(bool)
         if honest.all() or not honest.any():
             raise MissingDataError(f"{name}: needs both honest and Byzantine robots")
+        means = rows.groupby(["run", "honest"])["wealth_share"].mean().unstack().dropna()
+        run_level = stats.paired(100.0 * (means[True] - means[False]).to_numpy())
         mw = stats.mann_whitney(rows.loc[honest, "wealth_share"], rows.loc[~honest, "wealth_share"])
-        return Measurement(mw.pvalue, f"p = {mw.pvalue:.2g} (n = {mw.n_honest} vs {mw.n_byzantine})")
+        return Measurement(run_level.p, f"run-level: {run_level.describe(' pp')}; robot-level (robots pooled "
+                           f"over runs, as the paper): Mann-Whitney p = {mw.pvalue:.2g} (n = {mw.n_honest} vs "
+                           f"{mw.n_byzantine})", floor=run_level.min_p)
     return measure
 
 
@@ -230,14 +243,35 @@ def _throughput_medians(f: Frames, byzantines: int) -> pd.DataFrame:
 
 
 @metric("fig7B_staking_helps")
-def _fig7b(f: Frames) -> Measurement:
-    med = _throughput_medians(f, 3)
-    above = med[med.index > THETA_DEG]
-    if above.empty:
+def _fig7b(f: Frames, rule: Rule) -> Measurement:
+    """Fraction of angles above Theta where staking's per-run swarm throughput is significantly higher
+    than no staking's (one-sided Mann-Whitney, Holm over those angles, alpha declared in the rule).  A
+    row that fails while some non-significant angle had power < 0.8 to detect a gain of the declared
+    margin (a fraction of the no-staking median) is undecided: "inconclusive"."""
+    runs = metrics.swarm_throughput(f.robots)
+    panel = runs[(runs["byzantines"] == 3) & (runs["rotation_angle"] > THETA_DEG)]
+    _throughput_medians(f, 3)  # raises MissingDataError when a market is missing
+    angles = sorted(panel["rotation_angle"].unique())
+    if not angles:
         raise MissingDataError(f"fig7: no rotation angle above {THETA_DEG:g} deg with 3 Byzantines")
-    wins = above["staking"] > above["no_staking"]
-    return Measurement(float(wins.mean()), f"{int(wins.sum())} of {len(wins)} angles "
-                       f"({', '.join(f'{a:g}' for a in above.index[~wins]) or 'none'} failing)")
+    alpha, fraction = rule.params.get("alpha", stats.ALPHA), rule.params.get("margin_fraction", 0.10)
+    comps = []
+    for a in angles:
+        at = panel[panel["rotation_angle"] == a]
+        x = at.loc[at["market"] == "staking", "throughput"].to_numpy(float)
+        y = at.loc[at["market"] == "no_staking", "throughput"].to_numpy(float)
+        if len(x) == 0 or len(y) == 0:
+            continue
+        comps.append(stats.compare(x, y, declared=fraction * float(np.median(y)), alpha=alpha,
+                                   family=len(angles), label=f"{a:g} deg"))
+    comps = stats.adjust(comps)
+    wins = [c.significant for c in comps]
+    weak = [c.label for c, w in zip(comps, wins) if not w and not c.power >= stats.POWER]
+    shown = (f"{sum(wins)} of {len(comps)} angles significant (Holm, alpha {alpha:g}); "
+             + (f"underpowered at {', '.join(weak)}; " if weak else "")
+             + "; ".join(f"{c.label}: HL {c.effect.hl:+.3g} [{c.effect.hl_low:.3g}, {c.effect.hl_high:.3g}], "
+                         f"p = {c.p:.2g}, Holm {c.p_adjusted:.2g}, power {c.power:.2f}" for c in comps))
+    return Measurement(float(np.mean(wins)), shown, undecided=bool(weak))
 
 
 @metric("fig7A_no_difference")
@@ -249,9 +283,16 @@ def _fig7a(f: Frames) -> Measurement:
 
 
 # ---------------------------------------------------------------------------------------- table
+def _undecided(m: Measurement, rule: Rule) -> bool:
+    """The store's runs cannot decide the row: the metric says so, or the smallest value its run counts
+    allow cannot satisfy the rule's strict upper bound (a p-value that can never be below it)."""
+    return m.undecided or (m.floor is not None and rule.below is not None and m.floor >= rule.below)
+
+
 def headline_table(source, rules: dict[str, Rule] | None = None) -> pd.DataFrame:
     """One row per rule: the paper's value, this store's value, the tolerance and the verdict
-    (``pass``, ``fail``, or ``no data`` when the store lacks what the row needs).
+    (``pass``, ``fail``, ``inconclusive`` when the row fails but the store's run counts could not have
+    decided it, or ``no data`` when the store lacks what the row needs).
 
     ``source`` is anything ``Frames.of`` reads: a Store, a store path, Frames or a dict of tables."""
     frames = Frames.of(source)
@@ -259,10 +300,13 @@ def headline_table(source, rules: dict[str, Rule] | None = None) -> pd.DataFrame
     rows = []
     for rid, rule in rules.items():
         if rid not in METRICS:
-            raise KeyError(f"tolerance rows.{rid} has no metric in headline.py")
+            raise ConfigError(f"tolerance rows.{rid} has no metric in headline.py")
         try:
-            m = METRICS[rid](frames)
+            fn = METRICS[rid]
+            m = fn(frames, rule) if len(inspect.signature(fn).parameters) == 2 else fn(frames)
             store, value, verdict = m.shown, m.value, PASS if rule.passes(m.value) else FAIL
+            if verdict == FAIL and _undecided(m, rule):
+                verdict = INCONCLUSIVE
         except MissingDataError as exc:
             store, value, verdict = str(exc), math.nan, NO_DATA
         rows.append([rid, rule.figure, rule.claim, rule.paper, store, value, rule.describe(), verdict])

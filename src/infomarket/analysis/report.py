@@ -15,9 +15,10 @@ import pandas as pd
 
 from ..store import Store
 from . import future
+from .declared import check, summary
 from .figures import FIGURES, save
 from .frames import Frames, MissingDataError
-from .headline import FAIL, NO_DATA, PASS, headline_table
+from .headline import FAIL, INCONCLUSIVE, NO_DATA, PASS, headline_table
 from .provenance import Provenance, collect_provenance
 
 TABLE_COLUMNS = {"figure": "figure", "claim": "claim", "paper": "paper", "store": "this store",
@@ -41,9 +42,10 @@ class Report:
     files: list[Path] = field(default_factory=list)
     future: future.Section | None = None  # the open-questions section, for stores with the future sweep
     sections: list[tuple[str, str]] = field(default_factory=list)  # (markdown, html), e.g. sensitivity
+    lock: str = ""  # were the rows' rules declared before the store's first run (analysis.declared)
 
     def counts(self) -> dict[str, int]:
-        return {v: int((self.table["verdict"] == v).sum()) for v in (PASS, FAIL, NO_DATA)}
+        return {v: int((self.table["verdict"] == v).sum()) for v in (PASS, FAIL, INCONCLUSIVE, NO_DATA)}
 
 
 def build_report(source, out: str | Path, *, vector: str = "svg", label: str | None = None,
@@ -69,6 +71,7 @@ def build_report(source, out: str | Path, *, vector: str = "svg", label: str | N
         echo(f"{spec.name}: wrote {', '.join(p.name for p in files)}")
     table = headline_table(frames)
     report = Report(label, results, table, collect_provenance(frames, label))
+    report.lock = summary(check(frames.meta.get("declarations") if frames.meta else None), "tolerances.toml", "rows.")
     report.future = future.section(frames, out, vector, echo)
     store = store if store is not None else (Store(source) if isinstance(source, (str, Path)) else
                                              source if isinstance(source, Store) else None)
@@ -77,7 +80,7 @@ def build_report(source, out: str | Path, *, vector: str = "svg", label: str | N
 
         report.sections = report_section(store, out, vector, echo)
     c = report.counts()
-    echo(f"paper vs this store: {c[PASS]} pass, {c[FAIL]} fail, {c[NO_DATA]} no data")
+    echo(f"paper vs this store: {c[PASS]} pass, {c[FAIL]} fail, {c[INCONCLUSIVE]} inconclusive, {c[NO_DATA]} no data")
     for name, text in (("report.md", to_markdown(report)), ("report.html", to_html(report))):
         (out / name).write_text(text, encoding="utf-8")
         report.files.append(out / name)
@@ -106,14 +109,16 @@ def _md_table(df: pd.DataFrame) -> str:
 
 def _summary(report: Report) -> str:
     c = report.counts()
-    return f"{c[PASS]} pass, {c[FAIL]} fail, {c[NO_DATA]} without data, of {len(report.table)} rows."
+    text = (f"{c[PASS]} pass, {c[FAIL]} fail, {c[INCONCLUSIVE]} inconclusive (the store's run counts cannot "
+            f"decide them), {c[NO_DATA]} without data, of {len(report.table)} rows.")
+    return text + (f" Declarations: {report.lock}." if report.lock else "")
 
 
 def to_markdown(report: Report) -> str:
     md = [f"# Paper figures from {report.source}", "",
           "Figures and headline numbers of *An Information Market for Social Navigation in Robots*, "
           "recomputed from this results store. Tolerances: `src/infomarket/analysis/tolerances.toml` "
-          "(declared before any result was seen).", "", "## Figures", ""]
+          "(declared before any result was seen; rows marked REVISED there were changed for issue 24 after the full paper sweep).", "", "## Figures", ""]
     for r in report.figures:
         md.append(f"### {r.name.replace('fig', 'Fig. ')}")
         md.append("")
@@ -144,6 +149,7 @@ CSS = """body{font-family:system-ui,sans-serif;max-width:1200px;margin:2em auto;
 img{max-width:100%;border:1px solid #ddd}table{border-collapse:collapse;font-size:90%;margin:1em 0}
 td,th{border:1px solid #ccc;padding:4px 8px;text-align:left;vertical-align:top}th{background:#f3f3f3}
 .pass{background:#e3f5e1}.fail{background:#fbe0e0}.nodata{background:#f0f0f0;color:#666}
+.inconclusive{background:#fff6d6}
 .note{color:#666;font-style:italic}"""
 
 
@@ -165,7 +171,7 @@ def to_html(report: Report) -> str:
              f"<h1>Paper figures from {e(report.source)}</h1>",
              "<p>Figures and headline numbers of <i>An Information Market for Social Navigation in Robots</i>, "
              "recomputed from this results store. Tolerances: <code>src/infomarket/analysis/tolerances.toml"
-             "</code> (declared before any result was seen).</p>", "<h2>Figures</h2>"]
+             "</code> (declared before any result was seen; rows marked REVISED there were changed for issue 24 after the full paper sweep).</p>", "<h2>Figures</h2>"]
     for r in report.figures:
         parts.append(f"<h3>{e(r.name.replace('fig', 'Fig. '))}</h3><p>{e(r.caption)}</p>")
         if r.files:

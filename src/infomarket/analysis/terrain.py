@@ -3,9 +3,14 @@ stores of the shipped experiments ``corridor``, ``two_food`` and ``crowd``, with
 
 ``infomarket terrain-report RESULTS --out DIR`` reads RESULTS/corridor, RESULTS/two_food and
 RESULTS/crowd (``infomarket sweep NAME --out RESULTS/NAME``) and, when present,
-RESULTS/two_food_sites/sites.parquet (``infomarket run two_food``), and writes DIR/terrain.md,
+the items per site stored with the two_food sweep (or a two_food_sites store), and writes DIR/terrain.md,
 DIR/terrain.json and DIR/terrain.png.  Every test is on per-run values or on robots pooled over runs,
 as the questions say; the answers are whatever the rules give, "no" included.
+
+Issue 24: each comparison also reports its run-level effect with a bootstrap interval and the power its
+run count gives (``analysis.stats``); a rule its run count cannot decide answers "inconclusive".  Two-food
+is tested at the run level (Wilcoxon signed-rank on per-run honest - Byzantine gaps), the robot-level
+p-value reported beside it; the crowd's ratio is read from its bootstrap interval.
 """
 from __future__ import annotations
 
@@ -19,6 +24,8 @@ import pandas as pd
 from scipy import stats as sps
 
 from ..cliargs import UsageError
+from . import stats as st
+from .declared import check, size_note, summary
 from .stats import mann_whitney
 
 QUESTIONS = Path(__file__).with_name("terrain_questions.toml")
@@ -26,6 +33,25 @@ QUESTIONS = Path(__file__).with_name("terrain_questions.toml")
 
 def questions() -> dict:
     return tomllib.loads(QUESTIONS.read_text())["questions"]
+
+
+def _two_food_sites(root: Path) -> pd.DataFrame | None:
+    """Items per site of the runs with two food sites: from the ``two_food`` sweep's store (sweeps store
+    the sites table), else from a ``two_food_sites`` store (``infomarket run``); None without either."""
+    from ..store.results import Store
+
+    for name in ("two_food", "two_food_sites"):
+        store = Store(root / name)
+        if not store.exists():
+            continue
+        sites = store.sites()
+        if not len(sites):
+            continue
+        food = sites.groupby(["condition", "run"]).kind.transform(lambda k: int((k == "food").sum()))
+        two = sites[food == 2]
+        if len(two):  # one row per (run, site); runs of other conditions renamed apart
+            return two.assign(run=two.condition.astype(str) + "/" + two.run.astype(str))
+    return None
 
 
 def _robots(root: Path, name: str) -> pd.DataFrame:
@@ -42,22 +68,46 @@ def _ratio(a: float, b: float) -> float:
     return float("inf") if b == 0 else a / b
 
 
+def _verdict(test: st.Comparison, met: bool, target: float = st.POWER) -> str:
+    """yes when the rule is met; no when it is not and the test had the power to meet it; otherwise
+    inconclusive (the run count cannot reach the declared p, or power below ``target``)."""
+    if met:
+        return "yes"
+    return "no" if test.power >= target else "inconclusive"
+
+
+def _comparison_json(c: st.Comparison) -> dict:
+    e = c.effect
+    return {"test": c.test, "n": [c.n_x, c.n_y], "p": c.p, "min_p": c.min_p, "alpha": c.alpha,
+            "hl_shift": e.hl, "hl_ci": [e.hl_low, e.hl_high], "cliffs_delta": e.delta,
+            "cliffs_delta_ci": [e.delta_low, e.delta_high], "declared_shift": c.declared, "power": c.power}
+
+
 def chain_blocked(robots: pd.DataFrame, rule: dict) -> dict:
-    """Q1: per-run swarm items, market on vs off, behind the wall (and on the plane, descriptive)."""
+    """Q1: per-run swarm items, market on vs off, behind the wall (and on the plane, descriptive).
+    Power: to detect a doubling (a shift of (min_ratio - 1) x the market-off median) at p_below."""
     per_run = robots.groupby(["world", "market", "run"], observed=True).items_collected.sum()
     runs = {(w, m): per_run.loc[w, m].to_numpy() for w in ("corridor", "plane") for m in ("on", "off")}
     med = {k: float(np.median(v)) for k, v in runs.items()}
-    test = mann_whitney(runs["corridor", "on"], runs["corridor", "off"])
+    on, off = runs["corridor", "on"], runs["corridor", "off"]
+    test = st.compare(on, off, declared=(rule["min_ratio"] - 1.0) * med["corridor", "off"], alpha=rule["p_below"],
+                      label="corridor: market on vs off")
     ratio = _ratio(med["corridor", "on"], med["corridor", "off"])
-    yes = test.pvalue < rule["p_below"] and ratio >= rule["min_ratio"]
-    return {"answer": "yes" if yes else "no", "runs": len(runs["corridor", "on"]),
+    yes = test.p < rule["p_below"] and ratio >= rule["min_ratio"]
+    return {"answer": _verdict(test, yes), "runs": len(on),
             "median_items": {f"{w}/{m}": med[w, m] for w, m in med},
             "iqr_items": {f"{w}/{m}": [float(np.percentile(v, 25)), float(np.percentile(v, 75))]
                           for (w, m), v in runs.items()},
-            "p_corridor_on_gt_off": test.pvalue, "ratio_corridor": ratio,
+            "p_corridor_on_gt_off": test.p, "ratio_corridor": ratio,
+            "ratio_corridor_ci": list(_ci(st.median_ratio(on, off))), "test": _comparison_json(test),
+            "describe": test.describe(" items"),
             "ratio_plane": _ratio(med["plane", "on"], med["plane", "off"]),
             "corridor_share_of_plane": _ratio(med["corridor", "on"], med["plane", "on"]),
             "per_run": {f"{w}/{m}": v.tolist() for (w, m), v in runs.items()}}
+
+
+def _ci(r: st.Ratio) -> tuple[float, float]:
+    return r.low, r.high
 
 
 def waypoints_restore(naive: pd.DataFrame, waypoint: pd.DataFrame, rule: dict) -> dict:
@@ -71,43 +121,55 @@ def waypoints_restore(naive: pd.DataFrame, waypoint: pd.DataFrame, rule: dict) -
     way_plane = runs(waypoint, "plane")
     med = {k: float(np.median(v)) for k, v in (("waypoint/corridor", way), ("vector/corridor", vec),
                                                ("vector/plane", plane), ("waypoint/plane", way_plane))}
-    test = mann_whitney(way, vec)
+    test = st.compare(way, vec, declared=(rule["min_ratio"] - 1.0) * med["vector/corridor"], alpha=rule["p_below"],
+                      label="behind the wall: waypoints vs vector market")
     ratio = _ratio(med["waypoint/corridor"], med["vector/corridor"])
-    share = _ratio(med["waypoint/corridor"], med["vector/plane"])
-    a = test.pvalue < rule["p_below"] and ratio >= rule["min_ratio"]
-    b = share >= rule["min_share_of_plane"]
+    share = st.median_ratio(way, plane)
+    a = test.p < rule["p_below"] and ratio >= rule["min_ratio"]
+    b = share.value >= rule["min_share_of_plane"]
     two = lambda x, y: float(sps.mannwhitneyu(x, y, alternative="two-sided").pvalue)  # noqa: E731
-    return {"answer": ("yes" if b else "partly") if a else "no", "beats_vector_market": bool(a),
+    answer = ("yes" if b else "partly") if a else _verdict(test, False)
+    return {"answer": answer, "beats_vector_market": bool(a),
             "keeps_half_of_plane": bool(b), "runs": len(way),
             "median_items": med,
             "iqr_items": {k: [float(np.percentile(v, 25)), float(np.percentile(v, 75))]
                           for k, v in (("waypoint/corridor", way), ("vector/corridor", vec),
                                        ("vector/plane", plane), ("waypoint/plane", way_plane))},
-            "p_waypoint_gt_vector_corridor": test.pvalue, "ratio_to_vector_corridor": ratio,
-            "share_of_plane": share, "p_waypoint_corridor_vs_plane": two(way, plane),
+            "p_waypoint_gt_vector_corridor": test.p, "ratio_to_vector_corridor": ratio,
+            "test": _comparison_json(test), "describe": test.describe(" items"),
+            "share_of_plane": share.value, "share_of_plane_ci": list(_ci(share)),
+            "p_waypoint_corridor_vs_plane": two(way, plane),
             "p_waypoint_vs_vector_plane": two(way_plane, plane),
             "per_run": {"waypoint/corridor": way.tolist(), "waypoint/plane": way_plane.tolist()}}
 
 
-def _separation(sub: pd.DataFrame) -> dict:
+def _separation(sub: pd.DataFrame, alpha: float) -> dict:
     honest = sub[sub.honest].wealth_share.to_numpy()
     byz = sub[~sub.honest].wealth_share.to_numpy()
-    test = mann_whitney(honest, byz)
+    robot_level = mann_whitney(honest, byz)
     means = sub.groupby(["run", "honest"]).wealth_share.mean().unstack()
     gap = (means[True] - means[False]).to_numpy()
+    run_level = st.paired(100 * gap, alpha=alpha)
     return {"median_honest_pct": 100 * float(np.median(honest)), "median_byzantine_pct": 100 * float(np.median(byz)),
-            "p_honest_gt_byzantine": test.pvalue, "runs": len(gap), "runs_separated": float((gap > 0).mean()),
+            "p_run_level": run_level.p, "min_p_run_level": run_level.min_p,
+            "gap_hl_pct": run_level.hl, "gap_hl_ci_pct": [run_level.hl_low, run_level.hl_high],
+            "describe": run_level.describe(" points"),
+            "p_robot_level": robot_level.pvalue, "runs": len(gap), "runs_separated": float((gap > 0).mean()),
             "median_gap_pct": 100 * float(np.median(gap)), "gaps": gap}
 
 
 def outlier_two_food(robots: pd.DataFrame, rule: dict, sites: pd.DataFrame | None) -> dict:
-    """Q3: honest vs Byzantine wealth share with two food sites (and with one, descriptive)."""
-    two = _separation(robots[robots.food_sites == 2])
-    one = _separation(robots[robots.food_sites == 1])
-    yes = (two["median_honest_pct"] > two["median_byzantine_pct"] and two["p_honest_gt_byzantine"] < rule["p_below"]
+    """Q3: honest vs Byzantine wealth share with two food sites (and with one, descriptive).  The test is
+    run-level (issue 24): each run's honest-minus-Byzantine mean share, Wilcoxon signed-rank; the
+    robot-level Mann-Whitney of the original rule pools robots over runs and is reported beside it."""
+    two = _separation(robots[robots.food_sites == 2], rule["p_below"])
+    one = _separation(robots[robots.food_sites == 1], rule["p_below"])
+    yes = (two["median_honest_pct"] > two["median_byzantine_pct"] and two["p_run_level"] < rule["p_below"]
            and two["runs_separated"] >= rule["min_runs_separated"])
+    reachable = two["min_p_run_level"] < rule["p_below"]
     gaps = sps.mannwhitneyu(two["gaps"], one["gaps"], alternative="two-sided").pvalue
-    out = {"answer": "yes" if yes else "no", "two_sites": {k: v for k, v in two.items() if k != "gaps"},
+    out = {"answer": "yes" if yes else ("no" if reachable else "inconclusive"),
+           "two_sites": {k: v for k, v in two.items() if k != "gaps"},
            "one_site": {k: v for k, v in one.items() if k != "gaps"}, "p_gaps_differ": float(gaps),
            "gaps_pct": {"two": (100 * two["gaps"]).tolist(), "one": (100 * one["gaps"]).tolist()}}
     if sites is not None and len(sites):
@@ -120,16 +182,22 @@ def outlier_two_food(robots: pd.DataFrame, rule: dict, sites: pd.DataFrame | Non
 
 
 def crowd_collisions(robots: pd.DataFrame, rule: dict) -> dict:
-    """Q4: per-robot items per run with collisions on vs off, 100 robots (25, descriptive)."""
+    """Q4: per-robot items per run with collisions on vs off, 100 robots (25, descriptive).  The answer
+    reads the bootstrap interval of the ratio of medians (issue 24): yes when it lies at or above
+    min_ratio, no when below, inconclusive when it straddles."""
     per_run = robots.groupby(["robots", "collisions", "run"], observed=True).items_collected.mean()
     out = {}
     for n in (100, 25):
         on, off = per_run.loc[n, True].to_numpy(), per_run.loc[n, False].to_numpy()
         p = float(sps.mannwhitneyu(on, off, alternative="two-sided").pvalue)
+        r = st.median_ratio(on, off)
+        e = st.effect(on, off)
         out[n] = {"median_on": float(np.median(on)), "median_off": float(np.median(off)),
-                  "ratio": _ratio(float(np.median(on)), float(np.median(off))), "p_two_sided": p,
+                  "ratio": r.value, "ratio_ci": [r.low, r.high], "hl_shift": e.hl, "hl_ci": [e.hl_low, e.hl_high],
+                  "cliffs_delta": e.delta, "cliffs_delta_ci": [e.delta_low, e.delta_high], "p_two_sided": p,
                   "runs": len(on), "per_run_on": on.tolist(), "per_run_off": off.tolist()}
-    out["answer"] = "yes" if out[100]["ratio"] >= rule["min_ratio"] else "no"
+    out["answer"] = st.answer_interval(st.Ratio(out[100]["ratio"], *out[100]["ratio_ci"], st.CONFIDENCE),
+                                       rule["min_ratio"])
     return out
 
 
@@ -177,10 +245,21 @@ def figure(a: dict, path: Path) -> Path:
     return path
 
 
+def _declarations(root: Path, names) -> list[str]:
+    """Per store: were the terrain questions declared before its first run (analysis.declared)?"""
+    from ..store.results import Store
+
+    out = []
+    for name in names:
+        if (root / name).exists():
+            out.append(f"store {name}: " + summary(check(Store(root / name).declarations()),
+                                                   "terrain_questions.toml", "questions."))
+    return out
+
+
 def answer(root: Path) -> dict:
     q = questions()
-    sites_path = root / "two_food_sites" / "sites.parquet"
-    sites = pd.read_parquet(sites_path) if sites_path.exists() else None
+    sites = _two_food_sites(root)
     return {"chain_blocked": chain_blocked(_robots(root, "corridor"), q["chain_blocked"]),
             "waypoints_restore": (waypoints_restore(_robots(root, "corridor"), _robots(root, "corridor_waypoints"),
                                                     q["waypoints_restore"])
@@ -189,7 +268,8 @@ def answer(root: Path) -> dict:
             "outlier_two_food": outlier_two_food(_robots(root, "two_food"), q["outlier_two_food"], sites),
             "crowd_collisions": crowd_collisions(_robots(root, "crowd"), q["crowd_collisions"]),
             **({"crowd_sensing": exploratory(crowd_collisions(_robots(root, "crowd_sensing"), q["crowd_collisions"]))}
-               if (root / "crowd_sensing").exists() else {})}
+               if (root / "crowd_sensing").exists() else {}),
+            "declarations": _declarations(root, ("corridor", "corridor_waypoints", "two_food", "crowd"))}
 
 
 def exploratory(a: dict) -> dict:
@@ -206,10 +286,11 @@ def _waypoint_line(q: dict, w: dict) -> str:
     m, r = w["median_items"], q["waypoints_restore"]
     return (head + f"**{w['answer']}**.  Median items per run ({w['runs']} runs each, market on): waypoint robots "
             f"behind the wall {m['waypoint/corridor']:g} vs the vector market behind the same wall "
-            f"{m['vector/corridor']:g} (ratio {w['ratio_to_vector_corridor']:.2f}, one-sided Mann–Whitney p = "
-            f"{_p(w['p_waypoint_gt_vector_corridor'])}; needed p < {r['p_below']:g} and ratio ≥ {r['min_ratio']:g}: "
+            f"{m['vector/corridor']:g} (ratio {w['ratio_to_vector_corridor']:.2f}; {w['describe']}; needed p < "
+            f"{r['p_below']:g} and ratio ≥ {r['min_ratio']:g}: "
             f"{'met' if w['beats_vector_market'] else 'not met'}); the open plane with the vector market "
-            f"{m['vector/plane']:g}, so waypoints keep {100 * w['share_of_plane']:.0f} % of it (needed ≥ "
+            f"{m['vector/plane']:g}, so waypoints keep {100 * w['share_of_plane']:.0f} % of it (95 % interval "
+            f"{100 * w['share_of_plane_ci'][0]:.0f}–{100 * w['share_of_plane_ci'][1]:.0f} %; needed ≥ "
             f"{100 * r['min_share_of_plane']:.0f} %: {'met' if w['keeps_half_of_plane'] else 'not met'}; two-sided p = "
             f"{_p(w['p_waypoint_corridor_vs_plane'])}).  Descriptive: waypoint robots on the open plane "
             f"{m['waypoint/plane']:g} (vs naive {m['vector/plane']:g}, two-sided p = "
@@ -220,6 +301,10 @@ def _p(p: float) -> str:
     return f"{p:.1e}" if p < 0.001 else f"{p:.3f}"
 
 
+def _ci_txt(ci) -> str:
+    return f"[{ci[0]:.3g}, {ci[1]:.3g}]"
+
+
 def markdown(a: dict) -> str:
     q = questions()
     c, t, k = a["chain_blocked"], a["outlier_two_food"], a["crowd_collisions"]
@@ -227,20 +312,19 @@ def markdown(a: dict) -> str:
     lines = [
         f"1. **{q['chain_blocked']['question']}** — **{c['answer']}**.  Median items per run "
         f"({c['runs']} runs each): corridor with market {m['corridor/on']:g}, without {m['corridor/off']:g} "
-        f"(ratio {c['ratio_corridor']:.2f}, one-sided Mann–Whitney p = {_p(c['p_corridor_on_gt_off'])}); "
+        f"(ratio {c['ratio_corridor']:.2f} {_ci_txt(c['ratio_corridor_ci'])}; {c['describe']}); "
         f"plane with market {m['plane/on']:g}, without {m['plane/off']:g} (ratio {c['ratio_plane']:.1f}).  "
         f"Behind the wall the market keeps {100 * c['corridor_share_of_plane']:.0f} % of the plane's throughput.",
         _waypoint_line(q, a["waypoints_restore"]),
     ]
     two, one = t["two_sites"], t["one_site"]
     text = (f"3. **{q['outlier_two_food']['question']}** — **{t['answer']}**.  Two food sites: median wealth "
-            f"share honest {two['median_honest_pct']:.2f} % vs Byzantine {two['median_byzantine_pct']:.2f} % "
-            f"(one-sided Mann–Whitney p = {_p(two['p_honest_gt_byzantine'])}, robots pooled over "
-            f"{two['runs']} runs); honest ahead in {100 * two['runs_separated']:.0f} % of runs (median gap "
-            f"{two['median_gap_pct']:.2f} points).  One food site: {one['median_honest_pct']:.2f} % vs "
-            f"{one['median_byzantine_pct']:.2f} % (p = {_p(one['p_honest_gt_byzantine'])}), honest ahead in "
-            f"{100 * one['runs_separated']:.0f} % of runs (median gap {one['median_gap_pct']:.2f}); per-run gaps, "
-            f"two sites vs one: two-sided p = {_p(t['p_gaps_differ'])}.")
+            f"share honest {two['median_honest_pct']:.2f} % vs Byzantine {two['median_byzantine_pct']:.2f} %; "
+            f"per-run honest − Byzantine mean share: {two['describe']} (robot-level, robots pooled over runs as "
+            f"the paper does: one-sided Mann–Whitney p = {_p(two['p_robot_level'])}).  One food site: "
+            f"{one['median_honest_pct']:.2f} % vs {one['median_byzantine_pct']:.2f} %; {one['describe']} "
+            f"(robot-level p = {_p(one['p_robot_level'])}); per-run gaps, two sites vs one: two-sided "
+            f"Mann–Whitney p = {_p(t['p_gaps_differ'])}.")
     if "near_site_share" in t:
         s = t["near_site_share"]
         text += (f"  Share of food items picked at the near site: median {100 * s['median']:.0f} % "
@@ -249,9 +333,11 @@ def markdown(a: dict) -> str:
     lines.append(
         f"4. **{q['crowd_collisions']['question']}** — **{k['answer']}**.  100 robots: median items per robot "
         f"per run {k[100]['median_on']:.2f} with collisions vs {k[100]['median_off']:.2f} without (ratio "
-        f"{k[100]['ratio']:.2f}, two-sided Mann–Whitney p = {_p(k[100]['p_two_sided'])}, {k[100]['runs']} runs "
-        f"each); 25 robots: {k[25]['median_on']:.2f} vs {k[25]['median_off']:.2f} (ratio {k[25]['ratio']:.2f}, "
-        f"p = {_p(k[25]['p_two_sided'])}).")
+        f"{k[100]['ratio']:.2f}, 95 % bootstrap interval {_ci_txt(k[100]['ratio_ci'])}; HL shift "
+        f"{k[100]['hl_shift']:+.3g} {_ci_txt(k[100]['hl_ci'])}, Cliff's delta {k[100]['cliffs_delta']:+.2f} "
+        f"{_ci_txt(k[100]['cliffs_delta_ci'])}; two-sided Mann–Whitney p = {_p(k[100]['p_two_sided'])}, "
+        f"{k[100]['runs']} runs each); 25 robots: {k[25]['median_on']:.2f} vs {k[25]['median_off']:.2f} (ratio "
+        f"{k[25]['ratio']:.2f} {_ci_txt(k[25]['ratio_ci'])}, p = {_p(k[25]['p_two_sided'])}).")
     if "crowd_sensing" in a:
         e = a["crowd_sensing"]
         lines.append(
@@ -260,6 +346,21 @@ def markdown(a: dict) -> str:
             f"collisions vs {e[100]['median_off']:.2f} without (ratio {e[100]['ratio']:.2f}, p = "
             f"{_p(e[100]['p_two_sided'])}); 25 robots: {e[25]['median_on']:.2f} vs {e[25]['median_off']:.2f} "
             f"(ratio {e[25]['ratio']:.2f}, p = {_p(e[25]['p_two_sided'])}).")
+    notes = []
+    for qid, key in (("chain_blocked", "runs"), ("waypoints_restore", "runs"), ("outlier_two_food", None),
+                     ("crowd_collisions", None)):
+        ans = a[qid]
+        runs = (ans.get(key) if key else (ans["two_sites"]["runs"] if qid == "outlier_two_food" else ans[100]["runs"])) \
+            if ans.get("answer") != "not run" else None
+        note = size_note(q[qid].get("runs"), [runs] if runs else [])
+        if note:
+            notes.append(f"{qid}: {note}")
+    if notes:
+        lines.append("")
+        lines += [f"- NOTE: {n}." for n in notes]
+    if "declarations" in a:
+        lines.append("")
+        lines += [f"- {line}" for line in a["declarations"]]
     return "\n".join(lines) + "\n"
 
 
@@ -276,7 +377,7 @@ def _jsonable(a):
 def add_subcommand(subparsers) -> None:
     p = subparsers.add_parser("terrain-report", help="answer the terrain questions (corridor, two_food, crowd) "
                               "from their stores, with a figure")
-    p.add_argument("results", help="folder holding the stores corridor/, two_food/, crowd/ (and two_food_sites/)")
+    p.add_argument("results", help="folder holding the stores corridor/, two_food/, crowd/ (optionally corridor_waypoints/, crowd_sensing/)")
     p.add_argument("--out", required=True, help="folder for terrain.md, terrain.json, terrain.png")
     p.set_defaults(func=cmd_terrain_report)
 

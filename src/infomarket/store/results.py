@@ -2,7 +2,8 @@
 
 Layout (each part file written atomically, see ``files``)::
 
-    STORE/store.json               format version, package version, creation time, master seed per experiment
+    STORE/store.json               format version, package version, creation time, master seed per experiment,
+                                   hashes of the question and decision-rule files (analysis.declared)
     STORE/store.lock               held (an OS lock) by the one sweep writing the store
     STORE/robots/part-ID.parquet   one row per robot per run
     STORE/history/part-ID.parquet  wealth of every robot every K steps (when asked)
@@ -122,6 +123,14 @@ class StoreLock:
             self.fd = None
 
 
+def _declarations() -> dict:
+    """Hashes of the files declaring questions and decision rules (issue 24): a report flags any rule
+    edited after the store's first run (``store.declarations``, read by ``analysis.declared``)."""
+    from .declarations import fingerprint
+
+    return fingerprint()
+
+
 def _rel(root: Path, path: Path) -> str:
     return str(path.relative_to(root))
 
@@ -160,7 +169,8 @@ class Store:
         # store.json first: a folder holding only it (and the lock) reads as a store being created, so a
         # second writer racing this one is refused by the lock, not taken for a foreign folder
         self._write_meta({"format": FORMAT, "package_version": __version__,
-                          "created": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "seeds": {}})
+                          "created": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "seeds": {},
+                          "declarations": _declarations()})
         for t in TABLES:
             (self.root / t).mkdir(exist_ok=True)
         return self
@@ -191,6 +201,11 @@ class Store:
         with self.lock():
             self.create()
             yield self
+
+    def declarations(self) -> dict | None:
+        """The fingerprint of the question and decision-rule files recorded when the store was created
+        (before its first run; ``analysis.declared``), or None for a store made before it was recorded."""
+        return self.meta().get("declarations") if self.exists() else None
 
     def _write_meta(self, meta: dict) -> None:
         write_text_atomic(json.dumps(meta, indent=2) + "\n", self.meta_path)
