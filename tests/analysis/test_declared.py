@@ -8,6 +8,7 @@ import shutil
 import pytest
 
 from infomarket.analysis import declared, future
+from infomarket.store import declarations
 from infomarket.analysis.frames import Frames
 from infomarket.analysis.report import build_report
 from infomarket.store import Store
@@ -23,6 +24,7 @@ def files(tmp_path, monkeypatch):
     for name, path in declared.FILES.items():
         copies[name] = tmp_path / name
         shutil.copy(path, copies[name])
+    monkeypatch.setattr(declarations, "FILES", copies)  # the store records them (store.declarations)
     monkeypatch.setattr(declared, "FILES", copies)
     return copies
 
