@@ -1,0 +1,89 @@
+"""Issue 21: what broke when infomarket was tried as a new user would.  Each case gives one clear message and
+exit code 2 (no traceback, nothing written outside the output folder), or the documented result."""
+import json
+import os
+from pathlib import Path
+
+import pytest
+
+from infomarket.cli import main
+from infomarket.config import load_experiment, validate
+from infomarket.errors import ConfigError
+
+SMALL = """
+name = {name}
+steps = 50
+runs = 1
+
+[swarm]
+robots = 2
+
+[[swarm.groups]]
+behaviour = "naive"
+count = 2
+"""
+
+
+# ------------------------------------------------------------------ shipped names and same-named folders
+def test_a_folder_named_like_a_shipped_experiment_does_not_hide_it(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "fig2A").mkdir()  # e.g. what `infomarket sweep fig2A --out fig2A` wrote before
+    assert main(["check", "fig2A"]) == 0
+    assert capsys.readouterr().out.startswith("fig2A: valid. 25 naive")
+    assert load_experiment("fig2A").swarm.groups[0].count == 25
+
+
+@pytest.mark.parametrize("arg", ["./fig2A", "fig2A/"])
+def test_an_argument_that_looks_like_a_path_names_the_folder_and_says_how_to_name_the_shipped_one(
+        arg, tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "fig2A").mkdir()
+    assert main(["check", arg]) == 2
+    err = capsys.readouterr().err
+    assert "is a directory, not an experiment file" in err and "`fig2A`" in err and "Traceback" not in err
+
+
+def test_a_file_with_an_extension_is_read_even_when_its_stem_is_a_shipped_name(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "fig2A.toml").write_text(SMALL.format(name='"mine"'))
+    assert main(["check", "fig2A.toml"]) == 0
+    assert capsys.readouterr().out.startswith("mine: valid. 2 naive")
+
+
+@pytest.mark.parametrize("suffix", [".json", ".toml"])
+def test_a_file_nested_100000_levels_deep_is_one_clear_error(suffix, tmp_path, capsys):
+    p = tmp_path / f"deep{suffix}"
+    p.write_text("[" * 100_000 + "]" * 100_000 if suffix == ".json" else "a = " + "[" * 100_000 + "]" * 100_000)
+    assert main(["check", str(p)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"infomarket: error: {p}") and "Traceback" not in err and len(err.splitlines()) == 1
+
+
+# ------------------------------------------------------------------ names used as folders
+@pytest.mark.parametrize("name", ["../../../../elsewhere/x", "/tmp/abs", "", "x" * 1_000_000, "a\x1b[31mred",
+                                  "..", ".hidden", "a b", "a\\b", "x\n"])
+def test_unsafe_names_are_refused_and_never_echoed_raw(name, tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    p = tmp_path / "e.toml"
+    p.write_text(SMALL.format(name=json.dumps(name)))
+    before = sorted(os.listdir(tmp_path))
+    assert main(["run", str(p), "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"infomarket: error: {p}: invalid experiment\n  name: ") and "Traceback" not in err
+    assert "\x1b" not in err and len(err) < 1000
+    assert sorted(os.listdir(tmp_path)) == before  # nothing written, here or elsewhere
+    assert not (tmp_path.parent / "elsewhere").exists()
+
+
+def test_safe_names_and_the_default_from_the_file_name(tmp_path):
+    for ok in ("fig2A", "two_food", "a.b-c+d=e,f", "_x", "9" * 100):
+        assert validate({"name": ok, "swarm": {"robots": 1, "groups": [{"behaviour": "naive", "count": 1}]}}).name == ok
+    p = tmp_path / "my first run (copy).toml"
+    p.write_text(SMALL.replace("name = {name}\n", ""))
+    assert load_experiment(p).name == "my_first_run__copy_"
+
+
+def test_control_characters_in_a_path_are_not_echoed_raw(capsys):
+    assert main(["check", "no\x1b[2Jsuch.toml"]) == 2
+    err = capsys.readouterr().err
+    assert "\x1b" not in err and "no\\x1b[2Jsuch.toml" in err
