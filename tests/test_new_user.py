@@ -87,3 +87,16 @@ def test_control_characters_in_a_path_are_not_echoed_raw(capsys):
     assert main(["check", "no\x1b[2Jsuch.toml"]) == 2
     err = capsys.readouterr().err
     assert "\x1b" not in err and "no\\x1b[2Jsuch.toml" in err
+
+
+# ------------------------------------------------------------------ check says it ran plugin code
+def test_check_says_that_it_imported_plugin_code(tmp_path, capsys):
+    import shutil
+
+    root = Path(__file__).resolve().parents[1] / "examples"
+    for f in ("age_liar.toml", "age_liar.py", "equal_split.py"):
+        shutil.copy(root / f, tmp_path / f)
+    assert main(["check", str(tmp_path / "age_liar.toml")]) == 0
+    got = capsys.readouterr()
+    assert "age_liar: valid." in got.out
+    assert "imported (and so ran) the plugin code" in got.err and str(tmp_path / "age_liar.py") in got.err

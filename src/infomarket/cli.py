@@ -105,6 +105,9 @@ def cmd_check(args) -> int:
     from .config import load_experiment
 
     cfg = load_experiment(args.experiment)
+    if cfg.plugins:  # validating needs the rules they register: say that their code ran
+        print(f"note: validating imported (and so ran) the plugin code this file names: {', '.join(cfg.plugins)}",
+              file=sys.stderr, flush=True)
     groups = ", ".join(f"{g.count} {g.behaviour}" for g in cfg.swarm.groups if g.count)
     print(f"{cfg.name}: valid. {groups}; scheme {cfg.payment.scheme} (stake {cfg.payment.stake}); "
           f"{cfg.steps} steps, transitory {cfg.transitory}, {cfg.runs} runs, seed {cfg.seed}; "
@@ -148,7 +151,10 @@ def build_parser() -> Parser:
     ls = sub.add_parser("list", help="shipped experiments, behaviours and payment schemes")
     ls.set_defaults(func=cmd_list)
 
-    c = sub.add_parser("check", help="validate an experiment file and print what it describes")
+    c = sub.add_parser("check", help="validate an experiment file and print what it describes",
+                       description="Validate an experiment file and print what it describes. Validation imports "
+                                   "the plugins the file names (their code runs), since their rules are needed to "
+                                   "check the file; check says so when it does.")
     c.add_argument("experiment")
     c.set_defaults(func=cmd_check)
 
