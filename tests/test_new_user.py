@@ -100,3 +100,32 @@ def test_check_says_that_it_imported_plugin_code(tmp_path, capsys):
     got = capsys.readouterr()
     assert "age_liar: valid." in got.out
     assert "imported (and so ran) the plugin code" in got.err and str(tmp_path / "age_liar.py") in got.err
+
+
+# ------------------------------------------------------------------ the Python API's arguments
+SWARM = {"steps": 40, "swarm": {"robots": 2, "groups": [{"behaviour": "naive", "count": 2}]}}
+
+
+@pytest.mark.parametrize("kw,fragment", [({"steps": -1}, "steps must be a positive integer"),
+                                         ({"steps": 1.5}, "steps must be a positive integer"),
+                                         ({"history_every": -3}, "history_every must be an integer in [0, steps = 40]"),
+                                         ({"history_every": 2.5}, "history_every must be an integer"),
+                                         ({"history_every": 41}, "history_every must be an integer in [0, steps = 40]")])
+def test_simulate_refuses_impossible_lengths(kw, fragment):
+    import infomarket as im
+
+    cfg = validate(SWARM)
+    with pytest.raises(ConfigError) as err:
+        im.simulate(cfg, 1, **kw)
+    assert fragment in str(err.value)
+
+
+def test_simulate_takes_a_dict_and_validates_it_as_an_experiment():
+    import infomarket as im
+
+    res = im.simulate(SWARM, 1)
+    assert res.steps == 40 and len(res.robots) == 2
+    with pytest.raises(ConfigError, match=r"swarm.groups\[0\].count: Input should be greater than or equal to 0"):
+        im.simulate({**SWARM, "swarm": {"robots": 2, "groups": [{"behaviour": "naive", "count": -2}]}})
+    with pytest.raises(im.errors.InputTypeError, match="got int"):
+        im.simulate(42)

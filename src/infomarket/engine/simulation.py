@@ -15,7 +15,7 @@ import pandas as pd
 
 from ..config.schema import Experiment
 from ..config.load import load_experiment
-from ..errors import ArgumentError, ConfigError, SimulationError
+from ..errors import ArgumentError, ConfigError, InputTypeError, SimulationError
 from ..registry import behaviours
 from . import specialise
 from ..seeds import MAX_SEED
@@ -57,13 +57,12 @@ class Simulation:
 
     def __init__(self, config: Experiment | str | Path, seed: int | None = None, *, record_events: bool = False,
                  history_every: int | None = None):
-        if not isinstance(config, Experiment):  # a shipped name or a path, as on the command line
-            config = load_experiment(config)
+        config = as_experiment(config)
         self.config = config
         self.seed = _checked_seed(config.seed if seed is None else seed)
         self.rng = np.random.default_rng(self.seed)
         self.kinds = behaviour_kinds(config)
-        hist = config.history_every if history_every is None else history_every
+        hist = config.history_every if history_every is None else _checked_history(history_every, config.steps)
         self.world, self.behaviour_names = build_world(config, self.rng, record_events=record_events,
                                                        history_every=hist)
         t0 = time.perf_counter()
@@ -168,6 +167,27 @@ class Simulation:
                 "sites": SITE_NAMES}
 
 
+def as_experiment(config) -> Experiment:
+    """An Experiment from what the Python API takes: an Experiment, a shipped name or a file path (as on the
+    command line), or a dict of the experiment file's keys (validated like a file)."""
+    if isinstance(config, Experiment):
+        return config
+    if isinstance(config, dict):
+        from ..config.load import validate
+
+        return validate(config, "simulate()/Simulation() experiment")
+    if isinstance(config, (str, Path)):
+        return load_experiment(config)
+    raise InputTypeError(f"expected an Experiment, a shipped name, a file path or a dict of experiment keys, "
+                         f"got {type(config).__name__}")
+
+
+def _checked_history(every, steps: int) -> int:
+    if isinstance(every, bool) or not isinstance(every, (int, np.integer)) or not 0 <= int(every) <= steps:
+        raise ConfigError(f"history_every must be an integer in [0, steps = {steps}] (0: no history), got {every!r}")
+    return int(every)
+
+
 def _checked_seed(seed) -> int:
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) <= MAX_SEED:
         raise ConfigError(f"seed must be an integer in [0, 2**63 - 1] (as in experiment files and on the "
@@ -181,8 +201,7 @@ def simulate(config: Experiment | str | Path, seed: int | None = None, *, steps:
     The same configuration and seed give identical results.  ``steps`` is the run's length, exactly as
     the experiment's ``steps`` (it shapes the Lévy step-length table), so ``simulate(cfg, seed, steps=N)``
     reproduces a run stored with ``steps = N``."""
-    if not isinstance(config, Experiment):
-        config = load_experiment(config)
+    config = as_experiment(config)
     if steps is not None:
         if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1:
             raise ConfigError(f"steps must be a positive integer number of steps, got {steps!r}")
