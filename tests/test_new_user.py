@@ -129,3 +129,21 @@ def test_simulate_takes_a_dict_and_validates_it_as_an_experiment():
         im.simulate({**SWARM, "swarm": {"robots": 2, "groups": [{"behaviour": "naive", "count": -2}]}})
     with pytest.raises(im.errors.InputTypeError, match="got int"):
         im.simulate(42)
+
+
+# ------------------------------------------------------------------ defaults and impossible markets
+def test_a_site_given_in_part_takes_the_defaults_of_the_rest():
+    cfg = validate({**SWARM, "food": {"radius": 30.0}, "nest": {"x": 900.0}})
+    assert (cfg.food.x, cfg.food.y, cfg.food.radius) == (200.0, 300.0, 30.0)  # README: every key has a default
+    assert (cfg.nest.x, cfg.nest.y, cfg.nest.radius) == (900.0, 300.0, 50.0)
+    with pytest.raises(ConfigError, match="food.y"):
+        validate({**SWARM, "food": {"y": "high"}})
+
+
+def test_a_stake_above_the_initial_wealth_is_refused(tmp_path, capsys):
+    p = tmp_path / "stake.toml"
+    p.write_text(SMALL.format(name='"stake"') + "\n[payment]\nstake = 2.0\n")
+    assert main(["check", str(p)]) == 2
+    err = capsys.readouterr().err
+    assert "payment.stake = 2.0 is more than payment.initial_wealth = 1.0" in err and "Traceback" not in err
+    assert validate({**SWARM, "payment": {"stake": 1.0}}).payment.stake == 1.0  # equal: one purchase possible

@@ -220,6 +220,15 @@ class Experiment(_Strict):
                               "letter, digit or _ (it is used as a folder: no / or \\, no spaces or control characters)")
         return name
 
+    @field_validator("food", "nest", mode="before")
+    @classmethod
+    def _site_defaults(cls, value: Any, info: ValidationInfo) -> Any:
+        """One site given in part (``[food]`` with only ``radius``) takes the default site's other keys."""
+        if isinstance(value, dict):
+            default = cls.model_fields[info.field_name].default
+            return {"x": default.x, "y": default.y, **value}
+        return value
+
     @field_validator("plugins")
     @classmethod
     def _import_plugins(cls, entries: list[str], info: ValidationInfo) -> list[str]:
@@ -269,6 +278,10 @@ class Experiment(_Strict):
         if self.payment.scheme not in schemes:
             raise ConfigError(f"payment.scheme: unknown scheme {self.payment.scheme!r}; "
                              f"allowed: {', '.join(sorted(schemes))}")
+        if self.payment.stake > self.payment.initial_wealth:
+            raise ConfigError(f"payment.stake = {self.payment.stake} is more than payment.initial_wealth = "
+                              f"{self.payment.initial_wealth}: no seller could ever lock its stake, so every "
+                              f"purchase would be refused; lower the stake or raise the initial wealth")
         spec = schemes[self.payment.scheme]
         for p, v in self.payment.params.items():
             if p not in spec.params:
