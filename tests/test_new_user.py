@@ -147,3 +147,12 @@ def test_a_stake_above_the_initial_wealth_is_refused(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "payment.stake = 2.0 is more than payment.initial_wealth = 1.0" in err and "Traceback" not in err
     assert validate({**SWARM, "payment": {"stake": 1.0}}).payment.stake == 1.0  # equal: one purchase possible
+
+
+def test_check_describes_a_grid_sweep_its_conditions_and_total_runs(capsys):
+    assert main(["check", "fig7"]) == 0
+    out = capsys.readouterr().out
+    # fig7: rotation 0..90 by 10 (10 values) x 1 or 3 Byzantines x 2 markets = 40 conditions of 32 runs
+    assert "32 runs per condition" in out
+    assert "sweep: swarm.groups[1].params.rotation_angle (10 values) x byzantines (2 values) x market (2 values)" in out
+    assert "sweep: 40 conditions x 32 runs = 1,280 runs" in out

@@ -109,15 +109,29 @@ def cmd_check(args) -> int:
         print(f"note: validating imported (and so ran) the plugin code this file names: {', '.join(cfg.plugins)}",
               file=sys.stderr, flush=True)
     groups = ", ".join(f"{g.count} {g.behaviour}" for g in cfg.swarm.groups if g.count)
+    per = " per condition" if cfg.sweep is not None else ""
+    runs = (cfg.sweep.runs or cfg.runs) if cfg.sweep is not None else cfg.runs
     print(f"{cfg.name}: valid. {groups}; scheme {cfg.payment.scheme} (stake {cfg.payment.stake}); "
-          f"{cfg.steps} steps, transitory {cfg.transitory}, {cfg.runs} runs, seed {cfg.seed}; "
+          f"{cfg.steps} steps, transitory {cfg.transitory}, {runs} runs{per}, seed {cfg.seed}; "
           f"config hash {cfg.config_hash()}")
     if cfg.sweep is not None and cfg.sweep.sample is not None:  # the design is checked at every corner
         from .runner.design import make_design
 
         d = make_design(cfg)
+        runs = cfg.sweep.runs or cfg.runs
         print(f"sampled design: {d.method}, {d.samples} base samples, {d.points} points over {len(d.names)} "
               f"keys ({', '.join(d.names)}); outputs {', '.join(d.outputs)}")
+        print(f"sweep: {d.points:,} conditions x {runs} runs = {d.points * runs:,} runs "
+              f"(`infomarket sweep {args.experiment}`)")
+    elif cfg.sweep is not None:  # every condition is built and validated, as the sweep would
+        from .runner.plan import conditions
+
+        conds = conditions(cfg)
+        what = [f"{key} ({len(values)} values)" for key, values in cfg.sweep.grid.items()]
+        what += [f"{name} ({len(values)} values)" for name, values in cfg.sweep.axes.items()]
+        print(f"sweep: {' x '.join(what)}")
+        print(f"sweep: {len(conds):,} conditions x {conds[0].runs} runs = {sum(c.runs for c in conds):,} runs "
+              f"(`infomarket sweep {args.experiment}`)")
     return 0
 
 
