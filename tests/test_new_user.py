@@ -156,3 +156,45 @@ def test_check_describes_a_grid_sweep_its_conditions_and_total_runs(capsys):
     assert "32 runs per condition" in out
     assert "sweep: swarm.groups[1].params.rotation_angle (10 values) x byzantines (2 values) x market (2 values)" in out
     assert "sweep: 40 conditions x 32 runs = 1,280 runs" in out
+
+
+# ------------------------------------------------------------------ rough edges of the command line
+def test_a_shipped_name_in_the_wrong_case_suggests_the_right_one(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", "fig2b", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "no experiment file 'fig2b'" in err and "did you mean fig2B?" in err
+    assert os.listdir(tmp_path) == []
+
+
+def test_a_slow_kernel_load_is_announced_on_stderr_unless_quiet(capsys, monkeypatch):
+    import time
+
+    from infomarket.engine.simulation import compile_notice
+
+    monkeypatch.delenv("INFOMARKET_COMPILE_NOTICE", raising=False)
+    with compile_notice(("naive", "saboteur", "naive"), "delayed", after=0.01):
+        time.sleep(0.3)
+    err = capsys.readouterr().err
+    assert err == ("compiling the step kernel for naive+saboteur / delayed (the first time, ~15 s; "
+                   "later runs load it from the cache)...\n")
+    with compile_notice(("naive",), "delayed", after=0.5):
+        pass  # loaded from the cache at once: nothing to say
+    monkeypatch.setenv("INFOMARKET_COMPILE_NOTICE", "0")  # what --quiet sets
+    with compile_notice(("naive",), "delayed", after=0.01):
+        time.sleep(0.2)
+    time.sleep(0.6)
+    assert capsys.readouterr().err == ""
+
+
+def test_quiet_silences_the_compile_notice_for_the_command_only(monkeypatch):
+    import infomarket.cli as cli
+
+    seen = {}
+    monkeypatch.delenv("INFOMARKET_COMPILE_NOTICE", raising=False)
+    parser = cli.build_parser()
+    args = parser.parse_args(["run", "fig2A", "--quiet"])
+    args.func = lambda a: seen.setdefault("run", os.environ.get("INFOMARKET_COMPILE_NOTICE")) and 0
+    monkeypatch.setattr(cli, "build_parser", lambda: type("P", (), {"parse_args": lambda self, argv: args})())
+    assert cli.main(["run", "fig2A", "--quiet"]) == 0
+    assert seen["run"] == "0" and "INFOMARKET_COMPILE_NOTICE" not in os.environ

@@ -182,6 +182,10 @@ def build_parser() -> Parser:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    quiet = bool(getattr(args, "quiet", False))
+    notice = os.environ.get("INFOMARKET_COMPILE_NOTICE")
+    if quiet:  # the engine's "compiling the step kernel..." line too (workers inherit the variable)
+        os.environ["INFOMARKET_COMPILE_NOTICE"] = "0"
     try:
         return int(args.func(args) or 0)
     except InfomarketError as exc:
@@ -192,6 +196,12 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:  # output piped into e.g. `head`: stop quietly, like other Unix tools
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+    finally:
+        if quiet:
+            if notice is None:
+                os.environ.pop("INFOMARKET_COMPILE_NOTICE", None)
+            else:
+                os.environ["INFOMARKET_COMPILE_NOTICE"] = notice
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -6,7 +6,11 @@ advances the whole swarm for as many steps as asked in one call.
 """
 from __future__ import annotations
 
+import os
+import sys
+import threading
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -66,9 +70,10 @@ class Simulation:
         self.world, self.behaviour_names = build_world(config, self.rng, record_events=record_events,
                                                        history_every=hist)
         t0 = time.perf_counter()
-        self._kernel = specialise.kernel_module(self.kinds, config.payment.scheme, config.terrain)
-        self._view = kernel_view(self.world)
-        self._kernel.run_steps(self._view, self.rng, 0)  # compile or load from cache; runs no step
+        with compile_notice(self.kinds, config.payment.scheme):
+            self._kernel = specialise.kernel_module(self.kinds, config.payment.scheme, config.terrain)
+            self._view = kernel_view(self.world)
+            self._kernel.run_steps(self._view, self.rng, 0)  # compile or load from cache; runs no step
         self.compile_seconds = time.perf_counter() - t0
         self.run_seconds = 0.0
 
@@ -165,6 +170,34 @@ class Simulation:
                 "items": w.items.tolist(), "wealth": w.balance.tolist(),
                 "behaviour": list(self.behaviour_names), "honest": [specs[b].honest for b in self.behaviour_names],
                 "sites": SITE_NAMES}
+
+
+#: Seconds after which loading the step kernel is taken to be compiling it, and said so on stderr; the
+#: environment variable INFOMARKET_COMPILE_NOTICE=0 (set by the command line's --quiet) silences it.
+COMPILE_NOTICE_AFTER = 1.0
+
+
+@contextmanager
+def compile_notice(kinds, scheme: str, after: float | None = None):
+    """Say on stderr, once ``after`` seconds have gone by inside the block, that the step kernel is being
+    compiled (the first run of a behaviour mix waits 10-20 s with nothing else to show)."""
+    after = COMPILE_NOTICE_AFTER if after is None else after
+    if os.environ.get("INFOMARKET_COMPILE_NOTICE", "1") == "0":
+        yield
+        return
+    names = "+".join(str(k) for k in dict.fromkeys(kinds))
+
+    def say() -> None:
+        print(f"compiling the step kernel for {names} / {scheme} (the first time, ~15 s; later runs load it "
+              f"from the cache)...", file=sys.stderr, flush=True)
+
+    timer = threading.Timer(after, say)
+    timer.daemon = True
+    timer.start()
+    try:
+        yield
+    finally:
+        timer.cancel()
 
 
 def as_experiment(config) -> Experiment:
