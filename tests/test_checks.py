@@ -113,3 +113,17 @@ def test_the_decorators_take_limits_as_the_docs_say():
     assert im.registry.payments()["tmp_limited"].check("share", 2.0) == "must be in [0, 1]"
     assert im.registry.behaviours()["tmp_limited_liar"].check("age", -1.0) == "must be >= 0"
     assert im.registry.behaviours()["tmp_limited_liar"].check("age", 3.0) is None
+
+
+def test_a_sell_rule_reading_out_of_bounds_is_caught_with_its_file_and_line():
+    # issue 21: compiled without bounds checking this read past `tab_valid` and passed check_behaviour
+    def past_the_table(w, me, site):
+        n = w.tab_valid.shape[0]
+        return w.tab_valid[n + 3, site], w.tab_vec[me, site, 0], w.tab_vec[me, site, 1], 0
+
+    im.register_behaviour("tmp_past_the_table", buy="naive", sell=past_the_table, honest=False, replace=True)
+    with pytest.raises(checks.CheckFailed) as err:
+        checks.check_behaviour("tmp_past_the_table", steps=300)
+    msg = str(err.value)
+    assert "behaviour 'tmp_past_the_table': its sell rule past_the_table indexes an array out of bounds" in msg
+    assert f"{__file__}:{past_the_table.__code__.co_firstlineno + 2}" in msg

@@ -43,9 +43,51 @@ def _invariants(res, what: str, initial: float, robots: int) -> None:
         raise CheckFailed(f"{what}: a purchase carried a non-finite vector")
 
 
+def _behaviour_bounds_checked(name: str, cfg, seed: int, steps: int) -> None:
+    """Run ``name``'s buy and sell rules once per robot of that behaviour, compiled with numba's bounds
+    checking, on the world of a short run of ``cfg``; an index out of range is a CheckFailed naming the
+    rule, its file and the line (found by running the same call in plain Python)."""
+    from .engine.simulation import Simulation
+
+    spec = get_behaviour(name)
+    sim = Simulation(cfg, seed)
+    sim.step(max(1, min(steps, 500)))
+    w, view = sim.world, sim._view
+    kind = sim.kinds.index(name)
+    rng = np.random.default_rng(seed)
+    for role, rule in (("sell", spec.sell), ("buy", spec.buy)):
+        py = rule.py_func
+        try:
+            checked = numba.njit(boundscheck=True)(py)
+        except Exception:  # noqa: BLE001  (not compilable here: the runs report it)
+            continue
+        for me in np.flatnonzero(w.kind == kind):
+            params = [float(w.bparams[me][spec.params.index(p)]) for p in rule.params]
+            extra = ([rng] if rule.wants_rng else []) + params
+            calls = ([(int(me), site) for site in (0, 1)] if role == "sell"
+                     else [(int(me), np.array([j for j in range(w.kind.shape[0]) if j != me], np.int64))])
+            for args in calls:
+                try:
+                    checked(view, *args, *extra)
+                except (IndexError, ZeroDivisionError) as exc:
+                    filename, first = _rule_where(py)
+                    line = None
+                    try:
+                        py(w, *args, *extra)  # plain Python on the world's arrays: names the line
+                    except Exception as plain:  # noqa: BLE001  (only to locate the line)
+                        line = _failing_line(plain, filename)
+                    at = f"{filename}:{line}" if line else f"{filename}:{first} (the function)"
+                    what = "indexes an array out of bounds" if isinstance(exc, IndexError) else "divides by zero"
+                    raise CheckFailed(f"behaviour {name!r}: its {role} rule {py.__name__} {what} "
+                                      f"({type(exc).__name__}: {exc}) at {at}") from None
+
+
 def check_behaviour(name: str, *, robots: int = 10, steps: int = 3000, seed: int = 0) -> None:
-    """Run ``name`` among naive robots, with and without staking, twice each with the same seed."""
+    """Run ``name`` among naive robots, with and without staking, twice each with the same seed; and its
+    rules once each compiled with bounds checking (an index out of range is caught, named with the rule's
+    file and line)."""
     get_behaviour(name)  # a clear ConfigError for an unknown name
+    _behaviour_bounds_checked(name, _swarm(name, robots, *MARKETS["delayed"], steps), seed, steps)
     for scheme, stake in (MARKETS["delayed"], MARKETS["staking"]):
         cfg = _swarm(name, robots, scheme, stake, steps)
         a = simulate(cfg, seed, record_events=True)
