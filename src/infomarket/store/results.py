@@ -69,7 +69,7 @@ def record_digest(table: pa.Table) -> str:
     return hashlib.sha256(data.encode()).hexdigest()
 
 
-class RecordAltered(Exception):
+class RecordAltered(InfomarketError):
     """A commit record's content does not match the checksum it was written with (internal signal)."""
 
 
