@@ -198,3 +198,14 @@ def test_quiet_silences_the_compile_notice_for_the_command_only(monkeypatch):
     monkeypatch.setattr(cli, "build_parser", lambda: type("P", (), {"parse_args": lambda self, argv: args})())
     assert cli.main(["run", "fig2A", "--quiet"]) == 0
     assert seen["run"] == "0" and "INFOMARKET_COMPILE_NOTICE" not in os.environ
+
+
+def test_a_folder_named_like_a_shipped_suite_does_not_hide_it(tmp_path, monkeypatch):
+    import infomarket.runner.cli as runner_cli
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "future").mkdir()  # what `infomarket sweep future --out future` wrote before
+    got = {}
+    monkeypatch.setattr(runner_cli, "_execute", lambda exps, args, label: got.setdefault("names", [e.name for e in exps]) and 0)
+    assert main(["sweep", "future", "--out", "future", "--quiet"]) == 0
+    assert got["names"] == ["future_honest", "future_liar", "future_farmer", "future_surfer"]
