@@ -91,15 +91,18 @@ def test_control_characters_in_a_path_are_not_echoed_raw(capsys):
 
 # ------------------------------------------------------------------ check says it ran plugin code
 def test_check_says_that_it_imported_plugin_code(tmp_path, capsys):
-    import shutil
-
-    root = Path(__file__).resolve().parents[1] / "examples"
-    for f in ("age_liar.toml", "age_liar.py", "equal_split.py"):
-        shutil.copy(root / f, tmp_path / f)
-    assert main(["check", str(tmp_path / "age_liar.toml")]) == 0
+    (tmp_path / "noted.py").write_text(
+        "import infomarket as im\n\n\n"
+        "def sell(w, me, site):\n"
+        "    return w.tab_valid[me, site], w.tab_vec[me, site, 0], w.tab_vec[me, site, 1], 0\n\n\n"
+        "im.register_behaviour('tmp_noted', buy='naive', sell=sell, honest=False, replace=True)\n")
+    exp = tmp_path / "noted.toml"
+    exp.write_text(SMALL.format(name='"noted"').replace('behaviour = "naive"', 'behaviour = "tmp_noted"')
+                   .replace("runs = 1", 'runs = 1\nplugins = ["noted.py"]'))
+    assert main(["check", str(exp)]) == 0
     got = capsys.readouterr()
-    assert "age_liar: valid." in got.out
-    assert "imported (and so ran) the plugin code" in got.err and str(tmp_path / "age_liar.py") in got.err
+    assert "noted: valid. 2 tmp_noted" in got.out
+    assert "imported (and so ran) the plugin code" in got.err and str(tmp_path / "noted.py") in got.err
 
 
 # ------------------------------------------------------------------ the Python API's arguments
@@ -209,3 +212,10 @@ def test_a_folder_named_like_a_shipped_suite_does_not_hide_it(tmp_path, monkeypa
     monkeypatch.setattr(runner_cli, "_execute", lambda exps, args, label: got.setdefault("names", [e.name for e in exps]) and 0)
     assert main(["sweep", "future", "--out", "future", "--quiet"]) == 0
     assert got["names"] == ["future_honest", "future_liar", "future_farmer", "future_surfer"]
+
+
+def test_nesting_is_measured_outside_strings_and_comments():
+    from infomarket.config.load import nesting_depth
+
+    assert nesting_depth('a = [[1, 2], "[[[", \'[[\']  # [[[[', comments=True) == 2
+    assert nesting_depth('{"a": ["\\"[", {"b": 1}]}', comments=False) == 3

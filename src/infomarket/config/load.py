@@ -186,7 +186,45 @@ def _did_you_mean(what: str, shipped: dict[str, Path]) -> str:
     return f"; did you mean {close[0]}?" if close else ""
 
 
+#: Deepest nesting of arrays and tables an experiment file may have (real ones need 4 or 5): deeper ones are
+#: refused before parsing, since the parsers recurse and a deep enough file overflows the stack.
+MAX_NESTING = 64
+
+
+def nesting_depth(text: str, comments: bool) -> int:
+    """The deepest nesting of ``[``/``{`` in ``text``, outside strings ("..." with escapes, '...' without)
+    and, with ``comments``, outside ``#`` comments (TOML)."""
+    depth = deepest = 0
+    quote = ""
+    escaped = comment = False
+    for c in text:
+        if comment:
+            comment = c != "\n"
+        elif quote:
+            if escaped:
+                escaped = False
+            elif c == "\\" and quote == '"':
+                escaped = True
+            elif c == quote:
+                quote = ""
+        elif c in "[{":
+            depth += 1
+            if depth > deepest:
+                deepest = depth
+                if deepest > MAX_NESTING:
+                    return deepest
+        elif c in "]}":
+            depth = max(0, depth - 1)
+        elif c == '"' or (c == "'" and comments):
+            quote = c
+        elif c == "#" and comments:
+            comment = True
+    return deepest
+
+
 def _parse(path: Path, text: str) -> Experiment:
+    if path.suffix in (".toml", ".json") and nesting_depth(text, path.suffix == ".toml") > MAX_NESTING:
+        raise ConfigError(f"{path}: nested more than {MAX_NESTING} levels deep; not an experiment file")
     if path.suffix == ".toml":
         try:
             data = tomllib.loads(text)
