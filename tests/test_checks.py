@@ -58,3 +58,72 @@ def test_a_random_rule_gets_the_runs_generator_and_stays_reproducible():
     assert len(ages) >= 60 and counts.min() >= len(ages) / 50, counts
     assert np.array_equal(liar_sales(1), ages)  # from the run's seeded generator
     assert not np.array_equal(liar_sales(2), ages)
+
+
+def test_a_payment_rule_writing_out_of_bounds_is_caught_with_its_file_and_line():
+    # issue 21: compiled without bounds checking this wrote past `weights` and passed
+    def past_the_end(buyer, sellers, sites, directions, weights):
+        for x in range(weights.shape[0]):
+            weights[x] = 1.0
+        weights[weights.shape[0] + 5] = 1.0
+
+    im.register_payment("tmp_past_the_end", past_the_end, replace=True)
+    line = past_the_end.__code__.co_firstlineno + 3
+    with pytest.raises(checks.CheckFailed) as err:
+        checks.check_payment("tmp_past_the_end", sequences=3)
+    msg = str(err.value)
+    assert "'tmp_past_the_end'" in msg and "past_the_end" in msg and "out of bounds" in msg
+    assert f"{__file__}:{line}" in msg
+
+
+def test_a_sell_rule_without_its_site_argument_is_refused_at_registration():
+    def no_site(w, me, rotation=90.0):  # issue 21: registered, ran and passed check_behaviour
+        return True, 1.0, 0.0, 0
+
+    with pytest.raises(im.errors.RuleError) as err:
+        im.register_behaviour("tmp_no_site", buy="naive", sell=no_site, honest=False, replace=True)
+    msg = str(err.value)
+    assert "sell rule no_site" in msg and "w, me, site first" in msg and "'rotation', not 'site'" in msg
+    assert f"{__file__}:{no_site.__code__.co_firstlineno}" in msg
+    assert "tmp_no_site" not in im.registry.behaviours()
+
+    def bad_buy(w, me, neighbours):
+        pass
+
+    with pytest.raises(im.errors.RuleError, match="'neighbours', not 'nbrs'"):
+        im.register_behaviour("tmp_bad_buy", buy=bad_buy, sell="naive", honest=True, replace=True)
+
+    def bad_pay(buyer, sellers, sites, weights):
+        pass
+
+    with pytest.raises(im.errors.RuleError, match="payment rule bad_pay"):
+        im.register_payment("tmp_bad_pay", bad_pay, replace=True)
+
+
+def test_the_decorators_take_limits_as_the_docs_say():
+    @im.payment("tmp_limited", limits={"share": ("in [0, 1]", lambda v: 0 <= v <= 1)})
+    def limited(buyer, sellers, sites, directions, weights, share=0.5):
+        for x in range(weights.shape[0]):
+            weights[x] = share
+
+    @im.behaviour("tmp_limited_liar", buy="naive", honest=False, limits={"age": (">= 0", lambda v: v >= 0)})
+    def limited_sell(w, me, site, age=1.0):
+        return w.tab_valid[me, site], w.tab_vec[me, site, 0], w.tab_vec[me, site, 1], int(age)
+
+    assert im.registry.payments()["tmp_limited"].check("share", 2.0) == "must be in [0, 1]"
+    assert im.registry.behaviours()["tmp_limited_liar"].check("age", -1.0) == "must be >= 0"
+    assert im.registry.behaviours()["tmp_limited_liar"].check("age", 3.0) is None
+
+
+def test_a_sell_rule_reading_out_of_bounds_is_caught_with_its_file_and_line():
+    # issue 21: compiled without bounds checking this read past `tab_valid` and passed check_behaviour
+    def past_the_table(w, me, site):
+        n = w.tab_valid.shape[0]
+        return w.tab_valid[n + 3, site], w.tab_vec[me, site, 0], w.tab_vec[me, site, 1], 0
+
+    im.register_behaviour("tmp_past_the_table", buy="naive", sell=past_the_table, honest=False, replace=True)
+    with pytest.raises(checks.CheckFailed) as err:
+        checks.check_behaviour("tmp_past_the_table", steps=300)
+    msg = str(err.value)
+    assert "behaviour 'tmp_past_the_table': its sell rule past_the_table indexes an array out of bounds" in msg
+    assert f"{__file__}:{past_the_table.__code__.co_firstlineno + 2}" in msg

@@ -23,3 +23,14 @@ def test_pyproject_takes_the_version_from_the_package():
 def test_no_other_file_writes_a_version():
     writers = [str(p.relative_to(ROOT)) for p in (ROOT / "src").rglob("*.py") if VERSION_LINE.search(p.read_text())]
     assert writers == ["src/infomarket/__init__.py"]
+
+
+def test_the_package_says_it_is_typed_and_offers_a_sql_extra():
+    # issue 21: no py.typed marker; DuckDB (used in docs/sweeps.md) installed by no extra
+    import tomllib
+    from importlib import resources
+    from pathlib import Path
+
+    assert resources.files("infomarket").joinpath("py.typed").is_file()
+    project = tomllib.loads((Path(__file__).resolve().parents[1] / "pyproject.toml").read_text())["project"]
+    assert any(dep.startswith("duckdb") for dep in project["optional-dependencies"]["sql"])

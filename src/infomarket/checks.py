@@ -6,12 +6,17 @@ never go negative, navigation tables stay finite.  A failed check raises ``Check
 """
 from __future__ import annotations
 
+import dataclasses
+import traceback
+
+import numba
 import numpy as np
 
 from .config import validate
 from .engine.simulation import simulate
 from .errors import InfomarketError
 from .ledger import LedgerEvent, replay_events
+from .ledger.replay import Ledger
 from .payments import MARKETS, PAPER_STAKE
 from .registry import get_behaviour, get_payment
 
@@ -38,9 +43,51 @@ def _invariants(res, what: str, initial: float, robots: int) -> None:
         raise CheckFailed(f"{what}: a purchase carried a non-finite vector")
 
 
+def _behaviour_bounds_checked(name: str, cfg, seed: int, steps: int) -> None:
+    """Run ``name``'s buy and sell rules once per robot of that behaviour, compiled with numba's bounds
+    checking, on the world of a short run of ``cfg``; an index out of range is a CheckFailed naming the
+    rule, its file and the line (found by running the same call in plain Python)."""
+    from .engine.simulation import Simulation
+
+    spec = get_behaviour(name)
+    sim = Simulation(cfg, seed)
+    sim.step(max(1, min(steps, 500)))
+    w, view = sim.world, sim._view
+    kind = sim.kinds.index(name)
+    rng = np.random.default_rng(seed)
+    for role, rule in (("sell", spec.sell), ("buy", spec.buy)):
+        py = rule.py_func
+        try:
+            checked = numba.njit(boundscheck=True)(py)
+        except Exception:  # noqa: BLE001  (not compilable here: the runs report it)
+            continue
+        for me in np.flatnonzero(w.kind == kind):
+            params = [float(w.bparams[me][spec.params.index(p)]) for p in rule.params]
+            extra = ([rng] if rule.wants_rng else []) + params
+            calls = ([(int(me), site) for site in (0, 1)] if role == "sell"
+                     else [(int(me), np.array([j for j in range(w.kind.shape[0]) if j != me], np.int64))])
+            for args in calls:
+                try:
+                    checked(view, *args, *extra)
+                except (IndexError, ZeroDivisionError) as exc:
+                    filename, first = _rule_where(py)
+                    line = None
+                    try:
+                        py(w, *args, *extra)  # plain Python on the world's arrays: names the line
+                    except Exception as plain:  # noqa: BLE001  (only to locate the line)
+                        line = _failing_line(plain, filename)
+                    at = f"{filename}:{line}" if line else f"{filename}:{first} (the function)"
+                    what = "indexes an array out of bounds" if isinstance(exc, IndexError) else "divides by zero"
+                    raise CheckFailed(f"behaviour {name!r}: its {role} rule {py.__name__} {what} "
+                                      f"({type(exc).__name__}: {exc}) at {at}") from None
+
+
 def check_behaviour(name: str, *, robots: int = 10, steps: int = 3000, seed: int = 0) -> None:
-    """Run ``name`` among naive robots, with and without staking, twice each with the same seed."""
+    """Run ``name`` among naive robots, with and without staking, twice each with the same seed; and its
+    rules once each compiled with bounds checking (an index out of range is caught, named with the rule's
+    file and line)."""
     get_behaviour(name)  # a clear ConfigError for an unknown name
+    _behaviour_bounds_checked(name, _swarm(name, robots, *MARKETS["delayed"], steps), seed, steps)
     for scheme, stake in (MARKETS["delayed"], MARKETS["staking"]):
         cfg = _swarm(name, robots, scheme, stake, steps)
         a = simulate(cfg, seed, record_events=True)
@@ -51,8 +98,60 @@ def check_behaviour(name: str, *, robots: int = 10, steps: int = 3000, seed: int
         _invariants(a, what, cfg.payment.initial_wealth, robots)
 
 
+def _rule_where(func) -> tuple[str, int]:
+    code = func.__code__
+    return code.co_filename, code.co_firstlineno
+
+
+def _failing_line(exc: BaseException, filename: str) -> int | None:
+    """The line of ``filename`` where ``exc`` was raised (the innermost frame in that file), or None."""
+    lines = [f.lineno for f in traceback.extract_tb(exc.__traceback__) if f.filename == filename]
+    return lines[-1] if lines else None
+
+
+def _bounds_checked(name: str, events: list, robots: int, stake: float) -> None:
+    """Replay ``events`` through scheme ``name`` with its weight rule compiled with numba's bounds checking
+    (an index out of range raises instead of writing past the array), then, should it raise, through the
+    rule's plain Python to find the line; raise CheckFailed naming the rule, its file and line."""
+    spec = get_payment(name)
+    rule = spec.weights
+    py = rule.py_func
+    filename, first = _rule_where(py)
+    try:
+        checked = numba.njit(boundscheck=True)(py)
+    except Exception:  # not a compilable function: the ordinary replay reports it
+        return
+    ledger = Ledger(robots, scheme=name, stake=stake)
+    ledger.scheme = dataclasses.replace(spec, weights=dataclasses.replace(rule, func=checked))
+    try:
+        for ev in events:
+            if ev.kind == "deposit":
+                ledger.deposit(ev.buyer)
+            else:
+                ledger.purchase(ev.buyer, ev.seller, ev.site, ev.direction_deg)
+    except (IndexError, ZeroDivisionError) as exc:
+        line = None
+        ledger.scheme = dataclasses.replace(spec, weights=dataclasses.replace(rule, func=py))
+        try:  # the same call in plain Python names the line (numba's message does not)
+            replay_plain = Ledger(robots, scheme=name, stake=stake)
+            replay_plain.scheme = ledger.scheme
+            for ev in events:
+                if ev.kind == "deposit":
+                    replay_plain.deposit(ev.buyer)
+                else:
+                    replay_plain.purchase(ev.buyer, ev.seller, ev.site, ev.direction_deg)
+        except Exception as plain:  # noqa: BLE001  (only to locate the line)
+            line = _failing_line(plain, filename)
+        at = f"{filename}:{line}" if line else f"{filename}:{first} (the function)"
+        kind = "indexes an array out of bounds" if isinstance(exc, IndexError) else "divides by zero"
+        raise CheckFailed(f"payment scheme {name!r}: its rule {py.__name__} {kind} ({type(exc).__name__}: {exc}) "
+                          f"at {at}") from None
+
+
 def check_payment(name: str, *, robots: int = 6, sequences: int = 30, seed: int = 0) -> None:
-    """Replay random purchases and deposits through scheme ``name``, with and without staking."""
+    """Replay random purchases and deposits through scheme ``name``, with and without staking; the first
+    sequences also with the rule compiled with bounds checking (an index out of range is caught, named
+    with the rule's file and line, instead of writing past the array unnoticed)."""
     spec = get_payment(name)
     rng = np.random.default_rng(seed)
     for k in range(sequences):
@@ -67,6 +166,8 @@ def check_payment(name: str, *, robots: int = 6, sequences: int = 30, seed: int 
                                            float(rng.uniform(0, 360))))
         events.append(LedgerEvent("deposit", int(rng.integers(robots))))
         stake = PAPER_STAKE if k % 2 else 0.0
+        if k < 2:
+            _bounds_checked(spec.name, events, robots, stake)
         first = replay_events(events, robots, scheme=spec.name, stake=stake)
         again = replay_events(events, robots, scheme=spec.name, stake=stake)
         what = f"payment scheme {name!r} (sequence {k}, stake {stake})"

@@ -105,16 +105,33 @@ def cmd_check(args) -> int:
     from .config import load_experiment
 
     cfg = load_experiment(args.experiment)
+    if cfg.plugins:  # validating needs the rules they register: say that their code ran
+        print(f"note: validating imported (and so ran) the plugin code this file names: {', '.join(cfg.plugins)}",
+              file=sys.stderr, flush=True)
     groups = ", ".join(f"{g.count} {g.behaviour}" for g in cfg.swarm.groups if g.count)
+    per = " per condition" if cfg.sweep is not None else ""
+    runs = (cfg.sweep.runs or cfg.runs) if cfg.sweep is not None else cfg.runs
     print(f"{cfg.name}: valid. {groups}; scheme {cfg.payment.scheme} (stake {cfg.payment.stake}); "
-          f"{cfg.steps} steps, transitory {cfg.transitory}, {cfg.runs} runs, seed {cfg.seed}; "
+          f"{cfg.steps} steps, transitory {cfg.transitory}, {runs} runs{per}, seed {cfg.seed}; "
           f"config hash {cfg.config_hash()}")
     if cfg.sweep is not None and cfg.sweep.sample is not None:  # the design is checked at every corner
         from .runner.design import make_design
 
         d = make_design(cfg)
+        runs = cfg.sweep.runs or cfg.runs
         print(f"sampled design: {d.method}, {d.samples} base samples, {d.points} points over {len(d.names)} "
               f"keys ({', '.join(d.names)}); outputs {', '.join(d.outputs)}")
+        print(f"sweep: {d.points:,} conditions x {runs} runs = {d.points * runs:,} runs "
+              f"(`infomarket sweep {args.experiment}`)")
+    elif cfg.sweep is not None:  # every condition is built and validated, as the sweep would
+        from .runner.plan import conditions
+
+        conds = conditions(cfg)
+        what = [f"{key} ({len(values)} values)" for key, values in cfg.sweep.grid.items()]
+        what += [f"{name} ({len(values)} values)" for name, values in cfg.sweep.axes.items()]
+        print(f"sweep: {' x '.join(what)}")
+        print(f"sweep: {len(conds):,} conditions x {conds[0].runs} runs = {sum(c.runs for c in conds):,} runs "
+              f"(`infomarket sweep {args.experiment}`)")
     return 0
 
 
@@ -148,7 +165,10 @@ def build_parser() -> Parser:
     ls = sub.add_parser("list", help="shipped experiments, behaviours and payment schemes")
     ls.set_defaults(func=cmd_list)
 
-    c = sub.add_parser("check", help="validate an experiment file and print what it describes")
+    c = sub.add_parser("check", help="validate an experiment file and print what it describes",
+                       description="Validate an experiment file and print what it describes. Validation imports "
+                                   "the plugins the file names (their code runs), since their rules are needed to "
+                                   "check the file; check says so when it does.")
     c.add_argument("experiment")
     c.set_defaults(func=cmd_check)
 
@@ -162,6 +182,10 @@ def build_parser() -> Parser:
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
+    quiet = bool(getattr(args, "quiet", False))
+    notice = os.environ.get("INFOMARKET_COMPILE_NOTICE")
+    if quiet:  # the engine's "compiling the step kernel..." line too (workers inherit the variable)
+        os.environ["INFOMARKET_COMPILE_NOTICE"] = "0"
     try:
         return int(args.func(args) or 0)
     except InfomarketError as exc:
@@ -172,6 +196,12 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:  # output piped into e.g. `head`: stop quietly, like other Unix tools
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+    finally:
+        if quiet:
+            if notice is None:
+                os.environ.pop("INFOMARKET_COMPILE_NOTICE", None)
+            else:
+                os.environ["INFOMARKET_COMPILE_NOTICE"] = notice
 
 
 if __name__ == "__main__":  # pragma: no cover

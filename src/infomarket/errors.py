@@ -67,5 +67,12 @@ def report(error: str | BaseException, code: int | None = None) -> int:
     an exception ``exit_code(error)``, or 2 for a message.  Every command-line error goes through here."""
     if code is None:
         code = exit_code(error) if isinstance(error, BaseException) else EXIT_USAGE
-    print(f"infomarket: error: {error}", file=sys.stderr, flush=True)
+    print(f"infomarket: error: {printable(str(error))}", file=sys.stderr, flush=True)
     return code
+
+
+def printable(text: str, limit: int = 20000) -> str:
+    """``text`` safe to print on a terminal: control characters other than newline and tab (ANSI escape
+    sequences, carriage returns) are written as ``\\x1b``-style escapes, and it is cut to ``limit`` characters."""
+    out = "".join(c if c in "\n\t" or (c.isprintable()) else repr(c)[1:-1] for c in text)
+    return out if len(out) <= limit else out[:limit] + f"... ({len(out) - limit} more characters)"

@@ -97,12 +97,25 @@ def _jit(func: Callable) -> Callable:
     return numba.njit(func)
 
 
+def _where(func: Callable) -> str:
+    """``file.py:12``: where a rule is defined, for messages."""
+    code = getattr(func, "__code__", None)
+    return f"{code.co_filename}:{code.co_firstlineno}" if code is not None else "unknown file"
+
+
 def _rule(func: Callable, fixed: tuple[str, ...], what: str, market: bool = False) -> Rule:
     jitted = _jit(func)
     py = getattr(jitted, "py_func", jitted)
     sig = list(inspect.signature(py).parameters.values())
+    where = _where(py)
     if len(sig) < len(fixed):
-        raise RuleError(f"{what} {py.__name__} must take the arguments {', '.join(fixed)} first")
+        raise RuleError(f"{what} {py.__name__} ({where}) must take the arguments {', '.join(fixed)} first; "
+                        f"it takes ({', '.join(p.name for p in sig)})")
+    for want, p in zip(fixed, sig):
+        if p.name != want or p.default is not p.empty or p.kind not in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD):
+            raise RuleError(f"{what} {py.__name__} ({where}) must take the arguments {', '.join(fixed)} first, "
+                            f"without defaults; it takes ({', '.join(p.name for p in sig)}): argument "
+                            f"{sig.index(p) + 1} is {p.name!r}, not {want!r}")
     extra = sig[len(fixed):]
     wants_market = market and bool(extra) and extra[0].name == "market"
     if wants_market:
@@ -159,13 +172,14 @@ def register_behaviour(name: str, *, buy: Callable | str, sell: Callable | str, 
     return spec
 
 
-def behaviour(name: str, *, buy: Callable | str, honest: bool, description: str = "", replace: bool = False):
+def behaviour(name: str, *, buy: Callable | str, honest: bool, description: str = "", limits: dict | None = None,
+              replace: bool = False, paths: bool = False):
     """Decorator form of :func:`register_behaviour` for the sell rule: ``@behaviour("liar", buy="naive",
-    honest=False)`` over ``def sell(w, me, site): ...``."""
+    honest=False)`` over ``def sell(w, me, site): ...``; ``limits`` and ``paths`` as there."""
 
     def wrap(sell: Callable) -> Callable:
         spec = register_behaviour(name, buy=buy, sell=sell, honest=honest, description=description,
-                                  replace=replace)
+                                  limits=limits, replace=replace, paths=paths)
         return spec.sell.func
 
     return wrap
@@ -192,11 +206,12 @@ def register_payment(name: str, weights: Callable, *, description: str = "", lim
     return spec
 
 
-def payment(name: str, *, description: str = "", replace: bool = False):
-    """Decorator form of :func:`register_payment`."""
+def payment(name: str, *, description: str = "", limits: dict | None = None, replace: bool = False):
+    """Decorator form of :func:`register_payment` (``limits`` as there)."""
 
     def wrap(weights: Callable) -> Callable:
-        return register_payment(name, weights, description=description, replace=replace).weights.func
+        return register_payment(name, weights, description=description, limits=limits,
+                                replace=replace).weights.func
 
     return wrap
 

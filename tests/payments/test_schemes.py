@@ -77,3 +77,20 @@ def test_delayed_pays_per_transaction():
               LedgerEvent("purchase", 0, 2, 0, 90.0), LedgerEvent("deposit", 0)]
     res = replay_events(events, 3)
     assert res.balances == pytest.approx([1.5, 1 + 1 / 3, 1 + 1 / 6])
+
+
+@pytest.mark.parametrize("directions", [(10.0, 40.0, 41.0), (350.0, 20.0, 21.0)], ids=["plain", "across-0"])
+def test_directions_exactly_theta_apart_are_not_similar(directions):
+    # eq. 8 counts transactions strictly within theta: with theta = 30, 10 and 40 (or 350 and 20, across 0)
+    # are exactly 30 apart and do not count each other; 40 and 41 do.  Weights 1, 2, 2 (total 5), so the
+    # 0.5 paid out (information_share x reward) splits 0.1, 0.2, 0.2.  With <= it would be 2, 3, 2.
+    a, b, c = directions
+    events = [LedgerEvent("purchase", 0, 1, 0, a), LedgerEvent("purchase", 0, 2, 0, b),
+              LedgerEvent("purchase", 0, 3, 0, c), LedgerEvent("deposit", 0)]
+    out = replay_events(events, 4, scheme="outlier", params={"theta": 30.0})
+    assert list(out.balances) == pytest.approx([1.5, 1.1, 1.2, 1.2], abs=1e-12)
+    # and one hair inside theta they are similar: weights 2, 3, 2 (total 7)
+    inside = [LedgerEvent("purchase", 0, 1, 0, a), LedgerEvent("purchase", 0, 2, 0, b - 1e-9),
+              LedgerEvent("purchase", 0, 3, 0, c), LedgerEvent("deposit", 0)]
+    out = replay_events(inside, 4, scheme="outlier", params={"theta": 30.0})
+    assert list(out.balances) == pytest.approx([1.5, 1 + 0.5 * 2 / 7, 1 + 0.5 * 3 / 7, 1 + 0.5 * 2 / 7], abs=1e-12)

@@ -106,3 +106,32 @@ def test_parts_get_the_umasks_permissions(tiny, tmp_path):
     files = list(out.rglob("*.parquet")) + [out / "store.json"] + list(run.rglob("*.parquet")) + [run / "store.json"]
     assert any(f.parent == run / "robots" for f in files)
     assert files and {stat.S_IMODE(f.stat().st_mode) for f in files} == {0o644}
+
+
+@pytest.mark.parametrize("keep_metadata", [True, False], ids=["metadata-kept", "rewritten-by-pandas"])
+def test_one_value_edited_in_a_commit_record_fails_verify(store, tmp_path, capsys, keep_metadata):
+    # issue 21: a runs part rewritten as valid Parquet with one value changed passed verify and figures
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    part = first_part(store, "runs")
+    table = pq.read_table(part)
+    seeds = table.column("seed").to_pylist()
+    seeds[0] += 1
+    edited = table.set_column(table.column_names.index("seed"), "seed", pa.array(seeds, table.schema.field("seed").type))
+    if keep_metadata:
+        pq.write_table(edited, part)
+    else:
+        edited.to_pandas().to_parquet(part, index=False)
+    assert main(["store", "verify", str(store.root)]) == 2
+    out = capsys.readouterr().out
+    assert f"damaged: runs/{part.name}: commit record" in out
+    with pytest.raises(StoreDamaged, match=f"runs/{part.name} is damaged: commit record"):
+        store.runs()
+    assert main(["figures", str(store.root), "--out", str(tmp_path / "fig")]) == 2
+    assert not (tmp_path / "fig").exists()
+
+
+def test_an_untouched_store_verifies(store, capsys):
+    assert main(["store", "verify", str(store.root)]) == 0
+    assert len(store.runs()) == 6

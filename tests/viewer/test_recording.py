@@ -52,7 +52,8 @@ def test_page_is_self_contained_and_holds_the_run(recording, tmp_path):
 
 
 def test_nothing_in_the_data_can_close_the_script_tag(fig2b, tmp_path):
-    cfg = fig2b.with_overrides(name="evil</script><b>", description="<!-- x")
+    # names are validated (a safe charset, issue 21); the page must stay safe for any text all the same
+    cfg = fig2b.model_copy(update={"name": "evil</script><b>", "description": "<!-- x"})
     page = write_html(record(cfg, 1, steps=5, every=5), tmp_path / "x.html").read_text()
     assert "evil</script>" not in page and "<b>" not in page.split("<body>")[1].split("<script")[0]
     assert payload(page)["scene"]["name"] == "evil</script><b>"

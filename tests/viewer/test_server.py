@@ -274,14 +274,14 @@ def _ignore_ctrl_c() -> None:
 def test_view_command_prints_the_url_and_stops_cleanly_on_a_signal(sig, inherit):
     env = {**os.environ, "PYTHONUNBUFFERED": "1"}
     proc = subprocess.Popen([sys.executable, "-m", "infomarket.cli", "view", "fig2B", "--port", "0"],
-                            stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True, env=env,
+                            stderr=subprocess.PIPE, stdout=subprocess.PIPE, text=True, env=env,
                             preexec_fn=inherit)
     try:
         url = None
         deadline = time.monotonic() + 60
         lines = []
         while url is None and time.monotonic() < deadline:
-            line = proc.stderr.readline()
+            line = proc.stdout.readline()  # the address is on stdout (issue 21), progress on stderr
             if not line:
                 break
             lines.append(line)

@@ -15,6 +15,7 @@ def add_subcommand(subparsers) -> None:
     p.add_argument("store", metavar="STORE", help="a results store (folder with store.json)")
     p.add_argument("--out", required=True, metavar="DIR", help="folder for the figures and the report")
     p.add_argument("--vector", choices=("svg", "pdf"), default="svg", help="vector format besides PNG")
+    p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.set_defaults(func=cmd_figures)
 
 
@@ -30,8 +31,9 @@ def cmd_figures(args: argparse.Namespace) -> int:
     # raises StoreError for a missing or foreign folder, StoreDamaged (naming the repair) for a damaged one
     store = Store(args.store)
     frames = Frames.of(store)
+    echo = (lambda *a, **k: None) if getattr(args, "quiet", False) else print
     if frames.robots.empty and frames.history.empty:
-        print(f"{args.store}: the store holds no completed runs; writing an empty report")
+        echo(f"{args.store}: the store holds no completed runs; writing an empty report")
     writable_dir(out)
-    build_report(frames, out, vector=args.vector, echo=print, label=str(args.store), store=store)
+    build_report(frames, out, vector=args.vector, echo=echo, label=str(args.store), store=store)
     return 0

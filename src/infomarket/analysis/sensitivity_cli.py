@@ -11,7 +11,7 @@ def add_subcommand(subparsers) -> None:
     p = subparsers.add_parser(
         "sensitivity", help="Sobol'/Morris indices of a store's sampled design: table, figures, report section",
         description="Compute the sensitivity indices (SALib) of every output of the sampled design kept in a "
-                    "results store; write them as CSV and Parquet, draw them (bars with 95 %% intervals, the "
+                    "results store; write them as CSV and Parquet, draw them (bars with 95 % intervals, the "
                     "second-order heat map of a Sobol' design) and write sensitivity-EXPERIMENT.md in DIR.")
     p.add_argument("store", metavar="STORE", help="a results store swept from an experiment with [sweep.sample]")
     p.add_argument("--out", required=True, metavar="DIR", help="folder for the table, figures and report")

@@ -2,7 +2,10 @@
 ``ConfigError`` whose message names the file, the key and what is allowed."""
 from __future__ import annotations
 
+import difflib
 import json
+import os
+import re
 import tomllib
 from importlib import resources
 from pathlib import Path
@@ -12,7 +15,7 @@ from pydantic import ValidationError
 
 from ..errors import ConfigError
 from .legacy import from_legacy, is_legacy
-from .schema import CircleObstacle, Experiment, Rect, Segment
+from .schema import NAME_MAX, CircleObstacle, Experiment, Rect, Segment
 
 SHIPPED = "infomarket.experiments"
 
@@ -38,6 +41,12 @@ def key_path(loc: tuple) -> str:
     return out
 
 
+def _shown(value: Any, limit: int = 80) -> str:
+    """A value as an error message quotes it: its repr (control characters escaped), cut to ``limit``."""
+    text = repr(value)
+    return text if len(text) <= limit else f"{text[:limit]}... ({len(text)} characters)"
+
+
 def _describe(err: dict[str, Any]) -> str:
     loc = key_path(err["loc"])
     msg = err["msg"]
@@ -46,7 +55,7 @@ def _describe(err: dict[str, Any]) -> str:
     if msg.startswith("Value error, "):
         msg = msg[len("Value error, "):]
     got = err.get("input")
-    shown = "" if isinstance(got, dict) or err["type"] == "missing" else f" (got {got!r})"
+    shown = "" if isinstance(got, dict) or err["type"] == "missing" else f" (got {_shown(got)})"
     return f"{loc + ': ' if loc else ''}{msg}{shown}"
 
 
@@ -106,8 +115,12 @@ def _union_errors(errors: list[dict[str, Any]]) -> list[dict[str, Any]]:
 def validate(data: dict[str, Any], source: str = "configuration", base: Path | None = None) -> Experiment:
     """Validate a dictionary in our schema; raise ConfigError listing every problem.  ``base`` is the
     folder relative plugin paths are resolved against (the experiment file's)."""
+    if not isinstance(data, dict):
+        raise ConfigError(f"{source}: an experiment is a table of keys (a dict), got {type(data).__name__}")
     try:
         return Experiment.model_validate(data, context={"base": base})
+    except RecursionError:
+        raise ConfigError(f"{source}: nested too deeply to be an experiment") from None
     except ValidationError as exc:
         lines = []
         for err in _union_errors(exc.errors()):
@@ -119,22 +132,99 @@ def validate(data: dict[str, Any], source: str = "configuration", base: Path | N
         raise ConfigError(f"{source}: invalid experiment\n  " + "\n  ".join(lines)) from None
 
 
+def looks_like_path(what: str) -> bool:
+    """Does a command-line argument name a file or folder rather than a shipped experiment?  Yes when it has
+    a folder part or a trailing separator (``./fig2A``, ``runs/fig2A``, ``fig2A/``) or an extension
+    (``fig2A.toml``)."""
+    text = str(what)
+    return "/" in text or os.sep in text or (os.altsep is not None and os.altsep in text) or Path(text).suffix != ""
+
+
+def default_name(stem: str) -> str:
+    """An experiment name made from a file's stem when the file sets none: the characters a name may not
+    hold become ``_`` (schema.NAME_PATTERN), and it is cut to the longest name allowed."""
+    name = re.sub(r"[^A-Za-z0-9_.+=,-]", "_", stem)[:NAME_MAX].lstrip(".-+=,")
+    return name or "experiment"
+
+
 def load_experiment(what: str | Path) -> Experiment:
-    """Load an experiment from a ``.toml`` or ``.json`` file, or by the name of a shipped one."""
-    path = Path(what)
-    if not path.exists():
-        shipped = shipped_experiments()
-        if str(what) in shipped:
-            path = shipped[str(what)]
-        else:
-            raise ConfigError(f"no experiment file {str(what)!r} and no shipped experiment of that name; "
-                              f"shipped: {', '.join(shipped)}")
+    """Load an experiment from a ``.toml`` or ``.json`` file, or by the name of a shipped one.
+
+    A shipped name (``fig2A``) wins over a file or folder of the same name in the working directory, so
+    that ``infomarket sweep fig2A --out fig2A`` can be run again; write ``./fig2A`` (or give a path with a
+    folder or an extension) to name the file instead."""
+    shipped = shipped_experiments()
+    if isinstance(what, str) and what in shipped and not looks_like_path(what):
+        path = shipped[what]
+    else:
+        path = Path(what)
+        try:
+            exists = path.exists()
+        except (OSError, ValueError) as exc:  # a name too long for the file system, a NUL byte
+            raise ConfigError(f"{str(what)[:200]!r}: not an experiment file or a shipped name ({exc})") from None
+        if not exists:
+            raise ConfigError(f"no experiment file {str(what)[:200]!r} and no shipped experiment of that name"
+                              f"{_did_you_mean(str(what), shipped)}; shipped: {', '.join(shipped)}")
     if path.is_dir():
-        raise ConfigError(f"{path}: is a directory, not an experiment file (.toml or .json)")
+        other = (f"; the shipped experiment {path.name} is named without a folder or a trailing /: `{path.name}`"
+                 if path.name in shipped else "")
+        raise ConfigError(f"{path}: is a directory, not an experiment file (.toml or .json){other}")
     try:
         text = path.read_text()
     except (OSError, UnicodeDecodeError) as exc:
         raise ConfigError(f"{path}: cannot read: {exc}") from None
+    try:
+        return _parse(path, text)
+    except RecursionError:
+        raise ConfigError(f"{path}: nested too deeply to be an experiment file") from None
+
+
+def _did_you_mean(what: str, shipped: dict[str, Path]) -> str:
+    """``; did you mean fig2B?`` for a shipped name given in another case or with a typo."""
+    same = [n for n in shipped if n.lower() == what.lower()]
+    close = same or difflib.get_close_matches(what, list(shipped), n=1, cutoff=0.75)
+    return f"; did you mean {close[0]}?" if close else ""
+
+
+#: Deepest nesting of arrays and tables an experiment file may have (real ones need 4 or 5): deeper ones are
+#: refused before parsing, since the parsers recurse and a deep enough file overflows the stack.
+MAX_NESTING = 64
+
+
+def nesting_depth(text: str, comments: bool) -> int:
+    """The deepest nesting of ``[``/``{`` in ``text``, outside strings ("..." with escapes, '...' without)
+    and, with ``comments``, outside ``#`` comments (TOML)."""
+    depth = deepest = 0
+    quote = ""
+    escaped = comment = False
+    for c in text:
+        if comment:
+            comment = c != "\n"
+        elif quote:
+            if escaped:
+                escaped = False
+            elif c == "\\" and quote == '"':
+                escaped = True
+            elif c == quote:
+                quote = ""
+        elif c in "[{":
+            depth += 1
+            if depth > deepest:
+                deepest = depth
+                if deepest > MAX_NESTING:
+                    return deepest
+        elif c in "]}":
+            depth = max(0, depth - 1)
+        elif c == '"' or (c == "'" and comments):
+            quote = c
+        elif c == "#" and comments:
+            comment = True
+    return deepest
+
+
+def _parse(path: Path, text: str) -> Experiment:
+    if path.suffix in (".toml", ".json") and nesting_depth(text, path.suffix == ".toml") > MAX_NESTING:
+        raise ConfigError(f"{path}: nested more than {MAX_NESTING} levels deep; not an experiment file")
     if path.suffix == ".toml":
         try:
             data = tomllib.loads(text)
@@ -149,10 +239,10 @@ def load_experiment(what: str | Path) -> Experiment:
             raise ConfigError(f"{path}: the top level must be a JSON object")
         if is_legacy(data):
             try:
-                data = from_legacy(data, path.stem)
+                data = from_legacy(data, default_name(path.stem))
             except ConfigError as exc:
                 raise ConfigError(f"{path}: {exc}") from None
     else:
         raise ConfigError(f"{path}: unknown file type {path.suffix!r}; use .toml (or the original .json)")
-    data.setdefault("name", path.stem)
+    data.setdefault("name", default_name(path.stem))
     return validate(data, str(path), base=path.resolve().parent)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import re
 from typing import Annotated, Any, Literal, Union
 
 from pydantic import BaseModel, StrictBool, ConfigDict, Field, ValidationInfo, field_validator, model_validator
@@ -22,6 +23,12 @@ from .sample import Sample
 
 #: Seeds are 63-bit everywhere (files, the command line, the Python API, the store's int64 columns).
 from ..seeds import MAX_SEED  # noqa: E402  (one definition, infomarket.seeds)
+
+#: An experiment's name is also a folder name (``results/NAME``) and a label in tables: ASCII letters, digits
+#: and ``_ - . + = ,``, starting with a letter, digit or ``_``, at most NAME_MAX characters (no path separators,
+#: no control characters, never ``.`` or ``..``).
+NAME_MAX = 100
+NAME_PATTERN = r"^[A-Za-z0-9_][A-Za-z0-9_.+=,-]*$"
 
 PosFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 NonNegFloat = Annotated[float, Field(ge=0, allow_inf_nan=False)]
@@ -199,6 +206,29 @@ class Experiment(_Strict):
     payment: Payment = Payment()
     sweep: Sweep | None = None
 
+    @field_validator("name", mode="before")
+    @classmethod
+    def _safe_name(cls, name: Any) -> Any:
+        if not isinstance(name, str):
+            return name  # pydantic says "a valid string"
+        if not name:
+            raise ConfigError("an empty name; a name is used as a folder (results/NAME): give one")
+        if len(name) > NAME_MAX:
+            raise ConfigError(f"a name of {len(name)} characters; at most {NAME_MAX} (it is used as a folder)")
+        if not re.fullmatch(NAME_PATTERN, name):
+            raise ConfigError("a name may hold only ASCII letters, digits and _ - . + = , and must start with a "
+                              "letter, digit or _ (it is used as a folder: no / or \\, no spaces or control characters)")
+        return name
+
+    @field_validator("food", "nest", mode="before")
+    @classmethod
+    def _site_defaults(cls, value: Any, info: ValidationInfo) -> Any:
+        """One site given in part (``[food]`` with only ``radius``) takes the default site's other keys."""
+        if isinstance(value, dict):
+            default = cls.model_fields[info.field_name].default
+            return {"x": default.x, "y": default.y, **value}
+        return value
+
     @field_validator("plugins")
     @classmethod
     def _import_plugins(cls, entries: list[str], info: ValidationInfo) -> list[str]:
@@ -248,6 +278,10 @@ class Experiment(_Strict):
         if self.payment.scheme not in schemes:
             raise ConfigError(f"payment.scheme: unknown scheme {self.payment.scheme!r}; "
                              f"allowed: {', '.join(sorted(schemes))}")
+        if self.payment.stake > self.payment.initial_wealth:
+            raise ConfigError(f"payment.stake = {self.payment.stake} is more than payment.initial_wealth = "
+                              f"{self.payment.initial_wealth}: no seller could ever lock its stake, so every "
+                              f"purchase would be refused; lower the stake or raise the initial wealth")
         spec = schemes[self.payment.scheme]
         for p, v in self.payment.params.items():
             if p not in spec.params:

@@ -6,7 +6,11 @@ advances the whole swarm for as many steps as asked in one call.
 """
 from __future__ import annotations
 
+import os
+import sys
+import threading
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -15,7 +19,7 @@ import pandas as pd
 
 from ..config.schema import Experiment
 from ..config.load import load_experiment
-from ..errors import ArgumentError, ConfigError, SimulationError
+from ..errors import ArgumentError, ConfigError, InputTypeError, SimulationError
 from ..registry import behaviours
 from . import specialise
 from ..seeds import MAX_SEED
@@ -57,19 +61,19 @@ class Simulation:
 
     def __init__(self, config: Experiment | str | Path, seed: int | None = None, *, record_events: bool = False,
                  history_every: int | None = None):
-        if not isinstance(config, Experiment):  # a shipped name or a path, as on the command line
-            config = load_experiment(config)
+        config = as_experiment(config)
         self.config = config
         self.seed = _checked_seed(config.seed if seed is None else seed)
         self.rng = np.random.default_rng(self.seed)
         self.kinds = behaviour_kinds(config)
-        hist = config.history_every if history_every is None else history_every
+        hist = config.history_every if history_every is None else _checked_history(history_every, config.steps)
         self.world, self.behaviour_names = build_world(config, self.rng, record_events=record_events,
                                                        history_every=hist)
         t0 = time.perf_counter()
-        self._kernel = specialise.kernel_module(self.kinds, config.payment.scheme, config.terrain)
-        self._view = kernel_view(self.world)
-        self._kernel.run_steps(self._view, self.rng, 0)  # compile or load from cache; runs no step
+        with compile_notice(self.kinds, config.payment.scheme):
+            self._kernel = specialise.kernel_module(self.kinds, config.payment.scheme, config.terrain)
+            self._view = kernel_view(self.world)
+            self._kernel.run_steps(self._view, self.rng, 0)  # compile or load from cache; runs no step
         self.compile_seconds = time.perf_counter() - t0
         self.run_seconds = 0.0
 
@@ -168,6 +172,55 @@ class Simulation:
                 "sites": SITE_NAMES}
 
 
+#: Seconds after which loading the step kernel is taken to be compiling it, and said so on stderr; the
+#: environment variable INFOMARKET_COMPILE_NOTICE=0 (set by the command line's --quiet) silences it.
+COMPILE_NOTICE_AFTER = 1.0
+
+
+@contextmanager
+def compile_notice(kinds, scheme: str, after: float | None = None):
+    """Say on stderr, once ``after`` seconds have gone by inside the block, that the step kernel is being
+    compiled (the first run of a behaviour mix waits 10-20 s with nothing else to show)."""
+    after = COMPILE_NOTICE_AFTER if after is None else after
+    if os.environ.get("INFOMARKET_COMPILE_NOTICE", "1") == "0":
+        yield
+        return
+    names = "+".join(str(k) for k in dict.fromkeys(kinds))
+
+    def say() -> None:
+        print(f"compiling the step kernel for {names} / {scheme} (the first time, ~15 s; later runs load it "
+              f"from the cache)...", file=sys.stderr, flush=True)
+
+    timer = threading.Timer(after, say)
+    timer.daemon = True
+    timer.start()
+    try:
+        yield
+    finally:
+        timer.cancel()
+
+
+def as_experiment(config) -> Experiment:
+    """An Experiment from what the Python API takes: an Experiment, a shipped name or a file path (as on the
+    command line), or a dict of the experiment file's keys (validated like a file)."""
+    if isinstance(config, Experiment):
+        return config
+    if isinstance(config, dict):
+        from ..config.load import validate
+
+        return validate(config, "simulate()/Simulation() experiment")
+    if isinstance(config, (str, Path)):
+        return load_experiment(config)
+    raise InputTypeError(f"expected an Experiment, a shipped name, a file path or a dict of experiment keys, "
+                         f"got {type(config).__name__}")
+
+
+def _checked_history(every, steps: int) -> int:
+    if isinstance(every, bool) or not isinstance(every, (int, np.integer)) or not 0 <= int(every) <= steps:
+        raise ConfigError(f"history_every must be an integer in [0, steps = {steps}] (0: no history), got {every!r}")
+    return int(every)
+
+
 def _checked_seed(seed) -> int:
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) <= MAX_SEED:
         raise ConfigError(f"seed must be an integer in [0, 2**63 - 1] (as in experiment files and on the "
@@ -181,8 +234,7 @@ def simulate(config: Experiment | str | Path, seed: int | None = None, *, steps:
     The same configuration and seed give identical results.  ``steps`` is the run's length, exactly as
     the experiment's ``steps`` (it shapes the Lévy step-length table), so ``simulate(cfg, seed, steps=N)``
     reproduces a run stored with ``steps = N``."""
-    if not isinstance(config, Experiment):
-        config = load_experiment(config)
+    config = as_experiment(config)
     if steps is not None:
         if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1:
             raise ConfigError(f"steps must be a positive integer number of steps, got {steps!r}")

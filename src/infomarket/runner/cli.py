@@ -91,8 +91,11 @@ def _execute(experiments, args, label: str) -> int:
 
 def cmd_sweep(args) -> int:
     from ..config import load_experiment
+    from ..config.load import looks_like_path
 
-    if args.experiment in SUITES and not Path(args.experiment).exists():
+    # a shipped suite's name wins over a same-named folder (e.g. the store of `sweep future --out future`),
+    # as shipped experiments' names do; `./future` names the folder
+    if args.experiment in SUITES and not looks_like_path(args.experiment):
         return _execute([load_experiment(name) for name in SUITES[args.experiment]], args, args.experiment)
     exp = load_experiment(args.experiment)
     if getattr(args, "samples", None) is not None:

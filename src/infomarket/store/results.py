@@ -22,7 +22,10 @@ readers ignore and the next sweep deletes.
 
 **Integrity.**  The runs part records, for each other table, the SHA-256 and the row count of the part
 it commits (columns ``robots_sha256``, ``robots_rows``, ...); the runs part itself is written with
-Parquet page checksums.  Every read checks them and raises ``StoreDamaged`` naming the part and the
+Parquet page checksums and a SHA-256 of its own content (its values, not its bytes) in its Parquet
+metadata (key ``infomarket_record_sha256``), so a commit record rewritten with one value changed is
+caught too (stores made before that have ``record_checksums`` absent from ``store.json`` and are read as
+before).  Every read checks them and raises ``StoreDamaged`` naming the part and the
 repair command; ``verify`` lists every damaged and orphan part, ``repair`` moves damaged parts aside
 (into ``damaged/``) so that their runs count as not done and the next sweep reruns exactly those.
 
@@ -41,7 +44,10 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import hashlib
+
 import pandas as pd
+import pyarrow as pa
 import pyarrow.parquet as pq
 
 from .. import __version__
@@ -53,6 +59,19 @@ DATA_TABLES = ("robots", "history", "events", "payments", "sites", "configs")
 TABLES = DATA_TABLES + ("runs",)
 KEY = ["experiment", "condition", "run"]
 OK, FAILED = "ok", "failed"
+
+
+RECORD_SHA = b"infomarket_record_sha256"
+
+
+def record_digest(table: pa.Table) -> str:
+    """SHA-256 of a commit record's content: column names and values, in order (not the file's bytes)."""
+    data = json.dumps([table.column_names, table.to_pydict()], default=str, allow_nan=True)
+    return hashlib.sha256(data.encode()).hexdigest()
+
+
+class RecordAltered(InfomarketError):
+    """A commit record's content does not match the checksum it was written with (internal signal)."""
 
 
 class StoreError(InfomarketError, ValueError):
@@ -170,7 +189,7 @@ class Store:
         # second writer racing this one is refused by the lock, not taken for a foreign folder
         self._write_meta({"format": FORMAT, "package_version": __version__,
                           "created": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "seeds": {},
-                          "declarations": _declarations()})
+                          "record_checksums": True, "declarations": _declarations()})
         for t in TABLES:
             (self.root / t).mkdir(exist_ok=True)
         return self
@@ -282,15 +301,35 @@ class Store:
         self._write_runs(part_id, runs)
 
     def _write_runs(self, part_id: str, runs: pd.DataFrame) -> None:
-        write_atomic(self.part_path("runs", part_id),
-                     lambda tmp: runs.to_parquet(tmp, index=False, write_page_checksum=True))
+        def write(tmp: Path) -> None:
+            runs.to_parquet(tmp, index=False, write_page_checksum=True)
+            table = pq.read_table(tmp)  # the digest is of what a reader gets back
+            meta = {**(table.schema.metadata or {}), RECORD_SHA: record_digest(table).encode()}
+            pq.write_table(table.replace_schema_metadata(meta), tmp, write_page_checksum=True)
+
+        write_atomic(self.part_path("runs", part_id), write)
 
     # ------------------------------------------------------------------ integrity
     def _repair_hint(self) -> str:
         return f"run `infomarket store repair {self.root}` to move damaged parts aside (their runs are then rerun)"
 
     def _read_runs_part(self, path: Path) -> pd.DataFrame:
-        return pq.read_table(path, page_checksum_verification=True).to_pandas()
+        table = pq.read_table(path, page_checksum_verification=True)
+        stored = (table.schema.metadata or {}).get(RECORD_SHA)
+        if stored is None:
+            if self._record_checksums():
+                raise RecordAltered("its checksum is missing (rewritten by something other than infomarket)")
+        elif stored.decode() != record_digest(table):
+            raise RecordAltered("checksum mismatch: a value was altered after it was committed")
+        return table.to_pandas()
+
+    def _record_checksums(self) -> bool:
+        if not hasattr(self, "_sums"):
+            try:
+                self._sums = bool(self.meta().get("record_checksums", False))
+            except StoreError:
+                self._sums = False
+        return self._sums
 
     def _check_data_part(self, table: str, part_id: str, record: pd.DataFrame) -> str | None:
         """Why the ``table`` part of ``part_id`` does not match its commit record, or None."""
@@ -321,6 +360,9 @@ class Store:
             found.parts += 1
             try:
                 record = self._read_runs_part(path)
+            except RecordAltered as exc:
+                found.damaged.append(Problem(pid, _rel(self.root, path), f"commit record {exc}"))
+                continue
             except Exception as exc:  # noqa: BLE001 - any reader error means damage
                 found.damaged.append(Problem(pid, _rel(self.root, path),
                                              f"unreadable commit record ({type(exc).__name__}: {exc})"))
@@ -376,6 +418,9 @@ class Store:
         for pid, path in sorted(self._parts("runs").items()):
             try:
                 out[pid] = self._read_runs_part(path)
+            except RecordAltered as exc:
+                raise StoreDamaged(f"{self.root}: part {_rel(self.root, path)} is damaged: commit record {exc}; "
+                                   f"{self._repair_hint()}") from None
             except Exception as exc:  # noqa: BLE001
                 raise StoreDamaged(f"{self.root}: part {_rel(self.root, path)} is damaged: unreadable commit "
                                    f"record ({type(exc).__name__}); {self._repair_hint()}") from None

@@ -14,6 +14,8 @@ from ..cliargs import UsageError, at_least, seed_value, writable_file
 from ..errors import InfomarketError
 from . import DEFAULT_PORT
 
+HTML_SUFFIXES = (".html", ".htm")
+
 
 def _port(text: str) -> int:
     v = at_least(0)(text)
@@ -22,8 +24,17 @@ def _port(text: str) -> int:
     return v
 
 
+QUIET = False  # --quiet: progress lines are not printed (errors and the viewer's address still are)
+
+
 def _say(text: str) -> None:
-    print(text, file=sys.stderr, flush=True)
+    if not QUIET:
+        print(text, file=sys.stderr, flush=True)
+
+
+def _announce(text: str) -> None:
+    """The line a user acts on (the viewer's address): on stdout, so ``infomarket view X | head -1`` gets it."""
+    print(text, flush=True)
 
 
 def _load(experiment: str, steps: int | None = None):
@@ -58,9 +69,15 @@ def _ctrl_c_works() -> None:
     signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
 
 
+def _quiet(args) -> None:
+    global QUIET
+    QUIET = bool(getattr(args, "quiet", False))
+
+
 def cmd_view(args) -> int:
     import asyncio
 
+    _quiet(args)
     try:
         from .server import serve
     except ImportError as exc:  # aiohttp is a dependency; say so rather than show a traceback
@@ -69,7 +86,8 @@ def cmd_view(args) -> int:
     _ctrl_c_works()
     _warm_up(cfg, args.seed)
     try:
-        asyncio.run(serve(cfg, args.seed, port=args.port, keep_running=args.keep_running, say=_say))
+        asyncio.run(serve(cfg, args.seed, port=args.port, keep_running=args.keep_running, say=_say,
+                          announce=_announce))
     except KeyboardInterrupt:
         pass
     _say("viewer stopped")
@@ -93,8 +111,13 @@ class _Ticker:
 def cmd_replay(args) -> int:
     from .recording import record, write_html
 
+    _quiet(args)
     if not args.out and not args.movie:
         raise UsageError("replay: say what to write: --out FILE.html, --movie FILE.mp4 (or .gif), or both")
+    if args.out and Path(args.out).suffix.lower() not in HTML_SUFFIXES:
+        movie = Path(args.out).suffix.lower() in (".mp4", ".gif", ".avi", ".mov", ".webm", ".mkv")
+        raise UsageError(f"--out {args.out}: the HTML replay is written to a .html (or .htm) file"
+                         + ("; for a movie use --movie" if movie else ""))
     out = writable_file(args.out) if args.out else None  # before simulating: fail fast
     if args.movie:
         from .movie import check_movie_path
@@ -130,6 +153,8 @@ def add_subcommand(subparsers) -> None:
                    help=f"port on 127.0.0.1 (default {DEFAULT_PORT}; a free one if taken; 0 = any free one)")
     v.add_argument("--keep-running", action="store_true",
                    help="keep serving after the last page closes (default: stop a few seconds after)")
+    v.add_argument("--quiet", action="store_true",
+                   help="print only the address to open (on stdout) and errors")
     v.set_defaults(func=cmd_view)
 
     r = subparsers.add_parser(
@@ -143,4 +168,5 @@ def add_subcommand(subparsers) -> None:
     r.add_argument("--steps", type=at_least(1), help="steps to record (default: the file's)")
     r.add_argument("--every", type=at_least(1), metavar="K",
                    help="keep a frame every K steps (default: about 1500 frames in all)")
+    r.add_argument("--quiet", action="store_true", help="print nothing but errors")
     r.set_defaults(func=cmd_replay)

@@ -13,6 +13,12 @@ frames instead of a growing backlog, and pause stays instant.  Stepping runs in 
 Stopping: Ctrl-C or SIGTERM stop it, closing every page's socket first; so does closing the last page
 (after ``idle_grace`` seconds without a new one, so a reload does not stop it) unless
 ``keep_running``.  It binds 127.0.0.1 only: from another machine, forward the port (docs/viewer.md).
+
+Other web pages: a request whose ``Host`` is not a loopback name (``localhost``, ``127.0.0.1``, ``[::1]``,
+any port, so forwarded ports work) or the address it was started on is refused (403), so a page that
+re-binds its own domain name to 127.0.0.1 (DNS rebinding) cannot read it; and a WebSocket whose
+``Origin`` is not the viewer's own page (``http://`` + the request's ``Host``) is refused, so another
+site open in the browser cannot drive it.  Clients that send no ``Origin`` (scripts, not browsers) are let in.
 """
 from __future__ import annotations
 
@@ -52,6 +58,31 @@ class ServerState:
 
 
 STATE = web.AppKey("infomarket_viewer", ServerState)
+HOSTS = web.AppKey("infomarket_viewer_hosts", frozenset)
+
+#: Host names the viewer answers to wherever it was started (it binds loopback only).
+LOOPBACK = frozenset({"localhost", "127.0.0.1", "[::1]", "::1"})
+
+
+def _host_name(host: str) -> str:
+    """``localhost`` from ``localhost:8765``, ``[::1]`` from ``[::1]:8765``; lower case."""
+    host = host.strip().lower()
+    if host.startswith("["):
+        return host[:host.find("]") + 1] if "]" in host else host
+    return host.rsplit(":", 1)[0] if host.count(":") == 1 else host
+
+
+@web.middleware
+async def _same_origin_only(request: web.Request, handler):
+    """Refuse requests that another site could have made through the user's browser (module docstring)."""
+    host = request.headers.get("Host", "")
+    if _host_name(host) not in request.app[HOSTS]:
+        return web.Response(status=403, text="infomarket viewer: this address is not the viewer's own "
+                                             "(open it as http://localhost:PORT/)\n")
+    origin = request.headers.get("Origin")
+    if request.path == "/ws" and origin is not None and origin.lower() != f"http://{host.strip().lower()}":
+        return web.Response(status=403, text="infomarket viewer: WebSocket from another site refused\n")
+    return await handler(request)
 
 
 class _Connection:
@@ -197,10 +228,12 @@ async def _close_sockets(app: web.Application) -> None:
 
 
 def create_app(config: Experiment, seed: int | None = None, *, fps: float = DEFAULT_FPS,
-               idle_grace: float | None = None) -> web.Application:
-    """The viewer as an aiohttp application (tests serve it with aiohttp's test server)."""
-    app = web.Application()
+               idle_grace: float | None = None, host: str = "127.0.0.1") -> web.Application:
+    """The viewer as an aiohttp application (tests serve it with aiohttp's test server).  ``host``, the
+    address it is served on, is a ``Host`` it answers to besides the loopback names."""
+    app = web.Application(middlewares=[_same_origin_only])
     app[STATE] = ServerState(config, seed, fps, idle_grace)
+    app[HOSTS] = LOOPBACK | {_host_name(host), _host_name(f"[{host}]") if ":" in host else host.lower()}
     app.router.add_get("/", _page)
     app.router.add_get("/api/info", _info)
     app.router.add_get("/ws", _websocket)
@@ -228,9 +261,12 @@ def bind(host: str, port: int) -> tuple[socket.socket, bool]:
 
 async def serve(config: Experiment, seed: int | None = None, *, port: int = DEFAULT_PORT,
                 host: str = "127.0.0.1", keep_running: bool = False, idle_grace: float = 5.0,
-                fps: float = DEFAULT_FPS, say: Callable[[str], None] = print) -> None:
-    """Serve until Ctrl-C, SIGTERM, or (unless ``keep_running``) the last page closes."""
-    app = create_app(config, seed, fps=fps, idle_grace=None if keep_running else idle_grace)
+                fps: float = DEFAULT_FPS, say: Callable[[str], None] = print,
+                announce: Callable[[str], None] | None = None) -> None:
+    """Serve until Ctrl-C, SIGTERM, or (unless ``keep_running``) the last page closes.  ``say`` tells what
+    happens; ``announce`` (default: ``say``) gets the one line with the address to open."""
+    announce = announce or say
+    app = create_app(config, seed, fps=fps, idle_grace=None if keep_running else idle_grace, host=host)
     st = app[STATE]
     st.stop = asyncio.Event()
     st.on_idle = lambda: say("the last page was closed; stopping (--keep-running keeps serving)")
@@ -245,7 +281,7 @@ async def serve(config: Experiment, seed: int | None = None, *, port: int = DEFA
     await runner.setup()
     try:
         await web.SockSite(runner, sock).start()
-        say(f"infomarket viewer: {config.name}, {config.swarm.robots} robots; open http://{host}:{actual}/")
+        announce(f"infomarket viewer: {config.name}, {config.swarm.robots} robots; open http://{host}:{actual}/")
         say("press Ctrl-C to stop")
         await st.stop.wait()
     finally:
