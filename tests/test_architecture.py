@@ -104,7 +104,7 @@ def test_the_ledger_and_config_do_not_import_the_engine():
 
 
 STEP_PIECES = ("find_neighbours", "begin_communication", "install_table", "forage", "sense_sites",
-               "behaviour_step", "move", "record_history")
+               "behaviour_step", "move", "record_history")  # (those of a variant are defined in engine.step.variant)
 
 
 def test_each_step_piece_is_defined_once():

@@ -5,7 +5,11 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from infomarket.engine import step as K
+from infomarket.engine import step
+from infomarket.engine.step import variant
+
+K = step
+P = variant(terrain=False, paths=False)  # the paper's plane
 from infomarket.engine.params import cauchy_cdf, guide_table, levy_cdf
 from infomarket.engine.neighbours import find_all_neighbours as find_neighbours
 from infomarket.engine.world import EXPLORING, FOOD, NEST, SEEKING_FOOD, headings
@@ -29,7 +33,7 @@ def test_wall_sensors_and_reflection_use_the_reflected_move():
     h.place(0, 1200 - 8 - 1.0, 300, 0.0)  # facing the right wall, one unit away
     w.levy[0] = 50  # no turn this step: intended move is (v, 0)
     w.tab_vec[0, FOOD] = (-100.0, 0.0)  # some entry to check the odometry update with
-    dx, dy = K.behaviour_step(h.view, 0, h.rng, False, False)
+    dx, dy = P.behaviour_step(h.view, 0, h.rng)
     assert (dx, dy) == (-2.5, 0.0)  # FRONT wall: x component negated
     # table updated with the reflected move: (-100 - (-2.5), 0) turned by -180 degrees
     assert w.tab_vec[0, FOOD, 0] == pytest.approx(97.5)
@@ -37,7 +41,7 @@ def test_wall_sensors_and_reflection_use_the_reflected_move():
     assert w.tab_age[0, FOOD] == 1
     # the robot moves by the reflected vector: with no odometry noise, exactly 2.5 away from the wall
     w.bias[0] = 0.0
-    K.move(h.view, 0, dx, dy, np.random.default_rng(1), False)
+    P.move(h.view, 0, dx, dy, np.random.default_rng(1))
     assert w.pos[0] == pytest.approx([1200 - 8 - 1.0 - 2.5, 300.0], abs=1e-12)
     assert headings(w)[0] == pytest.approx(180.0, abs=1e-12)
 
@@ -51,7 +55,7 @@ def test_sensing_a_site_sets_the_exact_target_in_the_robot_frame():
     h = Handle(make_config(1))
     w = h.world
     h.place(0, 210, 300, 90.0)  # inside food, facing +y
-    K.sense_sites(h.view, 0, False)
+    P.sense_sites(h.view, 0)
     assert w.tab_valid[0, FOOD] and w.tab_age[0, FOOD] == 0
     # the centre is at (-10, 0) in the world: in a frame whose x axis is +y that is (0, +10)
     assert w.tab_vec[0, FOOD] == pytest.approx([0.0, 10.0], abs=1e-12)
@@ -63,19 +67,19 @@ def test_spot_pick_up_and_deposit():
     h = Handle(make_config(1))
     w, view = h.world, h.view
     h.place(0, 200, 300, 0.0)
-    assert not K.forage(view, 0, h.rng, False)
+    assert not P.forage(view, 0, h.rng)
     assert w.has_spot[0, FOOD] and not w.carrying[0]
     sx, sy = w.spot[0, FOOD]
     assert math.hypot(sx - 200, sy - 300) < 50
     w.pos[0] = (sx + 7.9, sy)  # within r = 8 of the spot: picks up, spot removed
-    assert not K.forage(view, 0, h.rng, False)
+    assert not P.forage(view, 0, h.rng)
     assert w.carrying[0] and not w.has_spot[0, FOOD]
     h.place(0, 1000, 300, 0.0)
-    assert not K.forage(view, 0, h.rng, False)  # nest spot drawn
+    assert not P.forage(view, 0, h.rng)  # nest spot drawn
     assert w.has_spot[0, NEST]
     w.pos[0] = w.spot[0, NEST]
     w.clock[0] = 1
-    assert K.forage(view, 0, h.rng, False)  # deposit
+    assert P.forage(view, 0, h.rng)  # deposit
     assert not w.carrying[0] and w.items[0] == 1 and not w.has_spot[0, NEST]
 
 
@@ -87,7 +91,7 @@ def test_deposit_in_transitory_period_pays_but_does_not_count():
     w.spot[0, NEST] = (1000, 300)
     h.place(0, 1000, 300, 0.0)
     w.clock[0] = 9  # the last step of the transitory period (the step equal to it counts in the original)
-    assert K.forage(h.view, 0, h.rng, False)
+    assert P.forage(h.view, 0, h.rng)
     assert w.items[0] == 0
 
 

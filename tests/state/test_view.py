@@ -6,7 +6,11 @@ import re
 import numba
 from numba import njit
 
-from infomarket.engine.step import begin_communication, behaviour_step, find_neighbours, forage, install_table, move
+from infomarket.engine.step import variant
+
+STEP = variant(terrain=False, paths=False)
+find_neighbours, begin_communication, install_table, forage, behaviour_step, move = (
+    STEP.find_neighbours, STEP.begin_communication, STEP.install_table, STEP.forage, STEP.behaviour_step, STEP.move)
 from infomarket.state.view import BorrowedArray, GuardedArray, WorldType, layout_type
 
 from ..conftest import Handle, make_config
@@ -17,13 +21,13 @@ def _steps(w, rng, k):
     """The engine's per-robot pieces, inlined as the step loop inlines them (with the bit generator)."""
     bits = rng.bit_generator
     for _ in range(k):
-        find_neighbours(w, False)
-        begin_communication(w, False)
+        find_neighbours(w)
+        begin_communication(w)
         for i in range(w.pos.shape[0]):
-            forage(w, i, bits, False)
-            install_table(w, i, False)
-            dx, dy = behaviour_step(w, i, bits, False, False)
-            move(w, i, dx, dy, bits, False)
+            forage(w, i, bits)
+            install_table(w, i)
+            dx, dy = behaviour_step(w, i, bits)
+            move(w, i, dx, dy, bits)
             w.items[i] += 1
 
 

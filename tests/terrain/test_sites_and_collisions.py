@@ -20,7 +20,7 @@ def test_line_of_sight_drops_neighbours_behind_a_wall(line_of_sight, wall, expec
     sim = simulation(terrain_config(robots=2, obstacles=[wall], line_of_sight=line_of_sight))
     place(sim, 0, 100.0, 300.0, 0.0)
     place(sim, 1, 140.0, 300.0, 0.0)
-    sim._kernel.find_neighbours(sim._view, sim._kernel.TERRAIN)
+    sim._kernel.find_neighbours(sim._view)
     assert sim.world.nbr_count.tolist() == [expected, expected]
 
 

@@ -2,8 +2,8 @@
 the step options (``TERRAIN``, ``PATHS``), this source, and the three dispatch functions for the
 configured rules (below, declared and left to the generator), so each rule call is a direct, inlinable
 call and the whole kernel is cached on disk.  Every step piece it calls is in ``engine.step``, written
-once; ``TERRAIN`` and ``PATHS`` are constants of the generated module, so the variants a kernel does not
-use are folded away.
+once; ``engine.step.variant(TERRAIN, PATHS)`` gives them compiled for this kernel's options, so the code of
+a variant the kernel does not use is pruned before numba types it.
 
 Order of operations per step (docs/model.md §3): neighbours; communication (offers from start-of-step
 tables, then every robot buys in id order); move (foraging and payment, install the new table,
@@ -16,8 +16,7 @@ with the step not begun, the host grows the arrays (``build.make_room``) and cal
 import numpy as np
 from numba import njit
 
-from infomarket.engine.step import (begin_communication, behaviour_step, find_neighbours, forage, install_table,
-                                    move, record_history)
+from infomarket.engine.step import record_history, variant
 from infomarket.ledger.kernels import burn_fuel, distribute, expire_stakes, reserve, settlement
 from infomarket.state.view import unlock
 
@@ -30,6 +29,9 @@ NEED_ROOM = 1
 #: buy_dispatch(kind, w, i, nbrs, rng): robot i buys from its neighbours
 #: pay_dispatch(w, buyer, sellers, sites, directions, weights, rng): the scheme's weights
 sell_dispatch = buy_dispatch = pay_dispatch = None
+
+#: This kernel's step pieces (engine.step.variant), chosen by its options before anything compiles.
+find_neighbours, begin_communication, install_table, forage, sense_sites, behaviour_step, move = variant(TERRAIN, PATHS)
 
 
 @njit(cache=True)
@@ -81,14 +83,14 @@ def run_steps(w, rng, t_end):
     fuel = w.fuel_cost
     bits = rng.bit_generator  # the engine's own draws (engine.draws); rules get the Generator
     while clock[0] < t_end:
-        find_neighbours(w, TERRAIN)
+        find_neighbours(w)
         if not has_room(w):
             return NEED_ROOM
         clock[0] += 1
         if w.stake_expiry > 0:
             for i in range(n):
                 expire_stakes(w, i)
-        begin_communication(w, PATHS)
+        begin_communication(w)
         for i in range(n):
             for site in range(2):
                 if cool[i] == 0:
@@ -103,9 +105,9 @@ def run_steps(w, rng, t_end):
             if cool[i] == 0:
                 buy_dispatch(kind[i], w, i, nbr[i, :nbr_count[i]], rng)
         for i in range(n):
-            if forage(w, i, bits, TERRAIN):
+            if forage(w, i, bits):
                 settle(w, i, rng)
-            install_table(w, i, PATHS)
+            install_table(w, i)
             if stop[i] > 0:
                 stop[i] -= 1
             elif fuel > 0.0 and balance[i] < fuel:
@@ -113,8 +115,8 @@ def run_steps(w, rng, t_end):
             else:
                 if fuel > 0.0:
                     burn_fuel(w, i)
-                dx, dy = behaviour_step(w, i, bits, TERRAIN, PATHS)
-                move(w, i, dx, dy, bits, TERRAIN)
+                dx, dy = behaviour_step(w, i, bits)
+                move(w, i, dx, dy, bits)
             if cool[i] > 0:
                 cool[i] -= 1
         record_history(w)

@@ -1,9 +1,9 @@
 """The pieces of one time step, each written once (docs/model.md §2-3, §6), with its variants explicit.
 
 The step loop (``engine/loop_template.py``, specialised per set of rules by ``engine.specialise``) calls
-these in the order of docs/model.md §3.  Two compile-time options select the variants, passed as
-arguments that are constants in each generated kernel (LLVM folds the branches away, so a kernel never
-pays for a variant it does not use):
+these in the order of docs/model.md §3.  Two compile-time options select the variants: ``variant(terrain,
+paths)`` returns the pieces compiled with those options as constants, so numba prunes the branches they
+turn off before it types them (a kernel neither compiles nor runs a variant it does not use):
 
 ``terrain``  obstacles, several sites of a kind, line of sight, collisions, robots sensing each other
              (``engine.terrain`` has the rules and their helpers).  Off on the paper's plane, where there
@@ -13,7 +13,9 @@ pays for a variant it does not use):
 
 Nothing here depends on the configured rules; the loop's generated dispatch calls the rules.
 """
+import functools
 import math
+from typing import Callable, NamedTuple
 
 from numba import njit
 
@@ -27,116 +29,7 @@ from .swarm import EXPLORING, SEEKING_FOOD, SEEKING_NEST
 from .terrain import blocked, containing_site, drop_hidden_pairs, obstructed
 
 
-# ---- neighbours and the communication phase ----------------------------------------------------------
-
-@njit
-def find_neighbours(w, terrain):
-    """Every pair strictly closer than the communication range (``engine.neighbours``); with terrain and
-    line of sight, pairs whose straight line an obstacle cuts are dropped."""
-    find_all_neighbours(w)
-    if terrain:
-        drop_hidden_pairs(w)
-
-
-@njit
-def begin_communication(w, paths):
-    """Start-of-phase copy: purchases go to the new table (and path); sellers keep selling the old one."""
-    tab_vec, new_vec, tab_age, new_age, tab_valid, new_valid = (w.tab_vec, w.new_vec, w.tab_age, w.new_age,
-                                                                w.tab_valid, w.new_valid)
-    for i in range(tab_age.shape[0]):  # arrays read once, outside the loop
-        for s in range(2):
-            new_vec[i, s, 0] = tab_vec[i, s, 0]
-            new_vec[i, s, 1] = tab_vec[i, s, 1]
-            new_age[i, s] = tab_age[i, s]
-            new_valid[i, s] = tab_valid[i, s]
-    if paths:
-        begin_paths(w)
-
-
-@njit(inline="always")
-def install_table(w, i, paths):
-    """The robot moves: what it bought becomes its table (and path)."""
-    for s in range(2):
-        w.tab_vec[i, s, 0] = w.new_vec[i, s, 0]
-        w.tab_vec[i, s, 1] = w.new_vec[i, s, 1]
-        w.tab_age[i, s] = w.new_age[i, s]
-        w.tab_valid[i, s] = w.new_valid[i, s]
-    if paths:
-        install_path(w, i)
-
-
-# ---- sites -------------------------------------------------------------------------------------------
-
-@njit(inline="always")
-def site_of(w, x, y, kind, terrain):
-    """The site of ``kind`` that (x, y) lies strictly inside (the first in file order), else -1."""
-    if terrain:
-        return containing_site(w, x, y, kind)
-    if within(x, y, w.sites_xy[kind, 0], w.sites_xy[kind, 1], w.sites_r[kind]):
-        return kind
-    return -1
-
-
-@njit(inline="always")
-def forage(w, i, rng, terrain):
-    """Pick-up and drop spots (docs/model.md §6), at whichever site of the needed kind the robot is in.
-    Returns True when robot i deposits an item this step (the caller then pays and shares the reward)."""
-    x = w.pos[i, 0]
-    y = w.pos[i, 1]
-    kind = NEST if w.carrying[i] else FOOD
-    if terrain:
-        s = containing_site(w, x, y, kind)
-        fresh = s >= 0 and not (w.has_spot[i, kind] and w.spot_site[i, kind] == s)
-    else:
-        s = kind
-        fresh = not w.has_spot[i, kind] and within(x, y, w.sites_xy[s, 0], w.sites_xy[s, 1], w.sites_r[s])
-    if fresh:  # a spot uniform in the site's disc
-        a = uniform(rng) * 2.0 * math.pi
-        r = w.sites_r[s] * math.sqrt(uniform(rng))
-        w.spot[i, kind, 0] = w.sites_xy[s, 0] + r * math.cos(a)
-        w.spot[i, kind, 1] = w.sites_xy[s, 1] + r * math.sin(a)
-        w.has_spot[i, kind] = True
-        w.spot_site[i, kind] = s
-    if not (w.has_spot[i, kind] and within(x, y, w.spot[i, kind, 0], w.spot[i, kind, 1], w.radius)):
-        return False
-    w.has_spot[i, kind] = False
-    counted = w.clock[0] >= w.transitory  # from step == transitory on, as the original counts
-    if terrain and counted:
-        unlock(w.site_items)[w.spot_site[i, kind]] += 1
-    if kind == FOOD:
-        w.carrying[i] = True
-        return False
-    w.carrying[i] = False
-    if counted:
-        w.items[i] += 1
-    return True
-
-
-@njit(inline="always")
-def sense_sites(w, i, terrain):
-    """A robot inside a site knows exactly where its target point there is (its spot if the spot lies in
-    that site, else the centre); for each kind, the first site containing it sets that kind's entry."""
-    x = w.pos[i, 0]
-    y = w.pos[i, 1]
-    for k in range(2):
-        s = site_of(w, x, y, k, terrain)
-        if s < 0:
-            continue
-        if w.has_spot[i, k] and (not terrain or w.spot_site[i, k] == s):
-            tx = w.spot[i, k, 0]
-            ty = w.spot[i, k, 1]
-        else:
-            tx = w.sites_xy[s, 0]
-            ty = w.sites_xy[s, 1]
-        vx, vy = to_frame(w, i, tx - x, ty - y)
-        w.tab_vec[i, k, 0] = vx
-        w.tab_vec[i, k, 1] = vy
-        w.tab_age[i, k] = 0
-        w.tab_valid[i, k] = True
-        w.last_site[i] = k
-
-
-# ---- the behaviour step ------------------------------------------------------------------------------
+# ---- the behaviour step's shared pieces ----------------------------------------------------------------
 
 @njit(inline="always")
 def walls(x, y, c, s, r, width, height):
@@ -145,20 +38,6 @@ def walls(x, y, c, s, r, width, height):
     (Scalar arguments: this runs for every robot every step.)"""
     return (outside(x + c, y + s, r, width, height), outside(x + s, y - c, r, width, height),
             outside(x - c, y - s, r, width, height), outside(x - s, y + c, r, width, height))
-
-
-@njit(inline="always")
-def sensors(w, i, terrain):
-    """FRONT, RIGHT, BACK, LEFT (docs/model.md §3); with terrain, obstacles (and, with sense_robots,
-    other robots) are sensed like the arena's walls."""
-    x = w.pos[i, 0]
-    y = w.pos[i, 1]
-    c = w.speed * w.hdir[i, 0]
-    s = w.speed * w.hdir[i, 1]
-    if terrain:
-        return (obstructed(w, i, x + c, y + s), obstructed(w, i, x + s, y - c), obstructed(w, i, x - c, y - s),
-                obstructed(w, i, x - s, y + c))
-    return walls(x, y, c, s, w.radius, w.width, w.height)
 
 
 @njit(inline="always")
@@ -247,57 +126,193 @@ def odometry_update(w, i, dx, dy):
             w.pend_age[i, k, j] += 1
 
 
-@njit(inline="always")
-def behaviour_step(w, i, rng, terrain, paths):
-    """Sensors, sites, state machine, intended movement with wall reflection, dead reckoning
-    (docs/model.md §3); with paths, a site sensed clears that kind's path and mark, the legs are followed,
-    a bump marks the site and waypoints are dead-reckoned.  Returns the reflected intended movement
-    (robot frame)."""
-    front, right, back, left = sensors(w, i, terrain)
-    sense_sites(w, i, terrain)
-    was_food = was_nest = False
-    if paths:
-        for k in range(2):
-            if containing_site(w, w.pos[i, 0], w.pos[i, 1], k) >= 0:
-                at_site(w, i, k)
-        advance(w, i)
-        was_food = w.tab_valid[i, FOOD]
-        was_nest = w.tab_valid[i, NEST]
-    update_state(w, i, front)
-    if paths:
-        bumped(w, i, front, was_food, was_nest)
-        drop_invalid(w, i)
-    dx, dy = intended_move(w, i, rng)
-    if (front and dx >= 0.0) or (back and dx <= 0.0):
-        dx = -dx
-    if (right and dy <= 0.0) or (left and dy >= 0.0):
-        dy = -dy
-    if dx != 0.0 or dy != 0.0:
-        odometry_update(w, i, dx, dy)
+class Step(NamedTuple):
+    """The step pieces of one variant, compiled for it (``variant``)."""
+
+    find_neighbours: Callable
+    begin_communication: Callable
+    install_table: Callable
+    forage: Callable
+    sense_sites: Callable
+    behaviour_step: Callable
+    move: Callable
+
+
+def variant(terrain: bool, paths: bool) -> Step:
+    """The step's pieces for these options, chosen before anything compiles.  ``terrain`` and ``paths``
+    are constants of the closures below, so numba prunes the branches they turn off before it types
+    them: a kernel neither compiles nor runs the code of a variant it does not use (passed as
+    arguments instead, every kernel typed and lowered all of it, and compiled 50-70 % slower)."""
+    return _variant(bool(terrain), bool(paths or False))
+
+
+@functools.cache
+def _variant(terrain: bool, paths: bool) -> Step:
+    # ---- neighbours and the communication phase
+    @njit
+    def find_neighbours(w):
+        """Every pair strictly closer than the communication range (``engine.neighbours``); with terrain and
+        line of sight, pairs whose straight line an obstacle cuts are dropped."""
+        find_all_neighbours(w)
+        if terrain:
+            drop_hidden_pairs(w)
+
+    @njit
+    def begin_communication(w):
+        """Start-of-phase copy: purchases go to the new table (and path); sellers keep selling the old one."""
+        tab_vec, new_vec, tab_age, new_age, tab_valid, new_valid = (w.tab_vec, w.new_vec, w.tab_age, w.new_age,
+                                                                    w.tab_valid, w.new_valid)
+        for i in range(tab_age.shape[0]):  # arrays read once, outside the loop
+            for s in range(2):
+                new_vec[i, s, 0] = tab_vec[i, s, 0]
+                new_vec[i, s, 1] = tab_vec[i, s, 1]
+                new_age[i, s] = tab_age[i, s]
+                new_valid[i, s] = tab_valid[i, s]
         if paths:
-            path_odometry(w, i, dx, dy)
-    return dx, dy
+            begin_paths(w)
 
+    @njit(inline="always")
+    def install_table(w, i):
+        """The robot moves: what it bought becomes its table (and path)."""
+        for s in range(2):
+            w.tab_vec[i, s, 0] = w.new_vec[i, s, 0]
+            w.tab_vec[i, s, 1] = w.new_vec[i, s, 1]
+            w.tab_age[i, s] = w.new_age[i, s]
+            w.tab_valid[i, s] = w.new_valid[i, s]
+        if paths:
+            install_path(w, i)
 
-@njit(inline="always")
-def move(w, i, dx, dy, rng, terrain):
-    """Execute the movement with odometry noise: the robot turns by N(bias, noise_sd) more than it
-    thinks; its new heading is the direction it actually moved; positions are clamped to the arena.
-    With terrain, a move whose end point is blocked (``terrain.blocked``) is not made."""
-    if dx == 0.0 and dy == 0.0:
-        return
-    mx, my = to_world(w, i, dx, dy)
-    mx, my = rotate(mx, my, normal(rng, w.bias[i], w.noise_sd))
-    length = norm(mx, my)
-    w.hdir[i, 0] = mx / length
-    w.hdir[i, 1] = my / length
-    r = w.radius
-    x = min(max(w.pos[i, 0] + mx, r), w.width - r)
-    y = min(max(w.pos[i, 1] + my, r), w.height - r)
-    if terrain and blocked(w, i, x, y):
-        return
-    w.pos[i, 0] = x
-    w.pos[i, 1] = y
+    @njit(inline="always")
+    def site_of(w, x, y, kind):
+        """The site of ``kind`` that (x, y) lies strictly inside (the first in file order), else -1."""
+        if terrain:
+            return containing_site(w, x, y, kind)
+        if within(x, y, w.sites_xy[kind, 0], w.sites_xy[kind, 1], w.sites_r[kind]):
+            return kind
+        return -1
+
+    @njit(inline="always")
+    def forage(w, i, rng):
+        """Pick-up and drop spots (docs/model.md §6), at whichever site of the needed kind the robot is in.
+        Returns True when robot i deposits an item this step (the caller then pays and shares the reward)."""
+        x = w.pos[i, 0]
+        y = w.pos[i, 1]
+        kind = NEST if w.carrying[i] else FOOD
+        if terrain:
+            s = containing_site(w, x, y, kind)
+            fresh = s >= 0 and not (w.has_spot[i, kind] and w.spot_site[i, kind] == s)
+        else:
+            s = kind
+            fresh = not w.has_spot[i, kind] and within(x, y, w.sites_xy[s, 0], w.sites_xy[s, 1], w.sites_r[s])
+        if fresh:  # a spot uniform in the site's disc
+            a = uniform(rng) * 2.0 * math.pi
+            r = w.sites_r[s] * math.sqrt(uniform(rng))
+            w.spot[i, kind, 0] = w.sites_xy[s, 0] + r * math.cos(a)
+            w.spot[i, kind, 1] = w.sites_xy[s, 1] + r * math.sin(a)
+            w.has_spot[i, kind] = True
+            w.spot_site[i, kind] = s
+        if not (w.has_spot[i, kind] and within(x, y, w.spot[i, kind, 0], w.spot[i, kind, 1], w.radius)):
+            return False
+        w.has_spot[i, kind] = False
+        counted = w.clock[0] >= w.transitory  # from step == transitory on, as the original counts
+        if terrain and counted:
+            unlock(w.site_items)[w.spot_site[i, kind]] += 1
+        if kind == FOOD:
+            w.carrying[i] = True
+            return False
+        w.carrying[i] = False
+        if counted:
+            w.items[i] += 1
+        return True
+
+    @njit(inline="always")
+    def sense_sites(w, i):
+        """A robot inside a site knows exactly where its target point there is (its spot if the spot lies in
+        that site, else the centre); for each kind, the first site containing it sets that kind's entry."""
+        x = w.pos[i, 0]
+        y = w.pos[i, 1]
+        for k in range(2):
+            s = site_of(w, x, y, k)
+            if s < 0:
+                continue
+            if w.has_spot[i, k] and (not terrain or w.spot_site[i, k] == s):
+                tx = w.spot[i, k, 0]
+                ty = w.spot[i, k, 1]
+            else:
+                tx = w.sites_xy[s, 0]
+                ty = w.sites_xy[s, 1]
+            vx, vy = to_frame(w, i, tx - x, ty - y)
+            w.tab_vec[i, k, 0] = vx
+            w.tab_vec[i, k, 1] = vy
+            w.tab_age[i, k] = 0
+            w.tab_valid[i, k] = True
+            w.last_site[i] = k
+
+    @njit(inline="always")
+    def sensors(w, i):
+        """FRONT, RIGHT, BACK, LEFT (docs/model.md §3); with terrain, obstacles (and, with sense_robots,
+        other robots) are sensed like the arena's walls."""
+        x = w.pos[i, 0]
+        y = w.pos[i, 1]
+        c = w.speed * w.hdir[i, 0]
+        s = w.speed * w.hdir[i, 1]
+        if terrain:
+            return (obstructed(w, i, x + c, y + s), obstructed(w, i, x + s, y - c), obstructed(w, i, x - c, y - s),
+                    obstructed(w, i, x - s, y + c))
+        return walls(x, y, c, s, w.radius, w.width, w.height)
+
+    @njit(inline="always")
+    def behaviour_step(w, i, rng):
+        """Sensors, sites, state machine, intended movement with wall reflection, dead reckoning
+        (docs/model.md §3); with paths, a site sensed clears that kind's path and mark, the legs are followed,
+        a bump marks the site and waypoints are dead-reckoned.  Returns the reflected intended movement
+        (robot frame)."""
+        front, right, back, left = sensors(w, i)
+        sense_sites(w, i)
+        was_food = was_nest = False
+        if paths:
+            for k in range(2):
+                if containing_site(w, w.pos[i, 0], w.pos[i, 1], k) >= 0:
+                    at_site(w, i, k)
+            advance(w, i)
+            was_food = w.tab_valid[i, FOOD]
+            was_nest = w.tab_valid[i, NEST]
+        update_state(w, i, front)
+        if paths:
+            bumped(w, i, front, was_food, was_nest)
+            drop_invalid(w, i)
+        dx, dy = intended_move(w, i, rng)
+        if (front and dx >= 0.0) or (back and dx <= 0.0):
+            dx = -dx
+        if (right and dy <= 0.0) or (left and dy >= 0.0):
+            dy = -dy
+        if dx != 0.0 or dy != 0.0:
+            odometry_update(w, i, dx, dy)
+            if paths:
+                path_odometry(w, i, dx, dy)
+        return dx, dy
+
+    @njit(inline="always")
+    def move(w, i, dx, dy, rng):
+        """Execute the movement with odometry noise: the robot turns by N(bias, noise_sd) more than it
+        thinks; its new heading is the direction it actually moved; positions are clamped to the arena.
+        With terrain, a move whose end point is blocked (``terrain.blocked``) is not made."""
+        if dx == 0.0 and dy == 0.0:
+            return
+        mx, my = to_world(w, i, dx, dy)
+        mx, my = rotate(mx, my, normal(rng, w.bias[i], w.noise_sd))
+        length = norm(mx, my)
+        w.hdir[i, 0] = mx / length
+        w.hdir[i, 1] = my / length
+        r = w.radius
+        x = min(max(w.pos[i, 0] + mx, r), w.width - r)
+        y = min(max(w.pos[i, 1] + my, r), w.height - r)
+        if terrain and blocked(w, i, x, y):
+            return
+        w.pos[i, 0] = x
+        w.pos[i, 1] = y
+
+    return Step(find_neighbours, begin_communication, install_table, forage, sense_sites, behaviour_step, move)
 
 
 # ---- the log -----------------------------------------------------------------------------------------
