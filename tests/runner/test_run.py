@@ -101,9 +101,12 @@ def test_a_second_run_into_the_same_folder_exits_2_and_writes_nothing(tmp_path):
     assert first.poll() is None, "the first run should still be running"
     err = _interrupt(first)
     assert "kept the" in err or "nothing kept" in err
-    runs = Store(out).runs()
-    assert not runs.duplicated(["experiment", "condition", "run"]).any() and set(runs.experiment) <= {"fig2B"}
-    assert set(runs.run) <= set(range(400))
+    runs = Store(out).runs()  # empty (no columns) when Ctrl-C came before the first commit, e.g. while compiling
+    if len(runs):
+        assert not runs.duplicated(["experiment", "condition", "run"]).any() and set(runs.experiment) <= {"fig2B"}
+        assert set(runs.run) <= set(range(400))
+    else:
+        assert "nothing kept" in err
     assert main(["store", "verify", str(out)]) == 0
 
 
