@@ -70,16 +70,9 @@ def _behaviour_bounds_checked(name: str, cfg, seed: int, steps: int) -> None:
                 try:
                     checked(view, *args, *extra)
                 except (IndexError, ZeroDivisionError) as exc:
-                    filename, first = _rule_where(py)
-                    line = None
-                    try:
-                        py(w, *args, *extra)  # plain Python on the world's arrays: names the line
-                    except Exception as plain:  # noqa: BLE001  (only to locate the line)
-                        line = _failing_line(plain, filename)
-                    at = f"{filename}:{line}" if line else f"{filename}:{first} (the function)"
-                    what = "indexes an array out of bounds" if isinstance(exc, IndexError) else "divides by zero"
-                    raise CheckFailed(f"behaviour {name!r}: its {role} rule {py.__name__} {what} "
-                                      f"({type(exc).__name__}: {exc}) at {at}") from None
+                    # plain Python on the world's arrays names the line
+                    raise CheckFailed(f"behaviour {name!r}: its {role} rule "
+                                      + _located(exc, py, lambda: py(w, *args, *extra))) from None
 
 
 def check_behaviour(name: str, *, robots: int = 10, steps: int = 3000, seed: int = 0) -> None:
@@ -109,6 +102,28 @@ def _failing_line(exc: BaseException, filename: str) -> int | None:
     return lines[-1] if lines else None
 
 
+def _located(exc: BaseException, py, plain_call) -> str:
+    """``NAME indexes an array out of bounds (...) at FILE:LINE`` for an error of the bounds-checked rule
+    ``py``: numba's message names no line, so ``plain_call`` repeats the failing call in plain Python."""
+    filename, first = _rule_where(py)
+    line = None
+    try:
+        plain_call()
+    except Exception as plain:  # noqa: BLE001  (only to locate the line)
+        line = _failing_line(plain, filename)
+    at = f"{filename}:{line}" if line else f"{filename}:{first} (the function)"
+    what = "indexes an array out of bounds" if isinstance(exc, IndexError) else "divides by zero"
+    return f"{py.__name__} {what} ({type(exc).__name__}: {exc}) at {at}"
+
+
+def _replay(ledger: Ledger, events: list) -> None:
+    for ev in events:
+        if ev.kind == "deposit":
+            ledger.deposit(ev.buyer)
+        else:
+            ledger.purchase(ev.buyer, ev.seller, ev.site, ev.direction_deg)
+
+
 def _bounds_checked(name: str, events: list, robots: int, stake: float) -> None:
     """Replay ``events`` through scheme ``name`` with its weight rule compiled with numba's bounds checking
     (an index out of range raises instead of writing past the array), then, should it raise, through the
@@ -116,36 +131,21 @@ def _bounds_checked(name: str, events: list, robots: int, stake: float) -> None:
     spec = get_payment(name)
     rule = spec.weights
     py = rule.py_func
-    filename, first = _rule_where(py)
     try:
         checked = numba.njit(boundscheck=True)(py)
     except Exception:  # not a compilable function: the ordinary replay reports it
         return
-    ledger = Ledger(robots, scheme=name, stake=stake)
-    ledger.scheme = dataclasses.replace(spec, weights=dataclasses.replace(rule, func=checked))
+
+    def ledger_with(func) -> Ledger:
+        ledger = Ledger(robots, scheme=name, stake=stake)
+        ledger.scheme = dataclasses.replace(spec, weights=dataclasses.replace(rule, func=func))
+        return ledger
+
     try:
-        for ev in events:
-            if ev.kind == "deposit":
-                ledger.deposit(ev.buyer)
-            else:
-                ledger.purchase(ev.buyer, ev.seller, ev.site, ev.direction_deg)
+        _replay(ledger_with(checked), events)
     except (IndexError, ZeroDivisionError) as exc:
-        line = None
-        ledger.scheme = dataclasses.replace(spec, weights=dataclasses.replace(rule, func=py))
-        try:  # the same call in plain Python names the line (numba's message does not)
-            replay_plain = Ledger(robots, scheme=name, stake=stake)
-            replay_plain.scheme = ledger.scheme
-            for ev in events:
-                if ev.kind == "deposit":
-                    replay_plain.deposit(ev.buyer)
-                else:
-                    replay_plain.purchase(ev.buyer, ev.seller, ev.site, ev.direction_deg)
-        except Exception as plain:  # noqa: BLE001  (only to locate the line)
-            line = _failing_line(plain, filename)
-        at = f"{filename}:{line}" if line else f"{filename}:{first} (the function)"
-        kind = "indexes an array out of bounds" if isinstance(exc, IndexError) else "divides by zero"
-        raise CheckFailed(f"payment scheme {name!r}: its rule {py.__name__} {kind} ({type(exc).__name__}: {exc}) "
-                          f"at {at}") from None
+        raise CheckFailed(f"payment scheme {name!r}: its rule "
+                          + _located(exc, py, lambda: _replay(ledger_with(py), events))) from None
 
 
 def check_payment(name: str, *, robots: int = 6, sequences: int = 30, seed: int = 0) -> None:

@@ -143,7 +143,7 @@ def variant(terrain: bool, paths: bool) -> Step:
     are constants of the closures below, so numba prunes the branches they turn off before it types
     them: a kernel neither compiles nor runs the code of a variant it does not use (passed as
     arguments instead, every kernel typed and lowered all of it, and compiled 50-70 % slower)."""
-    return _variant(bool(terrain), bool(paths or False))
+    return _variant(bool(terrain), bool(paths))
 
 
 @functools.cache
