@@ -22,6 +22,7 @@ from ..config.load import load_experiment
 from ..errors import ArgumentError, ConfigError, InputTypeError, SimulationError
 from ..registry import behaviours
 from . import specialise
+from ..generated import ctrl_c_survives_compiling
 from ..seeds import MAX_SEED
 from ..state.flags import ErrorFlags
 from .build import build_world, make_room
@@ -70,7 +71,7 @@ class Simulation:
         self.world, self.behaviour_names = build_world(config, self.rng, record_events=record_events,
                                                        history_every=hist)
         t0 = time.perf_counter()
-        with compile_notice(self.kinds, config.payment.scheme):
+        with compile_notice(self.kinds, config.payment.scheme), ctrl_c_survives_compiling():
             self._kernel = specialise.kernel_module(self.kinds, config.payment.scheme, config.terrain)
             self._view = kernel_view(self.world)
             self._kernel.run_steps(self._view, self.rng, 0)  # compile or load from cache; runs no step
