@@ -207,7 +207,7 @@ def fig6(robots: pd.DataFrame, history: pd.DataFrame | None = None) -> Figure:
         n = run_count(rows)
         _panel_title(ax, name[-1], f"{n} run{'s' if n != 1 else ''}, {c.n} honest robots")
         ax.set_xlabel(f"|odometry drift| (deg/step)\n{composition(rows)}\nPearson r = {c.r:.2f}, 95 % CI "
-                      f"[{c.low:.2f}, {c.high:.2f}], n = {c.n} robots, {when}", fontsize=8)
+                      f"[{c.low:.2f}, {c.high:.2f}]\nn = {c.n} robots, {when}", fontsize=8)
     axes[0].set_ylabel("wealth share (%), honest robots")
     fig.suptitle("Fig. 6: odometry drift vs wealth share", fontsize=11)
     return fig
