@@ -279,9 +279,17 @@ def question_table(source, questions: dict[str, Question] | None = None) -> pd.D
                 a = ANSWERS[qid](runs, q.params)
             except MissingDataError as exc:
                 a = Answer(NO_DATA, str(exc))
+        note = st.N_TOO_SMALL if a.answer == INCONCLUSIVE and st.too_few_runs(a.comparisons) else ""
         rows.append([qid, q.question, q.rule, a.answer, a.statistics,
-                     status_of(locks, "tolerances.toml", f"questions.{qid}")])
-    return pd.DataFrame(rows, columns=["id", "question", "rule", "answer", "statistics", "declared"])
+                     status_of(locks, "tolerances.toml", f"questions.{qid}"), note])
+    return pd.DataFrame(rows, columns=["id", "question", "rule", "answer", "statistics", "declared", "note"])
+
+
+def _shown(table: pd.DataFrame) -> pd.DataFrame:
+    """The table as printed: each answer with its note (``inconclusive (n too small)``)."""
+    out = table.copy()
+    out["answer"] = [st.shown(a, n) for a, n in zip(table["answer"], table["note"])]
+    return out
 
 
 # ------------------------------------------------------------------------------------------- figures
@@ -366,8 +374,9 @@ def section(frames: Frames, out: Path, vector: str, echo: Callable[[str], None])
             echo(f"{name}: skipped ({exc})")
     table = question_table(frames)
     counts = table["answer"].value_counts()
+    small = int((table["note"] == st.N_TOO_SMALL).sum())
     echo(f"open questions: {counts.get(YES, 0)} yes, {counts.get(NO, 0)} no, {counts.get(INCONCLUSIVE, 0)} "
-         f"inconclusive, {counts.get(NO_DATA, 0)} no data")
+         f"inconclusive{f' ({small} with n too small to reach alpha)' if small else ''}, {counts.get(NO_DATA, 0)} no data")
     lock = summary(check(frames.meta.get("declarations") if frames.meta else None), "tolerances.toml", "questions.")
     return Section(figs, table, lock)
 
@@ -389,7 +398,7 @@ def to_markdown(s: Section, md_table: Callable[[pd.DataFrame], str]) -> list[str
         md += [f"![{name}]({files[0].name})", "", f"Vector: [{files[1].name}]({files[1].name})"] if files \
             else [f"*Skipped: {note}.*"]
         md.append("")
-    md += ["### Answers", "", f"Declarations: {s.lock}.", "", md_table(s.table[COLUMNS]), ""]
+    md += ["### Answers", "", f"Declarations: {s.lock}.", "", md_table(_shown(s.table)[COLUMNS]), ""]
     return md
 
 
@@ -404,5 +413,5 @@ def to_html(s: Section, html_table: Callable[[pd.DataFrame], str]) -> list[str]:
             parts.append(f"<p><a href='{e(files[1].name)}'><img src='{e(files[0].name)}' alt='{e(name)}'></a></p>")
         else:
             parts.append(f"<p class='note'>Skipped: {e(note)}.</p>")
-    parts += ["<h3>Answers</h3>", f"<p>Declarations: {e(s.lock)}.</p>", html_table(s.table[COLUMNS])]
+    parts += ["<h3>Answers</h3>", f"<p>Declarations: {e(s.lock)}.</p>", html_table(_shown(s.table)[COLUMNS])]
     return parts
