@@ -43,6 +43,11 @@ def problems(fig: Figure, pad: float = 1.0) -> list[str]:
             if t is not u and b.overlaps(c.padded(-pad)):
                 out.append(f"{t.get_text()!r} overlaps {u.get_text()!r}")
     for ax in fig.axes:
+        leg = ax.get_legend()
+        if leg is not None and leg.get_visible():
+            b = leg.get_window_extent(r).padded(-pad)
+            if any(a.get_visible() and a.get_window_extent(r).overlaps(b) for a in _data_artists(ax)):
+                out.append(f"the legend of {ax.get_title(loc='left')!r} hides part of the data")
         for t in ax.texts:
             if not t.get_visible() or not t.get_text().strip():
                 continue

@@ -229,6 +229,9 @@ def test_a_noisy_output_sits_on_a_floor_of_one_and_a_noiseless_one_on_zero(repli
     assert any(lab.startswith("seed-noise floor of S_T") for lab in labels)
     titles = [ax.get_title(loc="left") for ax in fig.axes]
     assert titles and all("x 2 runs = " in t for t in titles)
+    from .layout import problems
+
+    assert problems(fig) == []  # nothing cut or overlapping; no legend over a bar (one hid a bar before)
 
 
 def test_the_noise_floor_matches_a_hand_computation():

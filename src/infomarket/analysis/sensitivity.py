@@ -526,7 +526,7 @@ def _bars(s: Sensitivity):
     has_pawn = bool((t["index"] == "PAWN").any())
     outs = d.outputs
     ncols = 2 if has_pawn else 1
-    fig = Figure(figsize=(2.2 + 0.85 * len(d.names) * ncols, 3.0 * len(outs)), layout="constrained")
+    fig = Figure(figsize=(3.6 + 1.0 * len(d.names) * ncols, 3.2 * len(outs)), layout="constrained")
     FigureCanvasAgg(fig)
     axes = fig.subplots(len(outs), ncols, squeeze=False)
     x = np.arange(len(d.names))
@@ -547,7 +547,7 @@ def _bars(s: Sensitivity):
             ax.axhspan(flo, fhi, color="grey", alpha=0.25, linewidth=0, label="floor's 95 % interval")
             ax.axhline(f, color="black", linestyle="--", linewidth=1.2,
                        label=f"seed-noise floor of S_T ({f:.2f})")
-        ax.set_xticks(x, d.names, rotation=25, ha="right", fontsize=8)
+        ax.set_xticks(x, d.names, rotation=40, ha="right", rotation_mode="anchor", fontsize=8)
         ax.axhline(0, color="black", linewidth=0.6)
         ax.set_title(f"{output}: {TITLES[kinds[0]].split()[0]}{' / total' if d.method == 'sobol' else ''}, "
                      f"{s.size()}", fontsize=9, loc="left")
@@ -560,7 +560,7 @@ def _bars(s: Sensitivity):
             ax.bar(x, rows["value"], 0.6, color="#9467bd", edgecolor="black", linewidth=0.5, label=TITLES["PAWN"])
             ax.plot(x, null["value"], linestyle="none", marker="_", markersize=14, markeredgewidth=2,
                     color="black", label=f"no effect: 95th percentile,\n{PAWN_PERMUTATIONS} shuffles of the output")
-            ax.set_xticks(x, d.names, rotation=25, ha="right", fontsize=8)
+            ax.set_xticks(x, d.names, rotation=40, ha="right", rotation_mode="anchor", fontsize=8)
             ax.set_ylim(0, max(0.1, float(np.nanmax(rows["value"].to_numpy())) * 1.15,
                                float(np.nanmax(null["value"].to_numpy())) * 1.15))
             ax.set_title(f"{output}: PAWN, {s.size()}", fontsize=9, loc="left")
