@@ -93,7 +93,7 @@ def test_every_panel_names_its_run_count(spec, paper_frames):
 
 def test_fig5_names_its_runs_in_the_legend_and_its_reference_line(paper_frames):
     fig = analysis.fig5(paper_frames.history, paper_frames.robots)
-    labels = [t.get_text() for t in fig.axes[1].get_legend().get_texts()]
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
     assert sum(bool(re.search(r"\(\d+ runs\)", lab)) for lab in labels) == 2
     assert any(lab.startswith("equal share") for lab in labels)
 

@@ -171,7 +171,8 @@ def fig5(history: pd.DataFrame, robots: pd.DataFrame | None = None) -> Figure:
         _panel_title(ax, letter)
         ax.set_xlabel("step")
         ax.set_ylabel(ylabel)
-        ax.legend(fontsize=8, frameon=False)
+    handles, labels = axes[1].get_legend_handles_labels()  # below the panels: no curve can be hidden
+    fig.legend(handles, labels, loc="outside lower center", ncols=len(labels), fontsize=8, frameon=False)
     fig.suptitle("Fig. 5: average wealth over time (shades: 95 % CI over runs)", fontsize=11)
     return fig
 

@@ -232,9 +232,10 @@ def terrain_figure(a: dict):
     _boxes(ax[0], data, labels)
     # items per run span 0 to several hundred: linear up to 10, logarithmic above, never below 0
     ax[0].set_yscale("symlog", linthresh=10, linscale=0.6)
-    top = max(float(np.max(d)) for d in data if len(d))
-    ax[0].set_ylim(0, top * 1.5)
-    ax[0].set_yticks([0, 5, 10, 100, 1000][: 4 + (top * 1.5 > 1000)], ["0", "5", "10", "100", "1000"][: 4 + (top * 1.5 > 1000)])
+    upper = max([20.0] + [1.5 * float(np.max(d)) for d in data if len(d)])
+    ticks = [t for t in (0, 5, 10, 100, 1000, 10000) if t <= upper]
+    ax[0].set_ylim(0, upper)
+    ax[0].set_yticks(ticks, [f"{t:g}" for t in ticks])
     ax[0].set_ylabel("items per run (whole swarm)")
     robots = "25 naive" + (" / 25 waypoint" if w["answer"] != "not run" else "")
     ax[0].set_title(f"corridor: {robots} robots\n(symlog axis: linear below 10)", loc="left", fontsize=9)
