@@ -250,7 +250,7 @@ def test_the_noise_floor_matches_a_hand_computation():
     assert noise_floor(runs.iloc[::2], d).empty  # one run per point: no replicates, no floor
 
 
-def _local(tmp_path, slope: float, seed: int = 3):
+def _local(tmp_path, slope: float, seed: int = 3, noise: float = 1.0):
     """A replicated Morris design over the KNOWN experiment's keys, its runs made up: y = slope x noise_sd
     (in units of the key's range) + N(0, 1) seed noise, 4 runs per point."""
     from infomarket.analysis.sensitivity import Sensitivity, analyse, point_outputs
@@ -263,7 +263,7 @@ def _local(tmp_path, slope: float, seed: int = 3):
     rng = np.random.default_rng(seed)
     x = d.X[:, 0] / 0.1
     runs = pd.DataFrame({"point": np.repeat(np.arange(d.points), 4),
-                         "y": np.repeat(slope * x, 4) + rng.normal(0.0, 1.0, 4 * d.points)})
+                         "y": np.repeat(slope * x, 4) + rng.normal(0.0, noise, 4 * d.points)})
     points = point_outputs(runs, d)
     return Sensitivity(d, analyse(d, points), points, runs)
 
@@ -280,6 +280,12 @@ def test_local_robustness_tells_a_flat_box_from_a_slope(tmp_path):
     # pure noise: Morris mu* is what noise alone gives, sqrt(2/pi) sqrt(2 * 1 / 4) / (4 / 6) = 0.846
     assert morris_noise(flat, "y") == pytest.approx(np.sqrt(2 / np.pi) * np.sqrt(0.5) / (4 / 6), rel=0.15)
     assert not params.moves.any()
+    # loud seed noise (sd 3: the means of 4 runs spread by 1.5) and no effect, against a tolerance of 1
+    # (5 % of a range of 20): the spread of the means alone would say "not robust"; noise removed, robust
+    loud = _local(tmp_path, 0.0, noise=3.0)
+    row = local_robustness(loud, pd.DataFrame({"y": np.linspace(0.0, 200 / 9, 101)}))[0].iloc[0]
+    assert row.tolerance == pytest.approx(1.0)
+    assert loud.points["y"].std() > 1.2 and row.robust == "yes", row
     steep = _local(tmp_path, 40.0)  # uniform levels 0, 1/3, 2/3, 1 of a 40-wide slope: sd about 15
     verdict, params = local_robustness(steep, reference)
     assert verdict.iloc[0].robust == "no" and verdict.iloc[0].spread_low > 4.5
