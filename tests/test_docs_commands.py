@@ -65,11 +65,13 @@ NOT_RUN = {
         "128 full runs; sweeps are tested in tests/runner, the waypoint rules in tests/terrain/test_waypoints.py",
     "infomarket view corridor": "a web server that runs until stopped; tests/viewer",
     "infomarket replay crowd --movie crowd.gif": "a full-length recording; movies: tests/viewer/test_terrain_view.py",
-    "infomarket sweep sensitivity --out results/sensitivity --workers 2": "the full study, 40 960 runs (~63 min on 2 cores)",
-    "infomarket sweep sensitivity --samples 8192 --out results/sensitivity":
-        "needs the full study's store; growing a design is tested in tests/runner/test_design.py",
+    "infomarket sweep sensitivity --out results/sensitivity --workers 2": "the full study, 5 120 runs (~18 min on 2 cores)",
+    "infomarket sweep sensitivity_local --out results/sensitivity_local":
+        "576 runs of 15 000 steps; tests/analysis/test_sensitivity.py judges a local design",
+    "infomarket sensitivity results/sensitivity --out report --local results/sensitivity_local":
+        "needs both full stores; tests/analysis/test_sensitivity.py runs --local on a small one",
     "infomarket sweep sensitivity --samples 16 --out /tmp/sens-quick":
-        "160 runs; tests/analysis/test_sensitivity.py runs the study with --samples 2",
+        "320 runs; tests/analysis/test_sensitivity.py runs the study with --samples 2",
     "infomarket sensitivity /tmp/sens-quick --out /tmp/sens-quick-report":
         "needs the store above; tests/analysis/test_sensitivity.py runs it on --samples 2",
 }

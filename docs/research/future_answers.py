@@ -18,4 +18,4 @@ stores = [Store(p) for p in sys.argv[1:]]
 robots = pd.concat([s.robots() for s in stores], ignore_index=True)
 table = future.question_table(Frames(robots=robots, meta=stores[0].meta()))
 for row in table.itertuples():
-    print(f"== {row.id} | {row.answer}\n   {row.statistics}")
+    print(f"== {row.id} | {future.st.shown(row.answer, row.note)}\n   {row.statistics}")

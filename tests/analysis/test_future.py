@@ -186,3 +186,18 @@ def test_no_cost_needs_a_shown_margin_not_a_missing_difference():
         noise[(d, r)] for d, r in robots.loc[honest & (robots["robot"] == 0), ["defence", "run"]].itertuples(index=False)]
     a = dict(zip(*future.question_table(Frames(robots=robots))[["id", "answer"]].T.values))
     assert a["honest_cost_reputation_sceptic"] == future.INCONCLUSIVE
+
+
+def test_attack_figures_count_runs_and_tell_reference_lines_apart_by_style():
+    from .layout import problems
+
+    robots = sweep(rescued)
+    fig = future.attack_figure(robots, "future_liar")
+    for ax in fig.axes:
+        assert ax.get_title(loc="left").endswith(f"{RUNS} runs per box")
+        refs = [ln for ln in ax.lines if ln.get_transform() != ax.transData and ln.get_color() != "grey"]
+        assert len(refs) == len(future.DEFENCES)  # one reference line per defence, each dashed its own way
+        assert len({str(ln._dash_pattern) for ln in refs}) == len(future.DEFENCES)
+    labels = [h.get_label() for h in fig.legends[0].legend_handles]
+    assert sum(lab.endswith("median without Byzantines") for lab in labels) == len(future.DEFENCES)
+    assert problems(fig) == []

@@ -14,6 +14,8 @@ import pandas as pd
 import pytest
 
 import infomarket as im
+from infomarket.analysis import sensitivity as sensitivity_module
+from infomarket.analysis.frames import MissingDataError
 from infomarket.analysis.sensitivity import from_store, run_outputs, sensitivity
 from infomarket.cli import main
 from infomarket.runner.design import load
@@ -71,6 +73,24 @@ def sobol_store(tmp_path_factory):
     return sweep(tmp_path_factory.mktemp("sobol"), "sobol", 128)
 
 
+@pytest.fixture(autouse=True)
+def few_pawn_resamples(monkeypatch):
+    """PAWN's permutation test calls SALib once per shuffle; 20 are enough to check the machinery."""
+    monkeypatch.setattr(sensitivity_module, "PAWN_PERMUTATIONS", 20)
+
+
+@pytest.fixture(scope="module")
+def replicated_store(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("replicated")
+    p = tmp / "known.toml"
+    text = KNOWN.format(method="sobol", samples=32, second="false").replace("runs = 1", "runs = 2")
+    p.write_text(text.replace('outputs = ["honest_robots", "items"]', 'outputs = ["honest_robots", "drift"]')
+                 + '\n[sweep.sample.custom.drift]\ncolumn = "drift"\nstat = "mean"\n')
+    out = tmp / "store"
+    assert main(["sweep", str(p), "--out", str(out), "--workers", "1", "--quiet"]) == 0
+    return out
+
+
 def by_param(table: pd.DataFrame, output: str, index: str) -> pd.Series:
     return table[(table.output == output) & (table["index"] == index)].set_index("parameter")["value"]
 
@@ -82,8 +102,15 @@ def test_sobol_recovers_the_known_indices(sobol_store):
         assert got.sort_values(ascending=False).index[:2].tolist() == ["robots", "byzantines"]
         for p, want in S1.items():
             assert got[p] == pytest.approx(want, abs=0.1), (index, p)
-    idle = s.table[(s.table.output == "honest_robots") & s.table.parameter.isin(["noise_sd", "stake"])]
+    idle = s.table[(s.table.output == "honest_robots") & s.table.parameter.isin(["noise_sd", "stake"])
+                   & s.table["index"].isin(["S1", "ST"])]
     assert (idle.value.abs() < 0.02).all() and (idle.high < 0.05).all()
+    # PAWN ranks the two keys first too; the idle keys stay at the level a shuffled output reaches
+    pawn = by_param(s.table, "honest_robots", "PAWN")
+    null = by_param(s.table, "honest_robots", "PAWN_null")
+    assert pawn.sort_values(ascending=False).index[:2].tolist() == ["robots", "byzantines"]
+    assert pawn["robots"] > 2 * null["robots"] and pawn["byzantines"] > null["byzantines"]
+    assert (pawn[["noise_sd", "stake"]] < null[["noise_sd", "stake"]]).all()
     # the per-point outputs are the function itself, point by point in the design's order
     design = load(sobol_store, "known")
     frame = design.frame()
@@ -110,7 +137,7 @@ def test_the_command_writes_table_figures_and_report(sobol_store, tmp_path, caps
     table = pd.read_parquet(out / "sensitivity-known.parquet")
     pd.testing.assert_frame_equal(table, pd.read_csv(out / "sensitivity-known.csv", keep_default_na=False, na_values={"conf": [""], "low": [""], "high": [""]}),
                                   check_dtype=False)
-    assert set(table["index"]) == {"S1", "ST"} and set(table.output) == {"honest_robots", "items"}
+    assert set(table["index"]) == {"S1", "ST", "PAWN", "PAWN_null"} and set(table.output) == {"honest_robots", "items"}
     assert "honest_robots" in capsys.readouterr().out
     rep = tmp_path / "rep"
     assert main(["figures", str(sobol_store), "--out", str(rep)]) == 0
@@ -165,31 +192,118 @@ def test_an_incomplete_design_or_a_store_without_one_is_refused(tmp_path, capsys
 def test_the_shipped_study_runs_at_reduced_size(tmp_path, capsys):
     store, out = tmp_path / "s", tmp_path / "r"
     assert main(["sweep", "sensitivity", "--samples", "2", "--out", str(store), "--quiet"]) == 0
-    assert len(Store(store).runs()) == 2 * (8 + 2)
+    # replicated points are the shipped default: 2 base samples x (8 + 2) points x 2 runs
+    assert len(Store(store).runs()) == 2 * (8 + 2) * 2
     assert main(["sensitivity", str(store), "--out", str(out)]) == 0
-    table = pd.read_csv(out / "sensitivity-sensitivity.csv")
+    names = {p.name for p in out.iterdir()}
+    # issue 21: named after the experiment, not sensitivity-sensitivity.*
+    assert {"sensitivity.csv", "sensitivity.parquet", "sensitivity-indices.png", "sensitivity.md"} <= names
+    assert not any(n.startswith("sensitivity-sensitivity") for n in names)
+    table = pd.read_csv(out / "sensitivity.csv")
     assert set(table.output) == {"items", "share_gap", "byzantine_share"}
-    assert set(table.parameter) == {"noise_sd", "bias_mean", "communication_range", "threshold", "theta", "stake",
-                                    "byzantines", "rotation_angle"}
-    assert (out / "sensitivity-sensitivity-indices.png").exists()
-    assert "## Global sensitivity: sensitivity" in (out / "sensitivity-sensitivity.md").read_text()
+    assert set(table.parameter.dropna()) == {"noise_sd", "bias_mean", "communication_range", "threshold", "theta",
+                                             "stake", "byzantines", "rotation_angle"}
+    assert {"S1", "ST", "floor", "run_share", "PAWN"} <= set(table["index"])
+    md = (out / "sensitivity.md").read_text()
+    assert "## Global sensitivity: sensitivity" in md and "40 runs" in md
+    # answered at another size than the declared one: every answer says so, precision is not answered
+    assert "not the 256 x 2 declared" in md and "not answered (2 x 2 is not the declared size)" in md
 
 
-def test_local_robustness_compares_the_points_bin_with_its_neighbours(sobol_store, tmp_path):
-    from infomarket.analysis.sensitivity import robustness
+def test_a_noisy_output_sits_on_a_floor_of_one_and_a_noiseless_one_on_zero(replicated_store):
+    """honest_robots is a function of the design (no seed noise: floor 0 exactly); the mean |drift| of a
+    run's robots is drawn from the run's seed only (no sampled key changes it): all its variance is seed
+    noise, so its floor and run-level share are 1 up to sampling error."""
+    s = from_store(replicated_store)
+    floor = s.floor.set_index("output")
+    assert floor.loc["honest_robots", "floor"] == 0 and floor.loc["honest_robots", "floor_high"] == 0
+    drift = floor.loc["drift"]
+    assert drift.runs_per_point == 2
+    assert drift.floor_low < 1.0 < drift.floor_high and drift.floor_low > 0.6
+    assert drift.run_share_low > 0.7
+    # the floor is drawn on the figure, with its value in the legend, and every panel names its run count
+    from infomarket.analysis.sensitivity import _bars
 
-    s = from_store(sobol_store)
-    runs = run_outputs(Store(sobol_store).robots(), s.design)
-    rows = robustness(s, runs, {"robots": 12, "byzantines": 5, "noise_sd": 0.05}).set_index(["output", "parameter"])
-    # only the parameters that drive an output are examined (noise is idle, items are all 0 in 2 steps)
-    assert set(rows.index) == {("honest_robots", "robots"), ("honest_robots", "byzantines")}
-    edge = rows.loc[("honest_robots", "robots")]
-    # integer key: the bin is the value itself; at the low edge the only neighbour is 13 robots
-    assert edge.runs_in_bin == (runs.merge(s.design.frame()[["point", "robots"]], on="point").robots == 12).sum()
-    assert edge.median_in_bin < edge.median_adjacent  # one more robot, one more honest robot
-    assert bool(edge.robust) == (abs(edge.difference) < 0.1 * edge.range_5_95)
-    assert robustness(s, runs, {"robots": 12}, tolerance=0.0).robust.eq(False).all()
-    assert main(["sensitivity", str(sobol_store), "--out", str(tmp_path / "o"), "--at", "robots=12,byzantines=5"]) == 0
-    assert (tmp_path / "o" / "sensitivity-known-robustness.csv").exists()
-    assert main(["sensitivity", str(sobol_store), "--out", str(tmp_path / "p"), "--at", "speed=3"]) == 2
-    assert not (tmp_path / "p").exists()
+    fig = _bars(s)
+    labels = [t.get_text() for ax in fig.axes for t in (ax.get_legend().get_texts() if ax.get_legend() else [])]
+    assert any(lab.startswith("seed-noise floor of S_T") for lab in labels)
+    titles = [ax.get_title(loc="left") for ax in fig.axes]
+    assert titles and all("x 2 runs = " in t for t in titles)
+    from .layout import problems
+
+    assert problems(fig) == []  # nothing cut or overlapping; no legend over a bar (one hid a bar before)
+
+
+def test_the_noise_floor_matches_a_hand_computation():
+    """Four points of a hypercube design, two runs each: 4 +/- 1 around means 0, 2, 4, 6.  By hand:
+    within-point variance (ddof 1) 2, so noise per mean 2 / 2 = 1; variance of the means (ddof 1)
+    (9 + 1 + 1 + 9) / 3 = 20 / 3; floor = 1 / (20 / 3) = 0.15; run share = 2 / (20 / 3 - 1 + 2) = 6 / 23."""
+    from infomarket.analysis.sensitivity import noise_floor
+    from infomarket.runner.design import Design
+
+    d = Design("toy", "lhs", 4, False, 4, 1, ["a", "b"], ["a", "b"], [[], []], [0.0, 0.0], [1.0, 1.0],
+               [False, False], None, ["y"], {}, "test", X=np.zeros((4, 2)))
+    runs = pd.DataFrame({"point": np.repeat(np.arange(4), 2), "y": [-1.0, 1.0, 1.0, 3.0, 3.0, 5.0, 5.0, 7.0]})
+    f = noise_floor(runs, d).iloc[0]
+    assert f.floor == pytest.approx(0.15) and f.run_share == pytest.approx(6 / 23)
+    assert f.floor_low <= f.floor <= f.floor_high
+    assert noise_floor(runs.iloc[::2], d).empty  # one run per point: no replicates, no floor
+
+
+def _local(tmp_path, slope: float, seed: int = 3, noise: float = 1.0):
+    """A replicated Morris design over the KNOWN experiment's keys, its runs made up: y = slope x noise_sd
+    (in units of the key's range) + N(0, 1) seed noise, 4 runs per point."""
+    from infomarket.analysis.sensitivity import Sensitivity, analyse, point_outputs
+    from infomarket.runner.design import make_design
+
+    p = tmp_path / "m.toml"
+    p.write_text(KNOWN.format(method="morris", samples=40, second="false").replace("runs = 1", "runs = 4"))
+    d = make_design(im.load_experiment(p))
+    d = type(d).from_spec({**d.spec(), "outputs": ["y"]}, d.X)
+    rng = np.random.default_rng(seed)
+    x = d.X[:, 0] / 0.1
+    runs = pd.DataFrame({"point": np.repeat(np.arange(d.points), 4),
+                         "y": np.repeat(slope * x, 4) + rng.normal(0.0, noise, 4 * d.points)})
+    points = point_outputs(runs, d)
+    return Sensitivity(d, analyse(d, points), points, runs)
+
+
+def test_local_robustness_tells_a_flat_box_from_a_slope(tmp_path):
+    from infomarket.analysis.sensitivity import local_robustness, morris_noise
+
+    flat = _local(tmp_path, 0.0)
+    reference = pd.DataFrame({"y": np.linspace(0.0, 100.0, 101)})  # 5-95 % range 90: tolerance 4.5
+    verdict, params = local_robustness(flat, reference)
+    row = verdict.iloc[0]
+    assert row.tolerance == pytest.approx(0.05 * 90.0)
+    assert row.robust == "yes" and row.spread_high < row.tolerance
+    # pure noise: Morris mu* is what noise alone gives, sqrt(2/pi) sqrt(2 * 1 / 4) / (4 / 6) = 0.846
+    assert morris_noise(flat, "y") == pytest.approx(np.sqrt(2 / np.pi) * np.sqrt(0.5) / (4 / 6), rel=0.15)
+    assert not params.moves.any()
+    # loud seed noise (sd 3: the means of 4 runs spread by 1.5) and no effect, against a tolerance of 1
+    # (5 % of a range of 20): the spread of the means alone would say "not robust"; noise removed, robust
+    loud = _local(tmp_path, 0.0, noise=3.0)
+    row = local_robustness(loud, pd.DataFrame({"y": np.linspace(0.0, 200 / 9, 101)}))[0].iloc[0]
+    assert row.tolerance == pytest.approx(1.0)
+    assert loud.points["y"].std() > 1.2 and row.robust == "yes", row
+    steep = _local(tmp_path, 40.0)  # uniform levels 0, 1/3, 2/3, 1 of a 40-wide slope: sd about 15
+    verdict, params = local_robustness(steep, reference)
+    assert verdict.iloc[0].robust == "no" and verdict.iloc[0].spread_low > 4.5
+    assert params.set_index("parameter").moves.to_dict() == {"noise_sd": True, "robots": False, "stake": False,
+                                                             "byzantines": False}
+    # a design without replicates cannot be judged
+    one = _local(tmp_path, 0.0)
+    one.runs = one.runs.groupby("point").head(1)
+    with pytest.raises(MissingDataError, match="replicates"):
+        local_robustness(one, reference)
+
+
+def test_the_command_judges_a_point_from_a_local_design(replicated_store, tmp_path, capsys):
+    out = tmp_path / "o"
+    assert main(["sensitivity", str(replicated_store), "--out", str(out), "--local", str(replicated_store)]) == 0
+    rows = pd.read_csv(out / "sensitivity-known-robustness.csv")
+    assert set(rows.output) == {"honest_robots", "drift"} and set(rows.robust) <= {"yes", "no", "inconclusive"}
+    # the bin-by-bin comparison of the global design is gone (issue 24): --at is refused
+    with pytest.raises(SystemExit) as exc:
+        main(["sensitivity", str(replicated_store), "--out", str(tmp_path / "p"), "--at", "robots=12"])
+    assert exc.value.code == 2

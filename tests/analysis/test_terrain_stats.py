@@ -56,3 +56,32 @@ def test_crowd_reads_the_ratio_from_its_interval():
     # 4 wildly spread runs with a point ratio below one half: the interval straddles it
     wide = terrain.crowd_collisions(_crowd([10, 20, 45, 90], [100, 100, 100, 100]), {"min_ratio": 0.5})
     assert wide[100]["ratio"] == 0.325 and wide["answer"] == "inconclusive"
+
+
+def _answers_for_figure() -> dict:
+    rng = np.random.default_rng(5)
+    runs = {"plane/on": rng.normal(450, 20, 64), "plane/off": rng.normal(30, 8, 64),
+            "corridor/on": rng.normal(18, 4, 64), "corridor/off": rng.normal(5, 2, 64).clip(0)}
+    return {"chain_blocked": {"per_run": runs},
+            "waypoints_restore": {"answer": "no", "per_run": {"waypoint/plane": rng.normal(440, 20, 64),
+                                                               "waypoint/corridor": rng.normal(22, 5, 64)}},
+            "outlier_two_food": {"gaps_pct": {"one": rng.normal(4.5, 1, 64), "two": rng.normal(4.9, 0.2, 64)}},
+            "crowd_collisions": {"25": {"per_run_off": rng.normal(19, 1, 32), "per_run_on": rng.normal(1, 0.3, 32)},
+                                 "100": {"per_run_off": rng.normal(22, 0.2, 32),
+                                         "per_run_on": rng.normal(0.1, 0.02, 32)}}}
+
+
+def test_the_terrain_figure_is_readable_and_counts_its_runs():
+    """docs/images/terrain.png was out of date: an old title, a symlog axis down to -10, overlapping
+    tick labels, a cut axis label and no run counts."""
+    from .layout import problems
+
+    fig = terrain.terrain_figure(_answers_for_figure())
+    assert problems(fig) == []
+    corridor, two_food, crowd = fig.axes
+    assert corridor.get_ylim()[0] == 0 and min(corridor.get_yticks()) >= 0
+    assert "waypoint" in corridor.get_title(loc="left")
+    for ax, n in ((corridor, 64), (two_food, 64), (crowd, 32)):
+        labels = [t.get_text() for t in ax.get_xticklabels()]
+        assert labels and all(lab.endswith(f"n = {n}") for lab in labels)
+    assert [h.get_label() for h in fig.legends[0].legend_handles] == ["no gap (0 points)"]

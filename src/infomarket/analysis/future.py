@@ -25,6 +25,7 @@ from scipy import stats as sps
 from . import stats as st
 from .boxplots import draw_boxes, legend_handles
 from .declared import check, size_note, status_of, summary
+from .figures import _runs_text
 from .frames import Frames, MissingDataError
 from ..errors import ConfigError
 
@@ -37,6 +38,9 @@ NEW = DEFENCES[1:]
 COLOURS = {"paper": "#7f7f7f", "reputation_sceptic": "#1f77b4", "adaptive_theta": "#2ca02c", "both": "#9467bd"}
 LABELS = {"paper": "paper (sceptical + outlier, staking)", "reputation_sceptic": "reputation-aware sceptic",
           "adaptive_theta": "adaptive Theta", "both": "both"}
+#: each defence's reference line (its median without Byzantines): a style of its own, not colour alone
+STYLES = {"paper": (0, (6, 2)), "reputation_sceptic": (0, (2, 1.5)), "adaptive_theta": (0, (6, 2, 1.5, 2)),
+          "both": (0, (1, 1))}
 BELOW = (5.0, 10.0, 20.0, 25.0)
 ABOVE = (40.0, 90.0)
 YES, NO, INCONCLUSIVE, NO_DATA = st.YES, st.NO, st.INCONCLUSIVE, "no data"
@@ -279,9 +283,17 @@ def question_table(source, questions: dict[str, Question] | None = None) -> pd.D
                 a = ANSWERS[qid](runs, q.params)
             except MissingDataError as exc:
                 a = Answer(NO_DATA, str(exc))
+        note = st.N_TOO_SMALL if a.answer == INCONCLUSIVE and st.too_few_runs(a.comparisons) else ""
         rows.append([qid, q.question, q.rule, a.answer, a.statistics,
-                     status_of(locks, "tolerances.toml", f"questions.{qid}")])
-    return pd.DataFrame(rows, columns=["id", "question", "rule", "answer", "statistics", "declared"])
+                     status_of(locks, "tolerances.toml", f"questions.{qid}"), note])
+    return pd.DataFrame(rows, columns=["id", "question", "rule", "answer", "statistics", "declared", "note"])
+
+
+def _shown(table: pd.DataFrame) -> pd.DataFrame:
+    """The table as printed: each answer with its note (``inconclusive (n too small)``)."""
+    out = table.copy()
+    out["answer"] = [st.shown(a, n) for a, n in zip(table["answer"], table["note"])]
+    return out
 
 
 # ------------------------------------------------------------------------------------------- figures
@@ -303,14 +315,18 @@ def attack_figure(robots: pd.DataFrame, experiment: str) -> Figure:
     width = 0.8 / len(DEFENCES)
     for ax, (letter, byz) in zip(axes, [("A", 1), ("B", 3)]):
         panel = att[att["byzantines"] == byz]
-        ax.set_title(f"({letter}) {byz} Byzantine{'s' if byz > 1 else ''}", loc="left", fontsize=10)
+        counts = []
         for k, d in enumerate(DEFENCES):
             sel = panel[panel["defence"] == d]
             data = [sel.loc[np.isclose(sel["rotation_angle"], a), "items"].to_numpy() for a in angles]
+            counts += [len(x) for x in data]
             draw_boxes(ax, data, pos + (k - 1.5) * width, COLOURS[d], width=width * 0.9)
+        ax.set_title(f"({letter}) {byz} Byzantine{'s' if byz > 1 else ''}, {_runs_text(counts)} per box",
+                     loc="left", fontsize=10)
+        for d in DEFENCES:
             base = honest.loc[honest["defence"] == d, "items"]
             if len(base):
-                ax.axhline(float(base.median()), color=COLOURS[d], linestyle="--", linewidth=1, zorder=0)
+                ax.axhline(float(base.median()), color=COLOURS[d], linestyle=STYLES[d], linewidth=1.2, zorder=0)
         below = [i for i, a in enumerate(angles) if a < 30.0]
         if below and len(below) < len(angles):
             ax.axvline(below[-1] + 0.5, color="grey", linestyle=":", linewidth=1)
@@ -318,8 +334,9 @@ def attack_figure(robots: pd.DataFrame, experiment: str) -> Figure:
         ax.set_xlabel("rotation angle of the Byzantine robots (deg)")
     axes[0].set_ylabel("items collected by the swarm\n(last 10 000 of 30 000 steps)")
     handles = legend_handles({COLOURS[d]: LABELS[d] for d in DEFENCES})
-    handles += [Line2D([], [], color="black", linestyle="--", label="median without Byzantines (same colour)"),
-                Line2D([], [], color="grey", linestyle=":", label="Theta = 30 deg")]
+    handles += [Line2D([], [], color=COLOURS[d], linestyle=STYLES[d], linewidth=1.2,
+                       label=f"{LABELS[d]}: median without Byzantines") for d in DEFENCES]
+    handles += [Line2D([], [], color="grey", linestyle=":", label="Theta = 30 deg")]
     fig.legend(handles=handles, loc="outside lower center", ncols=3, frameon=False, fontsize=8)
     fig.suptitle(f"The paper's open questions: {ATTACKS[experiment]} against four defences", fontsize=11)
     return fig
@@ -328,7 +345,7 @@ def attack_figure(robots: pd.DataFrame, experiment: str) -> Figure:
 def figure_specs():
     """(name, caption, draw) of each attack's figure, for the report."""
     return [(f"{name}", f"Swarm items after the transitory period vs rotation angle, attack: {label}; "
-             "boxes per defence, dashed lines: each defence's median without Byzantines, 32 runs per box "
+             "boxes per defence; lines (one style per defence): each defence's median without Byzantines; 32 runs per box "
              "at full scale.", (lambda f, n=name: attack_figure(f.robots, n)))
             for name, label in ATTACKS.items()]
 
@@ -366,8 +383,9 @@ def section(frames: Frames, out: Path, vector: str, echo: Callable[[str], None])
             echo(f"{name}: skipped ({exc})")
     table = question_table(frames)
     counts = table["answer"].value_counts()
+    small = int((table["note"] == st.N_TOO_SMALL).sum())
     echo(f"open questions: {counts.get(YES, 0)} yes, {counts.get(NO, 0)} no, {counts.get(INCONCLUSIVE, 0)} "
-         f"inconclusive, {counts.get(NO_DATA, 0)} no data")
+         f"inconclusive{f' ({small} with n too small to reach alpha)' if small else ''}, {counts.get(NO_DATA, 0)} no data")
     lock = summary(check(frames.meta.get("declarations") if frames.meta else None), "tolerances.toml", "questions.")
     return Section(figs, table, lock)
 
@@ -389,7 +407,7 @@ def to_markdown(s: Section, md_table: Callable[[pd.DataFrame], str]) -> list[str
         md += [f"![{name}]({files[0].name})", "", f"Vector: [{files[1].name}]({files[1].name})"] if files \
             else [f"*Skipped: {note}.*"]
         md.append("")
-    md += ["### Answers", "", f"Declarations: {s.lock}.", "", md_table(s.table[COLUMNS]), ""]
+    md += ["### Answers", "", f"Declarations: {s.lock}.", "", md_table(_shown(s.table)[COLUMNS]), ""]
     return md
 
 
@@ -404,5 +422,5 @@ def to_html(s: Section, html_table: Callable[[pd.DataFrame], str]) -> list[str]:
             parts.append(f"<p><a href='{e(files[1].name)}'><img src='{e(files[0].name)}' alt='{e(name)}'></a></p>")
         else:
             parts.append(f"<p class='note'>Skipped: {e(note)}.</p>")
-    parts += ["<h3>Answers</h3>", f"<p>Declarations: {e(s.lock)}.</p>", html_table(s.table[COLUMNS])]
+    parts += ["<h3>Answers</h3>", f"<p>Declarations: {e(s.lock)}.</p>", html_table(_shown(s.table)[COLUMNS])]
     return parts

@@ -24,7 +24,8 @@ from ..errors import ConfigError
 
 TOLERANCES = Path(__file__).with_name("tolerances.toml")
 PASS, FAIL, NO_DATA, INCONCLUSIVE = "pass", "fail", "no data", "inconclusive"
-COLUMNS = ["id", "figure", "claim", "paper", "store", "value", "tolerance", "verdict"]
+COLUMNS = ["id", "figure", "claim", "paper", "store", "value", "tolerance", "verdict", "note"]
+INCOMPLETE = "incomplete design"  # a row whose experiment lacks conditions of its shipped plan
 
 
 @dataclass(frozen=True)
@@ -74,6 +75,7 @@ class Measurement:
     shown: str     # how the table shows it (with the numbers it was computed from)
     floor: float | None = None  # the smallest value the store's run counts allow (a p-value's minimum)
     undecided: bool = False     # the store's runs cannot decide the row (a failing row is "inconclusive")
+    too_small: bool = False     # no run count of the store could reach the row's alpha
 
 
 METRICS: dict[str, Callable[[Frames], Measurement]] = {}
@@ -271,7 +273,7 @@ def _fig7b(f: Frames, rule: Rule) -> Measurement:
              + (f"underpowered at {', '.join(weak)}; " if weak else "")
              + "; ".join(f"{c.label}: HL {c.effect.hl:+.3g} [{c.effect.hl_low:.3g}, {c.effect.hl_high:.3g}], "
                          f"p = {c.p:.2g}, Holm {c.p_adjusted:.2g}, power {c.power:.2f}" for c in comps))
-    return Measurement(float(np.mean(wins)), shown, undecided=bool(weak))
+    return Measurement(float(np.mean(wins)), shown, undecided=bool(weak), too_small=stats.too_few_runs(comps))
 
 
 @metric("fig7A_no_difference")
@@ -295,8 +297,11 @@ def headline_table(source, rules: dict[str, Rule] | None = None) -> pd.DataFrame
     decided it, or ``no data`` when the store lacks what the row needs).
 
     ``source`` is anything ``Frames.of`` reads: a Store, a store path, Frames or a dict of tables."""
+    from .completeness import affected, gaps
+
     frames = Frames.of(source)
     rules = load_rules() if rules is None else rules
+    incomplete = gaps(frames.runs)
     rows = []
     for rid, rule in rules.items():
         if rid not in METRICS:
@@ -305,9 +310,16 @@ def headline_table(source, rules: dict[str, Rule] | None = None) -> pd.DataFrame
             fn = METRICS[rid]
             m = fn(frames, rule) if len(inspect.signature(fn).parameters) == 2 else fn(frames)
             store, value, verdict = m.shown, m.value, PASS if rule.passes(m.value) else FAIL
+            note = ""
             if verdict == FAIL and _undecided(m, rule):
                 verdict = INCONCLUSIVE
+                if m.too_small or (m.floor is not None and rule.below is not None and m.floor >= rule.below):
+                    note = stats.N_TOO_SMALL
+            gone = affected(rule.figure, incomplete)
+            if gone:  # part of the design is missing: the number describes what is there, not the claim
+                verdict, note = INCONCLUSIVE, INCOMPLETE
+                store = " ".join(incomplete[g].describe() for g in gone) + " -- " + store
         except MissingDataError as exc:
-            store, value, verdict = str(exc), math.nan, NO_DATA
-        rows.append([rid, rule.figure, rule.claim, rule.paper, store, value, rule.describe(), verdict])
+            store, value, verdict, note = str(exc), math.nan, NO_DATA, ""
+        rows.append([rid, rule.figure, rule.claim, rule.paper, store, value, rule.describe(), verdict, note])
     return pd.DataFrame(rows, columns=COLUMNS)

@@ -16,9 +16,11 @@ import pandas as pd
 from ..store import Store
 from . import future
 from .declared import check, summary
+from .completeness import gaps
 from .figures import FIGURES, save
 from .frames import Frames, MissingDataError
-from .headline import FAIL, INCONCLUSIVE, NO_DATA, PASS, headline_table
+from .headline import FAIL, INCOMPLETE, INCONCLUSIVE, NO_DATA, PASS, headline_table
+from .stats import N_TOO_SMALL, shown
 from .provenance import Provenance, collect_provenance
 
 TABLE_COLUMNS = {"figure": "figure", "claim": "claim", "paper": "paper", "store": "this store",
@@ -31,6 +33,7 @@ class FigureResult:
     caption: str
     files: list[Path] = field(default_factory=list)  # empty when skipped
     note: str = ""                                    # why it was skipped
+    warning: str = ""                                 # drawn from an incomplete design: what is missing
 
 
 @dataclass
@@ -43,6 +46,7 @@ class Report:
     future: future.Section | None = None  # the open-questions section, for stores with the future sweep
     sections: list[tuple[str, str]] = field(default_factory=list)  # (markdown, html), e.g. sensitivity
     lock: str = ""  # were the rows' rules declared before the store's first run (analysis.declared)
+    gaps: list[str] = field(default_factory=list)  # incomplete experiments (analysis.completeness)
 
     def counts(self) -> dict[str, int]:
         return {v: int((self.table["verdict"] == v).sum()) for v in (PASS, FAIL, INCONCLUSIVE, NO_DATA)}
@@ -58,6 +62,9 @@ def build_report(source, out: str | Path, *, vector: str = "svg", label: str | N
     out.mkdir(parents=True, exist_ok=True)
     label = label or _label(source)
     frames = Frames.of(source)
+    incomplete = gaps(frames.runs)
+    for gap in incomplete.values():
+        echo(f"WARNING: {gap.describe()}")
     results = []
     for spec in FIGURES:
         try:
@@ -67,10 +74,12 @@ def build_report(source, out: str | Path, *, vector: str = "svg", label: str | N
             echo(f"{spec.name}: skipped ({exc})")
             continue
         files = save(fig, out, spec.name, vector)
-        results.append(FigureResult(spec.name, spec.caption, files))
-        echo(f"{spec.name}: wrote {', '.join(p.name for p in files)}")
+        warning = " ".join(g.describe() for name, g in incomplete.items() if name.startswith(spec.name))
+        results.append(FigureResult(spec.name, spec.caption, files, warning=warning))
+        echo(f"{spec.name}: wrote {', '.join(p.name for p in files)}" + (" (INCOMPLETE design)" if warning else ""))
     table = headline_table(frames)
     report = Report(label, results, table, collect_provenance(frames, label))
+    report.gaps = [g.describe() for g in incomplete.values()]
     report.lock = summary(check(frames.meta.get("declarations") if frames.meta else None), "tolerances.toml", "rows.")
     report.future = future.section(frames, out, vector, echo)
     store = store if store is not None else (Store(source) if isinstance(source, (str, Path)) else
@@ -79,8 +88,7 @@ def build_report(source, out: str | Path, *, vector: str = "svg", label: str | N
         from .sensitivity import report_section
 
         report.sections = report_section(store, out, vector, echo)
-    c = report.counts()
-    echo(f"paper vs this store: {c[PASS]} pass, {c[FAIL]} fail, {c[INCONCLUSIVE]} inconclusive, {c[NO_DATA]} no data")
+    echo(f"paper vs this store: {_counts_text(report)}")
     for name, text in (("report.md", to_markdown(report)), ("report.html", to_html(report))):
         (out / name).write_text(text, encoding="utf-8")
         report.files.append(out / name)
@@ -107,10 +115,25 @@ def _md_table(df: pd.DataFrame) -> str:
     return "\n".join(lines)
 
 
-def _summary(report: Report) -> str:
+def _counts_text(report: Report) -> str:
     c = report.counts()
-    text = (f"{c[PASS]} pass, {c[FAIL]} fail, {c[INCONCLUSIVE]} inconclusive (the store's run counts cannot "
-            f"decide them), {c[NO_DATA]} without data, of {len(report.table)} rows.")
+    notes = report.table["note"] if "note" in report.table else pd.Series(dtype=str)
+    why = [f"{int((notes == n).sum())} {n}" for n in (N_TOO_SMALL, INCOMPLETE) if (notes == n).any()]
+    return (f"{c[PASS]} pass, {c[FAIL]} fail, {c[INCONCLUSIVE]} inconclusive"
+            + (f" ({', '.join(why)})" if why else "") + f", {c[NO_DATA]} no data")
+
+
+def _shown_table(report: Report) -> pd.DataFrame:
+    """The table as printed: each verdict with its note (``inconclusive (n too small)``)."""
+    t = report.table.copy()
+    if "note" in t:
+        t["verdict"] = [shown(v, n) for v, n in zip(t["verdict"], t["note"])]
+    return t[list(TABLE_COLUMNS)].rename(columns=TABLE_COLUMNS)
+
+
+def _summary(report: Report) -> str:
+    text = (f"{_counts_text(report)}, of {len(report.table)} rows (inconclusive: the store's runs cannot "
+            f"decide them).")
     return text + (f" Declarations: {report.lock}." if report.lock else "")
 
 
@@ -118,12 +141,18 @@ def to_markdown(report: Report) -> str:
     md = [f"# Paper figures from {report.source}", "",
           "Figures and headline numbers of *An Information Market for Social Navigation in Robots*, "
           "recomputed from this results store. Tolerances: `src/infomarket/analysis/tolerances.toml` "
-          "(declared before any result was seen; rows marked REVISED there were changed for issue 24 after the full paper sweep).", "", "## Figures", ""]
+          "(declared before any result was seen; rows marked REVISED there were changed for issue 24 after the full paper sweep).", ""]
+    if report.gaps:
+        md += ["## Incomplete designs", "", "The figures and rows that use these experiments are drawn from part of "
+               "their design; their rows are inconclusive.", ""] + [f"- {g}" for g in report.gaps] + [""]
+    md += ["## Figures", ""]
     for r in report.figures:
         md.append(f"### {r.name.replace('fig', 'Fig. ')}")
         md.append("")
         md.append(r.caption)
         md.append("")
+        if r.warning:
+            md += [f"**{r.warning}**", ""]
         if r.files:
             md.append(f"![{r.name}]({r.files[0].name})")
             md.append("")
@@ -132,7 +161,7 @@ def to_markdown(report: Report) -> str:
             md.append(f"*Skipped: {r.note}.*")
         md.append("")
     md += ["## Paper vs this store", "", _summary(report), "",
-           _md_table(report.table[list(TABLE_COLUMNS)].rename(columns=TABLE_COLUMNS)), ""]
+           _md_table(_shown_table(report)), ""]
     if report.future is not None:
         md += future.to_markdown(report.future, _md_table)
     md += ["## Provenance", ""]
@@ -159,7 +188,7 @@ def _html_table(df: pd.DataFrame, verdicts: bool = False) -> str:
     for row in df.itertuples(index=False):
         cls = ""
         if verdicts:
-            cls = f' class="{str(row[-1]).replace(" ", "")}"'
+            cls = f' class="{str(row[-1]).split(" (")[0].replace(" ", "")}"'
         body.append(f"<tr{cls}>" + "".join(f"<td>{html.escape(str(v))}</td>" for v in row) + "</tr>")
     return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
 
@@ -172,15 +201,19 @@ def to_html(report: Report) -> str:
              "<p>Figures and headline numbers of <i>An Information Market for Social Navigation in Robots</i>, "
              "recomputed from this results store. Tolerances: <code>src/infomarket/analysis/tolerances.toml"
              "</code> (declared before any result was seen; rows marked REVISED there were changed for issue 24 after the full paper sweep).</p>", "<h2>Figures</h2>"]
+    if report.gaps:
+        parts += ["<h2>Incomplete designs</h2><ul>"] + [f"<li>{e(g)}</li>" for g in report.gaps] + ["</ul>"]
     for r in report.figures:
         parts.append(f"<h3>{e(r.name.replace('fig', 'Fig. '))}</h3><p>{e(r.caption)}</p>")
+        if r.warning:
+            parts.append(f"<p><b>{e(r.warning)}</b></p>")
         if r.files:
             png, vec = (p.name for p in r.files)
             parts.append(f"<p><a href='{e(vec)}'><img src='{e(png)}' alt='{e(r.name)}'></a></p>")
         else:
             parts.append(f"<p class='note'>Skipped: {e(r.note)}.</p>")
     parts += ["<h2>Paper vs this store</h2>", f"<p>{e(_summary(report))}</p>",
-              _html_table(report.table[list(TABLE_COLUMNS)].rename(columns=TABLE_COLUMNS), verdicts=True)]
+              _html_table(_shown_table(report), verdicts=True)]
     if report.future is not None:
         parts += future.to_html(report.future, _html_table)
     parts.append("<h2>Provenance</h2><ul>")

@@ -1,11 +1,17 @@
-"""Global sensitivity indices of a sampled design (``[sweep.sample]``), computed by SALib.
+"""Global sensitivity indices of a sampled design (``[sweep.sample]``), computed by SALib, for a noisy simulator.
 
 ``run_outputs`` turns the robots table into one value per run and output; ``point_outputs`` averages
 the runs of each design point and puts the points in the design's order (what SALib's estimators need);
-``analyse`` calls SALib: Sobol' first-order, total (and second-order) indices with bootstrap 95 %
+``analyse`` calls SALib: Sobol' first-order and total (and second-order) indices with bootstrap 95 %
 intervals, Morris μ* (with its interval), μ and σ, or RBD-FAST first-order indices for a Latin
-hypercube.  Every function takes plain DataFrames and a ``Design``; ``from_store`` reads both from a
-results store.  ``write`` saves the table (CSV and Parquet), the figures and ``sensitivity.md``.
+hypercube.  A simulation is noisy: the runs of one point differ by their seeds.  So, from a design whose
+points ran more than once (``runs = R``), ``noise_floor`` estimates the share of the variance that is
+seed noise (with a bootstrap interval over the design's base samples): every total index contains it.
+``pawn`` gives PAWN indices (SALib; distribution-based, for heavy-tailed outputs) beside Sobol'.
+``local_robustness`` answers "is a point robust" from a local design around it (Morris trajectories in
+a small box): the spread the parameters cause there, corrected for seed noise, against a tolerance.
+Every function takes plain DataFrames and a ``Design``; ``from_store`` reads both from a results store.
+``write`` saves the tables (CSV and Parquet), the figures and a markdown section.
 """
 from __future__ import annotations
 
@@ -23,9 +29,13 @@ from .frames import MissingDataError
 RUN = ["condition", "run"]
 CONF_LEVEL = 0.95
 RESAMPLES = 1000
+PAWN_PERMUTATIONS = 40   # shuffles of the output for PAWN's no-effect level (SALib call: 0.2 s for 2 560 points)
+PAWN_SLICES = 10
 COLUMNS = ["experiment", "output", "method", "index", "parameter", "parameter2", "value", "conf", "low", "high"]
 TITLES = {"S1": "first order S1", "ST": "total ST", "S2": "second order S2", "mu_star": "Morris μ*",
-          "mu": "Morris μ", "sigma": "Morris σ"}
+          "mu": "Morris μ", "sigma": "Morris σ", "PAWN": "PAWN (median KS)",
+          "PAWN_null": "PAWN without effect (95th pct.)"}
+QUESTIONS = Path(__file__).with_name("sensitivity_questions.toml")
 
 
 @dataclass
@@ -35,7 +45,24 @@ class Sensitivity:
     design: Design
     table: pd.DataFrame
     points: pd.DataFrame                       # the per-point outputs the indices were computed from
+    runs: pd.DataFrame | None = None           # one row per run (``run_outputs``)
+    floor: pd.DataFrame | None = None          # ``noise_floor``: seed noise's share of the variance
     files: list[Path] = field(default_factory=list)
+
+    @property
+    def runs_per_point(self) -> tuple[int, int]:
+        """(fewest, most) runs at one point of the design."""
+        if self.runs is None or self.runs.empty:
+            return (1, 1)
+        n = self.runs.groupby("point").size()
+        return int(n.min()), int(n.max())
+
+    def size(self) -> str:
+        """The design's size, e.g. ``2 560 points x 2 runs = 5 120 runs``."""
+        lo, hi = self.runs_per_point
+        total = len(self.runs) if self.runs is not None else self.design.points
+        each = f"{lo} run{'s' if lo > 1 else ''}" if lo == hi else f"{lo}-{hi} runs"
+        return f"{self.design.points:,} points x {each} = {total:,} runs".replace(",", " ")
 
 
 def _rows(robots: pd.DataFrame, who: str) -> pd.DataFrame:
@@ -148,10 +175,132 @@ def analyse(design: Design, points: pd.DataFrame, *, seed: int | None = None) ->
     return pd.DataFrame(rows, columns=COLUMNS)
 
 
-def sensitivity(robots: pd.DataFrame, design: Design, *, seed: int | None = None) -> Sensitivity:
-    """The indices from a robots table (a store's, or a notebook's DataFrame) and its design."""
-    points = point_outputs(run_outputs(robots, design), design)
-    return Sensitivity(design, analyse(design, points, seed=seed), points)
+# ------------------------------------------------------------------------------------ seed noise
+def blocks(design: Design) -> np.ndarray:
+    """The independent unit of each point, for resampling: Saltelli's base sample (A_j, AB_1j .. AB_Dj,
+    B_j and, second order, BA_1j .. BA_Dj are drawn together), Morris's trajectory, a hypercube's point."""
+    d = len(design.names)
+    size = {"sobol": (2 * d + 2) if design.second_order else (d + 2), "morris": d + 1}.get(design.method, 1)
+    return np.arange(design.points) // size
+
+
+def _replicates(runs: pd.DataFrame, design: Design, output: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Per point, as [blocks, points per block]: the mean of its runs, their variance (ddof 1) and count."""
+    g = runs.groupby("point")[output]
+    idx = range(design.points)
+    m = g.mean().reindex(idx).to_numpy(float)
+    v = g.var(ddof=1).reindex(idx).to_numpy(float)
+    n = g.size().reindex(idx).to_numpy(float)
+    b = blocks(design)
+    shape = (b.max() + 1, design.points // (b.max() + 1))
+    return m.reshape(shape), v.reshape(shape), n.reshape(shape)
+
+
+def _floor_stats(m: np.ndarray, v: np.ndarray, n: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(floor, run share) over the last two axes: the seed noise's share of the variance of the point
+    means, (mean of v / n) / var(means), and of the variance of single runs, mean(v) / (var(means) -
+    mean(v / n) + mean(v)) (one-way random-effects decomposition: var(means) = between + noise / R)."""
+    k = m.shape[-1] * m.shape[-2]
+    vm = m.reshape(*m.shape[:-2], k).var(axis=-1, ddof=1)
+    e = (v / n).reshape(*m.shape[:-2], k).mean(axis=-1)
+    w = v.reshape(*m.shape[:-2], k).mean(axis=-1)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return e / vm, w / (np.maximum(vm - e, 0.0) + w)
+
+
+def noise_floor(runs: pd.DataFrame, design: Design, *, seed: int | None = None) -> pd.DataFrame:
+    """Seed noise's share of each output's variance, from the replicates of every point, with 95 %
+    percentile bootstrap intervals (``scipy.stats.bootstrap``, base samples resampled: the unit Saltelli's
+    scheme draws independently).  ``floor``: share of the variance of the point means (the floor every
+    total index of the point means sits on: Jansen's estimator gives (V_Ti + noise / R) / V);
+    ``run_share``: share of the variance of single runs.  Empty when a point ran once (no replicates)."""
+    from scipy import stats as sps
+
+    cols = ["output", "runs_per_point", "floor", "floor_low", "floor_high", "run_share", "run_share_low",
+            "run_share_high"]
+    per = runs.groupby("point").size()
+    if per.min() < 2:
+        return pd.DataFrame(columns=cols)
+    seed = design.seed if seed is None else seed
+    rows = []
+    for output in design.outputs:
+        m, v, n = _replicates(runs, design, output)
+        floor, share = (float(x) for x in _floor_stats(m, v, n))
+        ci = []
+        for k in (0, 1):
+            def stat(i, axis=-1, k=k):
+                i = np.asarray(i, dtype=np.int64)
+                return _floor_stats(m[i], v[i], n[i])[k]
+            res = sps.bootstrap((np.arange(m.shape[0]),), stat, vectorized=True, n_resamples=RESAMPLES,
+                                batch=100, confidence_level=CONF_LEVEL, method="percentile",
+                                rng=np.random.default_rng(seed))
+            ci.append((float(res.confidence_interval.low), float(res.confidence_interval.high)))
+        rows.append({"output": output, "runs_per_point": int(per.min()), "floor": floor, "floor_low": ci[0][0],
+                     "floor_high": ci[0][1], "run_share": share, "run_share_low": ci[1][0],
+                     "run_share_high": ci[1][1]})
+    return pd.DataFrame(rows, columns=cols)
+
+
+def _floor_rows(design: Design, floor: pd.DataFrame) -> list[dict]:
+    return [{"experiment": design.experiment, "output": r.output, "method": "replicates", "index": kind,
+             "parameter": "", "parameter2": "", "value": v, "conf": (hi - lo) / 2, "low": lo, "high": hi}
+            for r in floor.itertuples()
+            for kind, v, lo, hi in (("floor", r.floor, r.floor_low, r.floor_high),
+                                    ("run_share", r.run_share, r.run_share_low, r.run_share_high))]
+
+
+# ------------------------------------------------------------------------------------------ PAWN
+def pawn(design: Design, points: pd.DataFrame, *, seed: int | None = None,
+         permutations: int | None = None) -> pd.DataFrame:
+    """PAWN indices (SALib's ``pawn.analyze``: the median over 10 slices of each parameter of the
+    Kolmogorov-Smirnov distance between the conditional and the unconditional output distribution) of
+    every output, and ``PAWN_null``: the 95th percentile of the same index over ``permutations`` seeded
+    shuffles of the output (a permutation test: the level a parameter without effect reaches at this
+    sample size; a KS distance is never 0 on a finite sample).  Distribution-based, so a heavy tail does
+    not dominate it as it dominates variance.  (No bootstrap interval: resampling with replacement
+    duplicates points, which biases a KS distance upwards.)"""
+    import warnings
+
+    from SALib.analyze import pawn as salib_pawn
+
+    seed = design.seed if seed is None else seed
+    permutations = PAWN_PERMUTATIONS if permutations is None else permutations
+    problem, X = design.problem(), design.X
+    rows = []
+    for output in design.outputs:
+        Y = points[output].to_numpy(dtype=float)
+
+        def index(y):
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                return np.asarray(salib_pawn.analyze(problem, X, y, S=PAWN_SLICES, seed=seed)["median"], float)
+
+        value = index(Y)
+        rng = np.random.default_rng(seed)
+        null = np.percentile([index(rng.permutation(Y)) for _ in range(permutations)], 95, axis=0)
+        for j, p in enumerate(design.names):
+            for kind, v in (("PAWN", value[j]), ("PAWN_null", null[j])):
+                rows.append({"experiment": design.experiment, "output": output, "method": "pawn", "index": kind,
+                             "parameter": p, "parameter2": "", "value": float(v), "conf": np.nan, "low": np.nan,
+                             "high": np.nan})
+    return pd.DataFrame(rows, columns=COLUMNS)
+
+
+def sensitivity(robots: pd.DataFrame, design: Design, *, seed: int | None = None,
+                distribution: bool = True) -> Sensitivity:
+    """The indices from a robots table (a store's, or a notebook's DataFrame) and its design: SALib's,
+    the seed-noise floor (when points ran more than once) and, for a Sobol' or hypercube design with
+    ``distribution``, PAWN indices."""
+    runs = run_outputs(robots, design)
+    points = point_outputs(runs, design)
+    floor = noise_floor(runs, design, seed=seed)
+    parts = [analyse(design, points, seed=seed)]
+    if len(floor):
+        parts.append(pd.DataFrame(_floor_rows(design, floor), columns=COLUMNS))
+    if distribution and design.method in ("sobol", "lhs"):
+        parts.append(pawn(design, points, seed=seed))
+    table = pd.concat(parts, ignore_index=True) if len(parts) > 1 else parts[0]
+    return Sensitivity(design, table, points, runs, floor)
 
 
 def from_store(store, experiment: str | None = None) -> Sensitivity:
@@ -176,90 +325,249 @@ def from_store(store, experiment: str | None = None) -> Sensitivity:
 
 
 # ------------------------------------------------------------------------------------ robustness
-DRIVES = 0.1  # a parameter drives an output when its total index (Sobol') is at least this
+DRIVES = 0.1  # a parameter drives an output when its total index above the noise floor is at least this
+
+
+def _floor_of(s: Sensitivity, output: str) -> tuple[float, float, float]:
+    """(floor, low, high) of ``output``; NaN when the design's points ran once."""
+    if s.floor is None or s.floor.empty or output not in set(s.floor.output):
+        return (np.nan, np.nan, np.nan)
+    r = s.floor.set_index("output").loc[output]
+    return float(r.floor), float(r.floor_low), float(r.floor_high)
 
 
 def drivers(s: Sensitivity, threshold: float = DRIVES) -> dict[str, list[str]]:
-    """The parameters whose total index (Sobol'), μ* share (Morris) or S1 (RBD-FAST) is ≥ ``threshold``."""
+    """The parameters whose total index (Sobol') minus the seed-noise floor (0 when unknown), μ* share
+    (Morris) or S1 (RBD-FAST) is ≥ ``threshold``."""
     t = s.table
     kind = {"sobol": "ST", "morris": "mu_star", "lhs": "S1"}[s.design.method]
     out = {}
     for output in s.design.outputs:
         rows = t[(t.output == output) & (t["index"] == kind)]
         values = rows.value / rows.value.sum() if kind == "mu_star" and rows.value.sum() > 0 else rows.value
+        if kind == "ST":
+            values = values - np.nan_to_num(_floor_of(s, output)[0])
         out[output] = rows.parameter[values >= threshold].tolist()
     return out
 
 
-def robustness(s: Sensitivity, runs: pd.DataFrame, at: dict[str, float], *, bins: int = 10,
-               tolerance: float = 0.1) -> pd.DataFrame:
-    """Whether the point ``at`` (a value per parameter) sits in a flat region of each output.
-
-    For each output and each parameter that drives it, the runs are cut into ``bins`` equal-width bins
-    of that parameter (one bin per value for an integer parameter); the medians of the runs in ``at``'s bin and in the adjacent bins are compared
-    with the output's 5-95 % range over the design (robust when the difference is below ``tolerance``
-    of it), with a two-sided Mann-Whitney U test on the two sets of runs.  ``runs``: ``run_outputs``."""
-    from scipy.stats import mannwhitneyu
-
+def morris_noise(s: Sensitivity, output: str) -> float:
+    """The Morris μ* that seed noise alone gives a replicated Morris design: an elementary effect of pure
+    noise is the difference of two point means over Δ (levels / (2 (levels - 1)), SALib's step in units of
+    the range), normal with variance 2 s2 / R, whose mean absolute value is sqrt(2 / π) sqrt(2 s2 / R) / Δ
+    (s2 / R: the mean of each point's within-point variance over its run count).  NaN without replicates."""
     d = s.design
-    unknown = sorted(set(at) - set(d.names))
-    if unknown:
-        raise MissingDataError(f"--at: unknown parameter {unknown[0]!r}; the design has {', '.join(d.names)}")
-    values = d.frame().set_index("point")
+    if d.method != "morris" or s.runs is None or s.runs_per_point[0] < 2:
+        return np.nan
+    _, v, n = _replicates(s.runs, d, output)
+    delta = d.levels / (2.0 * (d.levels - 1))
+    return float(np.sqrt(2.0 / np.pi) * np.sqrt(2.0 * np.nanmean(v / n)) / delta)
+
+
+def _spread(m: np.ndarray, v: np.ndarray, n: np.ndarray) -> np.ndarray:
+    """Standard deviation the parameters cause between points (last two axes), seed noise removed:
+    sqrt(max(0, var(means) - mean(v / n)))."""
+    k = m.shape[-1] * m.shape[-2]
+    vm = m.reshape(*m.shape[:-2], k).var(axis=-1, ddof=1)
+    e = (v / n).reshape(*m.shape[:-2], k).mean(axis=-1)
+    return np.sqrt(np.maximum(vm - e, 0.0))
+
+
+def local_robustness(local: Sensitivity, reference: pd.DataFrame | None = None, *, tolerance: float = 0.05,
+                     seed: int | None = None) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Is the centre of a local design (e.g. Morris trajectories in a small box around the paper's
+    point, every point run R >= 2 times) in a robust region?  Returns (verdicts, parameters).
+
+    verdicts, one row per output: ``spread``, the standard deviation of the output that the parameters
+    cause across the box (the between-point variance of the point means minus the seed noise's share,
+    ``_spread``), with a 95 % percentile bootstrap interval over trajectories (``scipy.stats.bootstrap``);
+    ``tolerance`` x the 5-95 % range of the output over ``reference`` (the global design's point means;
+    the box's own runs when None); ``robust``: yes when the interval's upper end is below the tolerance,
+    no when its lower end is above it, else inconclusive (``stats.answer``).
+    parameters, one row per output and parameter: SALib's Morris μ* with its interval, and ``mu_star_noise``,
+    the μ* that seed noise alone gives (E|N(0, 2 s2 / R)| / Δ, s2 the within-point variance, Δ Morris's
+    step); ``moves``: μ*'s lower bound above it."""
+    from scipy import stats as sps
+
+    from .stats import answer
+
+    d = local.design
+    if local.runs is None or local.runs_per_point[0] < 2:
+        raise MissingDataError(f"{d.experiment}: the local design's points ran once; its robustness needs "
+                               f"replicates (runs >= 2) to tell the parameters' spread from seed noise")
+    seed = d.seed if seed is None else seed
+    verdicts, params = [], []
+    for output in d.outputs:
+        m, v, n = _replicates(local.runs, d, output)
+        spread = float(_spread(m, v, n))
+
+        def stat(i, axis=-1):
+            i = np.asarray(i, dtype=np.int64)
+            return _spread(m[i], v[i], n[i])
+
+        res = sps.bootstrap((np.arange(m.shape[0]),), stat, vectorized=True, n_resamples=RESAMPLES, batch=100,
+                            confidence_level=CONF_LEVEL, method="percentile", rng=np.random.default_rng(seed))
+        lo, hi = float(res.confidence_interval.low), float(res.confidence_interval.high)
+        ref = (reference[output] if reference is not None else local.runs[output]).to_numpy(float)
+        p5, p95 = np.nanpercentile(ref, [5, 95])
+        tol = tolerance * float(p95 - p5)
+        y = local.runs[output].to_numpy(float)
+        verdicts.append({"output": output, "spread": spread, "spread_low": lo, "spread_high": hi,
+                         "range_5_95": float(p95 - p5), "tolerance": tol,
+                         "robust": answer(hi < tol, lo > tol), "runs": len(y),
+                         "median": float(np.median(y)), "positive": float(np.mean(y > 0))})
+        noise_mu = morris_noise(local, output)
+        if d.method == "morris":
+            rows = local.table[(local.table.output == output) & (local.table["index"] == "mu_star")]
+            for r in rows.itertuples():
+                params.append({"output": output, "parameter": r.parameter, "mu_star": r.value, "mu_star_low": r.low,
+                               "mu_star_high": r.high, "mu_star_noise": noise_mu, "moves": bool(r.low > noise_mu)})
+    return pd.DataFrame(verdicts), pd.DataFrame(params)
+
+
+# ------------------------------------------------------------------------------------- questions
+def load_questions(path: Path = QUESTIONS) -> dict:
+    import tomllib
+
+    return tomllib.loads(Path(path).read_text())
+
+
+def answers(s: Sensitivity, questions: dict | None = None, local: tuple[pd.DataFrame, pd.DataFrame] | None = None,
+            locks: list | None = None) -> pd.DataFrame:
+    """The declared questions (``sensitivity_questions.toml``) answered from a global design and,
+    for robustness, a local one: one row per question and output with the answer and its numbers.
+    A design of another size than the declared one says so; the precision question is answered only
+    at the declared size."""
+    from .declared import status_of
+    from .stats import INCONCLUSIVE, NO, YES
+
+    q = (questions or load_questions())["questions"]
+    d, t = s.design, s.table
+    declared = q["design"]
+    lo_r, hi_r = s.runs_per_point
+    at_size = d.samples == declared["samples"] and lo_r == hi_r == declared["runs"]
+    size = ("" if at_size else f"NOTE: answered at {d.samples} base samples x {lo_r}"
+            f"{'' if lo_r == hi_r else f'-{hi_r}'} runs, not the {declared['samples']} x {declared['runs']} declared. ")
     rows = []
-    for output, params in drivers(s).items():
-        y = runs[output].to_numpy(dtype=float)
-        lo, hi = np.nanpercentile(y, [5, 95])
-        for p in params:
-            if p not in at:
-                continue
-            j = d.names.index(p)
-            if d.integer[j]:  # an integer key: one bin per value
-                edges = np.arange(d.low[j] - 0.5, d.high[j] + 1.0)
+
+    def lock(qid: str) -> str:
+        return status_of(locks, "sensitivity_questions.toml", f"questions.{qid}") if locks is not None else ""
+
+    def get(output: str, index: str) -> pd.DataFrame:
+        return t[(t.output == output) & (t["index"] == index)].set_index("parameter").reindex(d.names)
+
+    if d.method == "sobol":
+        for output in d.outputs:
+            st, s1 = get(output, "ST"), get(output, "S1")
+            f, flo, fhi = _floor_of(s, output)
+            pw, pn = get(output, "PAWN"), get(output, "PAWN_null")
+            pawn_text = ("; PAWN above its no-effect level: " + (", ".join(
+                f"{p} {pw.value[p]:.2f}" for p in pw.value.sort_values(ascending=False).index
+                if pw.value[p] > pn.value[p]) or "none") if pw.value.notna().any() else "")
+            if np.isnan(f):
+                rows.append(["drivers", output, INCONCLUSIVE, size + "one run per point: the seed-noise floor "
+                             "is unknown, so total indices cannot be told from noise", lock("drivers")])
             else:
-                edges = np.linspace(d.low[j], d.high[j], bins + 1)
-            nb = len(edges) - 1
-            x = values.loc[runs["point"].to_numpy(), p].to_numpy(dtype=float)
-            which = np.clip(np.searchsorted(edges, x, side="right") - 1, 0, nb - 1)
-            home = int(np.clip(np.searchsorted(edges, at[p], side="right") - 1, 0, nb - 1))
-            near = [b for b in (home - 1, home + 1) if 0 <= b < nb]
-            a, b = y[which == home], y[np.isin(which, near)]
-            diff = float(np.median(b) - np.median(a)) if len(a) and len(b) else np.nan
-            pval = float(mannwhitneyu(a, b, alternative="two-sided").pvalue) if len(a) and len(b) else np.nan
-            rows.append({"output": output, "parameter": p, "at": at[p],
-                         "bin": f"[{edges[home]:g}, {edges[home + 1]:g})", "runs_in_bin": len(a),
-                         "runs_adjacent": len(b), "median_in_bin": float(np.median(a)) if len(a) else np.nan,
-                         "median_adjacent": float(np.median(b)) if len(b) else np.nan, "difference": diff,
-                         "range_5_95": float(hi - lo), "relative": abs(diff) / (hi - lo) if hi > lo else np.nan,
-                         "mann_whitney_p": pval,
-                         "robust": bool(abs(diff) < tolerance * (hi - lo)) if np.isfinite(diff) else False,
-                         "positive_in_bin": float(np.mean(a > 0)) if len(a) else np.nan})
-    return pd.DataFrame(rows)
+                p = q["drivers"]
+                excess = st.value - f
+                drive = [n for n in d.names if excess[n] >= p["min_excess"] and st.low[n] > fhi]
+                top = s1.value.idxmax()
+                dominant = (top if s1.value[top] >= p["dominant_s1"] and s1.low[top] > 0 else None)
+                text = (f"floor {f:.2f} [{flo:.2f}, {fhi:.2f}]; S_T - floor: "
+                        + ", ".join(f"{n} {excess[n]:+.2f}" for n in excess.sort_values(ascending=False).index)
+                        + f"; largest S_1: {top} {s1.value[top]:.2f} [{s1.low[top]:.2f}, {s1.high[top]:.2f}]"
+                        + (f" (dominant)" if dominant else " (none dominant)") + pawn_text)
+                rows.append(["drivers", output, ", ".join(drive) or "none", size + text, lock("drivers")])
+                inter = [n for n in d.names if st.value[n] - s1.value[n] - f >= q["interactions"]["min_excess"]]
+                rows.append(["interactions", output, ", ".join(inter) or "none", size + "S_T - S_1 - floor: "
+                             + ", ".join(f"{n} {st.value[n] - s1.value[n] - f:+.2f}" for n in d.names),
+                             lock("interactions")])
+        if s.floor is not None and len(s.floor):
+            for r in s.floor.itertuples():
+                rows.append(["noise_floor", r.output, f"{100 * r.run_share:.0f} % of single-run variance",
+                             size + f"run level {r.run_share:.2f} [{r.run_share_low:.2f}, {r.run_share_high:.2f}]; "
+                             f"floor of the means of {r.runs_per_point} runs {r.floor:.2f} [{r.floor_low:.2f}, "
+                             f"{r.floor_high:.2f}]", lock("noise_floor")])
+        s1 = t[t["index"] == "S1"]
+        widths = (s1.high - s1.low).groupby(s1.output).max()
+        text = "largest full width of a first-order interval: " + ", ".join(f"{o} {w:.3f}" for o, w in widths.items())
+        if at_size:
+            ok = bool((widths < q["precision"]["max_width"]).all())
+            rows.append(["precision", "all", YES if ok else NO, text, lock("precision")])
+        else:
+            rows.append(["precision", "all", f"not answered ({d.samples} x {lo_r} is not the declared size)",
+                         size + text, lock("precision")])
+    if local is not None:
+        verdicts, params = local
+        for r in verdicts.itertuples():
+            moved = params[(params.output == r.output) & params.moves].parameter.tolist() if len(params) else []
+            rows.append(["robust", r.output, r.robust,
+                         f"spread caused by the parameters in the box {r.spread:.3g} [{r.spread_low:.3g}, "
+                         f"{r.spread_high:.3g}] vs tolerance {r.tolerance:.3g} (5 % of the global 5-95 % range "
+                         f"{r.range_5_95:.3g}); {r.runs} runs, median {r.median:.3g}, positive in "
+                         f"{100 * r.positive:.0f} %; parameters whose Morris mu* is above seed noise: "
+                         f"{', '.join(moved) or 'none'}", lock("robust")])
+    return pd.DataFrame(rows, columns=["question", "output", "answer", "statistics", "declared"])
 
 
 # --------------------------------------------------------------------------------------- figures
+HATCH = {"S1": "", "ST": "//", "mu_star": "", "sigma": "//", "PAWN": ""}
+
+
 def _bars(s: Sensitivity):
+    """Per output: the indices with their intervals (legend beside the axes, hiding no bar), the
+    seed-noise floor of the total indices as a dashed line with its interval shaded, and (Sobol' or
+    hypercube designs with PAWN) the PAWN indices with the level a parameter without effect reaches."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
     t, d = s.table, s.design
     kinds = {"sobol": ["S1", "ST"], "morris": ["mu_star", "sigma"], "lhs": ["S1"]}[d.method]
+    has_pawn = bool((t["index"] == "PAWN").any())
     outs = d.outputs
-    fig = Figure(figsize=(1.0 + 0.9 * len(d.names), 2.8 * len(outs)), layout="constrained")
-    axes = fig.subplots(len(outs), 1, squeeze=False)[:, 0]
+    ncols = 2 if has_pawn else 1
+    fig = Figure(figsize=(3.6 + 1.0 * len(d.names) * ncols, 3.2 * len(outs)), layout="constrained")
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(len(outs), ncols, squeeze=False)
     x = np.arange(len(d.names))
     width = 0.8 / len(kinds)
-    for ax, output in zip(axes, outs):
+    for row, output in enumerate(outs):
+        ax = axes[row, 0]
         for k, kind in enumerate(kinds):
             rows = t[(t.output == output) & (t["index"] == kind)].set_index("parameter").reindex(d.names)
             err = rows["conf"].to_numpy() if rows["conf"].notna().any() else None
             ax.bar(x + (k - (len(kinds) - 1) / 2) * width, rows["value"], width, yerr=err, capsize=3,
-                   label=TITLES[kind])
-        ax.set_xticks(x, d.names, rotation=20, ha="right")
+                   label=TITLES[kind], hatch=HATCH.get(kind, ""), edgecolor="black", linewidth=0.5)
+        f, flo, fhi = _floor_of(s, output)
+        noise_mu = morris_noise(s, output)
+        if np.isfinite(noise_mu):
+            ax.axhline(noise_mu, color="black", linestyle="--", linewidth=1.2,
+                       label=f"μ* of seed noise alone ({noise_mu:.3g})")
+        if d.method == "sobol" and np.isfinite(f):
+            ax.axhspan(flo, fhi, color="grey", alpha=0.25, linewidth=0, label="floor's 95 % interval")
+            ax.axhline(f, color="black", linestyle="--", linewidth=1.2,
+                       label=f"seed-noise floor of S_T ({f:.2f})")
+        ax.set_xticks(x, d.names, rotation=40, ha="right", rotation_mode="anchor", fontsize=8)
         ax.axhline(0, color="black", linewidth=0.6)
-        ax.set_title(f"{d.experiment}: {output}", fontsize=10)
+        ax.set_title(f"{output}: {TITLES[kinds[0]].split()[0]}{' / total' if d.method == 'sobol' else ''}, "
+                     f"{s.size()}", fontsize=9, loc="left")
         ax.set_ylabel("index" if d.method != "morris" else "effect (output units)")
-        ax.legend(fontsize=8)
-    fig.suptitle(f"{d.method} design, {d.points} points, 95 % bootstrap intervals", fontsize=9)
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+        if has_pawn:
+            ax = axes[row, 1]
+            rows = t[(t.output == output) & (t["index"] == "PAWN")].set_index("parameter").reindex(d.names)
+            null = t[(t.output == output) & (t["index"] == "PAWN_null")].set_index("parameter").reindex(d.names)
+            ax.bar(x, rows["value"], 0.6, color="#9467bd", edgecolor="black", linewidth=0.5, label=TITLES["PAWN"])
+            ax.plot(x, null["value"], linestyle="none", marker="_", markersize=14, markeredgewidth=2,
+                    color="black", label=f"no effect: 95th percentile,\n{PAWN_PERMUTATIONS} shuffles of the output")
+            ax.set_xticks(x, d.names, rotation=40, ha="right", rotation_mode="anchor", fontsize=8)
+            ax.set_ylim(0, max(0.1, float(np.nanmax(rows["value"].to_numpy())) * 1.15,
+                               float(np.nanmax(null["value"].to_numpy())) * 1.15))
+            ax.set_title(f"{output}: PAWN, {s.size()}", fontsize=9, loc="left")
+            ax.set_ylabel("PAWN index")
+            ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), frameon=False)
+    fig.suptitle(f"{d.experiment}: {d.method} design, {d.samples} base samples; 95 % bootstrap intervals",
+                 fontsize=10)
     return fig
 
 
@@ -290,62 +598,117 @@ def _fmt(v: float) -> str:
 
 
 def summary_table(s: Sensitivity) -> pd.DataFrame:
-    """One row per output and parameter: the main indices side by side (what the report shows)."""
-    t = s.table[s.table["index"] != "S2"]
-    wide = t.pivot_table(index=["output", "parameter"], columns="index", values=["value", "conf"],
-                         sort=False)
+    """One row per output and parameter: the main indices side by side (what the report shows); PAWN
+    with its percentile interval, the others ± the interval's half-width."""
+    t = s.table[s.table["index"].isin([k for k in TITLES if k != "S2"])]
     rows = []
-    for (output, p), r in wide.iterrows():
+    for (output, p), g in t.groupby(["output", "parameter"], sort=False):
         row = {"output": output, "parameter": p}
-        for kind in dict.fromkeys(t["index"]):
-            v, c = r[("value", kind)], r.get(("conf", kind), np.nan)
-            row[TITLES[kind]] = _fmt(v) + (f" ± {_fmt(c)}" if np.isfinite(c) else "")
+        for r in g.itertuples():
+            if r.index == "PAWN_null":
+                row[TITLES["PAWN"]] = row.get(TITLES["PAWN"], "") + f" (no effect: {_fmt(r.value)})"
+            elif r.index == "PAWN":
+                row[TITLES[r.index]] = _fmt(r.value) + row.get(TITLES["PAWN"], "")
+            else:
+                row[TITLES[r.index]] = _fmt(r.value) + (f" ± {_fmt(r.conf)}" if np.isfinite(r.conf) else "")
         rows.append(row)
     return pd.DataFrame(rows)
 
 
-def markdown(s: Sensitivity, files: list[str]) -> str:
+def floor_table(s: Sensitivity) -> pd.DataFrame:
+    """The seed-noise shares with their intervals, one row per output (empty for one run per point)."""
+    if s.floor is None or s.floor.empty:
+        return pd.DataFrame()
+    return pd.DataFrame({"output": s.floor.output,
+                         "runs per point": s.floor.runs_per_point,
+                         "seed noise, share of single-run variance": [
+                             f"{r.run_share:.3f} [{r.run_share_low:.3f}, {r.run_share_high:.3f}]" for r in s.floor.itertuples()],
+                         "floor of S_T (share of the point means' variance)": [
+                             f"{r.floor:.3f} [{r.floor_low:.3f}, {r.floor_high:.3f}]" for r in s.floor.itertuples()]})
+
+
+def _intro(s: Sensitivity) -> str:
+    d = s.design
+    lo, hi = s.runs_per_point
+    text = (f"{d.method} design, {d.samples} base samples, {s.size()} (seed {d.seed}, SALib {d.salib}) over "
+            f"{len(d.names)} parameters; the indices see the mean of each point's runs; 95 % bootstrap intervals "
+            f"({RESAMPLES} resamples); PAWN beside a permutation test ({PAWN_PERMUTATIONS} shuffles).")
+    if hi < 2:
+        text += (" Every point ran once, so seed noise sits under every total index and its share cannot be "
+                 "estimated: set `runs` >= 2 in the experiment.")
+    return text
+
+
+def markdown(s: Sensitivity, files: list[str], answers_table: pd.DataFrame | None = None) -> str:
     from .report import _md_table
 
     d = s.design
-    lines = [f"## Global sensitivity: {d.experiment}", "",
-             f"{d.method} design of {d.points} points ({d.samples} base samples, seed {d.seed}, SALib "
-             f"{d.salib}) over {len(d.names)} parameters; indices with 95 % bootstrap intervals "
-             f"({RESAMPLES} resamples).", ""]
+    lines = [f"## Global sensitivity: {d.experiment}", "", _intro(s), ""]
     lines += [_md_table(pd.DataFrame({"parameter": d.names, "key": d.keys,
                                       "range": [f"[{lo:g}, {hi:g}]" for lo, hi in zip(d.low, d.high)]})), ""]
+    ft = floor_table(s)
+    if len(ft):
+        lines += ["Seed noise (from the replicates of every point):", "", _md_table(ft), ""]
     lines += [_md_table(summary_table(s)), ""]
+    if answers_table is not None and len(answers_table):
+        lines += ["Declared questions (`src/infomarket/analysis/sensitivity_questions.toml`):", "",
+                  _md_table(answers_table), ""]
     lines += [f"![{f}]({f})" for f in files if f.endswith(".png")]
     return "\n".join(lines) + "\n"
 
 
-def html_section(s: Sensitivity, files: list[str]) -> str:
+def html_section(s: Sensitivity, files: list[str], answers_table: pd.DataFrame | None = None) -> str:
     from .report import _html_table
 
     d = s.design
-    parts = [f"<h2>Global sensitivity: {html.escape(d.experiment)}</h2>",
-             f"<p>{d.method} design of {d.points} points ({d.samples} base samples, seed {d.seed}, SALib "
-             f"{html.escape(d.salib)}); 95 % bootstrap intervals.</p>", _html_table(summary_table(s))]
+    parts = [f"<h2>Global sensitivity: {html.escape(d.experiment)}</h2>", f"<p>{html.escape(_intro(s))}</p>"]
+    ft = floor_table(s)
+    if len(ft):
+        parts.append(_html_table(ft))
+    parts.append(_html_table(summary_table(s)))
+    if answers_table is not None and len(answers_table):
+        parts.append(_html_table(answers_table))
     parts += [f"<p><img src='{html.escape(f)}' alt='{html.escape(f)}'></p>" for f in files if f.endswith(".png")]
     return "\n".join(parts)
 
 
-def write(s: Sensitivity, out: str | Path, *, vector: str = "svg") -> list[Path]:
-    """``sensitivity.csv`` / ``.parquet`` (the long table), the bar chart (and the S2 heat map of a
-    second-order Sobol' design) as PNG and ``vector``, and ``sensitivity.md``; returns the files."""
+def declared_answers(s: Sensitivity, store=None, local: tuple[pd.DataFrame, pd.DataFrame] | None = None
+                     ) -> pd.DataFrame | None:
+    """``answers`` for the design the questions file declares (None for another experiment), with each
+    question's lock status against ``store``'s record (``analysis.declared``)."""
+    from .declared import check
+
+    questions = load_questions()
+    if s.design.experiment != questions["questions"]["design"]["experiment"]:
+        return None
+    locks = check(store.declarations()) if store is not None else None
+    return answers(s, questions, local, locks)
+
+
+def stem(experiment: str) -> str:
+    """The files' name: the experiment's, prefixed with ``sensitivity-`` unless it says so already
+    (``sensitivity``, ``sensitivity_local``; not ``sensitivity-sensitivity``)."""
+    return experiment if experiment.startswith("sensitivity") else f"sensitivity-{experiment}"
+
+
+def write(s: Sensitivity, out: str | Path, *, vector: str = "svg",
+          answers_table: pd.DataFrame | None = None) -> list[Path]:
+    """``STEM.csv`` / ``.parquet`` (the long table, the noise floor and PAWN included), the bar chart
+    (and the S2 heat map of a second-order Sobol' design) as PNG and ``vector``, and ``STEM.md``
+    (``stem``: ``sensitivity-NAME``, or NAME when it starts with "sensitivity"); returns the files."""
     from .figures import save
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    stem = f"sensitivity-{s.design.experiment}"
-    files = [out / f"{stem}.csv", out / f"{stem}.parquet"]
+    name = stem(s.design.experiment)
+    files = [out / f"{name}.csv", out / f"{name}.parquet"]
     s.table.to_csv(files[0], index=False)
     s.table.to_parquet(files[1], index=False)
-    figs = save(_bars(s), out, f"{stem}-indices", vector)
+    figs = save(_bars(s), out, f"{name}-indices", vector)
     if s.design.method == "sobol" and s.design.second_order:
-        figs += save(_heatmap(s), out, f"{stem}-S2", vector)
-    md = out / f"{stem}.md"
-    md.write_text(markdown(s, [p.name for p in figs]), encoding="utf-8")
+        figs += save(_heatmap(s), out, f"{name}-S2", vector)
+    md = out / f"{name}.md"
+    md.write_text(markdown(s, [p.name for p in figs], answers_table), encoding="utf-8")
     s.files = files + figs + [md]
     return s.files
 
@@ -362,12 +725,13 @@ def report_section(store, out: Path, vector: str = "svg", echo=lambda line: None
         except MissingDataError as exc:
             echo(f"sensitivity of {name}: skipped ({exc})")
             continue
-        files = write(s, out, vector=vector)
+        table = declared_answers(s, store)
+        files = write(s, out, vector=vector, answers_table=table)
         names = [p.name for p in files if p.suffix in (".png", f".{vector}")]
-        sections.append((markdown(s, names), html_section(s, names)))
+        sections.append((markdown(s, names, table), html_section(s, names, table)))
         echo(f"sensitivity of {name}: wrote {', '.join(p.name for p in files)}")
     return sections
 
 
-__all__ = ["BUILTIN_OUTPUTS", "Sensitivity", "analyse", "from_store", "point_outputs", "run_outputs",
-           "sensitivity", "write"]
+__all__ = ["BUILTIN_OUTPUTS", "Sensitivity", "analyse", "answers", "from_store", "local_robustness", "noise_floor",
+           "pawn", "point_outputs", "run_outputs", "sensitivity", "stem", "write"]

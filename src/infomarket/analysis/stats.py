@@ -43,6 +43,7 @@ ALPHA = 0.05
 POWER = 0.80       # the power a "no" needs: below it, an undetected effect is "inconclusive"
 POWER_SIMS = 1000  # simulated experiments per power estimate (standard error <= 0.016)
 YES, NO, INCONCLUSIVE = "yes", "no", "inconclusive"
+N_TOO_SMALL = "n too small"  # the note an inconclusive answer carries when no run count could have decided it
 BATCH = 100  # resamples held in memory at once: 100 x 32 runs x 1001 steps x 8 B = 26 MB for Fig. 5
 
 
@@ -290,6 +291,18 @@ def tost(x, y, margin: float, alpha: float = ALPHA, seed: int = SEED) -> tuple[f
     lo = compare(x, y, alternative="greater", shift=margin, alpha=alpha, label="x > y - margin", seed=seed)
     hi = compare(x, y, alternative="less", shift=-margin, alpha=alpha, label="x < y + margin", seed=seed)
     return max(lo.p, hi.p), lo, hi
+
+
+def too_few_runs(comparisons) -> bool:
+    """Whether the run counts cannot reach alpha in any of these comparisons: even the most extreme
+    ordering of the runs (``min_p``), Holm-adjusted over the family (x ``family``), is not below alpha."""
+    comparisons = list(comparisons)
+    return bool(comparisons) and all(c.min_p * c.family >= c.alpha for c in comparisons)
+
+
+def shown(answer: str, note: str = "") -> str:
+    """An answer as printed: ``inconclusive (n too small)`` when a note qualifies it."""
+    return f"{answer} ({note})" if note else answer
 
 
 def answer(yes: bool, no: bool) -> str:

@@ -201,47 +201,69 @@ def crowd_collisions(robots: pd.DataFrame, rule: dict) -> dict:
     return out
 
 
-def figure(a: dict, path: Path) -> Path:
-    import matplotlib
+def _boxes(ax, data: list, labels: list[str], positions=None) -> None:
+    """Box plots in the report's convention (``boxplots.draw_boxes``), each tick naming its run count."""
+    from .boxplots import HONEST, draw_boxes
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    pos = list(range(1, len(data) + 1)) if positions is None else list(positions)
+    draw_boxes(ax, [np.asarray(d, float) for d in data], pos, HONEST, width=0.55)
+    ax.set_xticks(pos, [f"{lab}\nn = {len(d)}" for lab, d in zip(labels, data)], fontsize=7)
+    ax.set_xlim(min(pos) - 0.6, max(pos) + 0.6)
 
-    fig, ax = plt.subplots(1, 3, figsize=(14, 4.2))
+
+def terrain_figure(a: dict):
+    """The terrain answers' figure (a ``matplotlib.figure.Figure``): one panel per question, every box
+    labelled with its run count, reference lines named in a legend."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+    from matplotlib.lines import Line2D
+
+    fig = Figure(figsize=(15, 4.8), layout="constrained")
+    FigureCanvasAgg(fig)
+    ax = fig.subplots(1, 3, gridspec_kw={"width_ratios": [1.35, 0.8, 1.2]})
     q1 = a["chain_blocked"]["per_run"]
     keys = ["plane/on", "plane/off", "corridor/on", "corridor/off"]
-    ax[0].boxplot([q1[k] for k in keys], tick_labels=["plane\nmarket", "plane\nno market", "corridor\nmarket",
-                                                      "corridor\nno market"])
+    data = [q1[k] for k in keys]
+    labels = ["plane\nmarket", "plane\nno market", "corridor\nmarket", "corridor\nno market"]
     w = a["waypoints_restore"]
     if w["answer"] != "not run":
-        ax[0].boxplot([w["per_run"]["waypoint/plane"], w["per_run"]["waypoint/corridor"]], positions=[5, 6])
-        ax[0].set_xticks(range(1, 7), ["plane\nmarket", "plane\nno market", "corridor\nmarket",
-                                       "corridor\nno market", "plane\nwaypoints", "corridor\nwaypoints"])
-        ax[0].set_yscale("symlog", linthresh=10)
-        ax[0].set_ylim(bottom=0)
-        ax[0].set_title(f"corridor: 25 naive / 25 waypoint robots, {a['chain_blocked']['runs']} runs each")
+        data += [w["per_run"]["waypoint/plane"], w["per_run"]["waypoint/corridor"]]
+        labels += ["plane\nwaypoints", "corridor\nwaypoints"]
+    _boxes(ax[0], data, labels)
+    # items per run span 0 to several hundred: linear up to 10, logarithmic above, never below 0
+    ax[0].set_yscale("symlog", linthresh=10, linscale=0.6)
+    upper = max([20.0] + [1.5 * float(np.max(d)) for d in data if len(d)])
+    ticks = [t for t in (0, 5, 10, 100, 1000, 10000) if t <= upper]
+    ax[0].set_ylim(0, upper)
+    ax[0].set_yticks(ticks, [f"{t:g}" for t in ticks])
     ax[0].set_ylabel("items per run (whole swarm)")
-    if w["answer"] == "not run":
-        ax[0].set_title(f"corridor: 25 naive, {a['chain_blocked']['runs']} runs each")
+    robots = "25 naive" + (" / 25 waypoint" if w["answer"] != "not run" else "")
+    ax[0].set_title(f"corridor: {robots} robots\n(symlog axis: linear below 10)", loc="left", fontsize=9)
     q3 = a["outlier_two_food"]["gaps_pct"]
-    ax[1].boxplot([q3["one"], q3["two"]], tick_labels=["one food site", "two food sites"])
-    ax[1].axhline(0, color="#999", lw=0.8)
-    ax[1].set_ylabel("honest − Byzantine mean wealth share per run (points of %)")
-    ax[1].set_title("two_food: 20 sceptical + 5 scaboteurs, staking")
+    _boxes(ax[1], [q3["one"], q3["two"]], ["one food site", "two food sites"])
+    ax[1].axhline(0, color="grey", linestyle="--", linewidth=0.9)
+    ax[1].set_ylabel("honest − Byzantine mean wealth share\nper run (percentage points)")
+    ax[1].set_title("two_food: 20 sceptical + 5 scaboteurs,\nstaking", loc="left", fontsize=9)
     q4 = a["crowd_collisions"]
-    data = [q4[n][k] for n in (25, 100) for k in ("per_run_off", "per_run_on")]
+    data = [q4[str(n) if str(n) in q4 else n][k] for n in (25, 100) for k in ("per_run_off", "per_run_on")]
     labels = ["25\nno coll.", "25\ncollisions", "100\nno coll.", "100\ncollisions"]
     if "crowd_sensing" in a:  # exploratory: robots sense each other
         e = a["crowd_sensing"]
-        data += [e[n]["per_run_on"] for n in (25, 100)]
+        data += [e[str(n) if str(n) in e else n]["per_run_on"] for n in (25, 100)]
         labels += ["25 coll.\n+sensing*", "100 coll.\n+sensing*"]
-    ax[2].boxplot(data, tick_labels=labels)
+    _boxes(ax[2], data, labels)
+    ax[2].set_ylim(bottom=0)
     ax[2].set_ylabel("items per robot per run")
-    ax[2].set_title("crowd: naive robots that collide (* exploratory)" if "crowd_sensing" in a
-                    else "crowd: naive robots that collide")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    ax[2].set_title("crowd: naive robots that collide" + (" (* exploratory)" if "crowd_sensing" in a else ""),
+                    loc="left", fontsize=9)
+    fig.legend(handles=[Line2D([], [], color="grey", linestyle="--", label="no gap (0 points)")],
+               loc="outside lower center", frameon=False, fontsize=8)
+    fig.suptitle("Terrain questions: per-run values; n = runs per box", fontsize=10)
+    return fig
+
+
+def figure(a: dict, path: Path) -> Path:
+    terrain_figure(a).savefig(path, dpi=110, metadata={"Software": None})
     return path
 
 
