@@ -241,6 +241,31 @@ def test_a_heavier_branch_takes_over_the_canonical_chain_and_its_transactions_ar
     assert w.blk_bal[z2].tolist() == [W0 + R, W0] and w.blk_bal[x2].tolist() == [W0, W0 + R]
 
 
+def test_a_robot_left_behind_past_the_finality_depth_keeps_its_view_until_it_hears_a_heavier_block():
+    """Finality 2, two robots 300 apart, only robot 1 signs, P = 1: X1, X2, X3 at steps 1, 2, 3.  At step 3
+    X1 is 2 blocks below the head: final, although robot 0 is still on genesis.  Genesis is dropped and
+    robot 0 keeps what it knew (height 0, its balance) with no head block; its lag grows by the canonical
+    height each step (1 + 2 at steps 2 and 3, 3 + 4 at 4 and 5).  Moved next to robot 1 after step 5,
+    it takes X5 at step 6's gossip: a view reorganisation (its branch was dropped)."""
+    sim = im.Simulation(_config(2, period=1, signers=[1], finality=2), 1)
+    _place(sim, [(100.0, 100.0), (400.0, 100.0)])
+    w = sim.world
+    _deposit(sim, 0)
+    sim.step(2)
+    assert int(w.blk_height[w.chn_ckpt[0]]) == 0 and int(w.view_head[0]) == 0
+    sim.step(1)
+    assert int(w.blk_height[w.chn_ckpt[0]]) == 1 and int(w.view_head[0]) == -1
+    assert (int(w.view_height[0]), w.view_bal[0]) == (0, W0)
+    assert int(w.mp_count[0]) == 1  # robot 0's deposit: nobody else knows it
+    sim.step(2)
+    assert w.chn_lag_sum.tolist() == [1 + 2 + 3 + 4, 0] and int(w.chn_view_reorgs[0]) == 0
+    _place(sim, [(100.0, 100.0), (130.0, 100.0)])
+    sim.step(1)
+    assert int(w.view_height[0]) == 5 and int(w.chn_view_reorgs[0]) == 1
+    sim.step(1)  # robot 1 heard robot 0's deposit at step 6's gossip too: X6 holds it
+    assert w.balance.tolist() == [W0 + R, W0]
+
+
 def _branch_deposits(w, b):
     """Deposits on block b's branch: those settled by the checkpoint, plus the deposit transactions in
     the blocks from the checkpoint to b."""
@@ -328,3 +353,12 @@ def test_block_period_one_over_a_zero_latency_backbone_is_the_instant_ledger(see
     b = im.Simulation(chained, seed, record_events=True, history_every=100).run(1500)
     _same(a, b)
     assert b.totals["chain"]["blocks"] == 1500 and b.totals["chain"]["forks"] == 0
+
+
+def test_the_bench_chain_setup_is_fig4C_with_gossip_only_blocks():
+    from infomarket.bench.setups import bench_config
+
+    cfg = bench_config("fig4C+chain", 200)
+    base = bench_config("fig4C", 200)
+    assert cfg.chain.enabled and not cfg.chain.backbone and cfg.chain.period == 10
+    assert cfg.model_copy(update={"chain": base.chain}) == base and not base.chain.enabled

@@ -173,6 +173,9 @@ class Chain(_Strict):
     loss: Annotated[float, Field(ge=0, lt=1)] = 0.0
     #: Money per unit of gas; each reveal, deposit and settlement costs its measured gas (docs/gas.md).
     gas_price: NonNegFloat = 0.0
+    #: A block this many blocks below the canonical head is final (earlier, once every robot's head is
+    #: on it); branches that do not contain it are dropped.
+    finality: PosInt = 32
 
     @property
     def enabled(self) -> bool:

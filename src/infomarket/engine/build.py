@@ -52,7 +52,8 @@ def chain_of(cfg: Experiment, ledger: dict, rng: np.random.Generator) -> dict:
     return blocks.build_chain(ledger, period=c.period, delay=c.out_of_turn_delay,
                               signers=c.signers or list(range(cfg.swarm.robots)), backbone=c.backbone,
                               latency=c.latency, loss=c.loss, gas_price=c.gas_price, gas_reveal=reveal,
-                              gas_table=list(zip(blocks.GAS_DEPOSIT_N, deposit)), seed=chain_seed(rng))
+                              gas_table=list(zip(blocks.GAS_DEPOSIT_N, deposit)), seed=chain_seed(rng),
+                              finality=c.finality)
 
 
 def make_room(world: World, tx_need: np.ndarray | None = None) -> World:

@@ -83,9 +83,15 @@ SPEC = Spec("chain", [
         ("chn_gas_n", "float64", "G", "deposit-gas table: reveals settled"),
         ("chn_gas_deposit", "float64", "G", "deposit-gas table: gas"),
         ("chn_seed", "int", "", "seed of the chain's own draws (message loss)"),
+        ("chn_final", "int", "", "finality depth F: a block F blocks below the canonical head is final"),
     ]),
     *fields("ledger", [
-        ("view_head", "int64", "n", "each robot's head block (a slot of the block store)"),
+        ("view_head", "int64", "n", "each robot's head block (a slot of the block store; -1: its branch "
+                                    "was dropped, the robot keeps the head's height, weight and its balance)"),
+        ("view_height", "int64", "n", "height of each robot's head"),
+        ("view_weight", "int64", "n", "weight of each robot's head"),
+        ("view_hash", "int64", "n", "hash of each robot's head"),
+        ("view_bal", "float64", "n", "each robot's own balance at its head"),
         ("view_old", "int64", "n", "heads at the start of the gossip phase (what neighbours hear)"),
         ("view_avail", "float64", "n", "money each robot's view lets it spend: balance at its head less "
                                         "its own pending reveals' stakes and gas"),
@@ -114,6 +120,7 @@ SPEC = Spec("chain", [
         ("mp_cursor", "int64", "1", "where the next free slot is looked for"),
         ("mp_count", "int64", "1", "pending transactions"),
         ("mp_for_buyer", "int64", "n", "pending reveals per buyer"),
+        ("mp_own", "int64", "n", "pending reveals per seller (0: its view is its balance at its head)"),
         ("mp_kind", "int64", "T", "REVEAL / DEPOSIT"),
         ("mp_origin", "int64", "T", "robot that sent it (the seller of a reveal, the depositor)"),
         ("mp_buyer", "int64", "T", "buyer (the depositor for a deposit)"),
@@ -154,7 +161,7 @@ def _words(t: int) -> int:
 
 
 def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: bool, latency: int, loss: float,
-                gas_price: float, gas_reveal: float, gas_table, seed: int) -> dict:
+                gas_price: float, gas_reveal: float, gas_table, seed: int, finality: int) -> dict:
     """The chain's state for a fresh ledger: the genesis block (every robot's head), an empty mempool,
     the checkpoint a copy of the ledger."""
     n = ledger["balance"].shape[0]
@@ -167,6 +174,8 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
         "chn_backbone": bool(backbone), "chn_latency": int(latency), "chn_loss": float(loss),
         "chn_gas_price": float(gas_price), "chn_gas_reveal": float(gas_reveal),
         "chn_gas_n": np.array(ns, np.float64), "chn_gas_deposit": np.array(gs, np.float64), "chn_seed": int(seed),
+        "chn_final": int(finality), "view_height": z(n, np.int64), "view_weight": z(n, np.int64),
+        "view_hash": np.full(n, np.int64(int(seed) % (2**62)), np.int64), "view_bal": ledger["balance"].copy(),
         "view_head": z(n, np.int64), "view_old": z(n, np.int64), "view_avail": ledger["balance"].copy(),
         "gas_paid": z(n),
         "blk_live": z(bc, np.bool_), "blk_parent": np.full(bc, -1, np.int64), "blk_height": z(bc, np.int64),
@@ -177,7 +186,7 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
         "chn_mute": z(1, np.int64), "chn_stamp": z(1, np.int64), "chn_seq": z(1, np.int64),
         "chn_nopen": z(1, np.int64), "chn_path": z(bc, np.int64),
         "mp_live": z(t, np.bool_), "mp_cursor": z(1, np.int64), "mp_count": z(1, np.int64),
-        "mp_for_buyer": z(n, np.int64), "mp_kind": z(t, np.int64), "mp_origin": z(t, np.int64),
+        "mp_for_buyer": z(n, np.int64), "mp_own": z(n, np.int64), "mp_kind": z(t, np.int64), "mp_origin": z(t, np.int64),
         "mp_buyer": z(t, np.int64), "mp_seller": z(t, np.int64), "mp_site": z(t, np.int64), "mp_dir": z(t),
         "mp_stake": z(t), "mp_gas": z(t), "mp_step": z(t, np.int64), "mp_seq": z(t, np.int64),
         "mp_mark": z(t, np.int64), "mp_bb": z(t, np.bool_),
@@ -254,7 +263,7 @@ def chain_needs(w):
     due = 0
     for k in range(w.chn_signers.shape[0]):
         h = w.view_head[w.chn_signers[k]]
-        if t - w.blk_step[h] >= w.chn_period:
+        if h >= 0 and t - w.blk_step[h] >= w.chn_period:
             due += 1
     live = 0
     for b in range(w.blk_live.shape[0]):
@@ -331,6 +340,8 @@ def due(w, signer, t):
     """Does ``signer`` make a block on its head at step t: P steps after the head's block when in turn,
     P + delay when out of turn."""
     h = w.view_head[signer]
+    if h < 0:
+        return False  # its branch was dropped: it cannot build on it
     wait = w.chn_period if in_turn(w, w.blk_height[h] + 1) == signer else w.chn_period + w.chn_delay
     return t - w.blk_step[h] >= wait
 
@@ -506,13 +517,15 @@ def _copy_ledger(balance, pot, burned, tx_off, tx_cap, tx_count, tx_seller, tx_s
     o_tx_off[:] = tx_off
     o_tx_cap[:] = tx_cap
     o_tx_count[:] = tx_count
-    top = pool_top[0]
-    o_tx_seller[:top] = tx_seller[:top]
-    o_tx_site[:top] = tx_site[:top]
-    o_tx_dir[:top] = tx_dir[:top]
-    o_tx_step[:top] = tx_step[:top]
-    o_tx_stake[:top] = tx_stake[:top]
-    o_pool_top[0] = top
+    for i in range(tx_off.shape[0]):  # only each buyer's open transactions: the rest of the pool is free
+        a = tx_off[i]
+        for x in range(a, a + tx_count[i]):
+            o_tx_seller[x] = tx_seller[x]
+            o_tx_site[x] = tx_site[x]
+            o_tx_dir[x] = tx_dir[x]
+            o_tx_step[x] = tx_step[x]
+            o_tx_stake[x] = tx_stake[x]
+    o_pool_top[0] = pool_top[0]
     o_money[0] = money[0]
     o_rep_settled[:] = rep_settled
     o_rep_reduced[:] = rep_reduced
@@ -541,16 +554,33 @@ def mute(w, on):
     unlock(w.chn_mute)[0] = 1 if on else 0
 
 
+@njit(inline="always")
+def heavier_than_view(w, b, i):
+    """Is block b heavier than robot i's head (its cached weight and hash: the head may be dropped)?"""
+    return w.blk_weight[b] > w.view_weight[i] or (w.blk_weight[b] == w.view_weight[i]
+                                                   and w.blk_hash[b] < w.view_hash[i])
+
+
+@njit
+def set_head(w, i, b):
+    """Robot i's head becomes block b (a view reorganisation when its old head is not on b's branch)."""
+    h = w.view_head[i]
+    if h < 0 or ancestor_at(w, b, w.blk_height[h]) != h:
+        unlock(w.chn_view_reorgs)[0] += 1
+    unlock(w.view_head)[i] = b
+    unlock(w.view_height)[i] = w.blk_height[b]
+    unlock(w.view_weight)[i] = w.blk_weight[b]
+    unlock(w.view_hash)[i] = w.blk_hash[b]
+    unlock(w.view_bal)[i] = w.blk_bal[b, i]
+    refresh_view(w, i)
+
+
 @njit
 def adopt(w, i, b):
     """Robot i takes block b as its head if b is heavier than its head; True when it did."""
-    h = w.view_head[i]
-    if b == h or not heavier(w, b, h):
+    if b == w.view_head[i] or not heavier_than_view(w, b, i):
         return False
-    if ancestor_at(w, b, w.blk_height[h]) != h:
-        unlock(w.chn_view_reorgs)[0] += 1
-    unlock(w.view_head)[i] = b
-    refresh_view(w, i)
+    set_head(w, i, b)
     return True
 
 
@@ -588,17 +618,19 @@ def new_canonical(w, b):
 
 @njit
 def next_checkpoint(w):
-    """The block after the checkpoint on the canonical branch if every robot's head descends from it,
-    else -1."""
+    """The block after the checkpoint on the canonical branch if it is final: every robot's head
+    descends from it, or it lies ``chn_final`` blocks or more below the canonical head.  Else -1."""
     ck = w.chn_ckpt[0]
     canon = w.chn_canon[0]
     if canon == ck:
         return -1
     c = ancestor_at(w, canon, w.blk_height[ck] + 1)
     hc = w.blk_height[c]
+    if w.blk_height[canon] - hc >= w.chn_final:
+        return c  # final by depth, whoever has not heard of it
     for i in range(w.view_head.shape[0]):
         h = w.view_head[i]
-        if w.blk_height[h] < hc or ancestor_at(w, h, hc) != c:
+        if h < 0 or w.blk_height[h] < hc or ancestor_at(w, h, hc) != c:
             return -1
     return c
 
@@ -606,7 +638,9 @@ def next_checkpoint(w):
 @njit
 def move_checkpoint(w, c):
     """Block c (whose state the ledger arrays hold) becomes the checkpoint: its state is saved, its
-    transactions leave the mempool, and every block not descending from it is dropped."""
+    transactions leave the mempool, and every block not descending from it is dropped; a robot whose
+    head is dropped keeps its head's height, weight, hash and its own balance (``view_head`` -1) until
+    it hears a heavier block."""
     save_checkpoint(w)
     live, known = unlock(w.mp_live), unlock(w.mp_known)
     n = known.shape[0]
@@ -618,6 +652,7 @@ def move_checkpoint(w, c):
         unlock(w.mp_count)[0] -= 1
         if w.mp_kind[tx] == REVEAL:
             unlock(w.mp_for_buyer)[w.mp_buyer[tx]] -= 1
+            unlock(w.mp_own)[w.mp_origin[tx]] -= 1
         word = tx >> 6
         bit = ~(np.uint64(1) << np.uint64(tx & 63))
         for i in range(n):
@@ -629,6 +664,10 @@ def move_checkpoint(w, c):
             blive[b] = False
     unlock(w.blk_parent)[c] = -1
     unlock(w.chn_ckpt)[0] = c
+    for i in range(n):
+        h = w.view_head[i]
+        if h >= 0 and not blive[h]:
+            unlock(w.view_head)[i] = -1
 
 
 # ---- compiled: gossip ---------------------------------------------------------------------------------
@@ -650,22 +689,18 @@ def gossip(w):
             mold[i, k] = known[i, k]
     loss = w.chn_loss
     for i in range(n):
-        best = heads[i]
+        best = -1
         for a in range(w.nbr_count[i]):
             j = w.nbr[i, a]
             if loss > 0.0 and chance(w.chn_seed, t, j, i) < loss:
                 continue
-            if heavier(w, old[j], best):
-                best = old[j]
+            c = old[j]
+            if c >= 0 and c != heads[i] and (heavier(w, c, best) if best >= 0 else heavier_than_view(w, c, i)):
+                best = c
             for k in range(words):
                 known[i, k] |= mold[j, k]
-        if best != heads[i]:
-            unlock(w.view_head)[i] = best
-    for i in range(n):
-        if heads[i] != old[i]:
-            if ancestor_at(w, heads[i], w.blk_height[old[i]]) != old[i]:
-                unlock(w.chn_view_reorgs)[0] += 1
-            refresh_view(w, i)
+        if best >= 0:
+            set_head(w, i, best)
     if w.chn_backbone and w.chn_latency > 0:
         for tx in range(w.mp_live.shape[0]):
             if w.mp_live[tx] and not w.mp_bb[tx] and w.mp_step[tx] + w.chn_latency <= t:
@@ -678,4 +713,4 @@ def gossip(w):
     top = w.blk_height[w.chn_canon[0]]
     lag = unlock(w.chn_lag_sum)
     for i in range(n):
-        lag[i] += top - w.blk_height[heads[i]]
+        lag[i] += top - w.view_height[i]

@@ -100,7 +100,7 @@ def stamp_path(w, target):
     mark = unlock(w.mp_mark)
     b = target
     ck = w.chn_ckpt[0]
-    while b != ck and b >= 0:
+    while b >= 0 and b != ck:
         for k in range(w.blk_ntx[b]):
             mark[w.blk_tx[b, k]] = stamp
         b = w.blk_parent[b]
@@ -109,11 +109,14 @@ def stamp_path(w, target):
 
 @njit
 def refresh_view(w, i):
-    """Robot i's spendable money at its head: its balance in the head block's snapshot, less the gas and
-    stakes of its own reveals that its head does not include yet (in pool order)."""
-    h = w.view_head[i]
-    stamp = stamp_path(w, h)
-    a = w.blk_bal[h, i]
+    """Robot i's spendable money at its head: its balance there, less the gas and stakes of its own
+    reveals that its head's branch does not include yet (in pool order; all of them when its branch was
+    dropped, ``view_head`` -1)."""
+    a = w.view_bal[i]
+    if w.mp_own[i] == 0:  # nothing of its own pending: no branch to look at
+        unlock(w.view_avail)[i] = a
+        return
+    stamp = stamp_path(w, w.view_head[i])
     for tx in range(w.mp_live.shape[0]):
         if w.mp_live[tx] and w.mp_origin[tx] == i and w.mp_kind[tx] == REVEAL and w.mp_mark[tx] != stamp:
             a -= w.mp_gas[tx]
@@ -156,6 +159,7 @@ def new_tx(w, kind, origin, buyer, seller, site, direction, stake, gas):
         unlock(w.mp_bb)[x] = False
     if kind == REVEAL:
         unlock(w.mp_for_buyer)[buyer] += 1
+        unlock(w.mp_own)[origin] += 1
     return x
 
 
