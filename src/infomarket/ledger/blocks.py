@@ -7,10 +7,12 @@ State (``SPEC``, the ``chain`` domain; only ledger operations write it, like the
   2 per in-turn block, 1 per out-of-turn one, as Clique), hash, signer, step, the transactions it
   includes (mempool slots, in the order they were sent) and every robot's balance after it
   (``blk_bal``, the snapshot a robot's view reads).  The **checkpoint** (``chn_ckpt``) is the newest
-  block every robot's head descends from: nothing before it can change, so it is the root of the store.
+  final block (every robot's head descends from it, or it lies ``chn_final`` blocks below the canonical
+  head): nothing before it can change, so it is the root of the store.
 * **Mempool** (``ledger.mempool``): transactions not yet in a final block, with a bit per robot
   (``mp_known``) saying who knows each.
-* **Views**: each robot's head block (``view_head``) and spendable money (``view_avail``).
+* **Views**: each robot's head block (``view_head``, -1 once its branch is dropped), the head's height,
+  weight and hash and its own balance there (``view_*``), and its spendable money (``view_avail``).
 * **Ledgers**: the engine's ledger arrays (``ledger.state``) hold the state at the **canonical head**
   (``chn_canon``: the heaviest block, ties to the lower hash), which the run reports; ``ck_*`` hold the
   state at the checkpoint.  The state at any other block is the checkpoint's with the blocks on its branch
@@ -186,13 +188,15 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
         "chn_mute": z(1, np.int64), "chn_stamp": z(1, np.int64), "chn_seq": z(1, np.int64),
         "chn_nopen": z(1, np.int64), "chn_path": z(bc, np.int64),
         "mp_live": z(t, np.bool_), "mp_cursor": z(1, np.int64), "mp_count": z(1, np.int64),
-        "mp_for_buyer": z(n, np.int64), "mp_own": z(n, np.int64), "mp_kind": z(t, np.int64), "mp_origin": z(t, np.int64),
+        "mp_for_buyer": z(n, np.int64), "mp_own": z(n, np.int64), "mp_kind": z(t, np.int64),
+        "mp_origin": z(t, np.int64),
         "mp_buyer": z(t, np.int64), "mp_seller": z(t, np.int64), "mp_site": z(t, np.int64), "mp_dir": z(t),
         "mp_stake": z(t), "mp_gas": z(t), "mp_step": z(t, np.int64), "mp_seq": z(t, np.int64),
         "mp_mark": z(t, np.int64), "mp_bb": z(t, np.bool_),
         "mp_known": z((n, _words(t)), np.uint64), "mp_old": z((n, _words(t)), np.uint64),
         "chn_blocks": z(1, np.int64), "chn_forks": z(1, np.int64), "chn_reorgs": z(1, np.int64),
-        "chn_reorg_tx": z(1, np.int64), "chn_view_reorgs": z(1, np.int64), "chn_failed": z(1, np.int64), "chn_delay_sum": z(1, np.int64),
+        "chn_reorg_tx": z(1, np.int64), "chn_view_reorgs": z(1, np.int64), "chn_failed": z(1, np.int64),
+        "chn_delay_sum": z(1, np.int64),
         "chn_delay_count": z(1, np.int64), "chn_lag_sum": z(n, np.int64),
     }
     for f in CHECKPOINTED:
