@@ -12,13 +12,28 @@ from ..engine.simulation import Simulation
 from .floor import floor_steps_per_second
 
 
+#: A setup named ``NAME+chain`` is the shipped setup NAME with every robot a blockchain node
+#: (docs/chain-model.md): Proof-of-Authority blocks every 10 steps, out-of-turn signers 5 steps later,
+#: transactions and blocks spreading over the robots' own links only.  Its ``ratio_to_instant`` is its
+#: env-steps/s over NAME's when NAME is benched in the same run (issue 25's goal: at least 0.5).
+CHAIN_SUFFIX = "+chain"
+CHAIN_BENCH = {"consensus": "poa", "period": 10, "out_of_turn_delay": 5}
+
+
+def bench_config(name: str, steps: int):
+    """The configuration a bench setup runs: a shipped experiment, or one with the chain model on."""
+    if name.endswith(CHAIN_SUFFIX):
+        return load_experiment(name[:-len(CHAIN_SUFFIX)]).with_overrides(steps=steps, chain=CHAIN_BENCH)
+    return load_experiment(name).with_overrides(steps=steps)
+
+
 def run_bench(setups, *, steps: int = 15000, repeats: int = 7) -> dict:
     """Per setup: env-steps per second (median over ``repeats`` runs) and the time to get the compiled
     kernel ready in this process: a compilation, or a load from numba's disk cache (then
     ``kernel_from_disk_cache`` is true; a kernel already loaded in this process counts as cached)."""
     out = {}
     for name in setups:
-        cfg = load_experiment(name).with_overrides(steps=steps)
+        cfg = bench_config(name, steps)
         t0 = time.perf_counter()
         first = Simulation(cfg, run_seed(cfg.seed, 0))
         compile_seconds = time.perf_counter() - t0
@@ -37,4 +52,8 @@ def run_bench(setups, *, steps: int = 15000, repeats: int = 7) -> dict:
     floor = floor_steps_per_second(robots=25, steps=steps, repeats=repeats)
     for r in out.values():
         r["ratio_to_floor"] = floor["steps_per_second"] / r["steps_per_second"]
+    for name, r in out.items():
+        base = name[:-len(CHAIN_SUFFIX)]
+        if name.endswith(CHAIN_SUFFIX) and base in out:
+            r["ratio_to_instant"] = r["steps_per_second"] / out[base]["steps_per_second"]
     return {"version": __version__, "setups": out, "floor": floor}

@@ -153,6 +153,35 @@ class Payment(_Strict):
     params: dict[str, Finite] = Field(default_factory=dict)
 
 
+class Chain(_Strict):
+    """Robots as blockchain nodes (docs/chain-model.md): ``consensus = "instant"`` (the default) is the
+    paper's shared ledger, where every transaction applies at once; ``"poa"`` makes every robot a node
+    with its own view of a Proof-of-Authority chain."""
+
+    consensus: Literal["instant", "poa"] = "instant"
+    #: Steps between a block and the next one its in-turn signer makes.
+    period: PosInt = 1
+    #: Robot ids allowed to make blocks (block h is in turn for signers[h % len]); empty: every robot.
+    signers: list[NonNegInt] = Field(default_factory=list)
+    #: Extra steps an out-of-turn signer waits after the period before it makes a block itself.
+    out_of_turn_delay: PosInt = 1
+    #: A backbone network also carries every transaction and block to every robot, ``latency`` steps late.
+    backbone: StrictBool = False
+    latency: NonNegInt = 0
+    #: Probability that one message (a robot's head and pending transactions, to one neighbour, in one
+    #: step) is lost.
+    loss: Annotated[float, Field(ge=0, lt=1)] = 0.0
+    #: Money per unit of gas; each reveal, deposit and settlement costs its measured gas (docs/gas.md).
+    gas_price: NonNegFloat = 0.0
+    #: A block this many blocks below the canonical head is final (earlier, once every robot's head is
+    #: on it); branches that do not contain it are dropped.
+    finality: PosInt = 32
+
+    @property
+    def enabled(self) -> bool:
+        return self.consensus != "instant"
+
+
 class AxisValue(_Strict):
     """One value of a named sweep axis: the label stored in results, and the keys it sets."""
 
@@ -204,6 +233,7 @@ class Experiment(_Strict):
     random_walk: RandomWalk = RandomWalk()
     swarm: Swarm
     payment: Payment = Payment()
+    chain: Chain = Chain()
     sweep: Sweep | None = None
 
     @field_validator("name", mode="before")
@@ -293,6 +323,15 @@ class Experiment(_Strict):
         missing = [p for p in spec.params if p not in self.payment.params and p not in spec.defaults]
         if missing:
             raise ConfigError(f"payment.params: scheme {spec.name!r} needs {', '.join(missing)}")
+        if self.chain.enabled:
+            for s in self.chain.signers:
+                if s >= self.swarm.robots:
+                    raise ConfigError(f"chain.signers: robot {s} does not exist (robots = {self.swarm.robots})")
+            if len(set(self.chain.signers)) != len(self.chain.signers):
+                raise ConfigError("chain.signers: a robot is listed twice")
+            if self.robot.fuel_cost > 0 or self.payment.stake_expiry > 0:
+                raise ConfigError("chain.consensus = 'poa' does not model robot.fuel_cost or payment.stake_expiry "
+                                 "yet; set them to 0 or use the instant ledger")
         too_big = sizes.run_too_big(self)
         if too_big:
             raise ConfigError(too_big)
@@ -337,4 +376,6 @@ class Experiment(_Strict):
         """Hash of everything that determines results (not name, description, runs or seed)."""
         data = self.model_dump(exclude={"name", "description", "runs", "seed", "sweep"})
         terrain.drop_defaults(data)  # setups on the paper's plane keep the hashes they always had
+        if data.get("chain") == Chain().model_dump():
+            data.pop("chain")  # and so do setups on the instant ledger
         return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:16]

@@ -8,12 +8,13 @@ from __future__ import annotations
 import numpy as np
 
 from ..config.schema import Experiment
+from ..ledger import blocks
 from ..ledger.state import grow_ledger, ledger_of
 from ..state.log import build_log, grow_log
 from .params import behaviour_kinds, behaviour_table, build_params  # noqa: F401  (behaviour_kinds re-exported)
 from .swarm import build_swarm, grow_swarm
 from .terrain import place_clear
-from .world import World
+from .world import ChainWorld, World, kernel_view
 
 
 def build_world(cfg: Experiment, rng: np.random.Generator, *, record_events: bool = False,
@@ -26,10 +27,33 @@ def build_world(cfg: Experiment, rng: np.random.Generator, *, record_events: boo
     log = build_log(cfg.swarm.robots, record_events=record_events, history_every=history_every,
                     history_rows=cfg.steps // history_every if history_every else 0,
                     sites=len(params["sites_r"]))
-    world = World(**params, **swarm, **ledger_of(cfg), **log)
+    ledger = ledger_of(cfg)
+    if cfg.chain.enabled:
+        world = ChainWorld(**params, **swarm, **ledger, **log, **chain_of(cfg, ledger, rng))
+    else:
+        world = World(**params, **swarm, **ledger, **log)
     if cfg.terrain:
         place_clear(world, rng)
     return world, names
+
+
+def chain_seed(rng: np.random.Generator) -> int:
+    """The chain's own seed (message loss), derived from the run's seed sequence without drawing from
+    ``rng``: the swarm's random streams are the same with the chain on or off."""
+    seq = rng.bit_generator.seed_seq
+    child = np.random.SeedSequence(seq.entropy, spawn_key=tuple(seq.spawn_key) + (0xC4A1,))
+    return int(child.generate_state(1, np.uint64)[0] >> np.uint64(1))
+
+
+def chain_of(cfg: Experiment, ledger: dict, rng: np.random.Generator) -> dict:
+    """The chain model's state for a run of ``cfg`` (``ledger.blocks``)."""
+    c = cfg.chain
+    reveal, deposit = blocks.gas_schedule(cfg.payment.scheme, cfg.payment.stake)
+    return blocks.build_chain(ledger, period=c.period, delay=c.out_of_turn_delay,
+                              signers=c.signers or list(range(cfg.swarm.robots)), backbone=c.backbone,
+                              latency=c.latency, loss=c.loss, gas_price=c.gas_price, gas_reveal=reveal,
+                              gas_table=list(zip(blocks.GAS_DEPOSIT_N, deposit)), seed=chain_seed(rng),
+                              finality=c.finality)
 
 
 def make_room(world: World, tx_need: np.ndarray | None = None) -> World:
@@ -38,6 +62,12 @@ def make_room(world: World, tx_need: np.ndarray | None = None) -> World:
     overrides each buyer's transaction need (default: open ones + 2 per neighbour)."""
     nbr = world.nbr_count
     changes = grow_swarm(world)
+    if isinstance(world, ChainWorld):  # blocks open transactions: the chain's own bound (ledger.blocks)
+        needs = blocks.chain_needs(kernel_view(world))
+        changes.update(blocks.grow_chain(world, needs))
+        if world.record:
+            changes.update(grow_log(world, int(needs[3]), int(needs[4])))
+        return world._replace(**changes)
     need_t = world.tx_count + 2 * nbr if tx_need is None else tx_need
     changes.update(grow_ledger(world, need_t))
     if world.record:

@@ -1,5 +1,5 @@
 """Template of the compiled step loop.  Never imported as is: ``engine.specialise`` writes a module made of
-the step options (``TERRAIN``, ``PATHS``), this source, and the three dispatch functions for the
+the step options (``TERRAIN``, ``PATHS``, ``CHAIN``), this source, and the three dispatch functions for the
 configured rules (below, declared and left to the generator), so each rule call is a direct, inlinable
 call and the whole kernel is cached on disk.  Every step piece it calls is in ``engine.step``, written
 once; ``engine.step.variant(TERRAIN, PATHS)`` gives them compiled for this kernel's options, so the code of
@@ -9,6 +9,10 @@ Order of operations per step (docs/model.md §3): neighbours; communication (off
 tables, then every robot buys in id order); move (foraging and payment, install the new table,
 behaviour step, noisy motion), robots in id order.
 
+With ``CHAIN`` (docs/chain-model.md) a step also opens with a gossip round after the neighbours,
+purchases and deposits become pending transactions, and it closes with the signers' blocks; without it
+none of that code is compiled (``CHAIN`` is a constant: numba prunes the branches it turns off).
+
 Before a step changes anything, ``has_room`` checks that the step cannot outgrow a capacity (neighbour
 lists, pending lists, the transaction pool, the event log); if it could, the loop returns NEED_ROOM
 with the step not begun, the host grows the arrays (``build.make_room``) and calls again.
@@ -16,15 +20,16 @@ with the step not begun, the host grows the arrays (``build.make_room``) and cal
 import numpy as np
 from numba import njit
 
-from infomarket.engine.step import record_history, variant
+from infomarket.engine.step import chain_variant, record_history, variant
 from infomarket.ledger.kernels import burn_fuel, distribute, expire_stakes, reserve, settlement
+from infomarket.ledger.blocks import room_fits
 from infomarket.state.view import unlock
 
 DONE = 0
 NEED_ROOM = 1
 
 # ---- provided by the generator (engine.specialise) --------------------------------------------------
-#: TERRAIN, PATHS: the step options (bools), written above this template
+#: TERRAIN, PATHS, CHAIN: the step options (bools), written above this template
 #: sell_dispatch(kind, w, i, site, rng) -> (valid, x, y, age): robot i's offer for ``site``
 #: buy_dispatch(kind, w, i, nbrs, rng): robot i buys from its neighbours
 #: pay_dispatch(w, buyer, sellers, sites, directions, weights, rng): the scheme's weights
@@ -53,10 +58,12 @@ def has_room(w):
         if w.pend_count[i, 0] + c > kp or w.pend_count[i, 1] + c > kp:
             return False
         need = w.tx_count[i] + 2 * c
-        if need > w.tx_cap[i] and not reserve(w, i, need):
+        if not CHAIN and need > w.tx_cap[i] and not reserve(w, i, need):
             return False
         events += 2 * c
         payments += need
+    if CHAIN:  # blocks open the transactions (ledger.blocks.chain_needs)
+        return room_fits(w)
     if w.record and (w.ev_count[0] + events > w.ev_step.shape[0]
                      or w.pay_count[0] + payments > w.pay_step.shape[0]):
         return False
@@ -70,6 +77,10 @@ def settle(w, i, rng):
     weights = np.zeros(sellers.shape[0])
     pay_dispatch(w, i, sellers, sites, directions, weights, rng)
     distribute(w, i, weights)
+
+
+#: The chain model's pieces around this kernel's settlement (engine.step.chain_variant), when it has one.
+chain_gossip, chain_deposit, make_blocks = chain_variant(settle) if CHAIN else (None, None, None)
 
 
 @njit(cache=True)
@@ -87,6 +98,8 @@ def run_steps(w, rng, t_end):
         if not has_room(w):
             return NEED_ROOM
         clock[0] += 1
+        if CHAIN:
+            chain_gossip(w)
         if w.stake_expiry > 0:
             for i in range(n):
                 expire_stakes(w, i)
@@ -106,7 +119,10 @@ def run_steps(w, rng, t_end):
                 buy_dispatch(kind[i], w, i, nbr[i, :nbr_count[i]], rng)
         for i in range(n):
             if forage(w, i, bits):
-                settle(w, i, rng)
+                if CHAIN:
+                    chain_deposit(w, i)
+                else:
+                    settle(w, i, rng)
             install_table(w, i)
             if stop[i] > 0:
                 stop[i] -= 1
@@ -119,5 +135,7 @@ def run_steps(w, rng, t_end):
                 move(w, i, dx, dy, bits)
             if cool[i] > 0:
                 cool[i] -= 1
+        if CHAIN:
+            make_blocks(w, rng)
         record_history(w)
     return DONE

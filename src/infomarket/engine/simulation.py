@@ -72,7 +72,8 @@ class Simulation:
                                                        history_every=hist)
         t0 = time.perf_counter()
         with compile_notice(self.kinds, config.payment.scheme), ctrl_c_survives_compiling():
-            self._kernel = specialise.kernel_module(self.kinds, config.payment.scheme, config.terrain)
+            self._kernel = specialise.kernel_module(self.kinds, config.payment.scheme, config.terrain,
+                                                    config.chain.enabled)
             self._view = kernel_view(self.world)
             self._kernel.run_steps(self._view, self.rng, 0)  # compile or load from cache; runs no step
         self.compile_seconds = time.perf_counter() - t0
@@ -151,8 +152,26 @@ class Simulation:
                   "items": int(w.items.sum())}
         if self.config.terrain:
             totals["sites"] = self.site_counts()
+        if self.config.chain.enabled:
+            totals["chain"] = self.chain_measures()
         return Result(self.config, self.seed, robots, history, events, self.clock, self.compile_seconds,
                       self.run_seconds, totals, payments)
+
+    def chain_measures(self) -> dict:
+        """The chain model's measures so far (docs/chain-model.md): blocks made, forks, reorganisations
+        and the transactions they took out of the canonical chain, failed transactions, the mean delay
+        from a deposit to the block that paid it, and per robot the gas paid on the canonical chain and
+        the mean view lag (canonical height minus its head's, per step)."""
+        w = self.world
+        paid = int(w.chn_delay_count[0])
+        steps = max(self.clock, 1)
+        return {"blocks": int(w.chn_blocks[0]), "height": int(w.blk_height[w.chn_canon[0]]),
+                "forks": int(w.chn_forks[0]), "reorgs": int(w.chn_reorgs[0]),
+                "reorganised_tx": int(w.chn_reorg_tx[0]),
+                "view_reorgs": int(w.chn_view_reorgs[0]), "failed_tx": int(w.chn_failed[0]),
+                "pending_tx": int(w.mp_count[0]), "deposits_paid": paid,
+                "mean_payment_delay": float(w.chn_delay_sum[0]) / paid if paid else float("nan"),
+                "gas_paid": w.gas_paid.tolist(), "mean_lag": (w.chn_lag_sum / steps).tolist()}
 
     def site_counts(self) -> list[dict]:
         """Every site (food first, file order) with the items picked up there (food) or deposited

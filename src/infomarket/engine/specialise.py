@@ -58,15 +58,16 @@ def _header(behaviours: list[BehaviourSpec], payment: PaymentSpec) -> str:
 
 
 def generate_source(behaviours: list[BehaviourSpec], payment: PaymentSpec, terrain: bool = False,
-                    paths: bool = False) -> str:
+                    paths: bool = False, chain: bool = False) -> str:
     """Source of the specialised module (step options + template + dispatch) for these behaviours, in
     kind order; ``terrain`` selects the terrain variant of the step (engine.terrain), ``paths`` adds
-    waypoint paths to it (engine.paths; implies terrain)."""
+    waypoint paths to it (engine.paths; implies terrain), ``chain`` the chain model (docs/chain-model.md)."""
     lines = [_header(behaviours, payment),
              "# ---- step options: compile-time constants (numba freezes them; the branches they guard in",
              "# ---- engine.step are folded away when off)",
              f"TERRAIN = {bool(terrain or paths)}  # obstacles, several sites, line of sight, collisions",
-             f"PATHS = {bool(paths)}  # waypoint paths", "",
+             f"PATHS = {bool(paths)}  # waypoint paths",
+             f"CHAIN = {bool(chain)}  # robots as blockchain nodes (docs/chain-model.md)", "",
              _TEMPLATE.read_text(),
              "", "# ---- generated dispatch " + "-" * 60,
              "from infomarket.registry import rule_function as _rule_function", ""]
@@ -96,12 +97,13 @@ def uses_paths(behaviour_names: tuple[str, ...]) -> bool:
     return any(get_behaviour(b).paths for b in behaviour_names)
 
 
-def _kernel_parts(behaviour_names: tuple[str, ...], payment_name: str, terrain: bool) -> tuple[str, str, bool]:
+def _kernel_parts(behaviour_names: tuple[str, ...], payment_name: str, terrain: bool,
+                  chain: bool = False) -> tuple[str, str, bool]:
     """(source, key, cacheable) of the kernel for these rules: the key hashes everything its machine code
     depends on (template, engine source, every rule's source, versions)."""
     behaviours = [get_behaviour(b) for b in behaviour_names]
     payment = get_payment(payment_name)
-    source = generate_source(behaviours, payment, terrain, any(b.paths for b in behaviours))
+    source = generate_source(behaviours, payment, terrain, any(b.paths for b in behaviours), chain)
     digest = generated_digest(source)
     cacheable = True
     for rule in [r for b in behaviours for r in (b.buy, b.sell)] + [payment.weights]:
@@ -113,11 +115,12 @@ def _kernel_parts(behaviour_names: tuple[str, ...], payment_name: str, terrain: 
     return source, digest.hexdigest()[:20], cacheable
 
 
-def kernel_module(behaviour_names: tuple[str, ...], payment_name: str, terrain: bool = False) -> ModuleType:
+def kernel_module(behaviour_names: tuple[str, ...], payment_name: str, terrain: bool = False,
+                  chain: bool = False) -> ModuleType:
     """The specialised kernel module (``run_steps``) for these behaviours (kind order) and scheme, on
     the paper's plane or (``terrain``) with obstacles, several sites, line of sight and collisions;
     behaviours registered with ``paths=True`` add the paths variant (waypoint paths, engine.paths) to the terrain one."""
-    source, key, cacheable = _kernel_parts(behaviour_names, payment_name, terrain)
+    source, key, cacheable = _kernel_parts(behaviour_names, payment_name, terrain, chain)
     return load_generated("kernel", key, source, cacheable)
 
 
@@ -127,6 +130,6 @@ def kernel_id(cfg) -> str:
     workers is needed once per id.  Computes no code."""
     from .build import behaviour_kinds
 
-    return _kernel_parts(behaviour_kinds(cfg), cfg.payment.scheme, cfg.terrain)[1]
+    return _kernel_parts(behaviour_kinds(cfg), cfg.payment.scheme, cfg.terrain, cfg.chain.enabled)[1]
 
 

@@ -11,6 +11,9 @@ turn off before it types them (a kernel neither compiles nor runs a variant it d
 ``paths``    waypoint paths (``engine.paths``): a seeking robot follows the legs of a bought path, its
              waypoints are dead-reckoned, a bump marks the site.  Implies ``terrain``.
 
+The chain model (docs/chain-model.md) adds three pieces, ``chain_variant(settle)``: gossip, the deposit
+transaction, and block making with its ledger replays.  A kernel without the chain never builds them.
+
 Nothing here depends on the configured rules; the loop's generated dispatch calls the rules.
 """
 import functools
@@ -19,6 +22,8 @@ from typing import Callable, NamedTuple
 
 from numba import njit
 
+from ..ledger import blocks as _blocks
+from ..ledger.mempool import chain_deposit
 from ..state.view import unlock
 from .draws import normal, uniform
 from .geometry import norm, outside, rotate, to_frame, to_world, within
@@ -313,6 +318,86 @@ def _variant(terrain: bool, paths: bool) -> Step:
         w.pos[i, 1] = y
 
     return Step(find_neighbours, begin_communication, install_table, forage, sense_sites, behaviour_step, move)
+
+
+# ---- the chain model (docs/chain-model.md) -----------------------------------------------------------
+
+class ChainStep(NamedTuple):
+    """The chain model's pieces of a step, compiled around the kernel's settlement (``chain_variant``)."""
+
+    gossip: Callable
+    deposit: Callable
+    make_blocks: Callable
+
+
+@functools.cache
+def chain_variant(settle) -> ChainStep:
+    """The chain's step pieces around ``settle(w, buyer, rng)``, the kernel's settlement (the payment rule
+    weighs, ``ledger.kernels.distribute`` pays).  Every write goes through ``ledger.blocks``."""
+
+    @njit
+    def apply_block(w, b, rng):
+        """Apply block b's transactions, in order, to the ledger arrays (which hold its parent's state)."""
+        for k in range(w.blk_ntx[b]):
+            tx = w.blk_tx[b, k]
+            if _blocks.include_tx(w, b, tx):
+                settle(w, w.mp_buyer[tx], rng)
+                _blocks.finish_deposit(w, b, tx)
+
+    @njit
+    def ledger_at(w, target, rng):
+        """Make the ledger arrays hold the state after block ``target``, silently (nothing is logged
+        again): one block on from the current one, else from the checkpoint along target's branch."""
+        if w.chn_cur[0] == target:
+            return
+        _blocks.mute(w, True)
+        if w.blk_parent[target] == w.chn_cur[0]:
+            apply_block(w, target, rng)
+        else:
+            _blocks.restore_checkpoint(w)
+            for k in range(_blocks.path_from_checkpoint(w, target)):
+                apply_block(w, w.chn_path[k], rng)
+        _blocks.set_current(w, target)
+        _blocks.mute(w, False)
+
+    @njit
+    def make_blocks(w, rng):
+        """End of a step: every signer whose turn has come (in signer-set order) makes a block on its head
+        and applies it (logged, measured); the heaviest block is the canonical head, whose state the
+        ledger arrays hold when this returns; the checkpoint moves up as far as every head agrees."""
+        t = w.clock[0]
+        signers = w.chn_signers
+        for k in range(signers.shape[0]):
+            s = signers[k]
+            if not _blocks.due(w, s, t) or not _blocks.can_make(w):
+                continue
+            parent = w.view_head[s]
+            b = _blocks.new_block(w, s, t)
+            ledger_at(w, parent, rng)
+            apply_block(w, b, rng)
+            _blocks.set_current(w, b)
+            _blocks.snapshot(w, b)
+            _blocks.adopt(w, s, b)
+            if w.chn_backbone and w.chn_latency == 0:
+                _blocks.deliver_block(w, b)
+            _blocks.new_canonical(w, b)
+        while True:
+            c = _blocks.next_checkpoint(w)
+            if c < 0:
+                break
+            ledger_at(w, c, rng)
+            _blocks.move_checkpoint(w, c)
+        ledger_at(w, w.chn_canon[0], rng)
+
+    @njit
+    def gossip(w):
+        _blocks.gossip(w)
+
+    @njit
+    def deposit(w, i):
+        chain_deposit(w, i)
+
+    return ChainStep(gossip, deposit, make_blocks)
 
 
 # ---- the log -----------------------------------------------------------------------------------------

@@ -22,6 +22,7 @@ from collections import namedtuple
 
 import numpy as np
 
+from ..ledger import blocks as chain_state
 from ..ledger import state as ledger_state
 from ..state import log as log_state
 from ..state.view import make_view, register_layout
@@ -35,22 +36,27 @@ from ..state.log import EV_DEPOSIT, EV_PURCHASE, EV_REFUSED, EVENT_NAMES  # noqa
 DOMAINS = (params.SPEC, swarm.SPEC, ledger_state.SPEC, log_state.SPEC)
 World = namedtuple("World", tuple(name for spec in DOMAINS for name in spec.names))
 register_layout("world", DOMAINS)
+#: A chain model's world (docs/chain-model.md): the same domains and the chain's (``ledger.blocks``).
+#: A separate layout, so the paper's world type (and every kernel compiled for it) has none of its fields.
+CHAIN_DOMAINS = DOMAINS + (chain_state.SPEC,)
+ChainWorld = namedtuple("ChainWorld", tuple(name for spec in CHAIN_DOMAINS for name in spec.names))
+register_layout("chainworld", CHAIN_DOMAINS)
 
 #: Field names by writer (``state.spec``).
-PARAMS = tuple(f.name for spec in DOMAINS for f in spec if f.writer == "host")
+PARAMS = tuple(f.name for spec in CHAIN_DOMAINS for f in spec if f.writer == "host")
 ROBOTS = swarm.SPEC.names
-LEDGER = tuple(f.name for f in ledger_state.SPEC if f.writer == "ledger")
-LOG = tuple(f.name for f in log_state.SPEC if f.writer == "log")
+LEDGER = tuple(f.name for spec in (ledger_state.SPEC, chain_state.SPEC) for f in spec if f.writer == "ledger")
+LOG = tuple(f.name for spec in (log_state.SPEC, chain_state.SPEC) for f in spec if f.writer == "log")
 
 
 def kernel_view(world: World):
     """What to pass to the compiled kernels for this world (valid while ``world`` lives)."""
-    return make_view("world", world)
+    return make_view("chainworld" if isinstance(world, ChainWorld) else "world", world)
 
 
 def describe() -> str:
     """Every field of the world, domain by domain (markdown)."""
-    return "\n\n".join(f"### {spec.domain}\n\n{spec.table()}" for spec in DOMAINS)
+    return "\n\n".join(f"### {spec.domain}\n\n{spec.table()}" for spec in CHAIN_DOMAINS)
 
 
 def headings(world: World) -> np.ndarray:

@@ -14,11 +14,9 @@ from numba import njit
 from ..state import flags
 from ..state.log import EV_DEPOSIT, EV_PURCHASE, EV_REFUSED
 from ..state.view import unlock
-
-
 #: A seller whose balance falls short of the stake by less than this (float rounding of sums of
 #: stakes, e.g. 1 - 24 x 0.04) can still lock it: the exact on-chain ledger would accept it.
-STAKE_TOLERANCE = 1e-9
+from .mempool import STAKE_TOLERANCE, chain_on, chain_reveal, muted
 #: A settled sale counts as an outlier in its seller's reputation record when the scheme weighed it
 #: below this fraction of the best weight given to the same site in that settlement (or 0).  Half, not
 #: "below the best": with outlier penalisation honest sales weigh anywhere near the best (drift spreads
@@ -28,8 +26,9 @@ OUTLIER_FRACTION = 0.5
 
 @njit
 def log_event(w, kind, buyer, seller, site, direction, x, y, age, stake, sx=0.0, sy=0.0):
-    """Append one event to the log when recording; the host keeps enough room for a whole step."""
-    if not w.record:
+    """Append one event to the log when recording; the host keeps enough room for a whole step.
+    (A chain world replaying blocks it has logged already is ``muted``.)"""
+    if not w.record or muted(w):
         return
     k = w.ev_count[0]
     if k >= w.ev_step.shape[0]:
@@ -53,6 +52,8 @@ def log_event(w, kind, buyer, seller, site, direction, x, y, age, stake, sx=0.0,
 @njit
 def log_payment(w, buyer, tx, weight, amount):
     """Append one row to the payments log: what the seller of pool transaction ``tx`` received."""
+    if muted(w):
+        return
     k = w.pay_count[0]
     if k >= w.pay_step.shape[0]:
         unlock(w.flags)[0] |= flags.EVENT_OVERFLOW
@@ -98,7 +99,11 @@ def reserve(w, buyer, need):
 
 @njit(inline="always")
 def open_transaction(w, buyer, seller, site, direction):
-    """Lock the seller's stake and record the transaction; False (nothing recorded) when refused."""
+    """Lock the seller's stake and record the transaction; False (nothing recorded) when refused.
+    In a chain world (``ledger.mempool``) the seller's own view decides, and the purchase becomes a
+    pending reveal that a block applies later; elsewhere that branch compiles to a constant."""
+    if chain_on(w):
+        return chain_reveal(w, buyer, seller, site, direction)
     k = w.tx_count[buyer]
     if k >= w.tx_cap[buyer]:
         unlock(w.flags)[0] |= flags.TX_OVERFLOW

@@ -1,0 +1,720 @@
+"""The chain model: robots as blockchain nodes (docs/chain-model.md).  Its state, builder and growth, and
+the compiled ledger operations on blocks.
+
+State (``SPEC``, the ``chain`` domain; only ledger operations write it, like the ledger's own):
+
+* **Blocks**, a store of the blocks that are not final yet: parent, height, weight (total difficulty:
+  2 per in-turn block, 1 per out-of-turn one, as Clique), hash, signer, step, the transactions it
+  includes (mempool slots, in the order they were sent) and every robot's balance after it
+  (``blk_bal``, the snapshot a robot's view reads).  The **checkpoint** (``chn_ckpt``) is the newest
+  final block (every robot's head descends from it, or it lies ``chn_final`` blocks below the canonical
+  head): nothing before it can change, so it is the root of the store.
+* **Mempool** (``ledger.mempool``): transactions not yet in a final block, with a bit per robot
+  (``mp_known``) saying who knows each.
+* **Views**: each robot's head block (``view_head``, -1 once its branch is dropped), the head's height,
+  weight and hash and its own balance there (``view_*``), and its spendable money (``view_avail``).
+* **Ledgers**: the engine's ledger arrays (``ledger.state``) hold the state at the **canonical head**
+  (``chn_canon``: the heaviest block, ties to the lower hash), which the run reports; ``ck_*`` hold the
+  state at the checkpoint.  The state at any other block is the checkpoint's with the blocks on its branch
+  applied again (``engine.step.chain_variant``): a reorganisation undoes and redoes payments that way.
+* **Measures** (the log): blocks made, forks, reorganisations and the transactions they dropped, failed
+  transactions, deposit-to-payment delays, every robot's summed view lag.
+
+Memory: the blocks since the checkpoint (each with a balance snapshot, O(n)), the mempool with its
+known-bits (O(n x transactions in flight)), two ledgers.  Nothing grows with the run's history.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from ..state.spec import Spec, fields
+from ..state.view import unlock
+from .kernels import reserve
+from .mempool import DEPOSIT, REVEAL, STAKE_TOLERANCE, chance, knows, learn, mix, refresh_view, stamp_path
+from .state import TX_POOL
+
+# ---- gas (docs/gas.md, measured on the contract: in-process revm, Cancun rules, solc 0.8.28) ----------
+
+#: Gas of one ``revealInformation`` call, the mean over a round trip of 16 reveals (docs/gas.md,
+#: "reveal, mean", n = 16): delayed payment, outlier penalisation, outlier penalisation with staking.
+GAS_REVEAL_DELAYED = 90_155
+GAS_REVEAL_OUTLIER = 90_156
+GAS_REVEAL_STAKING = 94_038
+#: Gas of a deposit (``buyItem`` and the ``settle`` calls) by the number n of reveals it settles
+#: (docs/gas.md, "deposit, later trips": the steady state of a running swarm).
+GAS_DEPOSIT_N = (1, 4, 16, 64, 256, 1024)
+GAS_DEPOSIT_DELAYED = (109_864, 118_638, 153_784, 374_383, 1_171_407, 4_359_503)
+GAS_DEPOSIT_OUTLIER = (114_496, 135_168, 320_151, 3_444_418, 53_184_194, 1_064_925_378)
+GAS_DEPOSIT_STAKING = (114_496, 135_168, 320_151, 3_424_518, 53_164_294, 1_064_905_478)
+
+
+def gas_schedule(scheme: str, stake: float) -> tuple[float, tuple[int, ...]]:
+    """(reveal gas, deposit gas by n) for a payment scheme: the delayed scheme's figures for ``delayed``,
+    the outlier scheme's (with staking when ``stake > 0``) for every other scheme."""
+    if scheme == "delayed":
+        return float(GAS_REVEAL_DELAYED), GAS_DEPOSIT_DELAYED
+    if stake > 0:
+        return float(GAS_REVEAL_STAKING), GAS_DEPOSIT_STAKING
+    return float(GAS_REVEAL_OUTLIER), GAS_DEPOSIT_OUTLIER
+
+
+#: The checkpoint's copy of each ledger field (``ck_<field>``).
+CHECKPOINTED = ("balance", "pot", "burned", "tx_off", "tx_cap", "tx_count", *TX_POOL, "pool_top", "money",
+                "rep_settled", "rep_reduced", "rep_earned", "rep_stake_lost", "rep_deposits", "gas_paid")
+_LEDGER_KINDS = {"balance": ("float64", "n"), "pot": ("float64", "n"), "burned": ("float64", "1"),
+                 "tx_off": ("int64", "n"), "tx_cap": ("int64", "n"), "tx_count": ("int64", "n"),
+                 "tx_seller": ("int64", "P"), "tx_site": ("int64", "P"), "tx_dir": ("float64", "P"),
+                 "tx_step": ("int64", "P"), "tx_stake": ("float64", "P"), "pool_top": ("int64", "1"),
+                 "money": ("float64", "1"), "rep_settled": ("int64", "n"), "rep_reduced": ("int64", "n"),
+                 "rep_earned": ("float64", "n"), "rep_stake_lost": ("float64", "n"),
+                 "rep_deposits": ("int64", "n"), "gas_paid": ("float64", "n")}
+
+#: Shapes: ``Bc`` block slots, ``T`` mempool slots (a multiple of 64), ``T/64`` words of known-bits,
+#: ``S`` signers, ``G`` points of the deposit-gas table.
+SPEC = Spec("chain", [
+    *fields("host", [
+        ("chn_period", "int", "", "block period P, steps: an in-turn signer makes a block P steps after its head's"),
+        ("chn_delay", "int", "", "extra steps an out-of-turn signer waits (P + delay after its head's block)"),
+        ("chn_signers", "int64", "S", "the signer set (robot ids); block h is in turn for signers[h % S]"),
+        ("chn_backbone", "bool", "", "a backbone also carries every transaction and block to every robot"),
+        ("chn_latency", "int", "", "the backbone's latency, steps"),
+        ("chn_loss", "float", "", "probability that a message between two neighbours is lost"),
+        ("chn_gas_price", "float", "", "money per unit of gas"),
+        ("chn_gas_reveal", "float", "", "gas of one reveal (docs/gas.md)"),
+        ("chn_gas_n", "float64", "G", "deposit-gas table: reveals settled"),
+        ("chn_gas_deposit", "float64", "G", "deposit-gas table: gas"),
+        ("chn_seed", "int", "", "seed of the chain's own draws (message loss)"),
+        ("chn_final", "int", "", "finality depth F: a block F blocks below the canonical head is final"),
+    ]),
+    *fields("ledger", [
+        ("view_head", "int64", "n", "each robot's head block (a slot of the block store; -1: its branch "
+                                    "was dropped, the robot keeps the head's height, weight and its balance)"),
+        ("view_height", "int64", "n", "height of each robot's head"),
+        ("view_weight", "int64", "n", "weight of each robot's head"),
+        ("view_hash", "int64", "n", "hash of each robot's head"),
+        ("view_bal", "float64", "n", "each robot's own balance at its head"),
+        ("view_old", "int64", "n", "heads at the start of the gossip phase (what neighbours hear)"),
+        ("view_avail", "float64", "n", "money each robot's view lets it spend: balance at its head less "
+                                        "its own pending reveals' stakes and gas"),
+        ("gas_paid", "float64", "n", "gas each robot has paid on the canonical chain"),
+        ("blk_live", "bool", "Bc", "slot holds a block (the checkpoint or one after it)"),
+        ("blk_parent", "int64", "Bc", "parent slot (-1 for the checkpoint)"),
+        ("blk_height", "int64", "Bc", "height (genesis 0)"),
+        ("blk_weight", "int64", "Bc", "total difficulty: +2 in turn, +1 out of turn"),
+        ("blk_hash", "int64", "Bc", "hash (ties between equally heavy heads go to the lower)"),
+        ("blk_signer", "int64", "Bc", "robot that made it (-1 genesis)"),
+        ("blk_step", "int64", "Bc", "step it was made"),
+        ("blk_kids", "int64", "Bc", "blocks made on it"),
+        ("blk_bb", "bool", "Bc", "delivered by the backbone"),
+        ("blk_ntx", "int64", "Bc", "transactions it includes"),
+        ("blk_tx", "int64", "Bc,T", "the mempool slots it includes, in the order they were sent"),
+        ("blk_bal", "float64", "Bc,n", "every robot's balance after it"),
+        ("chn_ckpt", "int64", "1", "the checkpoint's slot"),
+        ("chn_canon", "int64", "1", "the canonical head's slot"),
+        ("chn_cur", "int64", "1", "the block whose state the ledger arrays hold"),
+        ("chn_mute", "int64", "1", "1 while replaying: logs and measures are not written again"),
+        ("chn_stamp", "int64", "1", "last stamp of mp_mark"),
+        ("chn_seq", "int64", "1", "transactions sent so far (their order)"),
+        ("chn_nopen", "int64", "1", "reveals the deposit being applied settles"),
+        ("chn_path", "int64", "Bc", "scratch: a branch, oldest block first"),
+        ("mp_live", "bool", "T", "slot holds a pending transaction"),
+        ("mp_cursor", "int64", "1", "where the next free slot is looked for"),
+        ("mp_count", "int64", "1", "pending transactions"),
+        ("mp_for_buyer", "int64", "n", "pending reveals per buyer"),
+        ("mp_own", "int64", "n", "pending reveals per seller (0: its view is its balance at its head)"),
+        ("mp_kind", "int64", "T", "REVEAL / DEPOSIT"),
+        ("mp_origin", "int64", "T", "robot that sent it (the seller of a reveal, the depositor)"),
+        ("mp_buyer", "int64", "T", "buyer (the depositor for a deposit)"),
+        ("mp_seller", "int64", "T", "seller (-1)"),
+        ("mp_site", "int64", "T", "site (-1)"),
+        ("mp_dir", "float64", "T", "direction of the bought vector, degrees"),
+        ("mp_stake", "float64", "T", "stake the seller's view locked"),
+        ("mp_gas", "float64", "T", "gas cost the sender's view set aside"),
+        ("mp_step", "int64", "T", "step it was sent"),
+        ("mp_seq", "int64", "T", "its place in sending order"),
+        ("mp_mark", "int64", "T", "scratch stamp (mempool.stamp_path)"),
+        ("mp_bb", "bool", "T", "delivered by the backbone"),
+        ("mp_known", "uint64", "n,T/64", "bit tx of row i: robot i knows transaction tx"),
+        ("mp_old", "uint64", "n,T/64", "known-bits at the start of the gossip phase"),
+        *[(f"ck_{f}", _LEDGER_KINDS[f][0], _LEDGER_KINDS[f][1], f"{f} at the checkpoint")
+          for f in CHECKPOINTED],
+    ]),
+    *fields("log", [
+        ("chn_blocks", "int64", "1", "blocks made"),
+        ("chn_forks", "int64", "1", "blocks made on a parent that already had a child"),
+        ("chn_reorgs", "int64", "1", "times the canonical head moved to another branch"),
+        ("chn_reorg_tx", "int64", "1", "transactions those moves took out of the canonical chain"),
+        ("chn_view_reorgs", "int64", "1", "times a robot's head moved to a block not descending from it"),
+        ("chn_failed", "int64", "1", "included transactions that failed (the branch could not pay)"),
+        ("chn_delay_sum", "int64", "1", "summed steps from deposit to the block that paid it"),
+        ("chn_delay_count", "int64", "1", "deposits paid"),
+        ("chn_lag_sum", "int64", "n", "each robot's summed lag (canonical height - its head's), per step"),
+    ]),
+])
+
+#: First capacities: block slots and mempool slots.
+BLOCK_CAPACITY = 16
+MEMPOOL_CAPACITY = 128
+
+
+def _words(t: int) -> int:
+    return (t + 63) // 64
+
+
+def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: bool, latency: int, loss: float,
+                gas_price: float, gas_reveal: float, gas_table, seed: int, finality: int) -> dict:
+    """The chain's state for a fresh ledger: the genesis block (every robot's head), an empty mempool,
+    the checkpoint a copy of the ledger."""
+    n = ledger["balance"].shape[0]
+    bc, t = BLOCK_CAPACITY, MEMPOOL_CAPACITY
+    z = np.zeros
+    pool = ledger["tx_seller"].shape[0]
+    ns, gs = zip(*gas_table)
+    chain = {
+        "chn_period": int(period), "chn_delay": int(delay), "chn_signers": np.asarray(signers, np.int64),
+        "chn_backbone": bool(backbone), "chn_latency": int(latency), "chn_loss": float(loss),
+        "chn_gas_price": float(gas_price), "chn_gas_reveal": float(gas_reveal),
+        "chn_gas_n": np.array(ns, np.float64), "chn_gas_deposit": np.array(gs, np.float64), "chn_seed": int(seed),
+        "chn_final": int(finality), "view_height": z(n, np.int64), "view_weight": z(n, np.int64),
+        "view_hash": np.full(n, np.int64(int(seed) % (2**62)), np.int64), "view_bal": ledger["balance"].copy(),
+        "view_head": z(n, np.int64), "view_old": z(n, np.int64), "view_avail": ledger["balance"].copy(),
+        "gas_paid": z(n),
+        "blk_live": z(bc, np.bool_), "blk_parent": np.full(bc, -1, np.int64), "blk_height": z(bc, np.int64),
+        "blk_weight": z(bc, np.int64), "blk_hash": z(bc, np.int64), "blk_signer": np.full(bc, -1, np.int64),
+        "blk_step": z(bc, np.int64), "blk_kids": z(bc, np.int64), "blk_bb": z(bc, np.bool_),
+        "blk_ntx": z(bc, np.int64), "blk_tx": z((bc, t), np.int64), "blk_bal": z((bc, n)),
+        "chn_ckpt": z(1, np.int64), "chn_canon": z(1, np.int64), "chn_cur": z(1, np.int64),
+        "chn_mute": z(1, np.int64), "chn_stamp": z(1, np.int64), "chn_seq": z(1, np.int64),
+        "chn_nopen": z(1, np.int64), "chn_path": z(bc, np.int64),
+        "mp_live": z(t, np.bool_), "mp_cursor": z(1, np.int64), "mp_count": z(1, np.int64),
+        "mp_for_buyer": z(n, np.int64), "mp_own": z(n, np.int64), "mp_kind": z(t, np.int64),
+        "mp_origin": z(t, np.int64),
+        "mp_buyer": z(t, np.int64), "mp_seller": z(t, np.int64), "mp_site": z(t, np.int64), "mp_dir": z(t),
+        "mp_stake": z(t), "mp_gas": z(t), "mp_step": z(t, np.int64), "mp_seq": z(t, np.int64),
+        "mp_mark": z(t, np.int64), "mp_bb": z(t, np.bool_),
+        "mp_known": z((n, _words(t)), np.uint64), "mp_old": z((n, _words(t)), np.uint64),
+        "chn_blocks": z(1, np.int64), "chn_forks": z(1, np.int64), "chn_reorgs": z(1, np.int64),
+        "chn_reorg_tx": z(1, np.int64), "chn_view_reorgs": z(1, np.int64), "chn_failed": z(1, np.int64),
+        "chn_delay_sum": z(1, np.int64),
+        "chn_delay_count": z(1, np.int64), "chn_lag_sum": z(n, np.int64),
+    }
+    for f in CHECKPOINTED:
+        chain[f"ck_{f}"] = (chain["gas_paid"] if f == "gas_paid" else ledger[f]).copy()
+    # genesis: slot 0, height 0, every robot's head, the checkpoint and the canonical head
+    chain["blk_live"][0] = True
+    chain["blk_hash"][0] = np.int64(int(seed) % (2**62))
+    chain["blk_bal"][0] = ledger["balance"]
+    assert chain["ck_tx_seller"].shape[0] == pool
+    SPEC.check(chain)
+    return chain
+
+
+def _grown(old: np.ndarray, axis: int, size: int, fill=0) -> np.ndarray:
+    shape = list(old.shape)
+    shape[axis] = size
+    new = np.full(shape, fill, old.dtype)
+    new[tuple(slice(0, k) for k in old.shape)] = old
+    return new
+
+
+def grow_chain(world, needs) -> dict:
+    """Replacement arrays (field -> array) so the next step fits (``needs``: ``chain_needs`` of the world's
+    view), at least doubling what grows; slots keep their numbers (nothing is moved).  Empty when nothing
+    is short."""
+    mp, blocks, pool = int(needs[0]), int(needs[1]), int(needs[2])
+    changes: dict = {}
+    t = world.mp_live.shape[0]
+    if mp > t:
+        size = 64 * _words(max(2 * t, mp))
+        for f in ("mp_live", "mp_kind", "mp_origin", "mp_buyer", "mp_seller", "mp_site", "mp_dir", "mp_stake",
+                  "mp_gas", "mp_step", "mp_seq", "mp_mark", "mp_bb"):
+            changes[f] = _grown(getattr(world, f), 0, size)
+        for f in ("mp_known", "mp_old"):
+            changes[f] = _grown(getattr(world, f), 1, _words(size))
+        changes["blk_tx"] = _grown(world.blk_tx, 1, size)
+    bc = world.blk_live.shape[0]
+    if blocks > bc:
+        size = max(2 * bc, blocks)
+        for f in ("blk_live", "blk_height", "blk_weight", "blk_hash", "blk_step", "blk_kids", "blk_bb", "blk_ntx",
+                  "chn_path"):
+            changes[f] = _grown(getattr(world, f), 0, size)
+        for f in ("blk_parent", "blk_signer"):
+            changes[f] = _grown(getattr(world, f), 0, size, -1)
+        changes["blk_tx"] = _grown(changes.get("blk_tx", world.blk_tx), 0, size)
+        changes["blk_bal"] = _grown(world.blk_bal, 0, size)
+    p = world.tx_seller.shape[0]
+    if pool > p:
+        size = max(2 * p, pool)
+        for f in TX_POOL:
+            changes[f] = _grown(getattr(world, f), 0, size)
+            changes[f"ck_{f}"] = _grown(getattr(world, f"ck_{f}"), 0, size)
+    return changes
+
+
+@njit
+def chain_needs(w):
+    """What the next step may need at most, for the kernel's ``has_room`` and the host's growth alike:
+    (mempool slots, block slots, transaction-pool entries, event rows, payment rows).  One transaction
+    per purchase and deposit; a block for every signer due now (one more may wait a step:
+    ``can_make``); for the ledgers replayed from the checkpoint, every buyer's block moved as often as
+    its pending reveals can make it grow; the logs of one block's settlements on top of the step's."""
+    n = w.nbr_count.shape[0]
+    links = 0
+    for i in range(n):
+        links += w.nbr_count[i]
+    t = w.clock[0] + 1
+    due = 0
+    for k in range(w.chn_signers.shape[0]):
+        h = w.view_head[w.chn_signers[k]]
+        if h >= 0 and t - w.blk_step[h] >= w.chn_period:
+            due += 1
+    live = 0
+    for b in range(w.blk_live.shape[0]):
+        if w.blk_live[b]:
+            live += 1
+    pool = max(w.pool_top[0], w.ck_pool_top[0])
+    open_ = 0
+    for i in range(n):
+        grow = max(w.tx_count[i], w.ck_tx_count[i]) + w.mp_for_buyer[i] + 2 * w.nbr_count[i]
+        pool += 4 * (grow + 8) + 2 * max(w.tx_cap[i], w.ck_tx_cap[i])
+        open_ += grow
+    mp = w.mp_count[0] + n + 2 * links
+    events = w.ev_count[0] + n + 2 * links + mp
+    payments = w.pay_count[0] + 2 * open_
+    return mp, live + due + 1, pool, events, payments
+
+
+@njit
+def room_fits(w):
+    """Does the next step fit in the chain's arrays (and, when recording, the logs)?"""
+    mp, blocks, pool, events, payments = chain_needs(w)
+    if mp > w.mp_live.shape[0] or blocks > w.blk_live.shape[0] or pool > w.tx_seller.shape[0]:
+        return False
+    return not w.record or (events <= w.ev_step.shape[0] and payments <= w.pay_step.shape[0])
+
+
+@njit
+def can_make(w):
+    """Is there room for one more block this step (a free slot; log rows for its settlements)?  A signer
+    that finds none makes its block in a later step, after the host has grown the arrays."""
+    free = False
+    for b in range(w.blk_live.shape[0]):
+        if not w.blk_live[b]:
+            free = True
+            break
+    if not free:
+        return False
+    if not w.record:
+        return True
+    payments = 0
+    for i in range(w.tx_count.shape[0]):
+        payments += max(w.tx_count[i], w.ck_tx_count[i]) + w.mp_for_buyer[i]
+    return (w.ev_count[0] + w.mp_count[0] <= w.ev_step.shape[0]
+            and w.pay_count[0] + payments <= w.pay_step.shape[0])
+
+
+# ---- compiled: blocks ---------------------------------------------------------------------------------
+
+@njit(inline="always")
+def heavier(w, a, b):
+    """Is block a heavier than block b: more total difficulty, or as much and a lower hash."""
+    wa = w.blk_weight[a]
+    wb = w.blk_weight[b]
+    return wa > wb or (wa == wb and w.blk_hash[a] < w.blk_hash[b])
+
+
+@njit(inline="always")
+def ancestor_at(w, b, height):
+    """The block on b's branch at ``height`` (b itself when b is not higher)."""
+    while w.blk_height[b] > height:
+        b = w.blk_parent[b]
+    return b
+
+
+@njit
+def in_turn(w, height):
+    """The signer whose turn block ``height`` is."""
+    s = w.chn_signers
+    return s[height % s.shape[0]]
+
+
+@njit
+def due(w, signer, t):
+    """Does ``signer`` make a block on its head at step t: P steps after the head's block when in turn,
+    P + delay when out of turn."""
+    h = w.view_head[signer]
+    if h < 0:
+        return False  # its branch was dropped: it cannot build on it
+    wait = w.chn_period if in_turn(w, w.blk_height[h] + 1) == signer else w.chn_period + w.chn_delay
+    return t - w.blk_step[h] >= wait
+
+
+@njit
+def path_from_checkpoint(w, target):
+    """The branch from the checkpoint (excluded) to ``target`` in ``chn_path``, oldest first; its length."""
+    path = unlock(w.chn_path)
+    k = 0
+    b = target
+    ck = w.chn_ckpt[0]
+    while b != ck:
+        path[k] = b
+        k += 1
+        b = w.blk_parent[b]
+    for a in range(k // 2):
+        path[a], path[k - 1 - a] = path[k - 1 - a], path[a]
+    return k
+
+
+@njit
+def new_block(w, signer, t):
+    """``signer`` makes a block on its head at step t, holding every pending transaction it knows that
+    its branch does not include yet, in sending order.  Returns its slot (the ledger is not touched)."""
+    parent = w.view_head[signer]
+    live = unlock(w.blk_live)
+    b = 0
+    while live[b]:
+        b += 1  # the host keeps a free slot for every block a step can make
+    height = w.blk_height[parent] + 1
+    live[b] = True
+    unlock(w.blk_parent)[b] = parent
+    unlock(w.blk_height)[b] = height
+    unlock(w.blk_weight)[b] = w.blk_weight[parent] + (2 if in_turn(w, height) == signer else 1)
+    h = mix(np.uint64(w.blk_hash[parent]) ^ (np.uint64(height) * np.uint64(0x9E3779B97F4A7C15)))
+    h = mix(h ^ (np.uint64(signer) + np.uint64(t) * np.uint64(0xD6E8FEB86659FD93)))
+    unlock(w.blk_hash)[b] = np.int64(h >> np.uint64(2))
+    unlock(w.blk_signer)[b] = signer
+    unlock(w.blk_step)[b] = t
+    unlock(w.blk_kids)[b] = 0
+    unlock(w.blk_bb)[b] = False
+    unlock(w.blk_kids)[parent] += 1
+    unlock(w.chn_blocks)[0] += 1
+    if w.blk_kids[parent] > 1:
+        unlock(w.chn_forks)[0] += 1
+    stamp = stamp_path(w, parent)
+    txs = unlock(w.blk_tx)
+    k = 0
+    for tx in range(w.mp_live.shape[0]):
+        if w.mp_live[tx] and w.mp_mark[tx] != stamp and knows(w, signer, tx):
+            txs[b, k] = tx
+            k += 1
+    for a in range(1, k):  # insertion sort by sending order (the slots are nearly in order already)
+        v = txs[b, a]
+        c = a - 1
+        while c >= 0 and w.mp_seq[txs[b, c]] > w.mp_seq[v]:
+            txs[b, c + 1] = txs[b, c]
+            c -= 1
+        txs[b, c + 1] = v
+    unlock(w.blk_ntx)[b] = k
+    return b
+
+
+@njit
+def include_tx(w, b, tx):
+    """Apply transaction ``tx`` of block b to the ledger arrays.  A reveal: the seller pays the gas and
+    locks the stake if the branch's balance covers both (the view's check, on the branch), and the
+    buyer's open list gets it; else it fails and moves nothing.  A deposit: True, the caller settles it
+    (``distribute`` pays the reward and the sellers) and then calls ``finish_deposit``."""
+    buyer = w.mp_buyer[tx]
+    if w.mp_kind[tx] == DEPOSIT:
+        unlock(w.chn_nopen)[0] = w.tx_count[buyer]
+        return True
+    seller = w.mp_seller[tx]
+    balance, money = unlock(w.balance), unlock(w.money)
+    gas = w.mp_gas[tx]
+    if w.stake > 0.0 or gas > 0.0:
+        if balance[seller] < w.stake + gas - STAKE_TOLERANCE:
+            if w.chn_mute[0] == 0:
+                unlock(w.chn_failed)[0] += 1
+            return False
+    count = w.tx_count[buyer]
+    if not reserve(w, buyer, count + 1):
+        return False  # the host keeps room (grow_chain); unreachable
+    if gas > 0.0:
+        balance[seller] -= gas
+        money[0] -= gas
+        unlock(w.gas_paid)[seller] += gas
+    lock = 0.0
+    if w.stake > 0.0:
+        lock = min(w.stake, balance[seller])
+        balance[seller] -= lock
+        money[0] -= lock
+        unlock(w.pot)[buyer] += lock
+    x = w.tx_off[buyer] + count
+    unlock(w.tx_seller)[x] = seller
+    unlock(w.tx_site)[x] = w.mp_site[tx]
+    unlock(w.tx_dir)[x] = w.mp_dir[tx]
+    unlock(w.tx_step)[x] = w.mp_step[tx]
+    unlock(w.tx_stake)[x] = lock
+    unlock(w.tx_count)[buyer] = count + 1
+    return False
+
+
+@njit
+def deposit_gas(w, n):
+    """Gas of a deposit that settles n reveals: the measured table, linear between its points and beyond
+    its last two; n below the first point costs the first point's gas."""
+    xs = w.chn_gas_n
+    ys = w.chn_gas_deposit
+    m = xs.shape[0]
+    if n <= xs[0]:
+        return ys[0]
+    k = 1
+    while k < m - 1 and n > xs[k]:
+        k += 1
+    return ys[k - 1] + (ys[k] - ys[k - 1]) * (n - xs[k - 1]) / (xs[k] - xs[k - 1])
+
+
+@njit
+def finish_deposit(w, b, tx):
+    """After a deposit's settlement: the depositor pays the deposit's gas (never below a zero balance),
+    and its delay from sending to this block is measured (first application only)."""
+    buyer = w.mp_buyer[tx]
+    if w.chn_gas_price > 0.0:
+        cost = min(w.chn_gas_price * deposit_gas(w, float(w.chn_nopen[0])), w.balance[buyer])
+        unlock(w.balance)[buyer] -= cost
+        unlock(w.money)[0] -= cost
+        unlock(w.gas_paid)[buyer] += cost
+    if w.chn_mute[0] == 0:
+        unlock(w.chn_delay_sum)[0] += w.blk_step[b] - w.mp_step[tx]
+        unlock(w.chn_delay_count)[0] += 1
+
+
+@njit
+def save_checkpoint(w):
+    """The ledger arrays' state becomes the checkpoint's."""
+    _copy_ledger(w.balance, w.pot, w.burned, w.tx_off, w.tx_cap, w.tx_count, w.tx_seller, w.tx_site, w.tx_dir,
+                 w.tx_step, w.tx_stake, w.pool_top, w.money, w.rep_settled, w.rep_reduced, w.rep_earned,
+                 w.rep_stake_lost, w.rep_deposits, w.gas_paid,
+                 unlock(w.ck_balance), unlock(w.ck_pot), unlock(w.ck_burned), unlock(w.ck_tx_off),
+                 unlock(w.ck_tx_cap), unlock(w.ck_tx_count), unlock(w.ck_tx_seller), unlock(w.ck_tx_site),
+                 unlock(w.ck_tx_dir), unlock(w.ck_tx_step), unlock(w.ck_tx_stake), unlock(w.ck_pool_top),
+                 unlock(w.ck_money), unlock(w.ck_rep_settled), unlock(w.ck_rep_reduced),
+                 unlock(w.ck_rep_earned), unlock(w.ck_rep_stake_lost), unlock(w.ck_rep_deposits),
+                 unlock(w.ck_gas_paid))
+
+
+@njit
+def restore_checkpoint(w):
+    """The ledger arrays go back to the checkpoint's state (the block ``chn_cur`` is then the checkpoint)."""
+    _copy_ledger(w.ck_balance, w.ck_pot, w.ck_burned, w.ck_tx_off, w.ck_tx_cap, w.ck_tx_count, w.ck_tx_seller,
+                 w.ck_tx_site, w.ck_tx_dir, w.ck_tx_step, w.ck_tx_stake, w.ck_pool_top, w.ck_money,
+                 w.ck_rep_settled, w.ck_rep_reduced, w.ck_rep_earned, w.ck_rep_stake_lost, w.ck_rep_deposits,
+                 w.ck_gas_paid,
+                 unlock(w.balance), unlock(w.pot), unlock(w.burned), unlock(w.tx_off), unlock(w.tx_cap),
+                 unlock(w.tx_count), unlock(w.tx_seller), unlock(w.tx_site), unlock(w.tx_dir), unlock(w.tx_step),
+                 unlock(w.tx_stake), unlock(w.pool_top), unlock(w.money), unlock(w.rep_settled),
+                 unlock(w.rep_reduced), unlock(w.rep_earned), unlock(w.rep_stake_lost), unlock(w.rep_deposits),
+                 unlock(w.gas_paid))
+    unlock(w.chn_cur)[0] = w.chn_ckpt[0]
+
+
+@njit
+def _copy_ledger(balance, pot, burned, tx_off, tx_cap, tx_count, tx_seller, tx_site, tx_dir, tx_step, tx_stake,
+                 pool_top, money, rep_settled, rep_reduced, rep_earned, rep_stake_lost, rep_deposits, gas_paid,
+                 o_balance, o_pot, o_burned, o_tx_off, o_tx_cap, o_tx_count, o_tx_seller, o_tx_site, o_tx_dir,
+                 o_tx_step, o_tx_stake, o_pool_top, o_money, o_rep_settled, o_rep_reduced, o_rep_earned,
+                 o_rep_stake_lost, o_rep_deposits, o_gas_paid):
+    o_balance[:] = balance
+    o_pot[:] = pot
+    o_burned[:] = burned
+    o_tx_off[:] = tx_off
+    o_tx_cap[:] = tx_cap
+    o_tx_count[:] = tx_count
+    for i in range(tx_off.shape[0]):  # only each buyer's open transactions: the rest of the pool is free
+        a = tx_off[i]
+        for x in range(a, a + tx_count[i]):
+            o_tx_seller[x] = tx_seller[x]
+            o_tx_site[x] = tx_site[x]
+            o_tx_dir[x] = tx_dir[x]
+            o_tx_step[x] = tx_step[x]
+            o_tx_stake[x] = tx_stake[x]
+    o_pool_top[0] = pool_top[0]
+    o_money[0] = money[0]
+    o_rep_settled[:] = rep_settled
+    o_rep_reduced[:] = rep_reduced
+    o_rep_earned[:] = rep_earned
+    o_rep_stake_lost[:] = rep_stake_lost
+    o_rep_deposits[:] = rep_deposits
+    o_gas_paid[:] = gas_paid
+
+
+@njit
+def set_current(w, b):
+    """The ledger arrays now hold the state after block b."""
+    unlock(w.chn_cur)[0] = b
+
+
+@njit
+def snapshot(w, b):
+    """Block b's balance snapshot: the ledger arrays' balances (they hold b's state)."""
+    bal = unlock(w.blk_bal)
+    for i in range(w.balance.shape[0]):
+        bal[b, i] = w.balance[i]
+
+
+@njit
+def mute(w, on):
+    unlock(w.chn_mute)[0] = 1 if on else 0
+
+
+@njit(inline="always")
+def heavier_than_view(w, b, i):
+    """Is block b heavier than robot i's head (its cached weight and hash: the head may be dropped)?"""
+    return w.blk_weight[b] > w.view_weight[i] or (w.blk_weight[b] == w.view_weight[i]
+                                                   and w.blk_hash[b] < w.view_hash[i])
+
+
+@njit
+def set_head(w, i, b):
+    """Robot i's head becomes block b (a view reorganisation when its old head is not on b's branch)."""
+    h = w.view_head[i]
+    if h < 0 or ancestor_at(w, b, w.blk_height[h]) != h:
+        unlock(w.chn_view_reorgs)[0] += 1
+    unlock(w.view_head)[i] = b
+    unlock(w.view_height)[i] = w.blk_height[b]
+    unlock(w.view_weight)[i] = w.blk_weight[b]
+    unlock(w.view_hash)[i] = w.blk_hash[b]
+    unlock(w.view_bal)[i] = w.blk_bal[b, i]
+    refresh_view(w, i)
+
+
+@njit
+def adopt(w, i, b):
+    """Robot i takes block b as its head if b is heavier than its head; True when it did."""
+    if b == w.view_head[i] or not heavier_than_view(w, b, i):
+        return False
+    set_head(w, i, b)
+    return True
+
+
+@njit
+def deliver_block(w, b):
+    """The backbone brings block b to every robot."""
+    unlock(w.blk_bb)[b] = True
+    for i in range(w.view_head.shape[0]):
+        adopt(w, i, b)
+
+
+@njit
+def new_canonical(w, b):
+    """Block b was made: if it is heavier than the canonical head it becomes the canonical head; when the
+    old head is not on b's branch that is a reorganisation, and the old branch's transactions that b's
+    branch does not include are counted.  Returns the canonical head."""
+    old = w.chn_canon[0]
+    if not heavier(w, b, old):
+        return old
+    unlock(w.chn_canon)[0] = b
+    if ancestor_at(w, b, w.blk_height[old]) != old:
+        stamp = stamp_path(w, b)
+        dropped = 0
+        x = old
+        ck = w.chn_ckpt[0]
+        while x != ck:
+            for k in range(w.blk_ntx[x]):
+                if w.mp_mark[w.blk_tx[x, k]] != stamp:
+                    dropped += 1
+            x = w.blk_parent[x]
+        unlock(w.chn_reorgs)[0] += 1
+        unlock(w.chn_reorg_tx)[0] += dropped
+    return b
+
+
+@njit
+def next_checkpoint(w):
+    """The block after the checkpoint on the canonical branch if it is final: every robot's head
+    descends from it, or it lies ``chn_final`` blocks or more below the canonical head.  Else -1."""
+    ck = w.chn_ckpt[0]
+    canon = w.chn_canon[0]
+    if canon == ck:
+        return -1
+    c = ancestor_at(w, canon, w.blk_height[ck] + 1)
+    hc = w.blk_height[c]
+    if w.blk_height[canon] - hc >= w.chn_final:
+        return c  # final by depth, whoever has not heard of it
+    for i in range(w.view_head.shape[0]):
+        h = w.view_head[i]
+        if h < 0 or w.blk_height[h] < hc or ancestor_at(w, h, hc) != c:
+            return -1
+    return c
+
+
+@njit
+def move_checkpoint(w, c):
+    """Block c (whose state the ledger arrays hold) becomes the checkpoint: its state is saved, its
+    transactions leave the mempool, and every block not descending from it is dropped; a robot whose
+    head is dropped keeps its head's height, weight, hash and its own balance (``view_head`` -1) until
+    it hears a heavier block."""
+    save_checkpoint(w)
+    live, known = unlock(w.mp_live), unlock(w.mp_known)
+    n = known.shape[0]
+    for k in range(w.blk_ntx[c]):
+        tx = w.blk_tx[c, k]
+        if not live[tx]:
+            continue
+        live[tx] = False
+        unlock(w.mp_count)[0] -= 1
+        if w.mp_kind[tx] == REVEAL:
+            unlock(w.mp_for_buyer)[w.mp_buyer[tx]] -= 1
+            unlock(w.mp_own)[w.mp_origin[tx]] -= 1
+        word = tx >> 6
+        bit = ~(np.uint64(1) << np.uint64(tx & 63))
+        for i in range(n):
+            known[i, word] &= bit
+    hc = w.blk_height[c]
+    blive = unlock(w.blk_live)
+    for b in range(blive.shape[0]):
+        if blive[b] and b != c and ancestor_at(w, b, hc) != c:
+            blive[b] = False
+    unlock(w.blk_parent)[c] = -1
+    unlock(w.chn_ckpt)[0] = c
+    for i in range(n):
+        h = w.view_head[i]
+        if h >= 0 and not blive[h]:
+            unlock(w.view_head)[i] = -1
+
+
+# ---- compiled: gossip ---------------------------------------------------------------------------------
+
+@njit
+def gossip(w):
+    """One gossip round at the start of a step: every robot hears each neighbour's head and pending
+    transactions as they were when the round began (so news travels one hop per step), each message
+    lost with probability ``chn_loss``; the backbone delivers what is ``chn_latency`` steps old; each
+    robot's view lag is measured."""
+    t = w.clock[0]
+    n = w.view_head.shape[0]
+    old, heads = unlock(w.view_old), w.view_head
+    mold, known = unlock(w.mp_old), unlock(w.mp_known)
+    words = known.shape[1]
+    for i in range(n):
+        old[i] = heads[i]
+        for k in range(words):
+            mold[i, k] = known[i, k]
+    loss = w.chn_loss
+    for i in range(n):
+        best = -1
+        for a in range(w.nbr_count[i]):
+            j = w.nbr[i, a]
+            if loss > 0.0 and chance(w.chn_seed, t, j, i) < loss:
+                continue
+            c = old[j]
+            if c >= 0 and c != heads[i] and (heavier(w, c, best) if best >= 0 else heavier_than_view(w, c, i)):
+                best = c
+            for k in range(words):
+                known[i, k] |= mold[j, k]
+        if best >= 0:
+            set_head(w, i, best)
+    if w.chn_backbone and w.chn_latency > 0:
+        for tx in range(w.mp_live.shape[0]):
+            if w.mp_live[tx] and not w.mp_bb[tx] and w.mp_step[tx] + w.chn_latency <= t:
+                unlock(w.mp_bb)[tx] = True
+                for i in range(n):
+                    learn(w, i, tx)
+        for b in range(w.blk_live.shape[0]):
+            if w.blk_live[b] and not w.blk_bb[b] and w.blk_step[b] + w.chn_latency <= t:
+                deliver_block(w, b)
+    top = w.blk_height[w.chn_canon[0]]
+    lag = unlock(w.chn_lag_sum)
+    for i in range(n):
+        lag[i] += top - w.view_height[i]

@@ -1,0 +1,202 @@
+"""The chain model's transactions in flight and each robot's view (docs/chain-model.md).
+
+With ``[chain] consensus = "poa"`` the ledger does not apply a purchase or a deposit at once: it becomes a
+pending transaction in a bounded pool (the *mempool*), known at first only to the robot that sent it, and
+it moves money only when a block includes it (``ledger.blocks``).  This module holds what acts on a
+robot's own view and nothing else: the view check of a reveal, the recording of a deposit, and a robot's
+spendable balance at its head.
+
+The world a chain run compiles for has the chain's fields (``ledger.blocks.SPEC``); the paper's world has
+none.  ``chain_on(w)`` and ``chain_reveal`` are resolved by the *type* of ``w`` when numba compiles, so a
+kernel of the paper's world calls a stub that returns a constant and compiles none of the chain's code
+(``ledger.kernels.open_transaction`` branches on it).
+
+Random draws (message loss) come from a counter-based hash of the run's chain seed, the step and the two
+robots (``chance``): the engine's random streams are never touched, so turning the chain on does not move
+a single draw of the swarm's.
+"""
+import numpy as np
+from numba import njit, types
+from numba.extending import overload
+
+from ..state.view import unlock
+
+#: A seller whose spendable money falls short of the stake by less than this (float rounding of sums of
+#: stakes, e.g. 1 - 24 x 0.04) can still lock it: the exact on-chain ledger would accept it.
+#: (``ledger.kernels.STAKE_TOLERANCE`` is this constant.)
+STAKE_TOLERANCE = 1e-9
+
+# Transaction kinds in the mempool.
+REVEAL = 0   #: revealInformation: a purchase (the seller sends it; stake and gas come from the seller)
+DEPOSIT = 1  #: buyItem + settle: a deposit (the depositing robot's; its reward pays the deposit's gas)
+
+_GOLDEN = np.uint64(0x9E3779B97F4A7C15)
+
+
+def _is_chain_type(w) -> bool:
+    fields = getattr(w, "field_dict", None)
+    return fields is not None and "chn_period" in fields
+
+
+def chain_on(w) -> bool:
+    """Is ``w`` a chain model's world?  (A compile-time constant in compiled code.)"""
+    return hasattr(w, "chn_period")
+
+
+@overload(chain_on)
+def _chain_on(w):
+    if _is_chain_type(w):
+        return lambda w: True
+    return lambda w: False
+
+
+def muted(w) -> bool:
+    """Are the event and payment logs muted (a chain world replaying blocks it has logged already)?"""
+    return hasattr(w, "chn_mute") and w.chn_mute[0] != 0
+
+
+@overload(muted)
+def _muted(w):
+    if _is_chain_type(w):
+        return lambda w: w.chn_mute[0] != 0
+    return lambda w: False
+
+
+@njit(inline="always")
+def mix(x):
+    """splitmix64's finaliser: a bijective scramble of a 64-bit word (``x`` uint64)."""
+    x = (x ^ (x >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+    x = (x ^ (x >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    return x ^ (x >> np.uint64(31))
+
+
+@njit
+def chance(seed, a, b, c):
+    """A uniform draw in [0, 1) that depends only on (seed, a, b, c), all non-negative integers."""
+    x = mix(np.uint64(seed) + _GOLDEN)
+    x = mix(x ^ (np.uint64(a) * _GOLDEN))
+    x = mix(x ^ (np.uint64(b) + np.uint64(0x632BE59BD9B4E019)))
+    x = mix(x ^ (np.uint64(c) * np.uint64(0xD6E8FEB86659FD93)))
+    return float(x >> np.uint64(11)) * (1.0 / 9007199254740992.0)
+
+
+@njit(inline="always")
+def knows(w, i, tx):
+    """Does robot i know pending transaction ``tx`` (its bit in ``mp_known``)?"""
+    return (w.mp_known[i, tx >> 6] >> np.uint64(tx & 63)) & np.uint64(1) != np.uint64(0)
+
+
+@njit(inline="always")
+def learn(w, i, tx):
+    unlock(w.mp_known)[i, tx >> 6] |= np.uint64(1) << np.uint64(tx & 63)
+
+
+@njit
+def stamp_path(w, target):
+    """Mark (``mp_mark``) every pending transaction included on the branch from the checkpoint (excluded)
+    to ``target``; returns the stamp: ``mp_mark[tx] == stamp`` iff ``tx`` is on that branch."""
+    stamp = w.chn_stamp[0] + 1
+    unlock(w.chn_stamp)[0] = stamp
+    mark = unlock(w.mp_mark)
+    b = target
+    ck = w.chn_ckpt[0]
+    while b >= 0 and b != ck:
+        for k in range(w.blk_ntx[b]):
+            mark[w.blk_tx[b, k]] = stamp
+        b = w.blk_parent[b]
+    return stamp
+
+
+@njit
+def refresh_view(w, i):
+    """Robot i's spendable money at its head: its balance there, less the gas and stakes of its own
+    reveals that its head's branch does not include yet (in pool order; all of them when its branch was
+    dropped, ``view_head`` -1)."""
+    a = w.view_bal[i]
+    if w.mp_own[i] == 0:  # nothing of its own pending: no branch to look at
+        unlock(w.view_avail)[i] = a
+        return
+    stamp = stamp_path(w, w.view_head[i])
+    for tx in range(w.mp_live.shape[0]):
+        if w.mp_live[tx] and w.mp_origin[tx] == i and w.mp_kind[tx] == REVEAL and w.mp_mark[tx] != stamp:
+            a -= w.mp_gas[tx]
+            a -= w.mp_stake[tx]
+    unlock(w.view_avail)[i] = a
+
+
+@njit
+def new_tx(w, kind, origin, buyer, seller, site, direction, stake, gas):
+    """Put a transaction in the mempool, known to its sender (and to everyone at once through a backbone
+    of zero latency).  The host keeps a free slot for every transaction a step can make."""
+    live = unlock(w.mp_live)
+    cap = live.shape[0]
+    x = w.mp_cursor[0]
+    for _ in range(cap):
+        if not live[x]:
+            break
+        x = (x + 1) % cap
+    live[x] = True
+    unlock(w.mp_cursor)[0] = (x + 1) % cap
+    unlock(w.mp_kind)[x] = kind
+    unlock(w.mp_origin)[x] = origin
+    unlock(w.mp_buyer)[x] = buyer
+    unlock(w.mp_seller)[x] = seller
+    unlock(w.mp_site)[x] = site
+    unlock(w.mp_dir)[x] = direction
+    unlock(w.mp_stake)[x] = stake
+    unlock(w.mp_gas)[x] = gas
+    unlock(w.mp_step)[x] = w.clock[0]
+    unlock(w.mp_seq)[x] = w.chn_seq[0]
+    unlock(w.chn_seq)[0] += 1
+    unlock(w.mp_mark)[x] = 0
+    unlock(w.mp_count)[0] += 1
+    if w.chn_backbone and w.chn_latency == 0:
+        for i in range(w.view_head.shape[0]):
+            learn(w, i, x)
+        unlock(w.mp_bb)[x] = True
+    else:
+        learn(w, origin, x)
+        unlock(w.mp_bb)[x] = False
+    if kind == REVEAL:
+        unlock(w.mp_for_buyer)[buyer] += 1
+        unlock(w.mp_own)[origin] += 1
+    return x
+
+
+@njit
+def _reveal(w, buyer, seller, site, direction):
+    """The seller signs the light contract only if its own view can pay: its spendable money at its head
+    must cover the stake and the reveal's gas (the instant ledger's check, on the view).  The buyer gets
+    the vector at once (off-chain light contract); the reveal goes to the mempool."""
+    gas = w.chn_gas_price * w.chn_gas_reveal
+    avail = unlock(w.view_avail)
+    lock = 0.0
+    if w.stake > 0.0 or gas > 0.0:
+        if avail[seller] < w.stake + gas - STAKE_TOLERANCE:
+            return False
+        if w.stake > 0.0:
+            lock = min(w.stake, avail[seller] - gas)
+        avail[seller] -= gas
+        avail[seller] -= lock
+    new_tx(w, REVEAL, seller, buyer, seller, site, direction, lock, gas)
+    return True
+
+
+def chain_reveal(w, buyer, seller, site, direction):
+    """A purchase in a chain world (``ledger.kernels.open_transaction``): True when the seller's view
+    accepts it; the reveal is then pending."""
+    return _reveal(w, buyer, seller, site, direction)
+
+
+@overload(chain_reveal)
+def _chain_reveal(w, buyer, seller, site, direction):
+    if _is_chain_type(w):
+        return lambda w, buyer, seller, site, direction: _reveal(w, buyer, seller, site, direction)
+    return lambda w, buyer, seller, site, direction: False
+
+
+@njit
+def chain_deposit(w, i):
+    """Robot i deposited an item: a deposit transaction (buyItem, then settle) goes to the mempool; the
+    reward and the payments move when a block includes it."""
+    new_tx(w, DEPOSIT, i, i, -1, -1, 0.0, 0.0, 0.0)
