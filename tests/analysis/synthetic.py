@@ -135,5 +135,6 @@ def write_store(root: Path, tables: dict[str, tuple], only: tuple[str, ...] | No
     store = Store(root).create()
     for pid, (robots, runs, history) in tables.items():
         if only is None or pid.startswith(only):
-            store.write_part(pid, robots, runs, history)
+            keys = [k for k in ("byzantines", "market", "rotation_angle") if k in robots.columns]
+            store.write_part(pid, robots, runs, history, keys=keys)
     return store

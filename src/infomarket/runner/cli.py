@@ -169,6 +169,13 @@ def add_subcommand(sub) -> None:
         a = ss.add_parser(name, help=text, description=text)
         a.add_argument("store", metavar="STORE")
         a.set_defaults(func=func)
+    text = ("run a DuckDB SQL query over the store's verified parts (tables robots, history, events, payments, "
+            "sites, configs, runs: docs/data.md); needs pip install 'infomarket[sql]'")
+    a = ss.add_parser("sql", help=text, description=text)
+    a.add_argument("store", metavar="STORE")
+    a.add_argument("query", metavar="QUERY", help="e.g. \"SELECT condition, avg(items_collected) FROM robots GROUP BY ALL\"")
+    a.add_argument("--csv", action="store_true", help="print CSV instead of a text table")
+    a.set_defaults(func=cmd_store_sql)
 
 
 def _open(path: str):
@@ -216,4 +223,13 @@ def cmd_store_failed(args) -> int:
         print(f"{row.experiment} [{row.condition}] run {row.run} (seed {row.seed}):")
         print("  " + row.error.strip().replace("\n", "\n  "))
     print(f"{args.store}: {len(failed)} failed run(s)")
+    return 0
+
+
+def cmd_store_sql(args) -> int:
+    df = _open(args.store).sql(args.query)
+    if args.csv:
+        print(df.to_csv(index=False), end="")
+    else:
+        print(df.to_string(index=False) if len(df.columns) else "(no columns)")
     return 0

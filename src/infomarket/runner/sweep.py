@@ -186,7 +186,8 @@ def _run(conds, store, workers, executor, on_done, on_plan, record_events) -> Sw
     def finished(task: Task, outputs: list[RunOutput]) -> None:
         nonlocal env_steps, compile_seconds, run_seconds
         tables = _frames(task, outputs)
-        store.write_part(task.part_id, **tables)
+        keys = dict.fromkeys(k for c, _ in task.members for k in c.keys)
+        store.write_part(task.part_id, **tables, keys=keys)
         env_steps += int(tables["runs"].steps.sum())
         run_seconds += float(tables["runs"].duration_s.sum())
         compile_seconds = max([compile_seconds] + [o.compile_seconds for o in outputs])
