@@ -15,7 +15,7 @@ from pathlib import Path
 from . import __version__
 from .bench import cli as bench_cli
 from .cliargs import Parser, at_least, seed_value
-from .errors import EXIT_FAILED, InfomarketError, report
+from .errors import EXIT_FAILED, EXIT_USAGE, InfomarketError, report
 
 SUBCOMMAND_MODULES = ("infomarket.runner.cli", "infomarket.analysis.cli", "infomarket.viewer.cli",
                       "infomarket.chain.cli", "infomarket.analysis.sensitivity_cli")
@@ -69,7 +69,8 @@ def cmd_run(args) -> int:
                   f"(compile/load {done.compile_seconds:.2f} s)")
     if done.failed:
         return report(f"{done.failed} of {done.done} runs failed (the first: {done.first_error}); every error "
-                      f"is listed by `infomarket store failed {out}`", EXIT_FAILED)
+                      f"is listed by `infomarket store failed {out}`",
+                      EXIT_USAGE if done.rule_errors else EXIT_FAILED)
     return 0
 
 

@@ -11,6 +11,7 @@ defaults of the behaviour or scheme, and an experiment file may override them by
 from __future__ import annotations
 
 import inspect
+import math
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -126,6 +127,12 @@ def _rule(func: Callable, fixed: tuple[str, ...], what: str, market: bool = Fals
     for p in extra:
         if p.kind not in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD):
             raise RuleError(f"{what} {py.__name__}: parameter {p.name} must be a plain positional argument")
+    for p in extra:  # parameters are numbers (the world holds them as float64)
+        if p.default is not p.empty and (isinstance(p.default, bool) or not isinstance(p.default, (int, float))
+                                         or not math.isfinite(p.default)):
+            raise RuleError(f"{what} {py.__name__} ({where}): parameter {p.name!r} has the default "
+                            f"{p.default!r}; rule parameters are numbers (floats), so a default must be a finite "
+                            f"number such as 0.0")
     defaults = {p.name: float(p.default) for p in extra if p.default is not p.empty}
     return Rule(jitted, tuple(p.name for p in extra), defaults, wants_rng, wants_market)
 

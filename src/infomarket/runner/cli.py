@@ -4,7 +4,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..cliargs import UsageError, at_least, fraction, seed_value
-from ..errors import EXIT_FAILED, report
+from ..errors import EXIT_FAILED, EXIT_USAGE, report
 
 PAPER = ("fig2A", "fig2B", "fig2C", "fig2D", "fig3A", "fig3B", "fig3C", "fig4A", "fig4B", "fig4C",
          "fig5", "fig6A", "fig6B", "fig7")
@@ -85,7 +85,7 @@ def _execute(experiments, args, label: str) -> int:
     if done.failed:
         return report(f"{done.failed} of {done.done} runs failed (the first: {done.first_error}); every error "
                       f"is listed by `infomarket store failed {out}`; `--retry-failed` reruns them",
-                      EXIT_FAILED)
+                      EXIT_USAGE if done.rule_errors else EXIT_FAILED)
     return 0
 
 
