@@ -83,22 +83,42 @@ def cmd_demo(args) -> int:
 
 # ----------------------------------------------------------------------------------- list / check
 def cmd_list(args) -> int:
+    """Three tables (rich): long descriptions wrap inside their column instead of being cut."""
+    import tomllib
+
+    from rich import box
+    from rich.console import Console
+    from rich.table import Table
+
     from .config import shipped_experiments
     from .registry import behaviours, payments
 
-    print("shipped experiments:")
+    def table(title: str, *columns: str) -> Table:
+        t = Table(title=title, title_justify="left", box=box.SIMPLE_HEAD, show_edge=False, pad_edge=False)
+        for c in columns:
+            t.add_column(c, no_wrap=c in ("name", "robots"), overflow="fold")
+        return t
+
+    def params(spec) -> str:
+        return ", ".join(f"{p}={spec.defaults.get(p, '?')}" for p in spec.params)
+
+    console = Console(soft_wrap=False)
+    exps = table("shipped experiments", "name", "description")
     for name, path in shipped_experiments().items():
-        first = path.read_text().splitlines()[0].lstrip("# ")
-        print(f"  {name:8s} {first}")
-    print("behaviours:")
+        try:
+            text = str(tomllib.loads(path.read_text()).get("description", "")).strip()
+        except (OSError, tomllib.TOMLDecodeError):
+            text = ""
+        exps.add_row(name, text or path.read_text().splitlines()[0].lstrip("# "))
+    rules = table("behaviours", "name", "robots", "description", "parameters (defaults)")
     for name, b in behaviours().items():
-        params = ", ".join(f"{p}={b.defaults.get(p, '?')}" for p in b.params)
-        print(f"  {name:11s} {'honest   ' if b.honest else 'byzantine'} {b.description}"
-              + (f" [{params}]" if params else ""))
-    print("payment schemes:")
+        rules.add_row(name, "honest" if b.honest else "byzantine", b.description, params(b))
+    schemes = table("payment schemes", "name", "description", "parameters (defaults)")
     for name, p in payments().items():
-        params = ", ".join(f"{k}={p.defaults.get(k, '?')}" for k in p.params)
-        print(f"  {name:11s} {p.description}" + (f" [{params}]" if params else ""))
+        schemes.add_row(name, p.description, params(p))
+    for t in (exps, rules, schemes):
+        console.print(t)
+        console.print()
     return 0
 
 

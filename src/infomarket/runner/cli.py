@@ -6,6 +6,8 @@ from pathlib import Path
 from ..cliargs import UsageError, at_least, fraction, seed_value
 from ..errors import EXIT_FAILED, EXIT_USAGE, report
 
+EXIT_INTERRUPTED = 130
+
 PAPER = ("fig2A", "fig2B", "fig2C", "fig2D", "fig3A", "fig3B", "fig3C", "fig4A", "fig4B", "fig4C",
          "fig5", "fig6A", "fig6B", "fig7")
 #: Named sets of shipped experiments that ``infomarket sweep NAME`` runs into one store.
@@ -61,14 +63,16 @@ def _execute(experiments, args, label: str) -> int:
     client, cluster = _client(args)  # before creating anything: a scheduler that does not answer writes nothing
     workers = args.workers or default_workers()
     t0 = time.perf_counter()
+    total = sum(c.runs for c in conds)
     try:
-        total = sum(c.runs for c in conds)
         with progress(label, total, enabled=not args.quiet) as bar:
             done = run_sweep(conds, store, workers=workers,
                              executor=client.get_executor(pure=False) if client is not None else None,
                              on_done=bar.advance,
                              on_plan=lambda todo: bar.skip(total - todo) if total - todo else None,
                              record_events=args.events, retry_failed=args.retry_failed)
+    except KeyboardInterrupt:
+        return report(_interrupted(store, conds, total, args), EXIT_INTERRUPTED)
     finally:
         if client is not None:
             client.close()
@@ -87,6 +91,28 @@ def _execute(experiments, args, label: str) -> int:
                       f"is listed by `infomarket store failed {out}`; `--retry-failed` reruns them",
                       EXIT_USAGE if done.rule_errors else EXIT_FAILED)
     return 0
+
+
+def _interrupted(store, conds, total: int, args) -> str:
+    """What Ctrl-C left: how many of the planned runs are committed in the store, and the command that
+    resumes (the same one: committed runs are skipped)."""
+    import shlex
+
+    try:
+        committed = store.completed_runs() if store.exists() else set()
+        planned = {(c.experiment, c.id, r) for c in conds for r in range(c.runs)}
+        kept = f"{len(planned & committed):,} of {total:,} runs committed in {store.root}"
+    except Exception:  # noqa: BLE001  (a store that cannot be read now: say so, and how to check it)
+        kept = f"the runs committed so far are in {store.root} (`infomarket store verify {store.root}`)"
+    words = ["infomarket", args.command]
+    words += [args.what] if args.command == "reproduce" else [args.experiment]
+    words += ["--out", str(args.out)]
+    for flag, value in (("--runs", getattr(args, "runs", None)), ("--scale", getattr(args, "scale", 1.0)),
+                        ("--seed", getattr(args, "seed", None)), ("--samples", getattr(args, "samples", None))):
+        if value is not None and not (flag == "--scale" and value == 1.0):
+            words += [flag, str(value)]
+    words += ["--events"] if args.events else []
+    return f"interrupted: {kept}; resume with: {shlex.join(words)}"
 
 
 def cmd_sweep(args) -> int:
