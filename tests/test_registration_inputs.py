@@ -61,3 +61,29 @@ def test_a_good_registration_still_works():
     spec = register_behaviour("fine_registration", buy="naive", sell=sell, honest=False,
                               limits={"k": ("> 0", lambda v: v > 0)}, replace=True)
     assert spec.params == ("k",) and spec.check("k", -1.0) and not spec.honest
+
+
+@pytest.mark.parametrize("files, entry, words", [
+    ({"exits.py": "import sys\nsys.exit(3)\n"}, "exits.py", ["called sys.exit(3) while being imported"]),
+    ({"folder.py/x": ""}, "folder.py", ["folder.py is not a file"]),
+    ({"notes.txt": "x = 1\n"}, "notes.txt", ["notes.txt is a file but not a .py file"]),
+    ({}, "/etc/passwd", ["/etc/passwd is a file but not a .py file"]),
+    ({}, "/no/such/module", ["'/no/such/module' is neither a .py file nor a module name"]),
+    ({}, "a b", ["'a b' is neither a .py file nor a module name"]),
+])
+def test_plugins_that_cannot_be_imported_give_one_message(tmp_path, monkeypatch, capsys, files, entry, words):
+    """Before: a plugin calling sys.exit ended `infomarket check` silently with its code; a folder or a
+    text file gave "No module named ..."."""
+    from infomarket.cli import main
+
+    for name, text in files.items():
+        (tmp_path / name).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / name).write_text(text)
+    (tmp_path / "e.toml").write_text(f'name = "e"\nplugins = ["{entry}"]\n[swarm]\nrobots = 2\n'
+                                     '[[swarm.groups]]\nbehaviour = "naive"\ncount = 2\n')
+    monkeypatch.chdir(tmp_path)
+    assert main(["check", "e.toml"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("infomarket: error:") == 1 and "Traceback" not in err
+    for w in words:
+        assert w in err, err
