@@ -231,3 +231,21 @@ def test_sql_reads_and_writes_no_other_file(store, tmp_path, capsys):
     assert main(["store", "sql", str(store.root), "SELECT * FROM nowhere"]) == 2
     err = capsys.readouterr().err
     assert err.count("infomarket: error:") == 1 and "nowhere" in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("meta", ["{not json", "[1, 2]", None])
+@pytest.mark.parametrize("action", ["verify", "failed", "repair", "sql"])
+def test_an_unreadable_store_json_is_one_message_not_an_empty_store(tmp_path, capsys, meta, action):
+    """Before: `store verify` on a store whose store.json was garbage (or a folder) said "0 committed
+    part(s), 0 damaged" and exited 0; a JSON list crashed the sweep with an AttributeError."""
+    root = tmp_path / "s"
+    root.mkdir()
+    if meta is None:
+        (root / "store.json").mkdir()
+    else:
+        (root / "store.json").write_text(meta)
+    argv = ["store", action, str(root)] + (["SELECT 1"] if action == "sql" else [])
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("infomarket: error:") == 1 and "store.json" in err and "Traceback" not in err
+    assert sorted(p.name for p in root.iterdir()) == ["store.json"]  # nothing written

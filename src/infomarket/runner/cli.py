@@ -210,6 +210,7 @@ def _open(path: str):
     store = Store(path)
     if not store.exists():
         raise StoreError(f"{path}: not an infomarket results store (no store.json)")
+    store.meta()  # an unreadable store.json: a StoreError naming it
     return store
 
 

@@ -185,9 +185,13 @@ class Store:
 
     def meta(self) -> dict:
         try:
-            return json.loads(self.meta_path.read_text())
+            meta = json.loads(self.meta_path.read_text())
         except (OSError, ValueError) as exc:
             raise StoreError(f"{self.meta_path}: unreadable ({exc})") from None
+        if not isinstance(meta, dict):
+            raise StoreError(f"{self.meta_path}: not an infomarket store.json (a JSON object is expected, found "
+                             f"{type(meta).__name__})")
+        return meta
 
     def create(self) -> "Store":
         """Create the folder layout (idempotent); refuse a folder that holds something else."""
@@ -372,6 +376,8 @@ class Store:
     def verify(self) -> Inspection:
         """Check every committed part against its commit record; list damaged and orphan parts."""
         found = Inspection()
+        if self.exists():
+            self.meta()  # an unreadable store.json is a StoreError, not a store of no parts
         runs_parts = self._parts("runs")
         for pid, path in sorted(runs_parts.items()):
             found.parts += 1
@@ -479,6 +485,7 @@ class Store:
             raise StoreError("Store.sql needs DuckDB: pip install 'infomarket[sql]'") from None
         if not self.exists():
             raise StoreError(f"{self.root}: not an infomarket results store (no store.json)")
+        self.meta()  # readable, or a StoreError
         found = self.verify()
         if found.damaged and not skip_damaged:
             self.check()
