@@ -334,8 +334,14 @@ def explain(cfg, seed: int, exc: Exception, sim=None, *, record_events: bool = F
     ``sim`` (a run with ``seed``), as a RuleRunError naming the rule, its file and line, and the step, or
     as a SimulationError naming the step; ``exc`` itself when nothing explains it.  Raise the result."""
     from .errors import SimulationError
+    from .state.flags import ErrorFlags
 
     try:
+        if isinstance(exc, SimulationError) and sim is not None:  # an error bit the compiled step set
+            why = _flagged(cfg, sim, ErrorFlags(int(sim.world.flags[0])))
+            return RuleRunError(why) if why else exc
+        if isinstance(exc, InfomarketError):
+            return exc
         if sim is None:  # compiling (numba's typing error points into the generated kernel)
             why = explain_compile_failure(cfg, exc)
             if why:
@@ -349,3 +355,38 @@ def explain(cfg, seed: int, exc: Exception, sim=None, *, record_events: bool = F
                                f"{', '.join(sim.kinds)} or {cfg.payment.scheme} raised it alone")
     except Exception:  # noqa: BLE001  (the explanation is best effort; the error itself is reported)
         return exc
+
+
+def _flagged(cfg, sim, flags) -> str | None:
+    """The rule behind an error bit of the step (``state.flags``), named with its file, or None."""
+    from .state.flags import ErrorFlags
+
+    step = _first_flagged_step(cfg, sim)
+    if ErrorFlags.BAD_WEIGHTS in flags:
+        rule = get_payment(cfg.payment.scheme).weights
+        return (f"payment scheme {cfg.payment.scheme!r}: its weight rule {rule.py_func.__name__} "
+                f"({_where(rule.py_func)}) gave a negative or non-finite weight at step {step}; weights must be "
+                f"finite and >= 0")
+    if ErrorFlags.TX_OVERFLOW in flags:
+        rules = [f"{k}: {get_behaviour(k).buy.py_func.__name__} ({_where(get_behaviour(k).buy.py_func)})"
+                 for k in sim.kinds]
+        return (f"a buy rule made more than 2 purchases per neighbour in one step (step {step}); the buy rules of "
+                f"this run: {'; '.join(rules)}")
+    return None
+
+
+def _first_flagged_step(cfg, sim) -> int:
+    """The step at which the run of ``sim`` first set an error bit: the compiled loop goes on to the end of
+    its call before the host reads the bits, so the run is repeated one step at a time up to there."""
+    from .engine.simulation import Simulation
+
+    try:
+        again = Simulation(cfg, sim.seed, record_events=bool(sim.world.record))
+    except Exception:  # noqa: BLE001
+        return sim.clock
+    try:
+        while again.clock < sim.clock:
+            again.advance_to(again.clock + 1)
+    except Exception:  # noqa: BLE001  (the repeat raised at the flagged step: its clock is that step)
+        return again.clock
+    return sim.clock

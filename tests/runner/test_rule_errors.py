@@ -188,3 +188,27 @@ def test_replay_names_the_rule_and_writes_nothing(tmp_path, capsys):
     assert "late_divider_sell raised ZeroDivisionError (division by zero) at step 37" in one_message(capsys)
     assert not out.exists()
     assert not np.any([p.name.startswith(".late") for p in tmp_path.iterdir()])  # no temporary file left
+
+
+NEGATIVE = '''
+import infomarket as im
+
+
+@im.payment("negative_weights", description="weights below zero")
+def negative_weights(buyer, sellers, sites, directions, weights):
+    for x in range(len(sellers)):
+        weights[x] = -1.0
+'''
+
+
+def test_a_weight_rule_giving_negative_weights_is_named_with_the_step(tmp_path, capsys):
+    """Before: "step N: a payment rule returned a negative or non-finite weight", naming no scheme, exit 1."""
+    exp = experiment(tmp_path, "negative", NEGATIVE, scheme="negative_weights", steps=2000, runs=1, robots=25)
+    out = tmp_path / "store"
+    assert main(["sweep", exp, "--out", str(out), "--workers", "1", "--quiet"]) == 2
+    err = one_message(capsys)
+    cfg = im.load_experiment(exp)
+    step = _first_paid_deposit(cfg, int(Store(out).runs().seed.iloc[0]))
+    at = f"{tmp_path / 'negative.py'}:{line_of(tmp_path / 'negative.py', '@im.payment')}"
+    assert (f"payment scheme 'negative_weights': its weight rule negative_weights ({at}) gave a negative or "
+            f"non-finite weight at step {step}") in err

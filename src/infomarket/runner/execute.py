@@ -72,9 +72,7 @@ def run_one(cfg: Experiment, run: int, seed: int, record_events: bool = False) -
     try:
         sim = Simulation(cfg, seed, record_events=record_events)
         r = sim.run()
-    except InfomarketError:
-        raise
-    except Exception as exc:
+    except Exception as exc:  # a rule's error (or an error bit a rule set): named, else as it is
         raise explain(cfg, seed, exc, sim, record_events=record_events) from exc
     robots = r.robots
     robots.insert(0, "run", np.int64(run))

@@ -67,8 +67,6 @@ def record(config: Experiment, seed: int | None = None, *, steps: int | None = N
     while sim.clock < steps:
         try:
             sim.step(min(every, steps - sim.clock))
-        except InfomarketError:
-            raise
         except Exception as exc:  # a rule raised: named with its file, line and the step
             raise explain(config, sim.seed, exc, sim, record_events=True) from None
         frames.append(encode(sim, honest))

@@ -125,8 +125,6 @@ class Session:
         """Step ``k`` times; the new frame and the selected robot's details (run in a worker thread)."""
         try:
             self.sim.step(k)
-        except InfomarketError:
-            raise
         except Exception as exc:  # a rule raised: the page is told which, at which step (checks.explain)
             raise explain(self.config, self.seed, exc, self.sim, record_events=True) from None
         return self.frame(), self.detail()
