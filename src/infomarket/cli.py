@@ -51,7 +51,7 @@ def cmd_run(args) -> int:
     try:
         with progress(cfg.name, runs, enabled=not args.quiet) as bar:
             res = run_experiment(cond, out, workers=workers, force=args.force, on_done=bar.advance,
-                                 on_plan=lambda todo: bar.skip(runs - todo) if runs - todo else None)
+                                 on_plan=lambda todo: bar.skip(runs - todo))
     except RunInterrupted as stop:
         if not stop.kept:
             return report(f"interrupted before any of the {runs} runs finished; nothing kept", EXIT_INTERRUPTED)

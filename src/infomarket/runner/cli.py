@@ -69,7 +69,7 @@ def _execute(experiments, args, label: str) -> int:
             done = run_sweep(conds, store, workers=workers,
                              executor=client.get_executor(pure=False) if client is not None else None,
                              on_done=bar.advance,
-                             on_plan=lambda todo: bar.skip(total - todo) if total - todo else None,
+                             on_plan=lambda todo: bar.skip(total - todo),
                              record_events=args.events, retry_failed=args.retry_failed)
     except KeyboardInterrupt:
         return report(_interrupted(store, conds, total, args), EXIT_INTERRUPTED)

@@ -501,6 +501,7 @@ class Store:
                     allowed += files
             # the query reads the verified parts and nothing else, and writes nothing (no COPY TO, no
             # ATTACH, no other file): the views' files are the only ones allowed, and that is locked
+            con.execute("SET temp_directory = ''")  # no spill files (DuckDB's default is ./.tmp)
             con.execute("SET allowed_paths = ?", [allowed])
             con.execute("SET enable_external_access = false")
             con.execute("SET lock_configuration = true")
