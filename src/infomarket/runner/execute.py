@@ -256,7 +256,7 @@ def preflight(configs: Iterable[Experiment]) -> None:
             continue
         seen.add(key)
         try:
-            warm(cfg)
+            Simulation(cfg, 0)  # compiles or loads the kernel (what a warm-up then finds done)
         except InfomarketError:
             raise
         except Exception as exc:  # noqa: BLE001
