@@ -14,7 +14,7 @@ import numpy as np
 
 from .config import validate
 from .engine.simulation import simulate
-from .errors import InfomarketError
+from .errors import InfomarketError, RuleRunError
 from .ledger import LedgerEvent, replay_events
 from .ledger.replay import Ledger
 from .payments import MARKETS, PAPER_STAKE
@@ -178,3 +178,215 @@ def check_payment(name: str, *, robots: int = 6, sequences: int = 30, seed: int 
             raise CheckFailed(f"{what}: money not conserved")
         if (first.balances < -1e-12).any():
             raise CheckFailed(f"{what}: a balance went negative")
+
+
+# ------------------------------------------------------------------ explaining a run that failed
+#: What each kind of rule returns, for messages, and how many values (None: nothing).
+_RETURNS = {"sell": (4, "(valid, x, y, age)"), "buy": (None, "nothing"), "weights": (None, "nothing (it fills weights)")}
+
+
+def _config_rules(cfg, kinds) -> list[tuple[str, str, object, object]]:
+    """(owner, role, Rule, spec) of every rule a run of ``cfg`` calls: each behaviour's sell and buy
+    rules (in kind order), then the scheme's weight rule."""
+    out = []
+    for role in ("sell", "buy"):  # the step's order: every offer, then every purchase
+        for name in kinds:
+            spec = get_behaviour(name)
+            out.append((f"behaviour {name!r}", role, getattr(spec, role), spec))
+    pay = get_payment(cfg.payment.scheme)
+    out.append((f"payment scheme {cfg.payment.scheme!r}", "weights", pay.weights, pay))
+    return out
+
+
+def _calls(sim, role: str, rule, spec):
+    """Every call the step would make of ``rule`` on the world of ``sim`` now: (label, compiled args,
+    plain-Python args), in the step's order."""
+    w, view = sim.world, sim._view
+    rng = [sim.rng] if rule.wants_rng else []
+    if role in ("sell", "buy"):
+        kind = sim.kinds.index(spec.name)
+        for me in (int(i) for i in np.flatnonzero(w.kind == kind)):
+            params = [float(w.bparams[me][spec.params.index(p)]) for p in rule.params]
+            if role == "sell":
+                for site in (0, 1):
+                    yield f"robot {me}, site {site}", (view, me, site, *rng, *params), (w, me, site, *rng, *params)
+            else:
+                nbrs = np.array(w.nbr[me, :w.nbr_count[me]], np.int64)
+                yield f"robot {me}", (view, me, nbrs, *rng, *params), (w, me, nbrs, *rng, *params)
+        return
+    params = [float(w.pparams[spec.params.index(p)]) for p in rule.params]
+    for buyer in (int(b) for b in np.flatnonzero(w.tx_count > 0)):
+        a, b = int(w.tx_off[buyer]), int(w.tx_off[buyer] + w.tx_count[buyer])
+        arrays = (w.tx_seller[a:b].copy(), w.tx_site[a:b].copy(), w.tx_dir[a:b].copy())
+        weights = np.zeros(b - a)
+        yield (f"buyer {buyer}", (buyer, *arrays, weights, *([view] if rule.wants_market else []), *rng, *params),
+               (buyer, *arrays, weights.copy(), *([w] if rule.wants_market else []), *rng, *params))
+
+
+def _where_line(py, plain_call) -> str:
+    """``FILE:LINE`` of the line of ``py`` that raises when ``plain_call`` repeats the call in plain Python
+    (numpy floating-point errors raised), else ``FILE:FIRST (the function)``."""
+    filename, first = _rule_where(py)
+    line = None
+    try:
+        with np.errstate(all="raise"):
+            plain_call()
+    except Exception as plain:  # noqa: BLE001  (only to locate the line)
+        line = _failing_line(plain, filename)
+    return f"{filename}:{line}" if line else f"{filename}:{first} (the function)"
+
+
+def explain_run_failure(cfg, seed: int, exc: BaseException, step: int, *, record_events: bool = False,
+                        history_every: int | None = None) -> str | None:
+    """Which rule raised ``exc`` at ``step`` of the run of ``cfg`` with ``seed``: the run is repeated
+    (compiled) up to the step before, then every rule the step calls is called on that world as the step
+    calls it, in the step's order (sell, buy, weights); the first that raises the same kind of error is
+    named with its file and line (from the same call in plain Python).  None when none does alone."""
+    from .engine.simulation import Simulation
+
+    try:
+        sim = Simulation(cfg, seed, record_events=record_events, history_every=history_every)
+        if step > 1:
+            sim.step(step - 1)
+        sim.world.clock[0] = step  # the loop counts the step before it calls a rule
+    except Exception:  # noqa: BLE001  (failed before the step: nothing to explain with)
+        return None
+    for owner, role, rule, spec in _config_rules(cfg, sim.kinds):
+        for label, args, plain in _calls(sim, role, rule, spec):
+            try:
+                rule.func(*args)
+            except type(exc) as again:
+                py = rule.py_func
+                at = _where_line(py, lambda: py(*plain))
+                what = "sell" if role == "sell" else "buy" if role == "buy" else "weight"
+                return (f"{owner}: its {what} rule {py.__name__} raised {type(exc).__name__} "
+                        f"({_short(again)}) at step {step} ({label}), at {at}")
+            except Exception:  # noqa: BLE001  (another error: not the one the run met)
+                continue
+    return None
+
+
+def _short(exc: BaseException) -> str:
+    text = str(exc).strip().splitlines()
+    return text[0][:300] if text else "no message"
+
+
+def explain_compile_failure(cfg, exc: BaseException) -> str | None:
+    """Which rule makes the step kernel of ``cfg`` fail to compile (``exc``, numba's error, points into
+    the generated kernel): each rule is compiled alone with the argument types the step passes; the first
+    that does not compile, or returns what its kind of rule must not (a sell rule returns four values), is
+    named with its file.  None when every rule compiles alone and returns what it must."""
+    from .engine.build import build_world
+    from .engine.params import behaviour_kinds
+    from .engine.world import kernel_view
+
+    class _Probe:  # the few attributes _calls reads
+        pass
+
+    try:
+        probe = _Probe()
+        probe.rng = np.random.default_rng(0)
+        probe.kinds = behaviour_kinds(cfg)
+        probe.world, _ = build_world(cfg, probe.rng, record_events=False, history_every=0)
+        probe._view = kernel_view(probe.world)
+    except Exception:  # noqa: BLE001
+        return None
+    w = probe.world
+    for owner, role, rule, spec in _config_rules(cfg, probe.kinds):
+        py = rule.py_func
+        where = _where(py)
+        if role == "weights":  # one transaction, typed as the ledger passes them
+            arrays = (np.zeros(1, w.tx_seller.dtype), np.zeros(1, w.tx_site.dtype), np.zeros(1, w.tx_dir.dtype))
+            params = [0.0] * len(rule.params)
+            args = (0, *arrays, np.zeros(1), *([probe._view] if rule.wants_market else []),
+                    *([probe.rng] if rule.wants_rng else []), *params)
+        else:
+            kind = probe.kinds.index(spec.name)
+            me = int(np.flatnonzero(w.kind == kind)[0])
+            args = next(iter(_calls(probe, role, rule, spec)))[1]
+            if role == "buy":
+                args = (args[0], me, np.zeros(0, np.int64), *args[3:])
+        what = {"sell": "sell rule", "buy": "buy rule", "weights": "weight rule"}[role]
+        try:
+            sig = tuple(numba.typeof(a) for a in args)
+            rule.func.compile(sig)
+            ret = rule.func.overloads[sig].signature.return_type
+        except Exception as failed:  # noqa: BLE001
+            lines = [ln for ln in str(failed).splitlines() if ln.strip() and "During:" not in ln]
+            return f"{owner}: its {what} {py.__name__} ({where}) does not compile: " + " | ".join(lines[:6])
+        count, shape = _RETURNS[role]
+        n = getattr(ret, "count", None) if isinstance(ret, numba.types.BaseTuple) else None
+        if count is not None and n != count:
+            got = f"{n} values ({ret})" if n is not None else f"{ret}"
+            return f"{owner}: its {what} {py.__name__} ({where}) returns {got}; a {what} returns {count}: {shape}"
+        if count is None and not isinstance(ret, numba.types.NoneType):
+            return f"{owner}: its {what} {py.__name__} ({where}) returns {ret}; a {what} returns {shape}"
+    return None
+
+
+def _where(func) -> str:
+    filename, first = _rule_where(func)
+    return f"{filename}:{first}"
+
+
+def explain(cfg, seed: int, exc: Exception, sim=None, *, record_events: bool = False) -> Exception:
+    """``exc``, raised by compiling the step kernel of ``cfg`` (``sim`` None) or by the compiled step of
+    ``sim`` (a run with ``seed``), as a RuleRunError naming the rule, its file and line, and the step, or
+    as a SimulationError naming the step; ``exc`` itself when nothing explains it.  Raise the result."""
+    from .errors import SimulationError
+    from .state.flags import ErrorFlags
+
+    try:
+        if isinstance(exc, SimulationError) and sim is not None:  # an error bit the compiled step set
+            why = _flagged(cfg, sim, ErrorFlags(int(sim.world.flags[0])))
+            return RuleRunError(why) if why else exc
+        if isinstance(exc, InfomarketError):
+            return exc
+        if sim is None:  # compiling (numba's typing error points into the generated kernel)
+            why = explain_compile_failure(cfg, exc)
+            if why:
+                return RuleRunError(f"{why}; the step kernel cannot be compiled")
+            return exc
+        step = max(1, sim.clock)  # the loop counts a step before it calls any rule
+        why = explain_run_failure(cfg, sim.seed, exc, step, record_events=record_events)
+        if why:
+            return RuleRunError(why)
+        return SimulationError(f"step {step} (seed {sim.seed}) raised {type(exc).__name__}: {exc}; no rule of "
+                               f"{', '.join(sim.kinds)} or {cfg.payment.scheme} raised it alone")
+    except Exception:  # noqa: BLE001  (the explanation is best effort; the error itself is reported)
+        return exc
+
+
+def _flagged(cfg, sim, flags) -> str | None:
+    """The rule behind an error bit of the step (``state.flags``), named with its file, or None."""
+    from .state.flags import ErrorFlags
+
+    step = _first_flagged_step(cfg, sim)
+    if ErrorFlags.BAD_WEIGHTS in flags:
+        rule = get_payment(cfg.payment.scheme).weights
+        return (f"payment scheme {cfg.payment.scheme!r}: its weight rule {rule.py_func.__name__} "
+                f"({_where(rule.py_func)}) gave a negative or non-finite weight at step {step}; weights must be "
+                f"finite and >= 0")
+    if ErrorFlags.TX_OVERFLOW in flags:
+        rules = [f"{k}: {get_behaviour(k).buy.py_func.__name__} ({_where(get_behaviour(k).buy.py_func)})"
+                 for k in sim.kinds]
+        return (f"a buy rule made more than 2 purchases per neighbour in one step (step {step}); the buy rules of "
+                f"this run: {'; '.join(rules)}")
+    return None
+
+
+def _first_flagged_step(cfg, sim) -> int:
+    """The step at which the run of ``sim`` first set an error bit: the compiled loop goes on to the end of
+    its call before the host reads the bits, so the run is repeated one step at a time up to there."""
+    from .engine.simulation import Simulation
+
+    try:
+        again = Simulation(cfg, sim.seed, record_events=bool(sim.world.record))
+    except Exception:  # noqa: BLE001
+        return sim.clock
+    try:
+        while again.clock < sim.clock:
+            again.advance_to(again.clock + 1)
+    except Exception:  # noqa: BLE001  (the repeat raised at the flagged step: its clock is that step)
+        return again.clock
+    return sim.clock

@@ -15,7 +15,7 @@ from pathlib import Path
 from . import __version__
 from .bench import cli as bench_cli
 from .cliargs import Parser, at_least, seed_value
-from .errors import EXIT_FAILED, InfomarketError, report
+from .errors import EXIT_FAILED, EXIT_USAGE, InfomarketError, report
 
 SUBCOMMAND_MODULES = ("infomarket.runner.cli", "infomarket.analysis.cli", "infomarket.viewer.cli",
                       "infomarket.chain.cli", "infomarket.analysis.sensitivity_cli")
@@ -51,7 +51,7 @@ def cmd_run(args) -> int:
     try:
         with progress(cfg.name, runs, enabled=not args.quiet) as bar:
             res = run_experiment(cond, out, workers=workers, force=args.force, on_done=bar.advance,
-                                 on_plan=lambda todo: bar.skip(runs - todo) if runs - todo else None)
+                                 on_plan=lambda todo: bar.skip(runs - todo))
     except RunInterrupted as stop:
         if not stop.kept:
             return report(f"interrupted before any of the {runs} runs finished; nothing kept", EXIT_INTERRUPTED)
@@ -69,7 +69,8 @@ def cmd_run(args) -> int:
                   f"(compile/load {done.compile_seconds:.2f} s)")
     if done.failed:
         return report(f"{done.failed} of {done.done} runs failed (the first: {done.first_error}); every error "
-                      f"is listed by `infomarket store failed {out}`", EXIT_FAILED)
+                      f"is listed by `infomarket store failed {out}`",
+                      EXIT_USAGE if done.rule_errors else EXIT_FAILED)
     return 0
 
 
@@ -82,22 +83,42 @@ def cmd_demo(args) -> int:
 
 # ----------------------------------------------------------------------------------- list / check
 def cmd_list(args) -> int:
+    """Three tables (rich): long descriptions wrap inside their column instead of being cut."""
+    import tomllib
+
+    from rich import box
+    from rich.console import Console
+    from rich.table import Table
+
     from .config import shipped_experiments
     from .registry import behaviours, payments
 
-    print("shipped experiments:")
+    def table(title: str, *columns: str) -> Table:
+        t = Table(title=title, title_justify="left", box=box.SIMPLE_HEAD, show_edge=False, pad_edge=False)
+        for c in columns:
+            t.add_column(c, no_wrap=c in ("name", "robots"), overflow="fold")
+        return t
+
+    def params(spec) -> str:
+        return ", ".join(f"{p}={spec.defaults.get(p, '?')}" for p in spec.params)
+
+    console = Console(soft_wrap=False)
+    exps = table("shipped experiments", "name", "description")
     for name, path in shipped_experiments().items():
-        first = path.read_text().splitlines()[0].lstrip("# ")
-        print(f"  {name:8s} {first}")
-    print("behaviours:")
+        try:
+            text = str(tomllib.loads(path.read_text()).get("description", "")).strip()
+        except (OSError, tomllib.TOMLDecodeError):
+            text = ""
+        exps.add_row(name, text or path.read_text().splitlines()[0].lstrip("# "))
+    rules = table("behaviours", "name", "robots", "description", "parameters (defaults)")
     for name, b in behaviours().items():
-        params = ", ".join(f"{p}={b.defaults.get(p, '?')}" for p in b.params)
-        print(f"  {name:11s} {'honest   ' if b.honest else 'byzantine'} {b.description}"
-              + (f" [{params}]" if params else ""))
-    print("payment schemes:")
+        rules.add_row(name, "honest" if b.honest else "byzantine", b.description, params(b))
+    schemes = table("payment schemes", "name", "description", "parameters (defaults)")
     for name, p in payments().items():
-        params = ", ".join(f"{k}={p.defaults.get(k, '?')}" for k in p.params)
-        print(f"  {name:11s} {p.description}" + (f" [{params}]" if params else ""))
+        schemes.add_row(name, p.description, params(p))
+    for t in (exps, rules, schemes):
+        console.print(t)
+        console.print()
     return 0
 
 

@@ -41,6 +41,11 @@ class RuleError(InfomarketError, TypeError):
     """A function handed to the registration API cannot be a rule (not a function, wrong arguments)."""
 
 
+class RuleRunError(InfomarketError, ValueError):
+    """A user's rule raised while it ran, or cannot be compiled into the step: the message names the rule,
+    its file and line, and the step (``checks.explain_failure``); the user's to fix, so exit 2."""
+
+
 class RegistrationError(InfomarketError, ValueError):
     """A registration clashes with what is registered (a name taken, rules disagreeing on a default)."""
 

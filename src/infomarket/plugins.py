@@ -9,6 +9,7 @@ import hashlib
 import importlib
 import importlib.util
 import os
+import re
 import sys
 from pathlib import Path
 
@@ -25,12 +26,27 @@ def resolve(entry: str, base: Path | None) -> str:
     return entry
 
 
+#: A module entry: dotted Python identifiers (``mylab.rules``).
+_MODULE = re.compile(r"[A-Za-z_]\w*(\.[A-Za-z_]\w*)*")
+
+
 def load(entry: str) -> None:
-    """Import a plugin (idempotent); raises ImportError with a readable message."""
+    """Import a plugin (idempotent); raises ImportError with a readable message.  A plugin that calls
+    ``sys.exit`` while being imported is a PluginError too (it would end the command silently)."""
+    try:
+        _load(entry)
+    except SystemExit as exc:
+        raise PluginError(f"{entry}: the plugin called sys.exit({exc.code!r}) while being imported; a plugin "
+                          f"module should only define and register rules") from None
+
+
+def _load(entry: str) -> None:
     if entry.endswith(".py"):
         path = Path(entry)
         if not path.exists():
             raise PluginError(f"no such file {entry}")
+        if not path.is_file():
+            raise PluginError(f"{entry} is not a file")
         name = "infomarket_plugin_" + hashlib.sha1(str(path).encode()).hexdigest()[:12] + "_" + path.stem
         if name in sys.modules:
             return
@@ -43,6 +59,10 @@ def load(entry: str) -> None:
             del sys.modules[name]
             raise
         return
+    if Path(entry).is_file():
+        raise PluginError(f"{entry} is a file but not a .py file: a plugin is a .py file or a module name")
+    if not _MODULE.fullmatch(entry):
+        raise PluginError(f"{entry!r} is neither a .py file nor a module name (like mylab.rules)")
     try:
         importlib.import_module(entry)
     except ModuleNotFoundError:

@@ -11,6 +11,8 @@ defaults of the behaviour or scheme, and an experiment file may override them by
 from __future__ import annotations
 
 import inspect
+import math
+import re
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -92,9 +94,40 @@ _PAYMENTS: dict[str, PaymentSpec] = {}
 def _jit(func: Callable) -> Callable:
     if isinstance(func, numba.core.registry.CPUDispatcher):
         return func
-    if not callable(func):
-        raise RuleError(f"a rule must be a function, got {func!r}")
+    if not inspect.isfunction(func):  # a builtin, a class, a number...: numba compiles only Python functions
+        raise RuleError(f"a rule must be a Python function (def ...), got {_shown(func)}")
     return numba.njit(func)
+
+
+#: What a behaviour's or a payment scheme's name may be: it is written in experiment files, stored in the
+#: results' columns and printed, so a word of letters, digits and underscores.
+_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,63}")
+
+
+def _shown(value) -> str:
+    text = repr(value)
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+def _check_registration(what: str, name, description, limits, params: tuple[str, ...], user_limits) -> None:
+    """RegistrationError for a name, description or limits that cannot be registered."""
+    if not isinstance(name, str) or not _NAME.fullmatch(name):
+        raise RegistrationError(f"{what} name {_shown(name)}: a name is 1 to 64 letters, digits or underscores, "
+                                f"not starting with a digit (it is written in experiment files and results)")
+    if not isinstance(description, str):
+        raise RegistrationError(f"{what} {name!r}: description must be text, got {_shown(description)}")
+    if user_limits is None:
+        return
+    if not isinstance(user_limits, dict):
+        raise RegistrationError(f"{what} {name!r}: limits must be a dict of parameter -> (text, predicate), "
+                                f"got {_shown(user_limits)}")
+    for key, value in user_limits.items():
+        if key not in params:
+            raise RegistrationError(f"{what} {name!r}: limits name {key!r}, which is not one of its parameters "
+                                    f"({', '.join(params) or 'none'})")
+        if not (isinstance(value, tuple) and len(value) == 2 and isinstance(value[0], str) and callable(value[1])):
+            raise RegistrationError(f"{what} {name!r}: the limit of {key!r} must be (text, predicate), e.g. "
+                                    f"(\"> 0\", lambda v: v > 0); got {_shown(value)}")
 
 
 def _where(func: Callable) -> str:
@@ -126,6 +159,12 @@ def _rule(func: Callable, fixed: tuple[str, ...], what: str, market: bool = Fals
     for p in extra:
         if p.kind not in (p.POSITIONAL_ONLY, p.POSITIONAL_OR_KEYWORD):
             raise RuleError(f"{what} {py.__name__}: parameter {p.name} must be a plain positional argument")
+    for p in extra:  # parameters are numbers (the world holds them as float64)
+        if p.default is not p.empty and (isinstance(p.default, bool) or not isinstance(p.default, (int, float))
+                                         or not math.isfinite(p.default)):
+            raise RuleError(f"{what} {py.__name__} ({where}): parameter {p.name!r} has the default "
+                            f"{p.default!r}; rule parameters are numbers (floats), so a default must be a finite "
+                            f"number such as 0.0")
     defaults = {p.name: float(p.default) for p in extra if p.default is not p.empty}
     return Rule(jitted, tuple(p.name for p in extra), defaults, wants_rng, wants_market)
 
@@ -145,8 +184,15 @@ def register_behaviour(name: str, *, buy: Callable | str, sell: Callable | str, 
     ``paths=True`` says the rules buy or install waypoint paths (``behaviours.paths``); runs with such a
     behaviour then compile the step's paths variant (``engine.step``, ``engine.paths``); other runs never pay for it.
     """
+    _check_registration("behaviour", name, description, None, (), None)
     if name in _BEHAVIOURS and not replace:
         raise RegistrationError(f"behaviour {name!r} is already registered (pass replace=True to override)")
+    if not isinstance(honest, bool):
+        raise RegistrationError(f"behaviour {name!r}: honest must be True or False, got {_shown(honest)}")
+    for role, r in (("buy", buy), ("sell", sell)):
+        if isinstance(r, str) and r not in _BEHAVIOURS:
+            raise RegistrationError(f"behaviour {name!r}: {role}={r!r} names no registered behaviour (whose "
+                                    f"{role} rule it would reuse); registered: {', '.join(_BEHAVIOURS)}")
     buy_rule = _BEHAVIOURS[buy].buy if isinstance(buy, str) else _rule(buy, BUY_ARGS, "buy rule")
     sell_rule = _BEHAVIOURS[sell].sell if isinstance(sell, str) else _rule(sell, SELL_ARGS, "sell rule")
     params: list[str] = []
@@ -159,6 +205,7 @@ def register_behaviour(name: str, *, buy: Callable | str, sell: Callable | str, 
             if k in defaults and defaults[k] != v:
                 raise RegistrationError(f"behaviour {name!r}: rules disagree on the default of {k!r}")
             defaults[k] = v
+    _check_registration("behaviour", name, description, limits, tuple(params), limits)
     limits = dict(limits or {})
     for r in (buy, sell):
         if isinstance(r, str):  # a reused rule brings its limits along
@@ -198,10 +245,12 @@ def register_payment(name: str, weights: Callable, *, description: str = "", lim
     read (never write) every robot's wealth and reputation record with ``infomarket.behaviours.market``;
     ``rng``, if wanted, comes next.
     """
+    _check_registration("payment scheme", name, description, None, (), None)
     if name in _PAYMENTS and not replace:
         raise RegistrationError(f"payment scheme {name!r} is already registered (pass replace=True to override)")
-    spec = PaymentSpec(name, _rule(weights, PAY_ARGS, "payment rule", market=True), description,
-                       dict(limits or {}))
+    rule = _rule(weights, PAY_ARGS, "payment rule", market=True)
+    _check_registration("payment scheme", name, description, limits, rule.params, limits)
+    spec = PaymentSpec(name, rule, description, dict(limits or {}))
     _PAYMENTS[name] = spec
     return spec
 

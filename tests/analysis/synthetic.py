@@ -12,6 +12,7 @@ import numpy as np
 import pandas as pd
 
 from infomarket.store import Store
+from infomarket.store.dictionary import TABLES
 
 ROBOTS = 25
 RUNS = 6
@@ -135,5 +136,6 @@ def write_store(root: Path, tables: dict[str, tuple], only: tuple[str, ...] | No
     store = Store(root).create()
     for pid, (robots, runs, history) in tables.items():
         if only is None or pid.startswith(only):
-            store.write_part(pid, robots, runs, history)
+            keys = [k for k in robots.columns if TABLES["robots"].column(k) is None]  # its condition keys
+            store.write_part(pid, robots, runs, history, keys=keys)
     return store

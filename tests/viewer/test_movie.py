@@ -22,9 +22,57 @@ def test_gif_has_one_picture_per_frame_with_the_swarm_drawn(recording, tmp_path)
         assert im.size[0] == movie.WIDTH_PX[".gif"]
         im.seek(im.n_frames - 1)
         rgb = np.asarray(im.convert("RGB")).astype(int)
-    blue = np.all(np.abs(rgb - (0x2F, 0x6F, 0xD6)) < 40, axis=-1).sum()
-    red = np.all(np.abs(rgb - (0xD6, 0x2F, 0x2F)) < 40, axis=-1).sum()
-    assert blue > 24 * 5 and red > 3, (blue, red)
+    blue = np.all(np.abs(rgb - (0x00, 0x72, 0xB2)) < 40, axis=-1).sum()
+    orange = np.all(np.abs(rgb - (0xE6, 0x9F, 0x00)) < 40, axis=-1).sum()
+    assert blue > 24 * 5 and orange > 3, (blue, orange)
+
+
+def _luminance(hex_colour: str) -> float:
+    """WCAG 2 relative luminance of an sRGB colour."""
+    channels = [int(hex_colour[i:i + 2], 16) / 255 for i in (1, 3, 5)]
+    lin = [c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4 for c in channels]
+    return 0.2126 * lin[0] + 0.7152 * lin[1] + 0.0722 * lin[2]
+
+
+def test_honest_and_byzantine_fills_differ_in_lightness_not_only_in_hue():
+    """Issue 21: the red Byzantine was hard to spot at 720 x 428: blue #2f6fd6 and red #d62f2f have the same
+    luminance (contrast ratio 1.01), so without full colour vision (or in grey) they look alike.  Blue
+    #0072b2 (L = 0.152) and orange #e69f00 (L = 0.416), by hand: ratio (0.416 + 0.05) / (0.152 + 0.05) = 2.3."""
+    hi, lo = sorted((_luminance(movie.HONEST), _luminance(movie.BYZANTINE)), reverse=True)
+    assert (hi + 0.05) / (lo + 0.05) >= 2.0
+
+
+def test_the_movie_has_a_legend_and_frames_each_byzantine(recording, tmp_path):
+    path = movie.write_movie(recording, tmp_path / "run.gif")
+    with Image.open(path) as im:
+        im.seek(im.n_frames - 1)
+        rgb = np.asarray(im.convert("RGB")).astype(int)
+    height, width, _ = rgb.shape
+    arena_px = 2 * round(width * 600 / 1200 / 2)
+    top = height - 28 - arena_px  # caption and legend above the arena, the progress bar under it
+    assert top >= 40 + 20  # room for a legend row under the 40-pixel caption
+    band = rgb[40:top]
+
+    def pixels(colour) -> int:
+        return int(np.all(np.abs(band - colour) < 40, axis=-1).sum())
+
+    assert pixels((0x00, 0x72, 0xB2)) > 20 and pixels((0xE6, 0x9F, 0x00)) > 20  # both fills in the legend
+    assert int((band.max(axis=-1) < 80).sum()) > 200  # its words (dark text)
+    # a black square frame around each Byzantine (honest robots have none)
+    last = recording.frame(len(recording.frames) - 1).columns
+    scene = recording.scene
+    honest = np.array([scene["behaviours"][k]["honest"] for k in scene["kind"]])
+    scale = width / 1200
+
+    def dark_in_frame_ring(i: int) -> int:
+        cx, cy = last["x"][i] * scale, top + last["y"][i] * scale
+        ys, xs = np.mgrid[0:height, 0:width]
+        cheb = np.maximum(np.abs(xs - cx), np.abs(ys - cy))  # square rings around the robot
+        ring = (cheb >= 6.5) & (cheb <= 10.5) & (ys >= top)
+        return int((rgb[ring].max(axis=-1) < 80).sum())
+
+    assert all(dark_in_frame_ring(i) > 12 for i in np.flatnonzero(~honest))
+    assert np.median([dark_in_frame_ring(i) for i in np.flatnonzero(honest)]) < 3
 
 
 def test_frames_are_thinned_evenly_to_the_cap():

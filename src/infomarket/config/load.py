@@ -170,7 +170,7 @@ def load_experiment(what: str | Path) -> Experiment:
                  if path.name in shipped else "")
         raise ConfigError(f"{path}: is a directory, not an experiment file (.toml or .json){other}")
     try:
-        text = path.read_text()
+        text = path.read_text(encoding="utf-8-sig")  # a byte-order mark (some editors write one) is not TOML
     except (OSError, UnicodeDecodeError) as exc:
         raise ConfigError(f"{path}: cannot read: {exc}") from None
     try:

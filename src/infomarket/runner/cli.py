@@ -4,7 +4,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..cliargs import UsageError, at_least, fraction, seed_value
-from ..errors import EXIT_FAILED, report
+from ..errors import EXIT_FAILED, EXIT_USAGE, report
+
+EXIT_INTERRUPTED = 130
 
 PAPER = ("fig2A", "fig2B", "fig2C", "fig2D", "fig3A", "fig3B", "fig3C", "fig4A", "fig4B", "fig4C",
          "fig5", "fig6A", "fig6B", "fig7")
@@ -61,14 +63,16 @@ def _execute(experiments, args, label: str) -> int:
     client, cluster = _client(args)  # before creating anything: a scheduler that does not answer writes nothing
     workers = args.workers or default_workers()
     t0 = time.perf_counter()
+    total = sum(c.runs for c in conds)
     try:
-        total = sum(c.runs for c in conds)
         with progress(label, total, enabled=not args.quiet) as bar:
             done = run_sweep(conds, store, workers=workers,
                              executor=client.get_executor(pure=False) if client is not None else None,
                              on_done=bar.advance,
-                             on_plan=lambda todo: bar.skip(total - todo) if total - todo else None,
+                             on_plan=lambda todo: bar.skip(total - todo),
                              record_events=args.events, retry_failed=args.retry_failed)
+    except KeyboardInterrupt:
+        return report(_interrupted(store, conds, total, args), EXIT_INTERRUPTED)
     finally:
         if client is not None:
             client.close()
@@ -85,8 +89,30 @@ def _execute(experiments, args, label: str) -> int:
     if done.failed:
         return report(f"{done.failed} of {done.done} runs failed (the first: {done.first_error}); every error "
                       f"is listed by `infomarket store failed {out}`; `--retry-failed` reruns them",
-                      EXIT_FAILED)
+                      EXIT_USAGE if done.rule_errors else EXIT_FAILED)
     return 0
+
+
+def _interrupted(store, conds, total: int, args) -> str:
+    """What Ctrl-C left: how many of the planned runs are committed in the store, and the command that
+    resumes (the same one: committed runs are skipped)."""
+    import shlex
+
+    try:
+        committed = store.completed_runs() if store.exists() else set()
+        planned = {(c.experiment, c.id, r) for c in conds for r in range(c.runs)}
+        kept = f"{len(planned & committed):,} of {total:,} runs committed in {store.root}"
+    except Exception:  # noqa: BLE001  (a store that cannot be read now: say so, and how to check it)
+        kept = f"the runs committed so far are in {store.root} (`infomarket store verify {store.root}`)"
+    words = ["infomarket", args.command]
+    words += [args.what] if args.command == "reproduce" else [args.experiment]
+    words += ["--out", str(args.out)]
+    for flag, value in (("--runs", getattr(args, "runs", None)), ("--scale", getattr(args, "scale", 1.0)),
+                        ("--seed", getattr(args, "seed", None)), ("--samples", getattr(args, "samples", None))):
+        if value is not None and not (flag == "--scale" and value == 1.0):
+            words += [flag, str(value)]
+    words += ["--events"] if args.events else []
+    return f"interrupted: {kept}; resume with: {shlex.join(words)}"
 
 
 def cmd_sweep(args) -> int:
@@ -169,6 +195,13 @@ def add_subcommand(sub) -> None:
         a = ss.add_parser(name, help=text, description=text)
         a.add_argument("store", metavar="STORE")
         a.set_defaults(func=func)
+    text = ("run a DuckDB SQL query over the store's verified parts (tables robots, history, events, payments, "
+            "sites, configs, runs: docs/data.md); needs pip install 'infomarket[sql]'")
+    a = ss.add_parser("sql", help=text, description=text)
+    a.add_argument("store", metavar="STORE")
+    a.add_argument("query", metavar="QUERY", help="e.g. \"SELECT condition, avg(items_collected) FROM robots GROUP BY ALL\"")
+    a.add_argument("--csv", action="store_true", help="print CSV instead of a text table")
+    a.set_defaults(func=cmd_store_sql)
 
 
 def _open(path: str):
@@ -177,6 +210,7 @@ def _open(path: str):
     store = Store(path)
     if not store.exists():
         raise StoreError(f"{path}: not an infomarket results store (no store.json)")
+    store.meta()  # an unreadable store.json: a StoreError naming it
     return store
 
 
@@ -216,4 +250,13 @@ def cmd_store_failed(args) -> int:
         print(f"{row.experiment} [{row.condition}] run {row.run} (seed {row.seed}):")
         print("  " + row.error.strip().replace("\n", "\n  "))
     print(f"{args.store}: {len(failed)} failed run(s)")
+    return 0
+
+
+def cmd_store_sql(args) -> int:
+    df = _open(args.store).sql(args.query)
+    if args.csv:
+        print(df.to_csv(index=False), end="")
+    else:
+        print(df.to_string(index=False) if len(df.columns) else "(no columns)")
     return 0

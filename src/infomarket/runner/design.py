@@ -316,7 +316,11 @@ def save(store, design: Design) -> None:
     """Keep the design in the store (matrix first, settings last); refuse a store whose design of the
     same experiment differs.  Call with the store's lock held."""
     from ..store import StoreError
-    from ..store.files import write_parquet_atomic, write_text_atomic
+    from ..store.files import write_atomic, write_text_atomic
+    from ..store.results import write_table
+
+    def write_parquet_atomic(frame, path):  # with each column's unit and description (store.dictionary)
+        write_atomic(path, lambda tmp: write_table("designs", frame, tmp))
 
     spec_path, matrix_path = _paths(store.root, design.experiment)
     if spec_path.exists():

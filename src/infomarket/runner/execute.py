@@ -31,8 +31,9 @@ import pandas as pd
 
 from .. import plugins
 from ..config.schema import Experiment
-from ..engine.simulation import Simulation, simulate
-from ..errors import InfomarketError
+from ..engine.simulation import Simulation
+from ..checks import explain
+from ..errors import InfomarketError, RuleRunError
 from .plan import Condition
 
 MAX_ERROR_CHARS = 4000
@@ -59,11 +60,20 @@ class RunOutput:
     steps: int = 0
     error: str | None = None
     sites: pd.DataFrame = field(default_factory=pd.DataFrame)
+    #: the error is a user's rule's (RuleRunError): the message names the rule, its file and line, the step
+    rule_error: bool = False
 
 
 def run_one(cfg: Experiment, run: int, seed: int, record_events: bool = False) -> RunOutput:
-    """Run ``cfg`` once with ``seed`` (its own ``steps`` and ``history_every``); tables get ``run``/``seed``."""
-    r = simulate(cfg, seed, record_events=record_events)
+    """Run ``cfg`` once with ``seed`` (its own ``steps`` and ``history_every``); tables get ``run``/``seed``.
+    An error raised inside the compiled step (a rule's) becomes a RuleRunError naming the rule, its file
+    and line, and the step (``checks.explain_run_failure``) when one rule reproduces it alone."""
+    sim = None
+    try:
+        sim = Simulation(cfg, seed, record_events=record_events)
+        r = sim.run()
+    except Exception as exc:  # a rule's error (or an error bit a rule set): named, else as it is
+        raise explain(cfg, seed, exc, sim, record_events=record_events) from exc
     robots = r.robots
     robots.insert(0, "run", np.int64(run))
     hist, events, payments = r.history, r.events, r.payments
@@ -81,9 +91,12 @@ def run_one(cfg: Experiment, run: int, seed: int, record_events: bool = False) -
 
 
 def _failed(run: int, seed: int, exc: BaseException) -> RunOutput:
-    text = "".join(traceback.format_exception(exc))[-MAX_ERROR_CHARS:]
+    if isinstance(exc, RuleRunError):  # one clear message: the rule, its file and line, the step
+        text = str(exc)
+    else:
+        text = "".join(traceback.format_exception(exc))[-MAX_ERROR_CHARS:]
     empty = pd.DataFrame()
-    return RunOutput(run, seed, empty, empty, empty, empty, error=text)
+    return RunOutput(run, seed, empty, empty, empty, empty, error=text, rule_error=isinstance(exc, RuleRunError))
 
 
 def run_chunk(cfg: Experiment, items: list[tuple[int, int]], record_events: bool = False) -> list[RunOutput]:
@@ -224,6 +237,32 @@ def stop_pool(pool: ProcessPoolExecutor) -> None:
 def warm(cfg: Experiment) -> None:
     """Compile (or load) the configuration's kernel in this process, so forked workers inherit it."""
     Simulation(cfg, 0)  # loads every compiled entry point (view constructor, step loop)
+
+
+def preflight(configs: Iterable[Experiment]) -> None:
+    """Compile (or load) each distinct kernel in this process before anything is written or run: a kernel
+    that cannot compile because of a user's rule is a RuleRunError naming the rule and what is wrong with
+    it (numba's own error points into the generated kernel).  Other errors are left to the runs."""
+    from ..checks import explain_compile_failure
+    from ..engine.specialise import kernel_id
+
+    seen: set[str] = set()
+    for cfg in configs:
+        try:
+            key = kernel_id(cfg)
+        except Exception:  # noqa: BLE001 - the runs themselves report it
+            continue
+        if key in seen:
+            continue
+        seen.add(key)
+        try:
+            Simulation(cfg, 0)  # compiles or loads the kernel (what a warm-up then finds done)
+        except InfomarketError:
+            raise
+        except Exception as exc:  # noqa: BLE001
+            why = explain_compile_failure(cfg, exc)
+            if why:
+                raise RuleRunError(f"{cfg.name}: {why}; the step kernel cannot be compiled, nothing was run") from None
 
 
 def warm_up(configs: Iterable[Experiment]) -> dict[str, float]:

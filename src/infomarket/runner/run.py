@@ -87,6 +87,9 @@ def run_experiment(cond: Condition, out: str | Path, *, workers: int = 1, force:
     store = Store(out)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {out}: exists and is not a directory")
+    from .execute import preflight
+
+    preflight([cond.config])  # a rule that keeps the kernel from compiling: refused, nothing written
     replaced = _legacy_files(store, force)
     try:
         with store.writing():

@@ -25,7 +25,7 @@ from .. import __version__
 from ..config.schema import Experiment
 from ..store import Store, StoreError
 from ..store.results import FAILED, OK
-from .execute import RunOutput, Task, execute, local_executor, make_tasks
+from .execute import RunOutput, Task, execute, local_executor, make_tasks, preflight
 from .plan import Condition, conditions
 
 __all__ = ["SweepReport", "Task", "check_compatible", "make_tasks", "plan", "run_sweep", "sweep_locked"]
@@ -40,6 +40,8 @@ class SweepReport:
     wall_seconds: float
     failed: int = 0
     first_error: str = ""
+    #: failed runs whose error is a user's rule's (RuleRunError: the rule, its file and line, the step)
+    rule_errors: int = 0
     retried: int = 0
     #: seconds spent compiling or loading kernels: the warm-up, or the longest a run spent on it
     compile_seconds: float = 0.0
@@ -144,7 +146,9 @@ def run_sweep(conds: list[Condition], store: Store, *, workers: int = 1, executo
     Executor, e.g. ``process_pool(n)`` or a Dask ``client.get_executor(pure=False)``; never shut down
     here), else inline when ``workers`` is 1, else on a local pool of ``workers`` processes made here.
     ``record_events``: also store each run's event log; ``retry_failed``: rerun the failed runs.
-    The store is locked throughout (a second writer gets StoreError at once, before writing anything)."""
+    The store is locked throughout (a second writer gets StoreError at once, before writing anything).
+    A kernel that a user's rule keeps from compiling is refused first (RuleRunError), nothing written."""
+    preflight(c.config for c in conds)
     with store.writing():
         return sweep_locked(conds, store, workers=workers, executor=executor, on_done=on_done, on_plan=on_plan,
                             record_events=record_events, retry_failed=retry_failed)
@@ -186,7 +190,8 @@ def _run(conds, store, workers, executor, on_done, on_plan, record_events) -> Sw
     def finished(task: Task, outputs: list[RunOutput]) -> None:
         nonlocal env_steps, compile_seconds, run_seconds
         tables = _frames(task, outputs)
-        store.write_part(task.part_id, **tables)
+        keys = dict.fromkeys(k for c, _ in task.members for k in c.keys)
+        store.write_part(task.part_id, **tables, keys=keys)
         env_steps += int(tables["runs"].steps.sum())
         run_seconds += float(tables["runs"].duration_s.sum())
         compile_seconds = max([compile_seconds] + [o.compile_seconds for o in outputs])
@@ -200,7 +205,11 @@ def _run(conds, store, workers, executor, on_done, on_plan, record_events) -> Sw
         with local_executor(workers) as pool:
             warm = execute(tasks, finished, executor=pool, record_events=record_events)
     first = failed[0].error.strip().splitlines()[-1] if failed else ""
+    rule_errors = [o for o in failed if o.rule_error]
+    if rule_errors:  # the clearest message: a rule's, named with its file, line and step
+        first = rule_errors[0].error.strip()
     return SweepReport(planned, planned - todo, todo, env_steps, time.perf_counter() - t0, len(failed), first,
-                       compile_seconds=max(warm, compile_seconds), run_seconds=run_seconds)
+                       compile_seconds=max(warm, compile_seconds), run_seconds=run_seconds,
+                       rule_errors=len(rule_errors))
 
 

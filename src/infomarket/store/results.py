@@ -29,13 +29,16 @@ before).  Every read checks them and raises ``StoreDamaged`` naming the part and
 repair command; ``verify`` lists every damaged and orphan part, ``repair`` moves damaged parts aside
 (into ``damaged/``) so that their runs count as not done and the next sweep reruns exactly those.
 
-Query with pandas (``Store(path).robots()``) or DuckDB::
+Every column, with its unit, is described in ``store.dictionary`` (docs/data.md) and in each file's Parquet
+field metadata.  Query with pandas (``Store(path).robots()``), ``Store(path).sql(query)`` (DuckDB, over the
+verified parts only) or DuckDB directly::
 
     SELECT r.* FROM 'STORE/robots/*.parquet' r JOIN 'STORE/runs/*.parquet' USING (experiment, condition, run)
 """
 from __future__ import annotations
 
 import fcntl
+from collections.abc import Iterable
 import json
 import os
 import shutil
@@ -52,6 +55,8 @@ import pyarrow.parquet as pq
 
 from .. import __version__
 from ..errors import InfomarketError
+from .dictionary import TABLES as TABLES_DICT
+from .dictionary import annotate
 from .files import sha256_file, write_atomic, write_text_atomic
 
 FORMAT = 1
@@ -70,12 +75,22 @@ def record_digest(table: pa.Table) -> str:
     return hashlib.sha256(data.encode()).hexdigest()
 
 
+def write_table(table: str, df: pd.DataFrame, path: Path, keys: Iterable[str] = (), **options) -> None:
+    """Write ``df`` as the store's ``table`` to ``path``, each column's unit and description in its field
+    metadata (``store.dictionary.annotate``; a column it does not describe is an InternalError)."""
+    pq.write_table(annotate(table, pa.Table.from_pandas(df, preserve_index=False), keys), path, **options)
+
+
 class RecordAltered(InfomarketError):
     """A commit record's content does not match the checksum it was written with (internal signal)."""
 
 
 class StoreError(InfomarketError, ValueError):
     """The folder is not a usable results store (wrong format, incompatible contents, locked)."""
+
+
+class SqlError(StoreError):
+    """A query given to ``Store.sql`` is not valid SQL or names what the store does not hold."""
 
 
 class StoreDamaged(StoreError):
@@ -170,9 +185,13 @@ class Store:
 
     def meta(self) -> dict:
         try:
-            return json.loads(self.meta_path.read_text())
+            meta = json.loads(self.meta_path.read_text())
         except (OSError, ValueError) as exc:
             raise StoreError(f"{self.meta_path}: unreadable ({exc})") from None
+        if not isinstance(meta, dict):
+            raise StoreError(f"{self.meta_path}: not an infomarket store.json (a JSON object is expected, found "
+                             f"{type(meta).__name__})")
+        return meta
 
     def create(self) -> "Store":
         """Create the folder layout (idempotent); refuse a folder that holds something else."""
@@ -281,9 +300,11 @@ class Store:
     def write_part(self, part_id: str, robots: pd.DataFrame | None, runs: pd.DataFrame,
                    history: pd.DataFrame | None = None, events: pd.DataFrame | None = None,
                    payments: pd.DataFrame | None = None, sites: pd.DataFrame | None = None,
-                   configs: pd.DataFrame | None = None) -> None:
+                   configs: pd.DataFrame | None = None, keys: Iterable[str] = ()) -> None:
         """Write one part: the data tables (robots, history, events, payments, sites, configs) first, then
-        the runs record with their checksums and row counts, last."""
+        the runs record with their checksums and row counts, last.  ``keys``: the condition keys' columns.
+        Every column's unit and description (``store.dictionary``) go into the Parquet field metadata."""
+        keys = list(keys)
         if self.part_path("runs", part_id).exists():
             raise StoreError(f"{self.root}: part {part_id} is already committed")
         runs = runs.copy()
@@ -294,15 +315,15 @@ class Store:
             sha, rows = "", 0
             if df is not None and len(df):
                 path = self.part_path(t, part_id)
-                write_atomic(path, lambda tmp, df=df: df.to_parquet(tmp, index=False))
+                write_atomic(path, lambda tmp, df=df, t=t: write_table(t, df, tmp, keys))
                 sha, rows = sha256_file(path), len(df)
             runs[f"{t}_sha256"] = sha
             runs[f"{t}_rows"] = rows
-        self._write_runs(part_id, runs)
+        self._write_runs(part_id, runs, keys)
 
-    def _write_runs(self, part_id: str, runs: pd.DataFrame) -> None:
+    def _write_runs(self, part_id: str, runs: pd.DataFrame, keys: Iterable[str]) -> None:
         def write(tmp: Path) -> None:
-            runs.to_parquet(tmp, index=False, write_page_checksum=True)
+            write_table("runs", runs, tmp, keys, write_page_checksum=True)
             table = pq.read_table(tmp)  # the digest is of what a reader gets back
             meta = {**(table.schema.metadata or {}), RECORD_SHA: record_digest(table).encode()}
             pq.write_table(table.replace_schema_metadata(meta), tmp, write_page_checksum=True)
@@ -355,6 +376,8 @@ class Store:
     def verify(self) -> Inspection:
         """Check every committed part against its commit record; list damaged and orphan parts."""
         found = Inspection()
+        if self.exists():
+            self.meta()  # an unreadable store.json is a StoreError, not a store of no parts
         runs_parts = self._parts("runs")
         for pid, path in sorted(runs_parts.items()):
             found.parts += 1
@@ -447,6 +470,49 @@ class Store:
         sort = [c for c in KEY + ["step", "robot"] if c in df.columns]
         return df.sort_values(sort, kind="stable").reset_index(drop=True)
 
+    def sql(self, query: str, *, skip_damaged: bool = False) -> pd.DataFrame:
+        """Run a DuckDB SQL ``query`` over the store's verified parts; returns a pandas DataFrame.
+
+        The tables are views named as in the store (``robots``, ``history``, ``events``, ``payments``,
+        ``sites``, ``configs``, ``runs``; docs/data.md) over the committed parts that pass ``verify`` now:
+        orphans of an interrupted sweep are never read, and a damaged part raises ``StoreDamaged`` like
+        every read (``skip_damaged=True``: leave the damaged parts out and read the others).  The query can
+        read those parts' files only and write no file (DuckDB's external access is switched off).  A table
+        with no rows in the store has no view.  Needs DuckDB: ``pip install 'infomarket[sql]'``."""
+        try:
+            import duckdb
+        except ImportError:
+            raise StoreError("Store.sql needs DuckDB: pip install 'infomarket[sql]'") from None
+        if not self.exists():
+            raise StoreError(f"{self.root}: not an infomarket results store (no store.json)")
+        self.meta()  # readable, or a StoreError
+        found = self.verify()
+        if found.damaged and not skip_damaged:
+            self.check()
+        bad = {p.part for p in found.damaged}
+        good = [pid for pid in self.committed() if pid not in bad]
+        con = duckdb.connect()
+        try:
+            allowed = []
+            for t in TABLES:
+                files = [str(self.part_path(t, pid).resolve()) for pid in good if self.part_path(t, pid).exists()]
+                if files:
+                    con.read_parquet(files, union_by_name=True).create_view(t)
+                    allowed += files
+            # the query reads the verified parts and nothing else, and writes nothing (no COPY TO, no
+            # ATTACH, no other file): the views' files are the only ones allowed, and that is locked
+            con.execute("SET temp_directory = ''")  # no spill files (DuckDB's default is ./.tmp)
+            con.execute("SET allowed_paths = ?", [allowed])
+            con.execute("SET enable_external_access = false")
+            con.execute("SET lock_configuration = true")
+            try:
+                return con.execute(query).df()
+            except duckdb.Error as exc:
+                raise SqlError(f"{self.root}: the query failed: {exc} (tables: "
+                               f"{', '.join(r[0] for r in con.execute('SHOW TABLES').fetchall())})") from None
+        finally:
+            con.close()
+
     def runs(self) -> pd.DataFrame:
         """One row per committed run, ``status`` ``ok`` or ``failed`` (then ``error`` says why)."""
         return self._read("runs")
@@ -529,8 +595,9 @@ class Store:
                 continue
             keep = record[record.status != FAILED]
             n += len(record) - len(keep)
-            if len(keep):
-                self._write_runs(pid, keep.reset_index(drop=True))
+            if len(keep):  # the condition keys: the columns the dictionary does not list
+                keys = [c for c in keep.columns if TABLES_DICT["runs"].column(c) is None]
+                self._write_runs(pid, keep.reset_index(drop=True), keys)
             else:  # nothing of this part succeeded: no data part exists, drop the record
                 self.part_path("runs", pid).unlink()
         return n

@@ -53,7 +53,14 @@ def _warm_up(cfg, seed: int | None) -> None:
 
     t0 = time.perf_counter()
     _say("preparing the step kernel (the first use of a behaviour mix compiles for a few seconds)...")
-    Simulation(cfg, seed)
+    try:
+        Simulation(cfg, seed)
+    except InfomarketError:
+        raise
+    except Exception as exc:  # a rule that keeps the kernel from compiling: named (checks.explain)
+        from ..checks import explain
+
+        raise explain(cfg, seed, exc) from None
     _say(f"ready in {time.perf_counter() - t0:.1f} s")
 
 

@@ -1,8 +1,9 @@
 """Render a recording as a movie, like the paper's Movie S1 (``infomarket replay --movie``).
 
-Same picture as the page: discs coloured by behaviour (honest blue, Byzantine red), outlined by the last
-site visited, a white heading line, a dark dot for a carried item; a caption with the items collected
-and a progress bar under the arena.  ``.gif`` uses matplotlib's Pillow writer and always works;
+Same picture as the page: discs coloured by behaviour (honest blue, Byzantine orange: colour-blind-safe
+colours of Okabe and Ito, told apart in grey too), each Byzantine also framed by a black square (a shape,
+not only a colour, at a movie's small size), outlined by the last site visited, a white heading line, a dark
+dot for a carried item; a caption with the items collected, a legend, and a progress bar under the arena.  ``.gif`` uses matplotlib's Pillow writer and always works;
 ``.mp4`` needs an ffmpeg binary, found on PATH or in the ``imageio-ffmpeg`` wheel.
 """
 from __future__ import annotations
@@ -17,7 +18,9 @@ from ..errors import ConfigError
 from .frames import CARRYING, LAST_FOOD, LAST_NEST
 from .recording import Recording
 
-HONEST, BYZANTINE = "#2f6fd6", "#d62f2f"
+#: Okabe-Ito blue and orange: distinct with every colour-vision deficiency and in luminance (grey prints).
+HONEST, BYZANTINE = "#0072b2", "#e69f00"
+BYZANTINE_FRAME = "#000000"
 SITE_COLOURS = {"food": "#2ca02c", "nest": "#e8b100"}
 NO_SITE = "#666666"
 #: Per format: frames per second and the most frames kept (a movie of ~15 s; GIFs grow fast).
@@ -98,8 +101,8 @@ def write_movie(rec: Recording, path: str | Path, *, fps: int | None = None, max
     dpi = 100
     width_px = WIDTH_PX[ext]
     arena_px = 2 * round(width_px * H / W / 2)
-    caption_px, bar_px = 40, 28
-    height_px = arena_px + caption_px + bar_px
+    caption_px, legend_px, bar_px = 40, 26, 28
+    height_px = arena_px + caption_px + legend_px + bar_px
     fig = Figure(figsize=(width_px / dpi, height_px / dpi), dpi=dpi, facecolor="white")
     FigureCanvasAgg(fig)
     ax = fig.add_axes((0, bar_px / height_px, 1, arena_px / height_px))
@@ -120,6 +123,10 @@ def write_movie(rec: Recording, path: str | Path, *, fps: int | None = None, max
                               offsets=np.c_[first["x"], first["y"]], offset_transform=ax.transData,
                               facecolors=np.where(honest, HONEST, BYZANTINE), linewidths=1.3)
     ax.add_collection(discs)
+    px_per_unit = width_px / W  # a Byzantine's square frame, in points: 1.7 robot diameters wide
+    frame_pt = 1.7 * 2 * r * px_per_unit * 72 / dpi
+    frames = ax.scatter(first["x"][~honest], first["y"][~honest], s=frame_pt ** 2, marker="s", facecolors="none",
+                        edgecolors=BYZANTINE_FRAME, linewidths=1.4, zorder=4)
     headings = LineCollection([], colors="white", linewidths=1.2)
     ax.add_collection(headings)
     carried = ax.scatter([], [], s=6, c="#222", zorder=5)
@@ -130,6 +137,8 @@ def write_movie(rec: Recording, path: str | Path, *, fps: int | None = None, max
     if collisions:
         ax.add_collection(rings)
     caption = fig.text(0.01, 1 - 0.5 * caption_px / height_px, "", va="center", fontsize=11)
+    _legend(fig, (1 - (caption_px + legend_px) / height_px, legend_px / height_px), collisions,
+            byzantines=bool((~honest).any()))
     bar_ax = fig.add_axes((0.01, 0.2 * bar_px / height_px, 0.98, 0.6 * bar_px / height_px))
     bar_ax.set_xlim(0, 1)
     bar_ax.set_ylim(0, 1)
@@ -155,6 +164,7 @@ def write_movie(rec: Recording, path: str | Path, *, fps: int | None = None, max
             xy = np.c_[c["x"], c["y"]]
             a = np.radians(c["heading"].astype(np.float64))
             discs.set_offsets(xy)
+            frames.set_offsets(xy[~honest].reshape(-1, 2))
             discs.set_edgecolors(np.where(c["flags"] & LAST_FOOD, SITE_COLOURS["food"],
                                           np.where(c["flags"] & LAST_NEST, SITE_COLOURS["nest"], NO_SITE)))
             headings.set_segments(np.stack([xy, xy + r * np.c_[np.cos(a), np.sin(a)]], axis=1))
@@ -176,3 +186,28 @@ def write_movie(rec: Recording, path: str | Path, *, fps: int | None = None, max
                 on_progress(j + 1, len(picks))
     tmp.replace(path)
     return path
+
+
+def _legend(fig, band: tuple[float, float], collisions: bool, byzantines: bool = True) -> None:
+    """One row under the caption: what the fills, the frame, the outlines, the dot and the rings mean."""
+    from matplotlib.lines import Line2D
+
+    def marker(**kw) -> Line2D:
+        return Line2D([], [], linestyle="none", **{"markersize": 9, **kw})
+
+    handles = [marker(marker="o", markerfacecolor=HONEST, markeredgecolor=NO_SITE)]
+    labels = ["honest"]
+    if byzantines:
+        handles.append((marker(marker="o", markerfacecolor=BYZANTINE, markeredgecolor=NO_SITE),
+                        marker(marker="s", markersize=13, markerfacecolor="none", markeredgecolor=BYZANTINE_FRAME)))
+        labels.append("Byzantine (framed)")
+    handles += [marker(marker="o", markerfacecolor="none", markeredgecolor=SITE_COLOURS["food"], markeredgewidth=2),
+                marker(marker="o", markerfacecolor="none", markeredgecolor=SITE_COLOURS["nest"], markeredgewidth=2),
+                marker(marker="o", markersize=3, markerfacecolor="#222", markeredgecolor="#222")]
+    labels += ["last visited food", "last visited nest", "carrying an item"]
+    if collisions:
+        handles.append(marker(marker="o", markersize=12, markerfacecolor="none", markeredgecolor=CONTACT))
+        labels.append("touching")
+    bottom, height = band
+    fig.legend(handles, labels, loc="center", bbox_to_anchor=(0, bottom, 1, height), ncol=len(labels),
+               frameon=False, fontsize=8.5, handletextpad=0.3, columnspacing=1.0, borderaxespad=0)

@@ -21,7 +21,8 @@ import numpy as np
 from .. import __version__
 from ..config.schema import Experiment
 from ..engine import Simulation
-from ..errors import InternalError
+from ..checks import explain
+from ..errors import InfomarketError, InternalError
 from . import STATIC
 from .frames import Frame, decode, encode, event_columns, frame_size, honest_mask, scene
 
@@ -55,11 +56,19 @@ def record(config: Experiment, seed: int | None = None, *, steps: int | None = N
     """Run ``config`` for ``steps`` (default: its own) keeping a frame every ``every`` steps."""
     steps = config.steps if steps is None else steps
     every = default_every(steps, config.swarm.robots) if every is None else every
-    sim = Simulation(config, seed, record_events=True)
+    try:
+        sim = Simulation(config, seed, record_events=True)
+    except InfomarketError:
+        raise
+    except Exception as exc:  # a rule that keeps the kernel from compiling: named (checks.explain)
+        raise explain(config, seed, exc) from None
     honest = honest_mask(sim)
     frames = [encode(sim, honest)]
     while sim.clock < steps:
-        sim.step(min(every, steps - sim.clock))
+        try:
+            sim.step(min(every, steps - sim.clock))
+        except Exception as exc:  # a rule raised: named with its file, line and the step
+            raise explain(config, sim.seed, exc, sim, record_events=True) from None
         frames.append(encode(sim, honest))
         if on_progress:
             on_progress(sim.clock, steps)

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 
 from ..config.schema import Experiment
 from ..engine import Simulation
+from ..checks import explain
 from ..errors import InfomarketError
 from ..seeds import MAX_SEED
 from .frames import encode, honest_mask, robot_detail, scene
@@ -99,7 +100,12 @@ class Session:
     def restart(self, seed: int | None = None) -> None:
         """A fresh swarm from step 0; a random seed unless one is given."""
         self.seed = secrets.randbelow(MAX_SEED + 1) if seed is None else int(seed)
-        self.sim = Simulation(self.config, self.seed, record_events=True)
+        try:
+            self.sim = Simulation(self.config, self.seed, record_events=True)
+        except InfomarketError:
+            raise
+        except Exception as exc:  # a rule that keeps the kernel from compiling: named (checks.explain)
+            raise explain(self.config, self.seed, exc) from None
         self._honest = honest_mask(self.sim)
 
     def scene(self) -> dict:
@@ -117,5 +123,8 @@ class Session:
 
     def advance(self, k: int) -> tuple[bytes, dict | None]:
         """Step ``k`` times; the new frame and the selected robot's details (run in a worker thread)."""
-        self.sim.step(k)
+        try:
+            self.sim.step(k)
+        except Exception as exc:  # a rule raised: the page is told which, at which step (checks.explain)
+            raise explain(self.config, self.seed, exc, self.sim, record_events=True) from None
         return self.frame(), self.detail()

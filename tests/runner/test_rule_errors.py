@@ -1,0 +1,214 @@
+"""A user's rule that raises while it runs, or that cannot be compiled into the step, is named: the rule,
+its file and line, and the step; one message, exit 2, no traceback, nothing half-written (issue 21).
+
+Before: a division by zero in a sell rule swept on a process pool gave a 44-line _RemoteTraceback naming
+neither rule nor step (and `run`/`sweep` exited 1 with "ZeroDivisionError: division by zero"); a sell rule
+returning three values gave numba's "Cannot unify Tuple" pointing into the generated kernel; a string
+default gave "could not convert string to float" naming no rule or parameter."""
+from __future__ import annotations
+
+import textwrap
+
+import numpy as np
+import pytest
+
+import infomarket as im
+from infomarket.cli import main
+from infomarket.store import Store
+
+HEAD = '''
+import infomarket as im
+from infomarket.behaviours.api import own_entry
+'''
+
+# raises at step 37 exactly (the clock counts the step before any rule runs): a hand-chosen step
+LATE = HEAD + '''
+
+@im.behaviour("late_divider", buy="naive", honest=False, description="divides by k at step 37")
+def late_divider_sell(w, me, site, k=0.0):
+    valid, x, y, age = own_entry(w, me, site)
+    if w.clock[0] == 37:
+        x = x / k
+    return valid, x, y, age
+'''
+
+THREE = HEAD + '''
+
+@im.behaviour("three_values", buy="naive", honest=False, description="returns three values")
+def three_values_sell(w, me, site):
+    valid, x, y, age = own_entry(w, me, site)
+    return valid, x, y
+'''
+
+STRING = HEAD + '''
+
+@im.behaviour("string_default", buy="naive", honest=False, description="a text default")
+def string_default_sell(w, me, site, mode="fast"):
+    return own_entry(w, me, site)
+'''
+
+PAY = '''
+import infomarket as im
+
+
+@im.payment("divided", description="divides by a parameter")
+def divided(buyer, sellers, sites, directions, weights, k=0.0):
+    for x in range(len(sellers)):
+        weights[x] = 1.0 / k
+'''
+
+
+def experiment(tmp_path, name: str, plugin: str, behaviour: str = "naive", scheme: str = "delayed",
+               steps: int = 200, runs: int = 2, robots: int = 6) -> str:
+    (tmp_path / f"{name}.py").write_text(plugin)
+    (tmp_path / f"{name}.toml").write_text(textwrap.dedent(f'''
+        name = "{name}"
+        steps = {steps}
+        runs = {runs}
+        seed = 4
+        plugins = ["{name}.py"]
+
+        [swarm]
+        robots = {robots}
+
+        [[swarm.groups]]
+        behaviour = "naive"
+        count = {robots - 1}
+
+        [[swarm.groups]]
+        behaviour = "{behaviour}"
+        count = 1
+
+        [payment]
+        scheme = "{scheme}"
+        '''))
+    return str(tmp_path / f"{name}.toml")
+
+
+def one_message(capsys) -> str:
+    err = capsys.readouterr().err
+    assert err.count("infomarket: error:") == 1, err
+    assert "Traceback" not in err and "_RemoteTraceback" not in err, err
+    return err
+
+
+def line_of(path, text: str) -> int:
+    return next(i for i, ln in enumerate(path.read_text().splitlines(), 1) if text in ln)
+
+
+def test_a_rule_raising_in_a_process_pool_sweep_is_named_with_its_line_and_step(tmp_path, capsys):
+    exp = experiment(tmp_path, "late", LATE, "late_divider")
+    out = tmp_path / "store"
+    assert main(["sweep", exp, "--out", str(out), "--workers", "2", "--quiet"]) == 2
+    err = one_message(capsys)
+    at = f"{tmp_path / 'late.py'}:{line_of(tmp_path / 'late.py', 'x = x / k')}"
+    assert (f"behaviour 'late_divider': its sell rule late_divider_sell raised ZeroDivisionError "
+            f"(division by zero) at step 37 (robot 5, site 0), at {at}") in err
+    failed = Store(out).failed()  # committed as failed, with the same one-line message
+    assert len(failed) == 2 and all(e.startswith("behaviour 'late_divider'") and "\n" not in e
+                                    for e in failed.error)
+
+
+def test_infomarket_run_names_the_rule_too(tmp_path, capsys):
+    exp = experiment(tmp_path, "late", LATE.replace('"late_divider"', '"late_divider_run"'), "late_divider_run",
+                     runs=1)
+    assert main(["run", exp, "--out", str(tmp_path / "store"), "--quiet"]) == 2
+    assert "late_divider_sell raised ZeroDivisionError (division by zero) at step 37" in one_message(capsys)
+
+
+def _first_paid_deposit(cfg, seed: int) -> int:
+    """The first step at which a robot deposits with transactions open: the first call of the weight rule.
+    From the event log of the same run under the delayed scheme (weights do not move robots)."""
+    data = cfg.model_dump()
+    data["payment"].update(scheme="delayed", params={})
+    res = im.simulate(im.config.validate(data), seed, record_events=True)
+    open_tx: dict[int, int] = {}
+    for ev in res.events.itertuples():
+        if ev.kind == "purchase":
+            open_tx[ev.buyer] = open_tx.get(ev.buyer, 0) + 1
+        elif ev.kind == "deposit":
+            if open_tx.get(ev.buyer, 0):
+                return int(ev.step)
+            open_tx[ev.buyer] = 0
+    raise AssertionError("no paid deposit")
+
+
+def test_a_weight_rule_raising_at_a_deposit_is_named_with_the_step(tmp_path, capsys):
+    exp = experiment(tmp_path, "divided", PAY, scheme="divided", steps=2000, runs=1,
+                     robots=25)
+    out = tmp_path / "store"
+    assert main(["sweep", exp, "--out", str(out), "--workers", "1", "--quiet"]) == 2
+    err = one_message(capsys)
+    cfg = im.load_experiment(exp)
+    seed = int(Store(out).runs().seed.iloc[0])
+    step = _first_paid_deposit(cfg, seed)
+    at = f"{tmp_path / 'divided.py'}:{line_of(tmp_path / 'divided.py', 'weights[x] = 1.0 / k')}"
+    assert f"payment scheme 'divided': its weight rule divided raised ZeroDivisionError" in err
+    assert f"at step {step} (buyer " in err and at in err
+
+
+def test_a_rule_returning_three_values_is_refused_before_anything_is_written(tmp_path, capsys):
+    exp = experiment(tmp_path, "three", THREE, "three_values")
+    out = tmp_path / "store"
+    assert main(["sweep", exp, "--out", str(out), "--quiet"]) == 2
+    err = one_message(capsys)
+    assert (f"behaviour 'three_values': its sell rule three_values_sell ({tmp_path / 'three.py'}:{line_of(tmp_path / 'three.py', '@im.behaviour')}) returns "
+            f"3 values") in err
+    assert "a sell rule returns 4: (valid, x, y, age)" in err and "Cannot unify" not in err
+    assert not out.exists()
+    assert main(["run", exp, "--out", str(out), "--quiet"]) == 2
+    assert "three_values_sell" in one_message(capsys) and not out.exists()
+
+
+def test_a_text_default_is_refused_naming_the_rule_and_the_parameter(tmp_path, capsys):
+    exp = experiment(tmp_path, "text", STRING, "string_default")
+    assert main(["check", exp]) == 2
+    err = one_message(capsys)
+    at = f"{tmp_path / 'text.py'}:{line_of(tmp_path / 'text.py', '@im.behaviour')}"
+    assert f"sell rule string_default_sell ({at}): parameter 'mode' has the default 'fast'" in err
+    assert "could not convert" not in err
+
+
+@pytest.mark.parametrize("default", ["float('nan')", "True", "None", "[1.0]"])
+def test_defaults_that_are_not_finite_numbers_are_refused(default):
+    from infomarket.errors import RuleError
+    from infomarket.registry import register_behaviour
+
+    scope: dict = {}
+    exec(f"def bad_sell(w, me, site, p={default}):\n    return True, 0.0, 0.0, 0\n", scope)
+    with pytest.raises(RuleError, match="parameter 'p' has the default"):
+        register_behaviour(f"bad_default_{abs(hash(default))}", buy="naive", sell=scope["bad_sell"], honest=True)
+
+
+def test_replay_names_the_rule_and_writes_nothing(tmp_path, capsys):
+    exp = experiment(tmp_path, "late", LATE.replace('"late_divider"', '"late_divider_replay"'),
+                     "late_divider_replay")
+    out = tmp_path / "late.html"
+    assert main(["replay", exp, "--out", str(out), "--steps", "100", "--quiet"]) == 2
+    assert "late_divider_sell raised ZeroDivisionError (division by zero) at step 37" in one_message(capsys)
+    assert not out.exists()
+    assert not np.any([p.name.startswith(".late") for p in tmp_path.iterdir()])  # no temporary file left
+
+
+NEGATIVE = '''
+import infomarket as im
+
+
+@im.payment("negative_weights", description="weights below zero")
+def negative_weights(buyer, sellers, sites, directions, weights):
+    for x in range(len(sellers)):
+        weights[x] = -1.0
+'''
+
+
+def test_a_weight_rule_giving_negative_weights_is_named_with_the_step(tmp_path, capsys):
+    """Before: "step N: a payment rule returned a negative or non-finite weight", naming no scheme, exit 1."""
+    exp = experiment(tmp_path, "negative", NEGATIVE, scheme="negative_weights", steps=2000, runs=1, robots=25)
+    out = tmp_path / "store"
+    assert main(["sweep", exp, "--out", str(out), "--workers", "1", "--quiet"]) == 2
+    err = one_message(capsys)
+    cfg = im.load_experiment(exp)
+    step = _first_paid_deposit(cfg, int(Store(out).runs().seed.iloc[0]))
+    at = f"{tmp_path / 'negative.py'}:{line_of(tmp_path / 'negative.py', '@im.payment')}"
+    assert (f"payment scheme 'negative_weights': its weight rule negative_weights ({at}) gave a negative or "
+            f"non-finite weight at step {step}") in err
