@@ -57,9 +57,6 @@ POLICY = (
 )
 #: What the attacker knows of the market it attacks (set from the defence, never searched).
 KNOWN = (("theta", 30.0), ("theta_min", 10.0), ("adaptive", 0.0), ("threshold", 0.25))
-#: A colluder buys its partners' offers only while it holds fewer open transactions than this, so a
-#: pair that stays in range does not pile up transactions without bound.
-COLLUSION_TX = 16
 #: Information age counted for a buyer with no valid entry (it would take anything).
 NO_ENTRY_AGE = 1000000
 
@@ -141,15 +138,26 @@ def policy_sell(w, me, site, rot_base=20.0, rot_rep=0.0, rot_buyer_rep=0.0, rot_
 
 
 @njit(inline="always")
+def holds(w, me, seller, site):
+    """Whether ``me`` has an open transaction (since its last deposit) buying ``site`` from ``seller``."""
+    start = w.tx_off[me]
+    for t in range(start, start + w.tx_count[me]):
+        if w.tx_seller[t] == seller and w.tx_site[t] == site:
+            return True
+    return False
+
+
+@njit(inline="always")
 def sceptical_or_colluding(w, me, nbrs, threshold, collude):
-    """The sceptical rule (``behaviours.sceptical``) that, when colluding, first buys each partner's offers
-    (same behaviour) without using them and never believes a partner."""
+    """The sceptical rule (``behaviours.sceptical``) that, when colluding, first buys each partner's offer
+    (same behaviour) for each site once per round trip (whatever its age), without using it, and never
+    believes a partner: every deposit then settles one agreeing sale per partner met and site."""
     mine = w.kind[me]
     for site in range(2):
         if collude >= 0.5:
             for k in range(nbrs.shape[0]):
                 s = nbrs[k]
-                if w.kind[s] == mine and w.off_valid[s, site] and w.tx_count[me] < COLLUSION_TX:
+                if w.kind[s] == mine and w.off_valid[s, site] and not holds(w, me, s, site):
                     buy(w, me, s, site)  # a transaction that settles agreeing with the partner's other lies
         age_seen, s = -1, -1
         while True:
