@@ -19,8 +19,10 @@ SRC = str(Path(__file__).resolve().parents[2] / "src")
 TINY = ["attack-search", "attack_search", "--defence", "staking", "--byzantines", "3", "--budget", "4",
         "--popsize", "2", "--runs", "2", "--heldout-runs", "2", "--best", "1", "--steps", "2500",
         "--transitory", "0", "--seed", "7"]
-# 2 generations x 2 candidates x 2 runs, then (1 searched + every declared baseline) x 2 held-out runs
-PLANNED = 2 * 2 * 2 + (1 + len(load_study.__globals__["load_declarations"]()["baselines"])) * 2
+BASELINES = len(load_study.__globals__["load_declarations"]()["baselines"])  # the hand-written + truthful
+# the start (every hand-written attack) and 2 generations x 2 candidates, 2 runs each; then (1 searched +
+# every declared baseline) x 2 held-out runs
+PLANNED = (BASELINES - 1) * 2 + 2 * 2 * 2 + (1 + BASELINES) * 2
 
 
 def _report(out: Path) -> dict:
@@ -47,6 +49,7 @@ def test_a_tiny_search_completes_with_every_run_once(inline):
     rep = _report(inline)
     assert [(c["defence"], c["byzantines"], c["evaluations"]) for c in rep["cells"]] == [("staking", 3, 4)]
     assert set(rep["cells"][0]["params"]) == set(space.NAMES)
+    assert rep["cells"][0]["start_from"] in load_study.__globals__["load_declarations"]()["baselines"]
 
 
 def test_candidates_of_a_generation_share_seeds_and_held_out_seeds_are_new(inline):
@@ -56,8 +59,9 @@ def test_candidates_of_a_generation_share_seeds_and_held_out_seeds_are_new(inlin
     g0 = {s for c, s in gen.items() if "gen=0" in c}
     g1 = {s for c, s in gen.items() if "gen=1" in c}
     held = {s for c, s in seeds.items() if "phase=heldout" in c}
-    assert len(g0) == len(g1) == len(held) == 1  # one seed set per generation, one for the held-out runs
-    assert g0 != g1 and not (held & (g0 | g1))
+    start = {s for c, s in seeds.items() if "phase=start" in c}
+    assert len(g0) == len(g1) == len(held) == len(start) == 1  # one seed set per generation, start, held-out
+    assert len(g0 | g1 | held | start) == 4
     assert not set(next(iter(held))) & (set(next(iter(g0))) | set(next(iter(g1))))
 
 

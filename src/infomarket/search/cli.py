@@ -41,7 +41,8 @@ def cmd_attack_search(args) -> int:
     store = Store(out / "store")
     store.refuse_foreign()
     s = st.settings
-    per_cell = s.generations * s.popsize * s.runs + (min(s.best, s.generations * s.popsize)
+    per_cell = (s.generations * s.popsize + len(st.baselines) - bool(st.reference)) * s.runs + (
+        min(s.best, s.generations * s.popsize)
                                                      + len(st.baselines)) * s.heldout_runs
     total = per_cell * len(chosen)
     client = cluster = None

@@ -11,6 +11,10 @@ study's seed, the cell and g), finds their runs committed and tells CMA-ES the s
 evaluation is lost or repeated.  A replay that asked another point would need another configuration, and
 the store refuses that (``runner.sweep.check_compatible``), so a divergence cannot pass unnoticed.
 
+Before the first generation, every hand-written attack runs on a seed set of its own (``phase=start``);
+CMA-ES starts at the point of the best of them (the search space contains every hand-written attack), so
+the search refines the strongest known attack instead of starting from the middle of the cube.
+
 After the search, the ``best`` candidates and every hand-written attack run on **held-out seeds** (one
 set shared by all of them, never used by the search): conditions ``phase=heldout,attack=NAME``.
 """
@@ -53,6 +57,7 @@ class CellSearch:
     searched: list[str] = field(default_factory=list)  # labels of the re-evaluated candidates, best first
     done: int = 0              # runs made now
     skipped: int = 0           # runs found in the store
+    start_from: str = ""       # the hand-written attack CMA-ES started at (the best on the start seeds)
 
 
 def _stream(*parts) -> int:
@@ -81,8 +86,19 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
     opts = {"bounds": [0.0, 1.0], "popsize": s.popsize, "seed": _stream(s.seed, cell.experiment) % (2**31 - 2) + 1,
             "verbose": -9, "verb_log": 0, "verb_disp": 0, "verb_filenameprefix": "", "tolfun": 0.0,
             "tolx": 0.0, "tolfunhist": 0.0, "tolstagnation": 10**9, "tolflatfitness": 10**9}
-    es = cma.CMAEvolutionStrategy(np.full(dim, 0.5), s.sigma0, opts)
-    rows, done, skipped = [], 0, 0
+    # the start: every hand-written attack on one shared seed set of its own; CMA-ES starts at the best
+    hand = [(n, p) for n, p in study.baselines.items() if n != study.reference]
+    start = [_condition(cell, p, _keys("start", -1, k, n), s.runs, _stream("start"), steps, transitory)
+             for k, (n, p) in enumerate(hand)]
+    done, skipped = run(start) if start else (0, 0)
+    x0, start_from = np.full(dim, 0.5), ""
+    if start:
+        values = _values(store, cell, start, s.objective)
+        scores = [float(loss(values.loc[c.id].mean(), s.objective)) for c in start]
+        k = int(np.argmin(scores))  # ties: the first declared
+        x0, start_from = np.clip(space.to_unit(hand[k][1]), 0.0, 1.0), hand[k][0]
+    es = cma.CMAEvolutionStrategy(x0, s.sigma0, opts)
+    rows = []
     for g in range(s.generations):
         np.random.seed(_stream(s.seed, cell.experiment, "gen", g) % (2**32))  # what cma samples from
         X = es.ask()
@@ -114,7 +130,7 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
     label = {c.id: c.keys["attack"] for c in held}
     heldout = per.assign(attack=per.condition.map(label))[["attack", "run", "items", "liar_wealth"]]
     return CellSearch(cell, candidates, heldout.reset_index(drop=True), [f"search{k + 1}" for k in range(len(best))],
-                      done + made, skipped + found)
+                      done + made, skipped + found, start_from)
 
 
 def _robots(store: Store, cell: Cell) -> pd.DataFrame:

@@ -54,6 +54,7 @@ def analyse(study: Study, results: list[CellSearch]) -> dict:
         chosen = best.iloc[int(x_label.removeprefix("search")) - 1]
         cells.append({"defence": r.cell.defence, "byzantines": r.cell.byzantines, "experiment": r.cell.experiment,
                       "evaluations": len(r.candidates), "search": x_label, "hand": y_label,
+                      "start_from": r.start_from,
                       "params": {k: float(chosen[k]) for k in chosen.index if k not in ("gen", "cand", "label", "fitness")},
                       "found_at": {"gen": int(chosen.gen), "cand": int(chosen.cand)},
                       "medians": {a: float(np.median(_runs(held, a, obj))) for a in held.attack.unique()},
@@ -146,10 +147,10 @@ def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None) -
     if a["bounded_defence"]:
         lines += ["", "Loss within 10 % at every Byzantine count (bounded_defence): "
                   + "; ".join(f"{d}: {v['answer']}" for d, v in a["bounded_defence"].items())]
-    lines += ["", "Searched parameters per cell:", ""]
+    lines += ["", "Searched parameters per cell (CMA-ES started at the best hand-written attack on the start seeds):", ""]
     for c in a["cells"]:
         p = ", ".join(f"{k}={v:g}" for k, v in c["params"].items())
-        lines.append(f"- {c['defence']}, {c['byzantines']}: {p}")
+        lines.append(f"- {c['defence']}, {c['byzantines']} (started at {c.get('start_from') or 'the centre'}): {p}")
     return "\n".join(lines) + "\n"
 
 
