@@ -45,7 +45,7 @@ def cmd_attack_search(args) -> int:
         min(s.best, s.generations * s.popsize)
                                                      + len(st.baselines)) * s.heldout_runs
     total = per_cell * len(chosen)
-    client = cluster = None
+    client = None
     if args.dask:
         try:
             from distributed import Client
@@ -70,8 +70,6 @@ def cmd_attack_search(args) -> int:
     finally:
         if client is not None:
             client.close()
-        if cluster is not None:
-            cluster.close()
     wall = time.perf_counter() - t0
     analysis = report.analyse(st, results)
     written = report.write(out, analysis, reduced=args.reduced or "", wall_seconds=wall)

@@ -88,6 +88,8 @@ def load(experiment: Experiment, declarations: dict | None = None, **overrides) 
     known = Settings.__dataclass_fields__
     base = {k: v for k, v in d.get("search", {}).items() if k in known}
     base.update({k: v for k, v in overrides.items() if v is not None})
+    if "budget" in base and base["budget"] < base.get("popsize", Settings.popsize):
+        base["popsize"] = max(2, base["budget"])  # a budget below one population: one smaller generation
     settings = Settings(**base)
     if settings.objective not in OBJECTIVES:
         raise UsageError(f"--objective {settings.objective}: unknown; allowed: {', '.join(OBJECTIVES)}")
