@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import pandas as pd
 
+from ..errors import ArgumentError
+
 OBJECTIVES = {"items": "honest items per honest robot (minimised)",
               "liar_wealth": "the Byzantine robots' wealth share (maximised)"}
 
@@ -29,4 +31,4 @@ def loss(values, objective: str):
         return values
     if objective == "liar_wealth":
         return -values
-    raise ValueError(f"unknown objective {objective!r}; allowed: {', '.join(OBJECTIVES)}")
+    raise ArgumentError(f"unknown objective {objective!r}; allowed: {', '.join(OBJECTIVES)}")

@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 from ..analysis import stats
+from ..errors import InputTypeError
 from .driver import CellSearch
 from .objective import loss
 from .study import Study
@@ -121,7 +122,7 @@ def _json(v):
         return float(v)
     if isinstance(v, np.ndarray):
         return v.tolist()
-    raise TypeError(type(v))
+    raise InputTypeError(f"not JSON: {type(v).__name__}")
 
 
 def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None) -> str:

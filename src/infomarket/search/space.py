@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..behaviours.attacks import POLICY
+from ..errors import ArgumentError
 
 #: name -> (shape, arguments): "linear" lo..hi; "signed" lo..0..hi with z in [0.4, 0.6] giving 0;
 #: "below" lo..hi over z < 0.5 and ``off`` from 0.5; "above" ``off`` = lo up to 0.5, then lo..hi;
@@ -77,7 +78,7 @@ def to_params(z) -> dict[str, float]:
     """The attacker's parameters at point ``z`` of the unit cube (clipped into it)."""
     z = np.clip(np.asarray(z, float), 0.0, 1.0)
     if z.shape != (len(NAMES),):
-        raise ValueError(f"a point of the attack space has {len(NAMES)} coordinates, got {z.shape}")
+        raise ArgumentError(f"a point of the attack space has {len(NAMES)} coordinates, got {z.shape}")
     return {n: round(float(_value(SHAPES[n], float(x))), DIGITS) for n, x in zip(NAMES, z)}
 
 
