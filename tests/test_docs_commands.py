@@ -20,6 +20,7 @@ RUN = {
     "infomarket check my.toml",
     "infomarket check corridor",
     "infomarket check corridor_waypoints",
+    "infomarket check attack_search",
 }
 #: Parsed only, with the reason they are not run here.
 NOT_RUN = {
@@ -74,6 +75,15 @@ NOT_RUN = {
         "320 runs; tests/analysis/test_sensitivity.py runs the study with --samples 2",
     "infomarket sensitivity /tmp/sens-quick --out /tmp/sens-quick-report":
         "needs the store above; tests/analysis/test_sensitivity.py runs it on --samples 2",
+    # docs/attack-search.md
+    "infomarket attack-search attack_search --defence staking,reputation_sceptic,adaptive_theta --byzantines 3 "
+    "--budget 48 --popsize 8 --runs 4 --heldout-runs 16 --best 2 --workers 2 --out /tmp/attack-reduced":
+        "the reduced study, 1 380 full runs (475 s on 2 cores); tests/search runs a tiny search",
+    "infomarket attack-search attack_search --out results/attack_search": "the full study, ~41 000 runs",
+    "infomarket attack-search attack_search --defence staking --byzantines 3 --budget 48 --runs 4 "
+    "--heldout-runs 16 --best 2 --out /tmp/attack-reduced": "~460 full runs; tests/search runs a tiny search",
+    "infomarket attack-search attack_search --defence staking,theta20 --byzantines 3 --dask tcp://head:8786 "
+    "--out results/as-dask": "needs a Dask scheduler at that address; tests/search runs one on a LocalCluster",
 }
 
 

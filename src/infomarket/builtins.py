@@ -63,3 +63,41 @@ register_payment("adaptive_outlier", adaptive.adaptive_outlier_weights,
                              "reputation",
                  limits={"theta": ("in (0, 180]", lambda v: 0 < v <= 180),
                          "theta_min": ("in (0, 180]", lambda v: 0 < v <= 180)})
+
+# Issue 23: the parameterised attack family, the threats the hand-written set lacked, and continuous trust.
+from .behaviours import attacks, weighted  # noqa: E402
+
+_UNIT = ("in [0, 1]", lambda v: 0 <= v <= 1)
+_ANGLE = ("in [0, 180]", lambda v: 0 <= v <= 180)
+_COUNT = (">= 0", lambda v: v >= 0)
+register_behaviour("attacker", buy=attacks.policy_buy, sell=attacks.policy_sell, honest=False,
+                   description="the parameterised attack (search space of `infomarket attack-search`): rotation as "
+                               "a function of its record, its buyers, Θ and the sellers in range; gates; collusion",
+                   limits={**{name: (f"in [{lo:g}, {hi:g}]", lambda v, lo=lo, hi=hi: lo <= v <= hi)
+                              for name, _, lo, hi in attacks.POLICY},
+                           "theta": ("in (0, 180]", lambda v: 0 < v <= 180),
+                           "theta_min": ("in (0, 180]", lambda v: 0 < v <= 180),
+                           "adaptive": ("0 or 1", lambda v: v in (0, 1)), "threshold": ("> 0", lambda v: v > 0)})
+register_behaviour("colluder", buy=attacks.colluder_buy, sell=attacks.colluder_sell, honest=False,
+                   description="liars that agree on one rotation_angle and buy each other's offers to inflate their "
+                               "records", limits={"rotation_angle": _ANGLE, "threshold": ("> 0", lambda v: v > 0)})
+register_behaviour("newcomer", buy="sceptical", sell=attacks.newcomer_sell, honest=False,
+                   description="identity reset: lies by rotation_angle while its record is shorter than "
+                               "fresh_record settled sales, then withdraws (the engine has no rejoin)",
+                   limits={"rotation_angle": _ANGLE, "fresh_record": _COUNT})
+register_behaviour("selective_liar", buy="sceptical", sell=attacks.selective_sell, honest=False,
+                   description="lies by rotation_angle only when at most max_confirmers other sellers are in range",
+                   limits={"rotation_angle": _ANGLE, "max_confirmers": _COUNT})
+register_behaviour("sceptic_surfer", buy="sceptical", sell=attacks.sceptic_surfer_sell, honest=False,
+                   description="Θ-surfer aimed at the sceptic: lies by at most margin x the angle its confirmation "
+                               "test accepts and margin x Θ",
+                   limits={"rotation_angle": _ANGLE, "margin": ("in (0, 1]", lambda v: 0 < v <= 1),
+                           "threshold": ("> 0", lambda v: v > 0), "theta": ("in (0, 180]", lambda v: 0 < v <= 180)})
+register_behaviour("tuned_farmer", buy="sceptical", sell=attacks.tuned_farmer_sell, honest=False,
+                   description="reputation farmer tuned to the trust it targets: honest until farm_record settled "
+                               "sales at reputation >= farm_reputation (the reputation sceptic's 10 and 0.85)",
+                   limits={"rotation_angle": _ANGLE, "farm_reputation": _UNIT, "farm_record": _COUNT})
+register_behaviour("reputation_weighted", buy=weighted.reputation_weighted_buy, sell="naive", honest=True,
+                   description="buys like the naive robot but averages a purchase in with its age weight times the "
+                               "seller's reputation ** power (continuous trust)",
+                   limits={"power": (">= 0", lambda v: v >= 0)})

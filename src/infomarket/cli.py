@@ -20,6 +20,7 @@ from .errors import EXIT_FAILED, EXIT_USAGE, InfomarketError, report
 SUBCOMMAND_MODULES = ("infomarket.runner.cli", "infomarket.analysis.cli", "infomarket.viewer.cli",
                       "infomarket.chain.cli", "infomarket.analysis.sensitivity_cli")
 SUBCOMMAND_MODULES += ("infomarket.analysis.terrain",)  # terrain-report (docs/terrain.md)
+SUBCOMMAND_MODULES += ("infomarket.search.cli",)  # attack-search (docs/attack-search.md)
 EXIT_INTERRUPTED = 130
 
 
