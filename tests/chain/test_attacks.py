@@ -63,10 +63,10 @@ def test_reveal_after_the_max_block_is_refused_and_the_last_block_is_still_allow
 def test_forged_buyer_signature_is_refused(market, robots):
     seller, buyer, forger = robots[1], robots[0], robots[6]
     info = PathInfo.from_floats(5.0, -2.0)
-    offer = market.light_contract(seller, forger, FOOD, 9, info).offer
+    offer = market.light_contract(seller, forger, FOOD, 9, info, (0.0, 0.0)).offer
     # The forger signs an acceptance and claims it comes from the buyer, to charge the buyer's reward.
     forged = replace(accept_offer(forger.key, market.domain, offer, sign_offer(seller.key, market.domain, offer),
-                                  (0.0, 0.0)), buyer=buyer.address)
+                                  (0.0, 0.0), 0), buyer=buyer.address)
     refused(lambda: market.reveal(seller, forged, info), "InfoMarketInvalidBuyerSignature",
             buyer=buyer.address, recovered=_recover(market.domain, forged))
     untouched(market, seller, buyer)
@@ -76,15 +76,27 @@ def test_the_same_light_contract_cannot_be_revealed_twice(market, robots):
     seller, buyer = robots[1], robots[0]
     lc, info = deal(market, seller, buyer)
     market.reveal(seller, lc, info)
-    key = market.view("revealKey", FOOD, 9, lc.offer.max_block, buyer.address, seller.address)
+    key = market.view("revealKey", FOOD, 9, lc.offer.max_block, buyer.address, seller.address, info.digest())
     refused(lambda: market.reveal(seller, lc, info), "InfoMarketAlreadyRevealed", key=key)
-    # Same tuple, new information and a fresh buyer signature: still the same sale, still refused.
-    other = PathInfo.from_floats(50.0, 20.0)
-    offer = replace(lc.offer, path_hash=other.digest())
-    again = accept_offer(buyer.key, market.domain, offer, sign_offer(seller.key, market.domain, offer), (0.5, 0.5))
-    refused(lambda: market.reveal(seller, again, other), "InfoMarketAlreadyRevealed", key=key)
+    # The same sale with a fresh buyer signature (another seller position): still the same sale.
+    again = accept_offer(buyer.key, market.domain, lc.offer, lc.offer_signature, (0.25, 0.5), 0)
+    refused(lambda: market.reveal(seller, again, info), "InfoMarketAlreadyRevealed", key=key)
     assert len(market.contributors(buyer.address)) == 1
     assert market.balance_of(seller.address) == 960_000_000
+
+
+def test_a_second_different_sale_with_the_same_site_age_and_max_block_is_allowed(market, robots):
+    """Finding: the uniqueness key omitted pathHash, so a second, different sale with the same
+    (site, age, maxBlock) was refused as a replay. The key now includes the committed information."""
+    seller, buyer = robots[1], robots[0]
+    lc, info = deal(market, seller, buyer)
+    market.reveal(seller, lc, info)
+    other = PathInfo.from_floats(50.0, 20.0)
+    offer = replace(lc.offer, path_hash=other.digest())
+    second = accept_offer(buyer.key, market.domain, offer, sign_offer(seller.key, market.domain, offer), (0.5, 0.5), 0)
+    market.reveal(seller, second, other)
+    assert len(market.contributors(buyer.address)) == 2
+    assert market.balance_of(seller.address) == 1_000_000_000 - 2 * 40_000_000
 
 
 def test_a_signature_for_another_market_contract_is_refused(make_market, market, robots):
@@ -164,13 +176,13 @@ def test_selling_to_oneself_is_refused(market, robots):
 def test_malformed_site_and_vector_out_of_range_are_refused(market, robots):
     seller, buyer = robots[1], robots[0]
     info = PathInfo.from_floats(1.0, 1.0)
-    lc = market.light_contract(seller, buyer, 2, 9, info)
+    lc = market.light_contract(seller, buyer, 2, 9, info, (0.0, 0.0))
     refused(lambda: market.reveal(seller, lc, info), "InfoMarketInvalidSite", site=2)
     far = PathInfo(2**47, 0)  # 2^47 micro units from the seller: beyond the exact similarity test
-    lc = market.light_contract(seller, buyer, FOOD, 9, far)
+    lc = market.light_contract(seller, buyer, FOOD, 9, far, (0.0, 0.0))
     refused(lambda: market.reveal(seller, lc, far), "InfoMarketVectorOutOfRange", dx=2**47, dy=0)
     near = PathInfo(2**47 - 1, -(2**47 - 1))
-    lc = market.light_contract(seller, buyer, FOOD, 10, near)
+    lc = market.light_contract(seller, buyer, FOOD, 10, near, (0.0, 0.0))
     market.reveal(seller, lc, near)
 
 
@@ -179,14 +191,15 @@ def test_one_seller_cannot_fill_a_buyers_round_trip(make_market, robots):
     seller, other, buyer = robots[1], robots[2], robots[0]
     for age in (1, 2):
         info = PathInfo.from_floats(1.0, 1.0)
-        market.reveal(seller, market.light_contract(seller, buyer, FOOD, age, info), info)
+        market.reveal(seller, market.light_contract(seller, buyer, FOOD, age, info, (0.0, 0.0)), info)
     info = PathInfo.from_floats(1.0, 1.0)
-    lc = market.light_contract(seller, buyer, FOOD, 3, info)
+    lc = market.light_contract(seller, buyer, FOOD, 3, info, (0.0, 0.0))
     refused(lambda: market.reveal(seller, lc, info), "InfoMarketTooManyRecords",
             buyer=buyer.address, seller=seller.address, limit=2)
-    market.reveal(other, market.light_contract(other, buyer, FOOD, 3, info), info)  # others still can
+    market.reveal(other, market.light_contract(other, buyer, FOOD, 3, info, (0.0, 0.0)), info)  # others still can
     market.deposit(buyer.address)
-    market.reveal(seller, lc, info)  # a new round trip after the deposit
+    fresh = market.light_contract(seller, buyer, FOOD, 4, info, (0.0, 0.0))  # signed for the new round trip
+    market.reveal(seller, fresh, info)
 
 
 def test_a_light_contract_cannot_stay_open_for_longer_than_max_validity(make_market, robots):
@@ -226,6 +239,6 @@ def test_a_saboteurs_rotated_vector_gets_the_outliers_weight_whatever_it_says(ma
 
 def _recover(domain, lc) -> str:
     """Who the light contract's buyer signature recovers to under ``domain``."""
-    typed = acceptance_typed_data(domain, lc.offer, lc.buyer, lc.seller_x, lc.seller_y)
+    typed = acceptance_typed_data(domain, lc.offer, lc.buyer, lc.seller_x, lc.seller_y, lc.trip)
     return Account.recover_message(encode_typed_data(full_message=typed),
                                    vrs=(lc.v, int.from_bytes(lc.r, "big"), int.from_bytes(lc.s, "big")))

@@ -29,7 +29,8 @@ from infomarket.ledger.replay import replay_events
 from .exact_ledger import SELLER_POSITION, ExactLedger, vector_for
 
 CASES = json.loads((Path(__file__).parents[1] / "fixtures" / "payment_vectors.json").read_text())["cases"]
-SCHEMES = {"delayed": ("delayed", 0.0), "outlier": ("outlier", 0.0), "outlier+stake": ("outlier", 0.04)}
+SCHEMES = {"delayed": ("delayed", 0.0), "outlier": ("outlier", 0.0), "outlier+stake": ("outlier", 0.04),
+           "distinct": ("outlier_distinct", 0.0), "distinct+stake": ("outlier_distinct", 0.04)}
 #: Directions 7.3 k degrees (k < 50): no two differ by Theta = 30 within 0.1 degree, so the
 #: simulation's degrees and the contract's micro-unit vectors cannot decide a pair differently.
 DIRECTIONS = [round(7.3 * k % 360, 6) for k in range(50)]
@@ -68,6 +69,27 @@ def scenarios(draw, expiries=(0, 0, 3, 10), longest=1000):
             seller = (buyer + rng.randrange(1, robots)) % robots
             events.append(purchase(step, buyer, seller, rng.randrange(2), rng.choice(DIRECTIONS), age))
     return robots, scheme, wealth, expiry, events
+
+
+def _case(sales, stake):
+    """Robot 0 buys ``sales`` ((seller, direction) on food) in one round trip at step 1, then deposits."""
+    return [purchase(1, 0, seller, 0, d, k) for k, (seller, d) in enumerate(sales)] + [deposit(2, 0)]
+
+
+_REPEAT = [(1, 10.0), (2, 15.0), (3, 20.0)] + [(4, 100.0)] * 5  # a saboteur sells one vector 5 times
+_COPY = [(1, 10.0), (2, 15.0), (3, 20.0)] + [(5, 12.0)] * 6  # a seller copies the honest direction 6 times
+F = Fraction
+#: (scheme, events, every robot's balance after the deposit), by hand (share 0.5 of a reward of 1).
+DISTINCT_CASES = [
+    # eq. 7 counts transactions: honest 3 each, the repeated vector 5 each (x5): the saboteur takes 25/34.
+    ("outlier", _case(_REPEAT, 0.0), [F(3, 2), 1 + F(1, 2) * F(3, 34), 1 + F(1, 2) * F(3, 34),
+                                      1 + F(1, 2) * F(3, 34), 1 + F(1, 2) * F(25, 34)]),
+    # one seller, one voice: honest 3 each, each repeat 1/5: the saboteur takes 1/10, as if it sold once.
+    ("distinct", _case(_REPEAT, 0.0), [F(3, 2), 1 + F(3, 20), 1 + F(3, 20), 1 + F(3, 20), 1 + F(1, 20)]),
+    # the copier's 6 records weigh 4/6 each: 4 of 16 in all, one honest seller's share (stakes shared too).
+    ("distinct+stake", _case(_COPY, 0.04),
+     [F(3, 2), *[1 - F(1, 25) + F(86, 100) / 4] * 3, F(1), 1 - 6 * F(1, 25) + F(86, 100) / 4]),
+]
 
 
 def exact_run(robots, scheme, wealth, expiry, events) -> tuple[ExactLedger, list[bool]]:
@@ -114,6 +136,16 @@ class LedgerConformance:
             assert balances[i] == pytest.approx(case["balances_after_deposit"][str(i)],
                                                 abs=self.tolerance(n) + 1e-9)
 
+    @pytest.mark.parametrize(("scheme", "events", "expected"), DISTINCT_CASES,
+                             ids=[f"{c[0]}-{k}" for k, c in enumerate(DISTINCT_CASES)])
+    def test_one_seller_one_voice_by_hand(self, scheme, events, expected):
+        """Shared hand-computed cases: repetition and copying sellers, under eq. 7 and outlier_distinct."""
+        events = [dict(e) for e in events]
+        balances = self.run(len(expected), scheme, 1.0, 0, events)
+        shares = sum(1 for e in events if e["kind"] == "purchase")
+        for i, value in enumerate(expected):
+            assert balances[i] == pytest.approx(float(value), abs=self.tolerance(shares) + 1e-9), i
+
     def test_random_event_sequences_agree_with_the_exact_model(self):
         @settings(max_examples=self.examples, deadline=None, derandomize=True,
                   suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
@@ -132,7 +164,7 @@ class TestSimulatedLedger(LedgerConformance):
     def run(self, robots, scheme, wealth, expiry, events):
         name, stake = SCHEMES[scheme]
         replayed = replay_events(events, robots, scheme=name, initial_wealth=wealth, stake=stake,
-                                 params={"theta": 30.0} if name == "outlier" else None, stake_expiry=expiry)
+                                 params={"theta": 30.0} if name != "delayed" else None, stake_expiry=expiry)
         # what the simulation would have in pots at the end (stakes of open round trips) is not a balance
         return [float(b) for b in replayed.balances]
 

@@ -57,6 +57,8 @@ def measure(scheme: str, sizes=SIZES, *, trips: int = 2, backend=None, seed: int
     backend.fund([a.address for a in sellers + buyers])
     for s in sellers:
         market.grant_wealth(s.address, to_units(1000.0))
+    for b in buyers:
+        market.grant_wealth(b.address, 0)  # registers the buyer
     rng = random.Random(seed)
     rows = []
     for n, buyer in zip(sizes, buyers):
@@ -66,7 +68,7 @@ def measure(scheme: str, sizes=SIZES, *, trips: int = 2, backend=None, seed: int
                 seller = sellers[k % SELLERS]
                 angle = math.radians(rng.uniform(0.0, 20.0))
                 info = PathInfo.from_floats(30 * math.cos(angle), 30 * math.sin(angle))
-                lc = market.light_contract(seller, buyer, FOOD, trip * n + k, info)
+                lc = market.light_contract(seller, buyer, FOOD, trip * n + k, info, (0.0, 0.0))
                 reveals.append(market.reveal(seller, lc, info).gas_used)
             results = market.deposit(buyer.address, SETTLE_BATCH)
             deposits.append(sum(r.gas_used for r in results))
