@@ -64,6 +64,8 @@ class ReplayReport:
     largest_tx: int = 0
     settle_calls: int = 0
     backend: str = ""
+    #: whether the backend charged gas with cold storage per transaction, as a chain does
+    cold_storage: bool = True
     disagreements: list[str] = field(default_factory=list)
     balances: list[int] = field(default_factory=list)
     pots: list[int] = field(default_factory=list)
@@ -196,6 +198,7 @@ def replay_on_chain(events: Iterable[Mapping] | object, *, robots: int, params: 
     report.pots = [market.locked_stake(a.address) for a in accounts]
     report.total_supply = market.total_supply()
     report.backend = chain.name
+    report.cold_storage = chain.cold_storage
     return report
 
 
