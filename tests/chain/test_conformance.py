@@ -27,6 +27,7 @@ from infomarket.chain.units import TOKEN_UNIT
 from infomarket.ledger.replay import replay_events
 
 from .exact_ledger import SELLER_POSITION, ExactLedger, vector_for
+from .node import running_node
 
 CASES = json.loads((Path(__file__).parents[1] / "fixtures" / "payment_vectors.json").read_text())["cases"]
 SCHEMES = {"delayed": ("delayed", 0.0), "outlier": ("outlier", 0.0), "outlier+stake": ("outlier", 0.04),
@@ -197,3 +198,29 @@ class TestContractLedgerOnPyEvm(TestContractLedger):
     examples = 4
     longest = 150
     expiries = (0,)  # py-evm mines one block per transaction: expiry needs one block per step (revm)
+
+
+class TestContractLedgerOnNode(TestContractLedger):
+    """The same suite once against a real JSON-RPC node (Hardhat Network, tools/node) that this class
+    starts on a free port and stops: every payment vector, the hand-computed cases, a small random
+    sample. Transactions are signed by the robots' keys and mined one per block, as on a chain."""
+
+    examples = 4
+    longest = 80
+    expiries = (0,)  # one block per transaction: the replay's expiry needs one block per step (revm)
+
+    @pytest.fixture(autouse=True, scope="class")
+    @classmethod
+    def node(cls):
+        with running_node() as url:
+            cls.rpc_url = url
+            yield url
+
+    def run(self, robots, scheme, wealth, expiry, events):
+        name, stake = SCHEMES[scheme]
+        params = MarketParams.from_floats(name, stake=stake, stake_expiry=expiry, max_records_per_seller=1000)
+        report = replay_on_chain(events, robots=robots, params=params, initial_wealth=wealth, rpc_url=self.rpc_url)
+        assert report.backend == self.rpc_url and report.cold_storage
+        assert not report.disagreements, report.disagreements[:3]
+        assert report.conserved()
+        return [b / TOKEN_UNIT for b in report.balances]
