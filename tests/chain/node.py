@@ -57,3 +57,4 @@ def running_node():
         except subprocess.TimeoutExpired:
             proc.kill()
             proc.wait()
+        proc.stderr.close()
