@@ -625,7 +625,8 @@ contract InformationMarket {
     /// @notice Whether `robot` has a deposited round trip still to settle, and where it stands.
     /// @param robot The account.
     /// @return pending True until the settlement completes.
-    /// @return phase 0 refunding expired records, 1 weighing, 2 paying.
+    /// @return phase 0 refunding expired records, 1 weighing, 2 paying, 3 refunding every stake (past the
+    /// settlement deadline).
     /// @return remaining Records left in the current phase.
     function pendingSettlement(address robot) external view returns (bool pending, uint8 phase, uint256 remaining) {
         Settlement storage s = _settlements[robot];

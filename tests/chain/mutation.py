@@ -8,8 +8,9 @@ solc-js into a temporary artifact, against which the tests guarding it run (thro
 ``INFOMARKET_CHAIN_ARTIFACT``, see conftest.py; on revm only). It needs Node and takes a few minutes,
 so it is a script, not part of the test suite:
 
-    .venv/bin/python tests/chain/mutation.py
+    .venv/bin/python tests/chain/mutation.py [WORD ...]
 
+With words, only the mutants whose label contains one of them run (the unpatched copy always does).
 Exit status 0 when every mutant is caught (a test guarding it fails) and the unpatched copy passes them.
 """
 from __future__ import annotations
@@ -125,7 +126,7 @@ def run_tests(artifact: Path, selected: list[str]) -> tuple[int, str]:
     return done.returncode, summary
 
 
-def main() -> int:
+def main(words: list[str] | None = None) -> int:
     original = SOURCE.read_text()
     variants = []
     for check, condition, tests in MUTANTS:
@@ -134,6 +135,8 @@ def main() -> int:
     for rule, old, new, tests in REWRITES:
         if tests:
             variants.append(("broken: " + rule, original.replace(old, new), original.count(old), tests))
+    if words:
+        variants = [v for v in variants if any(w in v[0] for w in words)]
     all_tests = [t for *_, tests in variants for t in tests]
     ok = True
     with tempfile.TemporaryDirectory() as tmp:
@@ -154,4 +157,4 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(main(sys.argv[1:]))
