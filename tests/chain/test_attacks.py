@@ -399,9 +399,10 @@ def test_a_reveal_after_the_buyers_deposit_is_refused(make_market, robots):
 def test_similar_refuses_vectors_beyond_the_exact_range(make_market):
     """Finding: similar() overflowed for components beyond the reveal path's range."""
     market = make_market("outlier", stake=0.0)
-    with pytest.raises(ContractRevert) as info:
-        market.view("similar", 2**62, 1, 2**62, -1)
-    assert info.value.name == "InfoMarketVectorOutOfRange"
+    for args, (dx, dy) in (((2**62, 1, 1, 1), (2**62, 1)), ((1, 1, -(2**62), 1), (-(2**62), 1))):
+        with pytest.raises(ContractRevert) as info:
+            market.view("similar", *args)
+        assert (info.value.name, info.value.args_by_name) == ("InfoMarketVectorOutOfRange", {"dx": dx, "dy": dy})
     assert market.view("similar", 2**47 - 1, 0, 2**47 - 1, 1) is True
 
 
