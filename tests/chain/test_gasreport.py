@@ -16,8 +16,9 @@ def test_a_deposit_with_cold_storage_splits_into_calls_under_the_declared_bound(
 
 
 def test_the_worst_call_at_a_full_round_trip_is_measured_after_the_reveals():
-    worst = worst_call("outlier + staking", 40, backend=connect(backend="py-evm"))
-    assert worst.n == 40 and worst.settle > 21_000 and worst.buy_item > worst.settle / 2
+    worst = worst_call("outlier + staking", 80, backend=connect(backend="py-evm"))
+    # 80 records: buyItem and the next call each weigh 24 (2 units a record), so both are weighing calls
+    assert worst.n == 80 and worst.settle > 21_000 and worst.buy_item > worst.settle / 2
     assert worst.largest < DECLARED_MAX_TX_GAS
 
 
