@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: venv demo test bench clean contracts gas
+.PHONY: venv demo test bench clean contracts gas node
 
 venv: $(STAMP)
 
@@ -40,5 +40,13 @@ tools/solc/node_modules: tools/solc/package.json tools/solc/package-lock.json
 	cd tools/solc && npm ci --no-audit --no-fund
 	touch $@
 
+# Gas with cold storage per transaction (py-evm; a few minutes): docs/gas.md and the declared bound.
 gas: venv
 	$(BIN)/python -m infomarket.chain.gasreport
+
+# A local JSON-RPC node (Hardhat Network, pinned in tools/node) that the conformance suite runs against.
+node: tools/node/node_modules
+
+tools/node/node_modules: tools/node/package.json tools/node/package-lock.json
+	cd tools/node && npm ci --no-audit --no-fund
+	touch $@

@@ -17,9 +17,16 @@ pragma solidity 0.8.28;
 /// by is that of the vector the seller committed to, minus the seller's position the buyer signed
 /// (docs/model.md §4), and "within theta" is decided on those integer vectors with dot products
 /// against a fixed cos(theta), exactly. A stake never stays locked for ever: records older than
-/// `stakeExpiry` blocks give their stake back to their seller (anyone may trigger it). A round trip
-/// of any length settles in bounded gas per transaction: `buyItem` settles what fits in one batch and
-/// `settle` continues where it stopped.
+/// `stakeExpiry` blocks (never 0) give their stake back to their seller (anyone may trigger it), and a
+/// deposit not settled within `settlementDeadline` blocks returns its stakes to their sellers and the
+/// share to the robot. Every call does a bounded amount of work: a round trip holds at most
+/// `maxRecordsPerTrip` (<= 512) live records, and `buyItem`, `settle` and `refundExpired` each do at
+/// most `settleBatch` (<= 64) units of work, so no call exceeds the gas bound docs/gas.md declares,
+/// measured with cold storage, whatever the number of records.
+///
+/// Only accounts the market registered (`grantWealth`, once per robot, at most `maxGrant`) may buy,
+/// sell or be paid a reward. A light contract names the buyer's round trip it belongs to, so a reveal
+/// after the buyer's deposit is refused rather than paid from the next item.
 ///
 /// Fixed point: token amounts in units of 1e-9 token; positions and vectors in micro arena units
 /// (signed); cos(theta) in units of 1e-9.
@@ -32,9 +39,13 @@ contract InformationMarket {
     /// @dev Delayed: in proportion to each seller's number of transactions; no stakes allowed.
     /// Outlier: in proportion to the number of same-site transactions within theta of each transaction,
     /// with the locked stakes added to the shared amount (staking is on when `stake() > 0`).
+    /// OutlierDistinct: like Outlier, but a transaction weighs the number of distinct sellers with a
+    /// same-site transaction within theta (its own seller once), divided by its seller's number of
+    /// transactions for that site in the round trip: one seller, one voice (docs/chain.md).
     enum Scheme {
         Delayed,
-        Outlier
+        Outlier,
+        OutlierDistinct
     }
 
     /// @notice The seller's offer, which the buyer accepts without seeing the information itself.
@@ -56,6 +67,7 @@ contract InformationMarket {
     /// @param buyer Account that accepted and whose next deposit pays the seller.
     /// @param sellerX Seller's position in the buyer's frame, x, micro units (signed by the buyer).
     /// @param sellerY Same, y.
+    /// @param trip The buyer's round trip the sale belongs to (`roundTrip(buyer)` when signed).
     /// @param v Buyer's signature over the EIP-712 `Acceptance` digest: recovery byte (27 or 28).
     /// @param r Signature r.
     /// @param s Signature s, in the lower half of the curve order.
@@ -64,6 +76,7 @@ contract InformationMarket {
         address buyer;
         int64 sellerX;
         int64 sellerY;
+        uint64 trip;
         uint8 v;
         bytes32 r;
         bytes32 s;
@@ -80,21 +93,26 @@ contract InformationMarket {
         bytes32 salt;
     }
 
-    /// @notice One sale recorded under its buyer until the buyer's deposit settles it (two slots).
+    /// @notice One sale recorded under its buyer until the buyer's deposit settles it (two slots; the
+    /// second holds all that weighing reads).
     /// @param seller Who sold it.
     /// @param openedAt Block of the reveal (its expiry counts from there).
     /// @param site 0 = food, 1 = nest.
     /// @param dx The seller's rotated vector in the buyer's frame (purchased vector minus the seller's
     /// position), x, micro units; a zero vector is stored as (1, 0), direction 0 like atan2(0, 0).
     /// @param dy Same, y.
-    /// @param weight The record's weight, written while its round trip is settled.
+    /// @param weight The record's weight, written while its round trip is settled (under
+    /// OutlierDistinct scaled by 1e27: distinct sellers * 1e27 / the seller's records for the site).
+    /// @param prevGap How many records back the same seller's previous record of this round trip lies
+    /// (0: none within reach).
     struct Information {
         address seller;
         uint64 openedAt;
         uint8 site;
         int64 dx;
         int64 dy;
-        uint64 weight;
+        uint104 weight;
+        uint16 prevGap;
     }
 
     /// @dev A buyer's records are `_records[buyer][i]`; its open round trip is [start, count).
@@ -105,7 +123,8 @@ contract InformationMarket {
         uint64 trip;
     }
 
-    /// @dev A deposited round trip being settled, records [next, end) still to process in `phase`.
+    /// @dev A deposited round trip being settled, records [next, end) still to process in `phase`
+    /// (in the weighing phase `next` is the next record to weigh).
     /// `escrow` holds the reward share and the stakes not yet paid out; `amount` is what the live
     /// records share (fixed when the expired ones are refunded); `live` is the first live record.
     struct Settlement {
@@ -138,7 +157,7 @@ contract InformationMarket {
     /// a record's weight depends on, so a settlement can be recomputed from the logs alone.
     /// @param buyer Buyer of the information.
     /// @param seller Seller of the information.
-    /// @param key `revealKey(site, age, maxBlock, buyer, seller)`, now spent.
+    /// @param key `revealKey(site, age, maxBlock, buyer, seller, pathHash)`, now spent.
     /// @param index Position of the record in the buyer's list (`_records[buyer][index]`).
     /// @param site 0 = food, 1 = nest.
     /// @param age Age of the information.
@@ -161,8 +180,9 @@ contract InformationMarket {
         bytes32 pathHash
     );
 
-    /// @notice A record expired (its buyer did not deposit within `stakeExpiry` blocks): its stake went
-    /// back to its seller and it takes no part in the buyer's settlement.
+    /// @notice A record expired (its buyer did not deposit within `stakeExpiry` blocks, or its deposit was
+    /// not settled within `settlementDeadline` blocks): its stake went back to its seller and it takes
+    /// no part in the buyer's settlement.
     /// @param buyer The buyer.
     /// @param seller The seller, refunded.
     /// @param index The record.
@@ -180,7 +200,8 @@ contract InformationMarket {
     /// @param robot Depositing robot (the buyer of the information).
     /// @param seller Receiving seller.
     /// @param index The record.
-    /// @param weight The record's weight (1 under delayed payment, similar-transaction count otherwise).
+    /// @param weight The record's weight (1 under delayed payment, similar-transaction count under
+    /// outlier, distinct-seller count * 1e27 / the seller's records for the site under outlier-distinct).
     /// @param amount Share paid, 1e-9 units.
     event RewardShared(address indexed robot, address indexed seller, uint256 index, uint256 weight, uint256 amount);
 
@@ -224,7 +245,7 @@ contract InformationMarket {
     /// @param s The refused s value.
     error InfoMarketMalleableSignature(bytes32 s);
 
-    /// @notice This (site, age, max block, buyer, seller) tuple was already revealed once.
+    /// @notice This (site, age, max block, buyer, seller, path hash) sale was already revealed once.
     /// @param key The spent `revealKey`.
     error InfoMarketAlreadyRevealed(bytes32 key);
 
@@ -259,6 +280,31 @@ contract InformationMarket {
     /// @param limit `maxRecordsPerSeller`.
     error InfoMarketTooManyRecords(address buyer, address seller, uint256 limit);
 
+    /// @notice The buyer's open round trip already holds `limit` live records.
+    /// @param buyer The buyer.
+    /// @param limit `maxRecordsPerTrip`.
+    error InfoMarketTripFull(address buyer, uint256 limit);
+
+    /// @notice The light contract was signed for another of the buyer's round trips (a reveal must land
+    /// before the buyer's next deposit).
+    /// @param buyer The buyer.
+    /// @param signed The round trip the buyer signed for.
+    /// @param current The buyer's open round trip.
+    error InfoMarketWrongTrip(address buyer, uint64 signed, uint64 current);
+
+    /// @notice `robot` was never registered by the market (`grantWealth`).
+    /// @param robot The unregistered account.
+    error InfoMarketUnregistered(address robot);
+
+    /// @notice `robot` is already registered: the market grants initial wealth once per robot.
+    /// @param robot The account.
+    error InfoMarketAlreadyRegistered(address robot);
+
+    /// @notice The grant exceeds `maxGrant`.
+    /// @param amount The refused grant.
+    /// @param limit `maxGrant`.
+    error InfoMarketGrantTooLarge(uint256 amount, uint256 limit);
+
     /// @notice The robot's previous round trip is still being settled: call `settle` first.
     /// @param robot The robot.
     /// @param remaining Records its settlement still has to process.
@@ -285,9 +331,16 @@ contract InformationMarket {
     int256 private constant _MAX_COMPONENT = 2 ** 47;
     /// @dev Pair comparisons that count as one record of settlement work.
     uint256 private constant _PAIRS_PER_UNIT = 64;
+    /// @dev Most live records a round trip may ever hold, and most work units one call may do: the
+    /// bounds the declared gas per transaction is measured at (docs/gas.md).
+    uint256 private constant _MAX_TRIP_RECORDS = 512;
+    uint256 private constant _MAX_SETTLE_BATCH = 64;
+    /// @dev Scale of an OutlierDistinct weight (distinct sellers / seller's records, as a fixed point).
+    uint256 private constant _DISTINCT_SCALE = 1e27;
     uint8 private constant _EXPIRE = 0;
     uint8 private constant _WEIGH = 1;
     uint8 private constant _PAY = 2;
+    uint8 private constant _REFUND = 3;
     /// @dev secp256k1 order / 2: a larger s is the malleated twin of a valid signature (EIP-2).
     uint256 private constant _HALF_ORDER = 0x7fffffffffffffffffffffffffffffff5d576e7357a4501ddfe92f46681b20a0;
 
@@ -296,11 +349,11 @@ contract InformationMarket {
     bytes32 private constant _OFFER_TYPEHASH =
         keccak256("Offer(address seller,uint8 site,uint32 age,uint64 maxBlock,bytes32 pathHash)");
     bytes32 private constant _ACCEPTANCE_TYPEHASH = keccak256(
-        "Acceptance(Offer offer,address buyer,int64 sellerX,int64 sellerY)"
+        "Acceptance(Offer offer,address buyer,int64 sellerX,int64 sellerY,uint64 trip)"
         "Offer(address seller,uint8 site,uint32 age,uint64 maxBlock,bytes32 pathHash)"
     );
     bytes32 private constant _NAME_HASH = keccak256("InformationMarket");
-    bytes32 private constant _VERSION_HASH = keccak256("2");
+    bytes32 private constant _VERSION_HASH = keccak256("3");
 
     address private immutable _market;
     Scheme private immutable _scheme;
@@ -310,8 +363,11 @@ contract InformationMarket {
     int256 private immutable _cosTheta;
     uint64 private immutable _stakeExpiry;
     uint256 private immutable _maxRecordsPerSeller;
+    uint256 private immutable _maxRecordsPerTrip;
     uint64 private immutable _maxValidity;
     uint256 private immutable _settleBatch;
+    uint64 private immutable _settlementDeadline;
+    uint256 private immutable _maxGrant;
     uint256 private immutable _cachedChainId;
     bytes32 private immutable _cachedDomainSeparator;
 
@@ -326,9 +382,11 @@ contract InformationMarket {
     mapping(address buyer => mapping(uint256 => Information)) private _records;
     mapping(address buyer => Round) private _rounds;
     mapping(address buyer => Settlement) private _settlements;
-    /// @dev (round trip number << 32) | records sold in it, per buyer and seller.
+    /// @dev ((round trip + 1) << 128) | (index of the seller's last record << 64) | records sold in
+    /// the round trip, per buyer and seller (0: none yet).
     mapping(address buyer => mapping(address seller => uint256)) private _sold;
     mapping(bytes32 key => bool) private _revealed;
+    mapping(address robot => bool) private _registered;
 
     /// @notice Deploys a market with a fixed payment scheme; `market` alone can grant wealth and buy items.
     /// @param market_ Account of the market node.
@@ -338,10 +396,14 @@ contract InformationMarket {
     /// @param stake_ Stake per sale, 1e-9 units (0 = no staking); must be 0 under delayed payment.
     /// @param cosTheta_ cos(theta) of the similarity window, in units of 1e-9 (in [-1e9, 1e9]); two
     /// records are similar when the angle between their vectors is strictly less than theta.
-    /// @param stakeExpiry_ Blocks after which an undeposited record expires (0 = never).
+    /// @param stakeExpiry_ Blocks after which an undeposited record expires (>= 1: stakes always expire).
     /// @param maxRecordsPerSeller_ Most records one seller may sell one buyer in one round trip (>= 1).
+    /// @param maxRecordsPerTrip_ Most live records a buyer's open round trip may hold (1 to 512).
     /// @param maxValidity_ Furthest a light contract's last block may lie ahead of its reveal (>= 1).
-    /// @param settleBatch_ Records `buyItem` settles itself before leaving the rest to `settle` (>= 1).
+    /// @param settleBatch_ Work units of one `buyItem`, `settle` or `refundExpired` call (1 to 64).
+    /// @param settlementDeadline_ Blocks after `buyItem` from which an unfinished settlement returns its
+    /// stakes to their sellers and the share to the robot instead of weighing (>= 1).
+    /// @param maxGrant_ Most initial wealth the market may grant one robot, 1e-9 units.
     constructor(
         address market_,
         Scheme scheme_,
@@ -351,8 +413,11 @@ contract InformationMarket {
         int256 cosTheta_,
         uint64 stakeExpiry_,
         uint256 maxRecordsPerSeller_,
+        uint256 maxRecordsPerTrip_,
         uint64 maxValidity_,
-        uint256 settleBatch_
+        uint256 settleBatch_,
+        uint64 settlementDeadline_,
+        uint256 maxGrant_
     ) {
         if (market_ == address(0)) revert InfoMarketInvalidParameter("market", 0);
         if (informationShare_ > _WAD) revert InfoMarketInvalidParameter("informationShare", int256(informationShare_));
@@ -361,8 +426,15 @@ contract InformationMarket {
         if (maxRecordsPerSeller_ == 0 || maxRecordsPerSeller_ >= 2 ** 32) {
             revert InfoMarketInvalidParameter("maxRecordsPerSeller", int256(maxRecordsPerSeller_));
         }
+        if (maxRecordsPerTrip_ == 0 || maxRecordsPerTrip_ > _MAX_TRIP_RECORDS) {
+            revert InfoMarketInvalidParameter("maxRecordsPerTrip", int256(maxRecordsPerTrip_));
+        }
+        if (stakeExpiry_ == 0) revert InfoMarketInvalidParameter("stakeExpiry", 0);
         if (maxValidity_ == 0) revert InfoMarketInvalidParameter("maxValidity", 0);
-        if (settleBatch_ == 0) revert InfoMarketInvalidParameter("settleBatch", 0);
+        if (settleBatch_ == 0 || settleBatch_ > _MAX_SETTLE_BATCH) {
+            revert InfoMarketInvalidParameter("settleBatch", int256(settleBatch_));
+        }
+        if (settlementDeadline_ == 0) revert InfoMarketInvalidParameter("settlementDeadline", 0);
         _market = market_;
         _scheme = scheme_;
         _reward = reward_;
@@ -371,8 +443,11 @@ contract InformationMarket {
         _cosTheta = cosTheta_;
         _stakeExpiry = stakeExpiry_;
         _maxRecordsPerSeller = maxRecordsPerSeller_;
+        _maxRecordsPerTrip = maxRecordsPerTrip_;
         _maxValidity = maxValidity_;
         _settleBatch = settleBatch_;
+        _settlementDeadline = settlementDeadline_;
+        _maxGrant = maxGrant_;
         _cachedChainId = block.chainid;
         _cachedDomainSeparator = _buildDomainSeparator();
     }
@@ -381,12 +456,17 @@ contract InformationMarket {
     // Market functions
     // ------------------------------------------------------------------------------------------------
 
-    /// @notice Mints `amount` tokens to `robot`: how robots receive their initial wealth.
-    /// @dev Requirements: the caller is the market. Emits a {WealthGranted} event.
+    /// @notice Registers `robot` and mints it `amount` tokens: how robots join the market and receive
+    /// their initial wealth (0 allowed). Only registered robots may buy, sell or deposit.
+    /// @dev Requirements: the caller is the market; `robot` is not registered yet; `amount` is at most
+    /// `maxGrant`. Emits a {WealthGranted} event.
     /// @param robot Receiving account.
     /// @param amount Tokens, 1e-9 units.
     function grantWealth(address robot, uint256 amount) external {
         _requireMarket();
+        if (_registered[robot]) revert InfoMarketAlreadyRegistered(robot);
+        if (amount > _maxGrant) revert InfoMarketGrantTooLarge(amount, _maxGrant);
+        _registered[robot] = true;
         _balances[robot] += amount;
         _totalSupply += amount;
         emit WealthGranted(robot, amount);
@@ -397,12 +477,13 @@ contract InformationMarket {
     /// @dev The reward share and the pot go into the settlement's escrow. Settling refunds the records
     /// that expired before this block, weighs the live ones and pays each floor(amount * w / sum w);
     /// the remainder goes back to `robot`, so the supply changes by exactly the reward.
-    /// Requirements: the caller is the market; the robot's previous round trip is fully settled.
-    /// Emits {ItemBought}, then what {settle} emits.
+    /// Requirements: the caller is the market; the robot is registered; its previous round trip is fully
+    /// settled. Emits {ItemBought}, then what {settle} emits.
     /// @param robot The depositing robot.
     /// @return done Whether the round trip is fully settled.
     function buyItem(address robot) external returns (bool done) {
         _requireMarket();
+        if (!_registered[robot]) revert InfoMarketUnregistered(robot);
         Settlement storage s = _settlements[robot];
         if (s.end != 0) revert InfoMarketSettlementPending(robot, s.end - s.next);
         Round storage round = _rounds[robot];
@@ -431,24 +512,24 @@ contract InformationMarket {
     /// @dev Requirements: a settlement is pending. Emits {RecordExpired}, {RewardShared} and, at the
     /// end, {SettlementCompleted}.
     /// @param robot The depositing robot.
-    /// @param maxRecords Work bound: each record refunded or paid counts one, each record weighed
-    /// ceil(m / 64) for m live records (at least one record is weighed when `maxRecords` equals
-    /// `settleBatch`, so the default batch always makes progress).
+    /// @param maxRecords Work bound, capped at `settleBatch`: each record refunded or paid counts one,
+    /// each record weighed ceil(m / 64) for m live records (at least one record is weighed when the
+    /// bound is `settleBatch`, so the default batch always makes progress).
     /// @return done Whether the round trip is now fully settled.
     function settle(address robot, uint256 maxRecords) external returns (bool done) {
         if (_settlements[robot].end == 0) revert InfoMarketNothingToSettle(robot);
-        return _settle(robot, maxRecords);
+        return _settle(robot, maxRecords < _settleBatch ? maxRecords : _settleBatch);
     }
 
     /// @notice Returns to their sellers the stakes of `buyer`'s open records that expired (opened
     /// `stakeExpiry` blocks ago or more), oldest first, at most `maxRecords`; anyone may call it.
     /// @dev Records are appended in block order, so the expired ones are a prefix of the open round
-    /// trip. Does nothing when `stakeExpiry` is 0. Emits {RecordExpired} per record.
+    /// trip. Emits {RecordExpired} per record.
     /// @param buyer The buyer whose pot holds the stakes.
-    /// @param maxRecords Most records to refund in this call.
+    /// @param maxRecords Most records to refund in this call (capped at `settleBatch`).
     /// @return refunded How many records expired.
     function refundExpired(address buyer, uint256 maxRecords) external returns (uint256 refunded) {
-        if (_stakeExpiry == 0) return 0;
+        if (maxRecords > _settleBatch) maxRecords = _settleBatch;
         Round storage round = _rounds[buyer];
         uint64 i = round.start;
         uint64 end = round.count;
@@ -467,10 +548,12 @@ contract InformationMarket {
     /// @notice Executes a light contract: records the sale under the buyer, reveals the path information
     /// and locks the seller's stake.
     /// @dev Checks, each with its own error: the seller is the caller; the current block is at most the
-    /// agreed max block, which lies at most `maxValidity` blocks ahead; the buyer's EIP-712 signature
-    /// over the acceptance is valid and not malleable; (site, age, max block, buyer, seller) was never
-    /// revealed before; the information hashes to the committed value; the seller's vector is in range;
-    /// the seller has not reached `maxRecordsPerSeller` in this round trip; it can lock the stake.
+    /// agreed max block, which lies at most `maxValidity` blocks ahead; buyer and seller are registered;
+    /// the buyer's EIP-712 signature over the acceptance is valid and not malleable; it names the
+    /// buyer's open round trip; (site, age, max block, buyer, seller, path hash) was never revealed
+    /// before; the information hashes to the committed value; the seller's vector is in range; the
+    /// round trip holds fewer than `maxRecordsPerTrip` live records; the seller has not reached
+    /// `maxRecordsPerSeller` in this round trip; it can lock the stake.
     /// Emits {StakeLocked} (under staking) and {InformationRevealed}.
     /// @param lc The double-signed light contract.
     /// @param info The path information in the buyer's frame.
@@ -485,10 +568,14 @@ contract InformationMarket {
         }
         if (buyer == seller) revert InfoMarketSelfDealing(seller);
         if (offer.site > 1) revert InfoMarketInvalidSite(offer.site);
+        if (!_registered[seller]) revert InfoMarketUnregistered(seller);
+        if (!_registered[buyer]) revert InfoMarketUnregistered(buyer);
 
         _checkBuyerSignature(lc);
+        Round storage round = _rounds[buyer];
+        if (lc.trip != round.trip) revert InfoMarketWrongTrip(buyer, lc.trip, round.trip);
 
-        bytes32 key = revealKey(offer.site, offer.age, offer.maxBlock, buyer, seller);
+        bytes32 key = revealKey(offer.site, offer.age, offer.maxBlock, buyer, seller, offer.pathHash);
         if (_revealed[key]) revert InfoMarketAlreadyRevealed(key);
         _revealed[key] = true;
 
@@ -496,7 +583,9 @@ contract InformationMarket {
         if (revealed != offer.pathHash) revert InfoMarketInformationMismatch(offer.pathHash, revealed);
 
         (int64 dx, int64 dy) = _sellerVector(info.x, info.y, lc.sellerX, lc.sellerY);
-        _countSale(buyer, seller);
+        uint64 index = round.count;
+        if (index - round.start >= _maxRecordsPerTrip) revert InfoMarketTripFull(buyer, _maxRecordsPerTrip);
+        uint16 prevGap = _countSale(buyer, seller, index);
 
         uint256 stake_ = _stake;
         if (stake_ > 0) {
@@ -507,9 +596,7 @@ contract InformationMarket {
             emit StakeLocked(seller, buyer, stake_);
         }
 
-        Round storage round = _rounds[buyer];
-        uint64 index = round.count;
-        _records[buyer][index] = Information(seller, uint64(block.number), offer.site, dx, dy, 0);
+        _records[buyer][index] = Information(seller, uint64(block.number), offer.site, dx, dy, 0, prevGap);
         round.count = index + 1;
         emit InformationRevealed(
             buyer, seller, key, index, offer.site, offer.age, info.x, info.y, lc.sellerX, lc.sellerY, offer.pathHash
@@ -538,7 +625,8 @@ contract InformationMarket {
     /// @notice Whether `robot` has a deposited round trip still to settle, and where it stands.
     /// @param robot The account.
     /// @return pending True until the settlement completes.
-    /// @return phase 0 refunding expired records, 1 weighing, 2 paying.
+    /// @return phase 0 refunding expired records, 1 weighing, 2 paying, 3 refunding every stake (past the
+    /// settlement deadline).
     /// @return remaining Records left in the current phase.
     function pendingSettlement(address robot) external view returns (bool pending, uint8 phase, uint256 remaining) {
         Settlement storage s = _settlements[robot];
@@ -568,6 +656,21 @@ contract InformationMarket {
         for (uint256 i; i < list.length; ++i) list[i] = _records[buyer][start + i];
     }
 
+    /// @notice The round trip of `buyer` that light contracts signed now belong to (it grows by one at
+    /// each of the buyer's deposits).
+    /// @param buyer The account.
+    /// @return The open round trip's number.
+    function roundTrip(address buyer) external view returns (uint64) {
+        return _rounds[buyer].trip;
+    }
+
+    /// @notice Whether the market registered `robot`.
+    /// @param robot The account.
+    /// @return True once registered.
+    function isRegistered(address robot) external view returns (bool) {
+        return _registered[robot];
+    }
+
     /// @notice Whether the light contract identified by `key` was already revealed.
     /// @param key A `revealKey`.
     /// @return True once revealed.
@@ -576,31 +679,34 @@ contract InformationMarket {
     }
 
     /// @notice Whether two seller vectors are similar: the angle between them is strictly less than
-    /// theta. Exposed so that clients and tests can check the rule on its own.
+    /// theta. Exposed so that clients and tests can check the rule on its own; components must be below
+    /// 2^47 in magnitude, as on the reveal path (`InfoMarketVectorOutOfRange` otherwise).
     /// @param ax First vector, x.
     /// @param ay First vector, y.
     /// @param bx Second vector, x.
     /// @param by Second vector, y.
     /// @return Whether they are similar.
     function similar(int64 ax, int64 ay, int64 bx, int64 by) external view returns (bool) {
-        (ax, ay) = _nonZero(ax, ay);
-        (bx, by) = _nonZero(bx, by);
+        (ax, ay) = _sellerVector(ax, ay, 0, 0);
+        (bx, by) = _sellerVector(bx, by, 0, 0);
         return _similar(ax, ay, _norm2(ax, ay), bx, by, _norm2(bx, by), _cosTheta);
     }
 
-    /// @notice The identity of a light contract for the never-twice check: the paper's tuple.
+    /// @notice The identity of a sale for the never-twice check: the paper's tuple and the committed
+    /// information, so two different sales with the same (site, age, max block) are both allowed.
     /// @param site Site code.
     /// @param age Information age.
     /// @param maxBlock Agreed last block.
     /// @param buyer Buyer.
     /// @param seller Seller.
-    /// @return `keccak256(abi.encode(site, age, maxBlock, buyer, seller))`.
-    function revealKey(uint8 site, uint32 age, uint64 maxBlock, address buyer, address seller)
+    /// @param pathHash The commitment.
+    /// @return `keccak256(abi.encode(site, age, maxBlock, buyer, seller, pathHash))`.
+    function revealKey(uint8 site, uint32 age, uint64 maxBlock, address buyer, address seller, bytes32 pathHash)
         public
         pure
         returns (bytes32)
     {
-        return keccak256(abi.encode(site, age, maxBlock, buyer, seller));
+        return keccak256(abi.encode(site, age, maxBlock, buyer, seller, pathHash));
     }
 
     /// @notice The EIP-712 digest the buyer signs to accept `offer` (for clients to cross-check).
@@ -608,8 +714,9 @@ contract InformationMarket {
     /// @param buyer The buyer.
     /// @param sellerX Seller's position in the buyer's frame, x.
     /// @param sellerY Same, y.
+    /// @param trip The buyer's round trip.
     /// @return The digest.
-    function acceptanceDigest(Offer calldata offer, address buyer, int64 sellerX, int64 sellerY)
+    function acceptanceDigest(Offer calldata offer, address buyer, int64 sellerX, int64 sellerY, uint64 trip)
         public
         view
         returns (bytes32)
@@ -617,14 +724,15 @@ contract InformationMarket {
         bytes32 offerHash = keccak256(
             abi.encode(_OFFER_TYPEHASH, offer.seller, offer.site, offer.age, offer.maxBlock, offer.pathHash)
         );
-        bytes32 structHash = keccak256(abi.encode(_ACCEPTANCE_TYPEHASH, offerHash, buyer, sellerX, sellerY));
+        bytes32 structHash =
+            keccak256(abi.encode(_ACCEPTANCE_TYPEHASH, offerHash, buyer, sellerX, sellerY, trip));
         return keccak256(abi.encodePacked(hex"1901", _domainSeparator(), structHash));
     }
 
     /// @notice The EIP-712 domain (EIP-5267), so that clients sign for this contract on this chain only.
     /// @return fields Bit mask of the fields used (name, version, chainId, verifyingContract).
     /// @return name "InformationMarket".
-    /// @return version "2".
+    /// @return version "3".
     /// @return chainId Current chain id.
     /// @return verifyingContract This contract.
     /// @return salt Unused.
@@ -642,7 +750,7 @@ contract InformationMarket {
             uint256[] memory extensions
         )
     {
-        return (hex"0f", "InformationMarket", "2", block.chainid, address(this), bytes32(0), new uint256[](0));
+        return (hex"0f", "InformationMarket", "3", block.chainid, address(this), bytes32(0), new uint256[](0));
     }
 
     /// @notice The market's configuration (the constructor's arguments).
@@ -652,10 +760,13 @@ contract InformationMarket {
     /// @return informationShare_ Shared part of the reward, WAD.
     /// @return stake_ Stake per sale, 1e-9 units.
     /// @return cosTheta_ cos(theta), 1e-9 units.
-    /// @return stakeExpiry_ Blocks before a record expires (0 = never).
+    /// @return stakeExpiry_ Blocks before a record expires.
     /// @return maxRecordsPerSeller_ Most records per seller, buyer and round trip.
+    /// @return maxRecordsPerTrip_ Most live records per round trip.
     /// @return maxValidity_ Furthest a light contract's last block may lie ahead.
-    /// @return settleBatch_ Records `buyItem` settles itself.
+    /// @return settleBatch_ Work units per call.
+    /// @return settlementDeadline_ Blocks after a deposit from which its settlement refunds instead.
+    /// @return maxGrant_ Most initial wealth per robot.
     function configuration()
         external
         view
@@ -668,8 +779,11 @@ contract InformationMarket {
             int256 cosTheta_,
             uint64 stakeExpiry_,
             uint256 maxRecordsPerSeller_,
+            uint256 maxRecordsPerTrip_,
             uint64 maxValidity_,
-            uint256 settleBatch_
+            uint256 settleBatch_,
+            uint64 settlementDeadline_,
+            uint256 maxGrant_
         )
     {
         return (
@@ -681,8 +795,11 @@ contract InformationMarket {
             _cosTheta,
             _stakeExpiry,
             _maxRecordsPerSeller,
+            _maxRecordsPerTrip,
             _maxValidity,
-            _settleBatch
+            _settleBatch,
+            _settlementDeadline,
+            _maxGrant
         );
     }
 
@@ -696,7 +813,7 @@ contract InformationMarket {
 
     function _checkBuyerSignature(LightContract calldata lc) private view {
         if (uint256(lc.s) > _HALF_ORDER) revert InfoMarketMalleableSignature(lc.s);
-        bytes32 digest = acceptanceDigest(lc.offer, lc.buyer, lc.sellerX, lc.sellerY);
+        bytes32 digest = acceptanceDigest(lc.offer, lc.buyer, lc.sellerX, lc.sellerY, lc.trip);
         address recovered = ecrecover(digest, lc.v, lc.r, lc.s);
         if (recovered == address(0) || recovered != lc.buyer) revert InfoMarketInvalidBuyerSignature(lc.buyer, recovered);
     }
@@ -716,17 +833,24 @@ contract InformationMarket {
         return x == 0 && y == 0 ? (int64(1), int64(0)) : (x, y);
     }
 
-    /// @dev Counts a sale of `seller` to `buyer` in the buyer's open round trip, within the bound.
-    function _countSale(address buyer, address seller) private {
+    /// @dev Counts a sale of `seller` to `buyer` in the buyer's open round trip, within the bound, as
+    /// record `index`; returns how far back the seller's previous record of the round trip lies (0 when
+    /// none, or when it is too far back to be live: a live window is at most 512 records).
+    function _countSale(address buyer, address seller, uint64 index) private returns (uint16 prevGap) {
         uint256 trip = _rounds[buyer].trip;
         uint256 packed = _sold[buyer][seller];
-        uint256 n = packed >> 32 == trip ? packed & 0xffffffff : 0;
+        bool same = packed >> 128 == trip + 1;
+        uint256 n = same ? packed & type(uint64).max : 0;
         if (n >= _maxRecordsPerSeller) revert InfoMarketTooManyRecords(buyer, seller, _maxRecordsPerSeller);
-        _sold[buyer][seller] = (trip << 32) | (n + 1);
+        if (same) {
+            uint256 gap = index - ((packed >> 64) & type(uint64).max);
+            if (gap <= _MAX_TRIP_RECORDS) prevGap = uint16(gap);
+        }
+        _sold[buyer][seller] = ((trip + 1) << 128) | (uint256(index) << 64) | (n + 1);
     }
 
     function _expired(uint64 openedAt, uint256 now_) private view returns (bool) {
-        return _stakeExpiry != 0 && uint256(openedAt) + _stakeExpiry <= now_;
+        return uint256(openedAt) + _stakeExpiry <= now_;
     }
 
     /// @dev Gives record `index` of `buyer` its stake back; returns the stake (the caller debits it).
@@ -738,11 +862,18 @@ contract InformationMarket {
     }
 
     /// @dev Runs the pending settlement of `robot` for at most `budget` records of work, phase by
-    /// phase: refund the expired prefix, weigh the live records, pay them; then return the rest.
+    /// phase: refund the expired prefix, weigh the live records, pay them; then return the rest. From
+    /// `settlementDeadline` blocks after the deposit, a settlement still refunding or weighing refunds
+    /// every live record's stake instead and returns the share to the robot.
     function _settle(address robot, uint256 budget) private returns (bool) {
         Settlement storage s = _settlements[robot];
         uint64 next = s.next;
         uint64 end = s.end;
+        if (s.phase < _PAY && block.number >= uint256(s.closedAt) + _settlementDeadline) {
+            if (s.phase == _EXPIRE) s.live = next;
+            next = s.live;
+            s.phase = _REFUND;
+        }
         if (s.phase == _EXPIRE) {
             uint64 closedAt = s.closedAt;
             uint256 escrow = s.escrow;
@@ -758,12 +889,12 @@ contract InformationMarket {
             }
             s.live = next;
             s.amount = escrow;
-            s.phase = _scheme == Scheme.Outlier ? _WEIGH : _PAY;
+            s.phase = _scheme == Scheme.Delayed ? _PAY : _WEIGH;
             if (_scheme == Scheme.Delayed) s.totalWeight = end - next;
         }
         if (s.phase == _WEIGH) {
             // Weighing one record compares it with every live record: it costs ceil(m / 64) units of
-            // the budget, so a batch's gas stays bounded however long the round trip (docs/gas.md).
+            // the budget, so a batch's gas stays bounded (m <= maxRecordsPerTrip <= 512, docs/gas.md).
             uint256 cost = (end - s.live + _PAIRS_PER_UNIT - 1) / _PAIRS_PER_UNIT;
             if (cost == 0) cost = 1; // no live record: nothing to weigh
             uint256 affordable = budget / cost;
@@ -782,12 +913,25 @@ contract InformationMarket {
             s.phase = _PAY;
             next = s.live;
         }
+        uint256 escrowLeft = s.escrow;
+        if (s.phase == _REFUND) {
+            while (next < end && budget > 0) {
+                escrowLeft -= _refund(robot, next);
+                ++next;
+                --budget;
+            }
+            s.escrow = escrowLeft;
+            if (next < end) {
+                s.next = next;
+                return false;
+            }
+            return _finish(robot, escrowLeft, 0, 0);
+        }
         uint256 amount = s.amount;
         uint256 total = s.totalWeight;
-        uint256 escrowLeft = s.escrow;
         while (next < end && budget > 0) {
             Information storage record = _records[robot][next];
-            uint256 weight = _scheme == Scheme.Outlier ? record.weight : 1;
+            uint256 weight = _scheme == Scheme.Delayed ? 1 : record.weight;
             uint256 share = (amount * weight) / total;
             _balances[record.seller] += share;
             escrowLeft -= share;
@@ -800,8 +944,16 @@ contract InformationMarket {
             s.next = next;
             return false;
         }
-        _balances[robot] += escrowLeft;
-        emit SettlementCompleted(robot, amount - (s.live < end ? escrowLeft : amount), escrowLeft, total);
+        return _finish(robot, escrowLeft, s.live < end ? amount - escrowLeft : 0, total);
+    }
+
+    /// @dev Ends a settlement: what the escrow still holds goes back to the robot.
+    function _finish(address robot, uint256 kept, uint256 shared, uint256 total)
+        private
+        returns (bool)
+    {
+        _balances[robot] += kept;
+        emit SettlementCompleted(robot, shared, kept, total);
         delete _settlements[robot];
         // When nothing was revealed to the robot since its deposit, its next round trip can start
         // again at index 0 and rewrite warm slots (about 5k gas each) instead of fresh ones (22k).
@@ -813,35 +965,64 @@ contract InformationMarket {
         return true;
     }
 
-    /// @dev Weights of records [from, to) of `robot`: for each, the number of records among the live
-    /// ones [live, end) of the same site (itself included) whose vector lies strictly within theta of
-    /// its own. Loads the live records once into memory: O(end - live) storage reads and
-    /// O((to - from) * (end - live)) comparisons, bounded by the caller's batch. Returns their sum.
+    /// @dev Weights of records [from, to) of `robot` against the live ones [live, end) of the same site.
+    /// Outlier: the number of records (itself included) whose vector lies strictly within theta of its
+    /// own. OutlierDistinct: the number of distinct sellers with such a record (its own seller once),
+    /// times 1e27, divided by its seller's live records for the same site. Loads the live records once into memory (one
+    /// storage slot each): O(end - live) storage reads and O((to - from) * (end - live)) comparisons,
+    /// bounded by the caller's batch. Returns the weights' sum.
     function _weigh(address robot, uint64 live, uint64 from, uint64 to, uint64 end) private returns (uint256 sum) {
         uint256 m = end - live;
         int256[] memory xs = new int256[](m);
         int256[] memory ys = new int256[](m);
         uint256[] memory norms = new uint256[](m);
         uint256[] memory sites = new uint256[](m);
+        // Distinct scheme: each record's seller as a small number (its rank among the live records'
+        // sellers, from the chain of previous-record gaps), and each rank's number of live records.
+        bool distinct = _scheme == Scheme.OutlierDistinct;
+        uint256[] memory rank = new uint256[](distinct ? m : 0);
+        uint256[] memory sales = new uint256[](distinct ? 2 * m : 0);
+        uint256[] memory mark = new uint256[](distinct ? m : 0);
+        uint256 ranks;
         mapping(uint256 => Information) storage records = _records[robot];
         for (uint256 k; k < m; ++k) {
             Information storage r = records[live + k];
             (xs[k], ys[k], sites[k]) = (r.dx, r.dy, r.site);
             norms[k] = _norm2(r.dx, r.dy);
+            if (distinct) {
+                uint256 gap = r.prevGap;
+                uint256 q = gap != 0 && gap <= k ? rank[k - gap] : ranks++;
+                rank[k] = q;
+                ++sales[2 * q + r.site];
+            }
         }
         int256 cosTheta = _cosTheta;
         for (uint256 i = from - live; i < to - live; ++i) {
             uint256 w = 1;
             (int256 x, int256 y, uint256 n, uint256 site) = (xs[i], ys[i], norms[i], sites[i]);
-            for (uint256 j; j < m; ++j) {
-                if (j == i || sites[j] != site) continue;
-                if (_similar(x, y, n, xs[j], ys[j], norms[j], cosTheta)) {
-                    unchecked {
-                        ++w;
+            if (distinct) {
+                mark[rank[i]] = i + 1; // its own seller counts once, by this record
+                for (uint256 j; j < m; ++j) {
+                    if (sites[j] != site || mark[rank[j]] == i + 1) continue;
+                    if (_similar(x, y, n, xs[j], ys[j], norms[j], cosTheta)) {
+                        mark[rank[j]] = i + 1;
+                        unchecked {
+                            ++w;
+                        }
+                    }
+                }
+                w = (w * _DISTINCT_SCALE) / sales[2 * rank[i] + site];
+            } else {
+                for (uint256 j; j < m; ++j) {
+                    if (j == i || sites[j] != site) continue;
+                    if (_similar(x, y, n, xs[j], ys[j], norms[j], cosTheta)) {
+                        unchecked {
+                            ++w;
+                        }
                     }
                 }
             }
-            records[live + i].weight = uint64(w);
+            records[live + i].weight = uint104(w);
             sum += w;
         }
     }

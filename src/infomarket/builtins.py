@@ -36,6 +36,7 @@ register_payment("outlier", schemes.outlier_weights,
 # The paper's open questions (issue 10, docs/research.md): rules that read the ledger's reputation record.
 from .behaviours import reputation  # noqa: E402
 from .payments import adaptive  # noqa: E402
+from .payments import distinct  # noqa: E402
 
 register_behaviour("reputation_sceptic", buy=reputation.reputation_sceptic_buy, sell="naive", honest=True,
                    description="sceptical, but believes sellers with a high reputation or wealth share at once "
@@ -58,6 +59,10 @@ register_behaviour("theta_surfer", buy="sceptical", sell=reputation.theta_surfer
                            "theta": ("in (0, 180]", lambda v: 0 < v <= 180),
                            "theta_min": ("in (0, 180]", lambda v: 0 < v <= 180),
                            "adaptive": ("0 or 1", lambda v: v in (0, 1))})
+register_payment("outlier_distinct", distinct.outlier_distinct_weights,
+                 description="outlier penalisation counting sellers, not sales: a seller counts once in a "
+                             "transaction's weight and its weight is split across its transactions",
+                 limits={"theta": ("in (0, 180]", lambda v: 0 < v <= 180)})
 register_payment("adaptive_outlier", adaptive.adaptive_outlier_weights,
                  description="outlier penalisation with each seller's Theta between theta_min and theta by its "
                              "reputation",

@@ -48,9 +48,8 @@ def make_market(chain, robots, artifact):
         params = MarketParams.from_floats(scheme, stake=stake, theta_deg=theta_deg, **options)
         market = ChainMarket.deploy(params, backend=chain, artifact=artifact)
         wealths = wealth if isinstance(wealth, list) else [wealth] * len(robots)
-        for account, amount in zip(robots, wealths):
-            if amount:
-                market.grant_wealth(account.address, to_units(amount))
+        for account, amount in zip(robots, wealths):  # registers every robot, with or without wealth
+            market.grant_wealth(account.address, to_units(amount))
         return market
 
     return make

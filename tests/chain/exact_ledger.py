@@ -83,6 +83,12 @@ class ExactLedger:
         if txs:
             if self.scheme == "delayed":
                 weights = [1] * len(txs)
+            elif self.scheme == "outlier_distinct":
+                # distinct sellers with a same-site transaction within theta, over the seller's sales for the site
+                weights = [Fraction(len({s2 for (s2, site2, d2, _) in txs
+                                         if site2 == site and circular_distance(d, d2) < self.theta}),
+                                    sum(1 for t in txs if t[0] == seller and t[1] == site))
+                           for (seller, site, d, _) in txs]
             else:
                 weights = [sum(1 for (_, s2, d2, _) in txs if s2 == s and circular_distance(d, d2) < self.theta)
                            for (_, s, d, _) in txs]

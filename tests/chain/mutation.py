@@ -8,8 +8,9 @@ solc-js into a temporary artifact, against which the tests guarding it run (thro
 ``INFOMARKET_CHAIN_ARTIFACT``, see conftest.py; on revm only). It needs Node and takes a few minutes,
 so it is a script, not part of the test suite:
 
-    .venv/bin/python tests/chain/mutation.py
+    .venv/bin/python tests/chain/mutation.py [WORD ...]
 
+With words, only the mutants whose label contains one of them run (the unpatched copy always does).
 Exit status 0 when every mutant is caught (a test guarding it fails) and the unpatched copy passes them.
 """
 from __future__ import annotations
@@ -52,6 +53,22 @@ MUTANTS = [
      ["test_a_light_contract_cannot_stay_open"]),
     ("previous settlement finished", "s.end != 0",
      ["test_a_pending_settlement_blocks"]),
+    # issue 22
+    ("round trip below its live-record bound", "index - round.start >= _maxRecordsPerTrip",
+     ["test_a_buyer_that_signs_many_offers"]),
+    ("the signed round trip is the open one", "lc.trip != round.trip",
+     ["test_a_reveal_after_the_buyers_deposit"]),
+    ("seller registered", "!_registered[seller]", ["test_an_unregistered_account"]),
+    ("buyer registered", "!_registered[buyer]", ["test_an_unregistered_account"]),
+    ("depositing robot registered", "!_registered[robot]", ["test_an_unregistered_account"]),
+    ("wealth granted once", "_registered[robot]", ["test_the_market_grants_wealth_once"]),
+    ("grant within its cap", "amount > _maxGrant", ["test_the_market_grants_wealth_once"]),
+    ("trip bound at most 512", "maxRecordsPerTrip_ == 0 || maxRecordsPerTrip_ > _MAX_TRIP_RECORDS",
+     ["test_the_trip_bound_and_the_batch_bound"]),
+    ("batch at most 64", "settleBatch_ == 0 || settleBatch_ > _MAX_SETTLE_BATCH",
+     ["test_the_trip_bound_and_the_batch_bound"]),
+    ("stake expiry never off", "stakeExpiry_ == 0", ["test_the_trip_bound_and_the_batch_bound"]),
+    ("settlement deadline never off", "settlementDeadline_ == 0", ["test_the_trip_bound_and_the_batch_bound"]),
 ]
 
 #: (the rule broken, text replaced, its wrong replacement, tests that must then fail)
@@ -64,9 +81,29 @@ REWRITES = [
      ["test_similarity_is_an_exact_integer_test"]),
     ("zero vector has direction 0", "return x == 0 && y == 0 ? (int64(1), int64(0)) : (x, y);",
      "return (x, y);", ["test_similarity_is_an_exact_integer_test"]),
-    ("expired records refunded at settlement", "return _stakeExpiry != 0 && uint256(openedAt) + _stakeExpiry <= now_;",
-     "return _stakeExpiry != 0 && uint256(openedAt) + _stakeExpiry < now_;",
+    ("expired records refunded at settlement", "return uint256(openedAt) + _stakeExpiry <= now_;",
+     "return uint256(openedAt) + _stakeExpiry < now_;",
      ["test_a_robot_that_dies", "test_settlement_drops_expired"]),
+    # issue 22
+    ("settle capped at one batch", "return _settle(robot, maxRecords < _settleBatch ? maxRecords : _settleBatch);",
+     "return _settle(robot, maxRecords);", ["test_no_call_does_more_than_one_batch"]),
+    ("refundExpired capped at one batch", "if (maxRecords > _settleBatch) maxRecords = _settleBatch;", "",
+     ["test_no_call_does_more_than_one_batch"]),
+    ("settlement deadline refunds", "if (s.phase < _PAY && block.number >= uint256(s.closedAt) + _settlementDeadline) {",
+     "if (false) {", ["test_a_deposit_not_settled_by_its_deadline"]),
+    ("a seller counts once", "if (sites[j] != site || mark[rank[j]] == i + 1) continue;",
+     "if (sites[j] != site || j == i) continue;",
+     ["test_a_repeating_seller_gets_one_sellers_share", "test_a_copying_seller"]),
+    ("a seller's weight split across its records", "w = (w * _DISTINCT_SCALE) / sales[2 * rank[i] + site];",
+     "w = w * _DISTINCT_SCALE;", ["test_a_repeating_seller_gets_one_sellers_share", "test_a_copying_seller"]),
+    ("a seller's records linked", "if (gap <= _MAX_TRIP_RECORDS) prevGap = uint16(gap);", "",
+     ["test_a_repeating_seller_gets_one_sellers_share", "test_a_copying_seller"]),
+    ("sale key includes the path hash",
+     "bytes32 key = revealKey(offer.site, offer.age, offer.maxBlock, buyer, seller, offer.pathHash);",
+     "bytes32 key = revealKey(offer.site, offer.age, offer.maxBlock, buyer, seller, bytes32(0));",
+     ["test_a_second_different_sale"]),
+    ("similar() range-checked", "(ax, ay) = _sellerVector(ax, ay, 0, 0);", "(ax, ay) = _nonZero(ax, ay);",
+     ["test_similar_refuses_vectors_beyond"]),
 ]
 
 
@@ -89,7 +126,7 @@ def run_tests(artifact: Path, selected: list[str]) -> tuple[int, str]:
     return done.returncode, summary
 
 
-def main() -> int:
+def main(words: list[str] | None = None) -> int:
     original = SOURCE.read_text()
     variants = []
     for check, condition, tests in MUTANTS:
@@ -98,6 +135,8 @@ def main() -> int:
     for rule, old, new, tests in REWRITES:
         if tests:
             variants.append(("broken: " + rule, original.replace(old, new), original.count(old), tests))
+    if words:
+        variants = [v for v in variants if any(w in v[0] for w in words)]
     all_tests = [t for *_, tests in variants for t in tests]
     ok = True
     with tempfile.TemporaryDirectory() as tmp:
@@ -118,4 +157,4 @@ def main() -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    sys.exit(main(sys.argv[1:]))

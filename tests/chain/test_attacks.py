@@ -12,6 +12,7 @@ from eth_account import Account
 from eth_account.messages import encode_typed_data
 
 from infomarket.chain.errors import ContractRevert
+from infomarket.chain.market import derived_account
 from infomarket.chain.protocol import (
     FOOD,
     SECP256K1_N,
@@ -63,10 +64,10 @@ def test_reveal_after_the_max_block_is_refused_and_the_last_block_is_still_allow
 def test_forged_buyer_signature_is_refused(market, robots):
     seller, buyer, forger = robots[1], robots[0], robots[6]
     info = PathInfo.from_floats(5.0, -2.0)
-    offer = market.light_contract(seller, forger, FOOD, 9, info).offer
+    offer = market.light_contract(seller, forger, FOOD, 9, info, (0.0, 0.0)).offer
     # The forger signs an acceptance and claims it comes from the buyer, to charge the buyer's reward.
     forged = replace(accept_offer(forger.key, market.domain, offer, sign_offer(seller.key, market.domain, offer),
-                                  (0.0, 0.0)), buyer=buyer.address)
+                                  (0.0, 0.0), 0), buyer=buyer.address)
     refused(lambda: market.reveal(seller, forged, info), "InfoMarketInvalidBuyerSignature",
             buyer=buyer.address, recovered=_recover(market.domain, forged))
     untouched(market, seller, buyer)
@@ -76,15 +77,27 @@ def test_the_same_light_contract_cannot_be_revealed_twice(market, robots):
     seller, buyer = robots[1], robots[0]
     lc, info = deal(market, seller, buyer)
     market.reveal(seller, lc, info)
-    key = market.view("revealKey", FOOD, 9, lc.offer.max_block, buyer.address, seller.address)
+    key = market.view("revealKey", FOOD, 9, lc.offer.max_block, buyer.address, seller.address, info.digest())
     refused(lambda: market.reveal(seller, lc, info), "InfoMarketAlreadyRevealed", key=key)
-    # Same tuple, new information and a fresh buyer signature: still the same sale, still refused.
-    other = PathInfo.from_floats(50.0, 20.0)
-    offer = replace(lc.offer, path_hash=other.digest())
-    again = accept_offer(buyer.key, market.domain, offer, sign_offer(seller.key, market.domain, offer), (0.5, 0.5))
-    refused(lambda: market.reveal(seller, again, other), "InfoMarketAlreadyRevealed", key=key)
+    # The same sale with a fresh buyer signature (another seller position): still the same sale.
+    again = accept_offer(buyer.key, market.domain, lc.offer, lc.offer_signature, (0.25, 0.5), 0)
+    refused(lambda: market.reveal(seller, again, info), "InfoMarketAlreadyRevealed", key=key)
     assert len(market.contributors(buyer.address)) == 1
     assert market.balance_of(seller.address) == 960_000_000
+
+
+def test_a_second_different_sale_with_the_same_site_age_and_max_block_is_allowed(market, robots):
+    """Finding: the uniqueness key omitted pathHash, so a second, different sale with the same
+    (site, age, maxBlock) was refused as a replay. The key now includes the committed information."""
+    seller, buyer = robots[1], robots[0]
+    lc, info = deal(market, seller, buyer)
+    market.reveal(seller, lc, info)
+    other = PathInfo.from_floats(50.0, 20.0)
+    offer = replace(lc.offer, path_hash=other.digest())
+    second = accept_offer(buyer.key, market.domain, offer, sign_offer(seller.key, market.domain, offer), (0.5, 0.5), 0)
+    market.reveal(seller, second, other)
+    assert len(market.contributors(buyer.address)) == 2
+    assert market.balance_of(seller.address) == 1_000_000_000 - 2 * 40_000_000
 
 
 def test_a_signature_for_another_market_contract_is_refused(make_market, market, robots):
@@ -164,13 +177,13 @@ def test_selling_to_oneself_is_refused(market, robots):
 def test_malformed_site_and_vector_out_of_range_are_refused(market, robots):
     seller, buyer = robots[1], robots[0]
     info = PathInfo.from_floats(1.0, 1.0)
-    lc = market.light_contract(seller, buyer, 2, 9, info)
+    lc = market.light_contract(seller, buyer, 2, 9, info, (0.0, 0.0))
     refused(lambda: market.reveal(seller, lc, info), "InfoMarketInvalidSite", site=2)
     far = PathInfo(2**47, 0)  # 2^47 micro units from the seller: beyond the exact similarity test
-    lc = market.light_contract(seller, buyer, FOOD, 9, far)
+    lc = market.light_contract(seller, buyer, FOOD, 9, far, (0.0, 0.0))
     refused(lambda: market.reveal(seller, lc, far), "InfoMarketVectorOutOfRange", dx=2**47, dy=0)
     near = PathInfo(2**47 - 1, -(2**47 - 1))
-    lc = market.light_contract(seller, buyer, FOOD, 10, near)
+    lc = market.light_contract(seller, buyer, FOOD, 10, near, (0.0, 0.0))
     market.reveal(seller, lc, near)
 
 
@@ -179,14 +192,15 @@ def test_one_seller_cannot_fill_a_buyers_round_trip(make_market, robots):
     seller, other, buyer = robots[1], robots[2], robots[0]
     for age in (1, 2):
         info = PathInfo.from_floats(1.0, 1.0)
-        market.reveal(seller, market.light_contract(seller, buyer, FOOD, age, info), info)
+        market.reveal(seller, market.light_contract(seller, buyer, FOOD, age, info, (0.0, 0.0)), info)
     info = PathInfo.from_floats(1.0, 1.0)
-    lc = market.light_contract(seller, buyer, FOOD, 3, info)
+    lc = market.light_contract(seller, buyer, FOOD, 3, info, (0.0, 0.0))
     refused(lambda: market.reveal(seller, lc, info), "InfoMarketTooManyRecords",
             buyer=buyer.address, seller=seller.address, limit=2)
-    market.reveal(other, market.light_contract(other, buyer, FOOD, 3, info), info)  # others still can
+    market.reveal(other, market.light_contract(other, buyer, FOOD, 3, info, (0.0, 0.0)), info)  # others still can
     market.deposit(buyer.address)
-    market.reveal(seller, lc, info)  # a new round trip after the deposit
+    fresh = market.light_contract(seller, buyer, FOOD, 4, info, (0.0, 0.0))  # signed for the new round trip
+    market.reveal(seller, fresh, info)
 
 
 def test_a_light_contract_cannot_stay_open_for_longer_than_max_validity(make_market, robots):
@@ -226,6 +240,185 @@ def test_a_saboteurs_rotated_vector_gets_the_outliers_weight_whatever_it_says(ma
 
 def _recover(domain, lc) -> str:
     """Who the light contract's buyer signature recovers to under ``domain``."""
-    typed = acceptance_typed_data(domain, lc.offer, lc.buyer, lc.seller_x, lc.seller_y)
+    typed = acceptance_typed_data(domain, lc.offer, lc.buyer, lc.seller_x, lc.seller_y, lc.trip)
     return Account.recover_message(encode_typed_data(full_message=typed),
                                    vrs=(lc.v, int.from_bytes(lc.r, "big"), int.from_bytes(lc.s, "big")))
+
+
+# -- Findings of the second security review (issue 22): each test failed on the contract before it ----
+
+
+def _sell(market, seller, buyer, direction=10.0, age=0, site=FOOD):
+    """A sale whose seller vector (seen from (0.5, 0.5)) points at ``direction`` degrees."""
+    import math
+
+    rad = math.radians(direction)
+    info = PathInfo.from_floats(0.5 + 7 * math.cos(rad), 0.5 + 7 * math.sin(rad))
+    lc = market.light_contract(seller, buyer, site, age, info, (0.5, 0.5))
+    return market.reveal(seller, lc, info)
+
+
+def test_a_buyer_that_signs_many_offers_cannot_grow_a_round_trip_past_its_bound(make_market, robots):
+    """Finding (high): the round trip had no bound, so a buyer signing thousands of offers made a deposit
+    that no transaction could settle. Now the open round trip holds at most maxRecordsPerTrip live records
+    (the declared gas bound is measured at the largest, 512) and the reveal beyond is refused."""
+    market = make_market("outlier", stake=0.04, max_records_per_trip=3)
+    buyer = robots[0]
+    for age, seller in enumerate(robots[1:4]):
+        _sell(market, seller, buyer, age=age)
+    lc, info = deal(market, robots[4], buyer)
+    refused(lambda: market.reveal(robots[4], lc, info), "InfoMarketTripFull", buyer=buyer.address, limit=3)
+    assert market.balance_of(robots[4].address) == 1_000_000_000
+    assert len(market.contributors(buyer.address)) == 3
+    results = market.deposit(buyer.address)
+    assert not market.pending_settlement(buyer.address)[0] and results[-1].of("SettlementCompleted")
+
+
+def test_the_trip_bound_and_the_batch_bound_cannot_be_configured_away(make_market):
+    for option, value, name in (("max_records_per_trip", 513, "maxRecordsPerTrip"),
+                                ("settle_batch", 65, "settleBatch"), ("stake_expiry", 0, "stakeExpiry"),
+                                ("settlement_deadline", 0, "settlementDeadline")):
+        with pytest.raises(ContractRevert) as info:
+            make_market("outlier", **{option: value})
+        assert info.value.name == "InfoMarketInvalidParameter"
+        assert info.value.args_by_name == {"parameter": name.encode().ljust(32, b"\0"), "value": value}
+
+
+def test_no_call_does_more_than_one_batch_of_work_whatever_it_asks(make_market, robots):
+    """settle(robot, 2**200) and refundExpired(buyer, 2**200) are capped at settleBatch units, so the
+    caller cannot pick a call size beyond the declared gas bound."""
+    market = make_market("delayed", stake=0.0, settle_batch=2, stake_expiry=2)
+    buyer = robots[0]
+    for age, seller in enumerate(robots[1:6]):
+        _sell(market, seller, buyer, age=age)
+    market.buy_item(buyer.address)  # 2 units of work (records refunded, weighed or paid)
+    done = market.settle(buyer.address, 2**200)
+    assert len(done.of("RewardShared")) + len(done.of("RecordExpired")) == 2
+    assert market.pending_settlement(buyer.address)[0]
+    for age, seller in enumerate(robots[1:6]):
+        _sell(market, seller, buyer, age=10 + age)
+    market.backend.advance_to(market.backend.block_number + 5)
+    assert len(market.refund_expired(buyer.address, 2**200).of("RecordExpired")) == 2
+
+
+def test_a_deposit_not_settled_by_its_deadline_returns_the_stakes_and_the_share(make_market, robots):
+    """Finding (high): stakes of a trip that could not be settled were locked for ever. From
+    settlementDeadline blocks after the deposit, settling refunds every live stake to its seller and the
+    share to the robot, in bounded calls."""
+    market = make_market("outlier", stake=0.04, settle_batch=1, settlement_deadline=3)
+    buyer = robots[0]
+    for age, seller in enumerate(robots[1:4]):
+        _sell(market, seller, buyer, age=age)
+    market.buy_item(buyer.address)  # one unit of work: the settlement stays pending
+    market.backend.advance_to(market.backend.block_number + 3)
+    results = []
+    while market.pending_settlement(buyer.address)[0]:
+        results.append(market.settle(buyer.address, 1))
+    refunds = [e for r in results for e in r.of("RecordExpired")]
+    assert [(e["seller"], e["amount"]) for e in refunds] == [(s.address, 40_000_000) for s in robots[1:4]]
+    (done,) = results[-1].of("SettlementCompleted")
+    assert done == {"robot": buyer.address, "shared": 0, "kept": 500_000_000, "totalWeight": 0}
+    for seller in robots[1:4]:
+        assert market.balance_of(seller.address) == 1_000_000_000
+    assert market.balance_of(buyer.address) == 2_000_000_000
+    assert market.locked_stake(buyer.address) == 0
+
+
+def test_an_unregistered_account_can_neither_sell_nor_be_paid_a_reward(make_market, robots):
+    """Finding (medium): a fresh zero-balance address could sell (under delayed payment no stake is
+    needed) and the market could pay a reward to any address. Only registered robots take part."""
+    market = make_market("delayed", stake=0.0)
+    sybil, buyer = derived_account("sybil", 0), robots[0]
+    market.backend.fund([sybil.address])
+    lc, info = deal(market, sybil, buyer)
+    refused(lambda: market.reveal(sybil, lc, info), "InfoMarketUnregistered", robot=sybil.address)
+    refused(lambda: market.buy_item(sybil.address), "InfoMarketUnregistered", robot=sybil.address)
+    lc, info = deal(market, robots[1], sybil)  # nor buy: a registered seller selling to it is refused
+    refused(lambda: market.reveal(robots[1], lc, info), "InfoMarketUnregistered", robot=sybil.address)
+    assert market.balance_of(sybil.address) == 0 and market.contributors(buyer.address) == []
+    assert market.contributors(sybil.address) == []
+
+
+def test_the_market_grants_wealth_once_per_robot_and_within_its_cap(make_market, robots):
+    """Finding: the market account could mint without limit."""
+    market = make_market("outlier", stake=0.04, max_grant=5.0)
+    supply = market.total_supply()
+    refused(lambda: market.grant_wealth(robots[0].address, 1), "InfoMarketAlreadyRegistered",
+            robot=robots[0].address)
+    newcomer = derived_account("newcomer", 0)
+    refused(lambda: market.grant_wealth(newcomer.address, 5_000_000_001), "InfoMarketGrantTooLarge",
+            amount=5_000_000_001, limit=5_000_000_000)
+    market.grant_wealth(newcomer.address, 5_000_000_000)
+    assert market.total_supply() == supply + 5_000_000_000
+
+
+def test_a_repeating_seller_gets_one_sellers_share_under_outlier_distinct(make_market, robots):
+    """Finding (medium): a saboteur selling one 90-degree-rotated vector 5 times took 25/34 = 73.5 % of
+    the share against three honest sellers. Under outlier_distinct it counts once: 1/10."""
+    market = make_market("outlier_distinct", stake=0.0)
+    buyer, saboteur = robots[0], robots[4]
+    for age, (seller, d) in enumerate(zip(robots[1:4], (10.0, 15.0, 20.0))):
+        _sell(market, seller, buyer, d, age)
+    for age in range(5):
+        _sell(market, saboteur, buyer, 100.0, 10 + age)
+    market.deposit(buyer.address)
+    assert market.balance_of(saboteur.address) == 1_000_000_000 + 5 * (500_000_000 // 50)
+    for seller in robots[1:4]:
+        assert market.balance_of(seller.address) == 1_000_000_000 + 150_000_000
+
+
+def test_a_copying_seller_gets_no_more_than_one_honest_sellers_share(make_market, robots):
+    """The 256-copies attack in small: one seller copies the honest direction 6 times; its copies weigh
+    4/6 each, so all six earn what one honest seller earns (4 of 16)."""
+    market = make_market("outlier_distinct", stake=0.04)
+    buyer, copier = robots[0], robots[5]
+    for age, (seller, d) in enumerate(zip(robots[1:4], (10.0, 15.0, 20.0))):
+        _sell(market, seller, buyer, d, age)
+    for age in range(6):
+        _sell(market, copier, buyer, 12.0, 10 + age)
+    shares = [e for r in market.deposit(buyer.address) for e in r.of("RewardShared")]
+    honest = [e["amount"] for e in shares[:3]]
+    copied = sum(e["amount"] for e in shares[3:])
+    amount = 500_000_000 + 9 * 40_000_000
+    assert honest == [amount // 4] * 3
+    assert amount // 4 - 6 <= copied <= amount // 4  # six floored shares of a sixth each
+
+
+def test_a_reveal_after_the_buyers_deposit_is_refused(make_market, robots):
+    """Finding (low): a seller could hold a signed contract and reveal it after the buyer's deposit,
+    choosing its trip; it was then paid from the next item. The buyer now signs its round trip."""
+    market = make_market("outlier", stake=0.04)
+    seller, buyer = robots[1], robots[0]
+    lc, info = deal(market, seller, buyer)
+    assert lc.trip == market.round_trip(buyer.address) == 0
+    market.deposit(buyer.address)
+    refused(lambda: market.reveal(seller, lc, info), "InfoMarketWrongTrip", buyer=buyer.address, signed=0, current=1)
+    untouched(market, seller)
+
+
+def test_similar_refuses_vectors_beyond_the_exact_range(make_market):
+    """Finding: similar() overflowed for components beyond the reveal path's range."""
+    market = make_market("outlier", stake=0.0)
+    for args, (dx, dy) in (((2**62, 1, 1, 1), (2**62, 1)), ((1, 1, -(2**62), 1), (-(2**62), 1))):
+        with pytest.raises(ContractRevert) as info:
+            market.view("similar", *args)
+        assert (info.value.name, info.value.args_by_name) == ("InfoMarketVectorOutOfRange", {"dx": dx, "dy": dy})
+    assert market.view("similar", 2**47 - 1, 0, 2**47 - 1, 1) is True
+
+
+def test_the_client_needs_the_seller_position_and_caps_its_acceptances(make_market, robots):
+    """Finding: light_contract defaulted seller_position to (0, 0), which reopens the rotated-vector
+    bypass; and the client signed any number of offers."""
+    import inspect
+
+    from infomarket.chain.market import ChainMarket
+    from infomarket.chain.protocol import ProtocolError
+
+    assert inspect.signature(ChainMarket.light_contract).parameters["seller_position"].default is inspect.Parameter.empty
+    market = make_market("outlier", stake=0.04)
+    market.max_acceptances_per_trip = 2
+    seller, buyer = robots[1], robots[0]
+    for age in range(2):
+        market.light_contract(seller, buyer, FOOD, age, PathInfo.from_floats(1.0, 1.0), (0.0, 0.0))
+    with pytest.raises(ProtocolError, match="at most 2"):
+        market.light_contract(seller, buyer, FOOD, 5, PathInfo.from_floats(1.0, 1.0), (0.0, 0.0))

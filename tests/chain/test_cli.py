@@ -82,8 +82,32 @@ def test_on_chain_balances_equal_the_simulated_ledger(capsys):
 
 def test_demo_command_prints_the_costs_and_the_verdict(capsys):
     _simulator()
-    assert main(["chain", "demo", "--robots", "3", "--steps", "300", "--scheme", "delayed"]) == 0
+    assert main(["chain", "demo", "--robots", "5", "--steps", "4000", "--seed", "2", "--scheme", "delayed"]) == 0
     out = capsys.readouterr().out
     for label in ("gas per reveal", "gas per deposit", "gas per item delivered", "blocks used"):
         assert label in out
+    assert "warm storage across transactions: below a chain's gas" in out  # revm's gas is labelled as such
     assert out.rstrip().endswith("on-chain balances match the simulated ledger (within the fixed-point rounding bound)")
+
+
+def test_a_run_without_deposits_is_refused_not_compared(capsys):
+    """Finding (low): `--robots 6 --steps 2000` made purchases and no deposit, so "balances match" held
+    whatever the contract's weights; such a run is now refused before the replay."""
+    _simulator()
+    assert main(["chain", "demo", "--robots", "6", "--steps", "2000"]) == 2
+    captured = capsys.readouterr()
+    assert "0 deposits" in captured.err and "would prove nothing" in captured.err
+    assert "replayed" not in captured.out and "match" not in captured.out
+
+
+def test_the_demo_defaults_make_deposits():
+    load_experiment, simulate = _simulator()
+    from infomarket.chain.cli import add_subcommand
+    import argparse
+
+    parser = argparse.ArgumentParser()
+    add_subcommand(parser.add_subparsers(dest="command"))
+    args = parser.parse_args(["chain", "demo"])
+    config = demo_config(load_experiment(args.experiment), args.robots, args.steps, args.scheme)
+    kinds = simulate(config, seed=args.seed, record_events=True).events["kind"].value_counts()
+    assert kinds.get("deposit", 0) >= 10 and kinds.get("purchase", 0) >= 100

@@ -27,9 +27,11 @@ from infomarket.chain.units import TOKEN_UNIT
 from infomarket.ledger.replay import replay_events
 
 from .exact_ledger import SELLER_POSITION, ExactLedger, vector_for
+from .node import running_node
 
 CASES = json.loads((Path(__file__).parents[1] / "fixtures" / "payment_vectors.json").read_text())["cases"]
-SCHEMES = {"delayed": ("delayed", 0.0), "outlier": ("outlier", 0.0), "outlier+stake": ("outlier", 0.04)}
+SCHEMES = {"delayed": ("delayed", 0.0), "outlier": ("outlier", 0.0), "outlier+stake": ("outlier", 0.04),
+           "distinct": ("outlier_distinct", 0.0), "distinct+stake": ("outlier_distinct", 0.04)}
 #: Directions 7.3 k degrees (k < 50): no two differ by Theta = 30 within 0.1 degree, so the
 #: simulation's degrees and the contract's micro-unit vectors cannot decide a pair differently.
 DIRECTIONS = [round(7.3 * k % 360, 6) for k in range(50)]
@@ -68,6 +70,27 @@ def scenarios(draw, expiries=(0, 0, 3, 10), longest=1000):
             seller = (buyer + rng.randrange(1, robots)) % robots
             events.append(purchase(step, buyer, seller, rng.randrange(2), rng.choice(DIRECTIONS), age))
     return robots, scheme, wealth, expiry, events
+
+
+def _case(sales, stake):
+    """Robot 0 buys ``sales`` ((seller, direction) on food) in one round trip at step 1, then deposits."""
+    return [purchase(1, 0, seller, 0, d, k) for k, (seller, d) in enumerate(sales)] + [deposit(2, 0)]
+
+
+_REPEAT = [(1, 10.0), (2, 15.0), (3, 20.0)] + [(4, 100.0)] * 5  # a saboteur sells one vector 5 times
+_COPY = [(1, 10.0), (2, 15.0), (3, 20.0)] + [(5, 12.0)] * 6  # a seller copies the honest direction 6 times
+F = Fraction
+#: (scheme, events, every robot's balance after the deposit), by hand (share 0.5 of a reward of 1).
+DISTINCT_CASES = [
+    # eq. 7 counts transactions: honest 3 each, the repeated vector 5 each (x5): the saboteur takes 25/34.
+    ("outlier", _case(_REPEAT, 0.0), [F(3, 2), 1 + F(1, 2) * F(3, 34), 1 + F(1, 2) * F(3, 34),
+                                      1 + F(1, 2) * F(3, 34), 1 + F(1, 2) * F(25, 34)]),
+    # one seller, one voice: honest 3 each, each repeat 1/5: the saboteur takes 1/10, as if it sold once.
+    ("distinct", _case(_REPEAT, 0.0), [F(3, 2), 1 + F(3, 20), 1 + F(3, 20), 1 + F(3, 20), 1 + F(1, 20)]),
+    # the copier's 6 records weigh 4/6 each: 4 of 16 in all, one honest seller's share (stakes shared too).
+    ("distinct+stake", _case(_COPY, 0.04),
+     [F(3, 2), *[1 - F(1, 25) + F(86, 100) / 4] * 3, F(1), 1 - 6 * F(1, 25) + F(86, 100) / 4]),
+]
 
 
 def exact_run(robots, scheme, wealth, expiry, events) -> tuple[ExactLedger, list[bool]]:
@@ -114,6 +137,16 @@ class LedgerConformance:
             assert balances[i] == pytest.approx(case["balances_after_deposit"][str(i)],
                                                 abs=self.tolerance(n) + 1e-9)
 
+    @pytest.mark.parametrize(("scheme", "events", "expected"), DISTINCT_CASES,
+                             ids=[f"{c[0]}-{k}" for k, c in enumerate(DISTINCT_CASES)])
+    def test_one_seller_one_voice_by_hand(self, scheme, events, expected):
+        """Shared hand-computed cases: repetition and copying sellers, under eq. 7 and outlier_distinct."""
+        events = [dict(e) for e in events]
+        balances = self.run(len(expected), scheme, 1.0, 0, events)
+        shares = sum(1 for e in events if e["kind"] == "purchase")
+        for i, value in enumerate(expected):
+            assert balances[i] == pytest.approx(float(value), abs=self.tolerance(shares) + 1e-9), i
+
     def test_random_event_sequences_agree_with_the_exact_model(self):
         @settings(max_examples=self.examples, deadline=None, derandomize=True,
                   suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
@@ -132,7 +165,7 @@ class TestSimulatedLedger(LedgerConformance):
     def run(self, robots, scheme, wealth, expiry, events):
         name, stake = SCHEMES[scheme]
         replayed = replay_events(events, robots, scheme=name, initial_wealth=wealth, stake=stake,
-                                 params={"theta": 30.0} if name == "outlier" else None, stake_expiry=expiry)
+                                 params={"theta": 30.0} if name != "delayed" else None, stake_expiry=expiry)
         # what the simulation would have in pots at the end (stakes of open round trips) is not a balance
         return [float(b) for b in replayed.balances]
 
@@ -165,3 +198,53 @@ class TestContractLedgerOnPyEvm(TestContractLedger):
     examples = 4
     longest = 150
     expiries = (0,)  # py-evm mines one block per transaction: expiry needs one block per step (revm)
+
+
+class TestContractLedgerOnNode(TestContractLedger):
+    """The same suite once against a real JSON-RPC node (Hardhat Network, tools/node) that this class
+    starts on a free port and stops: every payment vector, the hand-computed cases, a small random
+    sample. Transactions are signed by the robots' keys and mined one per block, as on a chain."""
+
+    examples = 4
+    longest = 80
+    expiries = (0,)  # one block per transaction: the replay's expiry needs one block per step (revm)
+
+    @pytest.fixture(autouse=True, scope="class")
+    @classmethod
+    def node(cls):
+        with running_node() as url:
+            cls.rpc_url = url
+            yield url
+
+    def run(self, robots, scheme, wealth, expiry, events):
+        name, stake = SCHEMES[scheme]
+        params = MarketParams.from_floats(name, stake=stake, stake_expiry=expiry, max_records_per_seller=1000)
+        report = replay_on_chain(events, robots=robots, params=params, initial_wealth=wealth, rpc_url=self.rpc_url)
+        assert report.backend == self.rpc_url and report.cold_storage
+        assert not report.disagreements, report.disagreements[:3]
+        assert report.conserved()
+        return [b / TOKEN_UNIT for b in report.balances]
+
+    def test_py_evm_charges_the_gas_a_node_charges_per_transaction(self):
+        """The gas figures (docs/gas.md, the declared bound) come from py-evm: on the same calls, a real
+        node charges the same gas, transaction by transaction, within 1 % (calldata differs slightly:
+        the signatures are over each chain's domain)."""
+        from infomarket.chain.market import ChainMarket, connect, derived_account
+        from infomarket.chain.protocol import PathInfo
+
+        def gas(backend):
+            market = ChainMarket.deploy(MarketParams.from_floats("outlier_distinct", stake=0.04), backend=backend)
+            robots = [derived_account("gas-check", i) for i in range(4)]
+            backend.fund([r.address for r in robots])
+            used = [market.grant_wealth(r.address, 10**9).gas_used for r in robots]
+            for k in range(6):
+                seller = robots[1 + k % 3]
+                info = PathInfo.from_floats(*vector_for(7.3 * k), salt=bytes([k]) * 32)
+                lc = market.light_contract(seller, robots[0], k % 2, k, info, SELLER_POSITION)
+                used.append(market.reveal(seller, lc, info).gas_used)
+            return used + [r.gas_used for r in market.deposit(robots[0].address)]
+
+        reference, node = gas(connect(backend="py-evm")), gas(connect(self.rpc_url))
+        assert len(reference) == len(node) == 11
+        for a, b in zip(reference, node):
+            assert abs(a - b) <= 0.01 * a, (reference, node)

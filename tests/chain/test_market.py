@@ -37,14 +37,14 @@ def test_reveal_records_the_sale_and_moves_the_stake_into_the_buyers_pot(make_ma
     result, lc, info = sell(market, seller, buyer, NEST, 123.456789, age=17)
 
     (revealed,) = result.of("InformationRevealed")
-    key = market.view("revealKey", NEST, 17, lc.offer.max_block, buyer.address, seller.address)
+    key = market.view("revealKey", NEST, 17, lc.offer.max_block, buyer.address, seller.address, info.digest())
     assert revealed == {"buyer": buyer.address, "seller": seller.address, "key": key, "index": 0, "site": NEST,
                         "age": 17, "x": info.x, "y": info.y, "sellerX": 1_500_000, "sellerY": -500_000,
                         "pathHash": info.digest()}
     (locked,) = result.of("StakeLocked")
     assert locked == {"seller": seller.address, "buyer": buyer.address, "amount": 40_000_000}
     assert market.contributors(buyer.address) == [
-        (seller.address, result.block_number, NEST, info.x - 1_500_000, info.y + 500_000, 0)]
+        (seller.address, result.block_number, NEST, info.x - 1_500_000, info.y + 500_000, 0, 0)]
     assert market.locked_stake(buyer.address) == 40_000_000
     assert market.balance_of(seller.address) == 960_000_000
     assert market.view("isRevealed", key)

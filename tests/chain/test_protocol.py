@@ -68,8 +68,8 @@ def test_hand_hashed_digests_equal_eth_accounts_typed_data_encoding():
     domain = Domain(7, "0x" + "44" * 20)
     offer = _offer("0x" + "55" * 20)
     for typed, digest in ((offer_typed_data(domain, offer), offer_digest(domain, offer)),
-                          (acceptance_typed_data(domain, offer, "0x" + "66" * 20, -3, 4),
-                           acceptance_digest(domain, offer, "0x" + "66" * 20, -3, 4))):
+                          (acceptance_typed_data(domain, offer, "0x" + "66" * 20, -3, 4, 11),
+                           acceptance_digest(domain, offer, "0x" + "66" * 20, -3, 4, 11))):
         signable = encode_typed_data(full_message=typed)
         assert digest == keccak(b"\x19" + signable.version + signable.header + signable.body)
 
@@ -84,7 +84,7 @@ def test_buyer_refuses_an_offer_signed_by_someone_else():
     offer = _offer(seller.address)
     forged = sign_offer(impostor.key, domain, Offer(impostor.address, 1, 7, 10, b"\x11" * 32))
     with pytest.raises(ProtocolError, match="signed by"):
-        accept_offer(buyer.key, domain, offer, forged, (0.0, 0.0))
+        accept_offer(buyer.key, domain, offer, forged, (0.0, 0.0), 0)
     with pytest.raises(ProtocolError):
         sign_offer(impostor.key, domain, offer)
 
@@ -93,9 +93,10 @@ def test_acceptance_signature_recovers_to_the_buyer_and_signs_the_seller_positio
     seller, buyer = Account.create(), Account.create()
     domain = Domain(5, "0x" + "33" * 20)
     offer = _offer(seller.address)
-    lc = accept_offer(buyer.key, domain, offer, sign_offer(seller.key, domain, offer), (1.5, -2.0))
-    assert (lc.seller_x, lc.seller_y) == (1_500_000, -2_000_000)
-    message = encode_typed_data(full_message=acceptance_typed_data(domain, offer, buyer.address, 1_500_000, -2_000_000))
+    lc = accept_offer(buyer.key, domain, offer, sign_offer(seller.key, domain, offer), (1.5, -2.0), 3)
+    assert (lc.seller_x, lc.seller_y, lc.trip) == (1_500_000, -2_000_000, 3)
+    message = encode_typed_data(full_message=acceptance_typed_data(domain, offer, buyer.address, 1_500_000, -2_000_000,
+                                                                          3))
     assert Account.recover_message(message, vrs=(lc.v, lc.r, lc.s)) == buyer.address
     # eth-account only ever emits low-s signatures, which the contract requires.
     assert int.from_bytes(lc.s, "big") <= 0x7FFFFFFFFFFFFFFFFFFFFFFFFFFFFFFF5D576E7357A4501DDFE92F46681B20A0
@@ -106,8 +107,8 @@ def test_python_and_contract_hash_the_acceptance_identically(make_market, robots
     seller, buyer = robots[1], robots[0]
     info = PathInfo.from_floats(12.0, -3.0)
     lc = market.light_contract(seller, buyer, 0, 42, info, (-7.25, 0.5))
-    on_chain = market.view("acceptanceDigest", lc.offer.as_abi(), buyer.address, lc.seller_x, lc.seller_y)
-    typed = acceptance_typed_data(market.domain, lc.offer, buyer.address, lc.seller_x, lc.seller_y)
+    on_chain = market.view("acceptanceDigest", lc.offer.as_abi(), buyer.address, lc.seller_x, lc.seller_y, 5)
+    typed = acceptance_typed_data(market.domain, lc.offer, buyer.address, lc.seller_x, lc.seller_y, 5)
     signable = encode_typed_data(full_message=typed)
     assert on_chain == keccak(b"\x19" + signable.version + signable.header + signable.body)
     assert market.domain.verifying_contract == market.address

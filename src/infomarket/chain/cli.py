@@ -5,7 +5,9 @@ contract (the seller's offer and the buyer's acceptance signed with their own ke
 by its seller, each refused purchase is checked to be refused by the contract too, and each deposit
 is a ``buyItem`` by the market account. The command prints the gas and blocks this took and compares
 every robot's on-chain balance with its wealth in the simulation (exit status 1 if any differs by more
-than the fixed-point rounding allows, see ``evm_replay``).
+than the fixed-point rounding allows, see ``evm_replay``). A run without deposits is refused before the
+replay (exit status 2): with no deposit nothing is ever weighed or paid, and the comparison would pass
+whatever the contract's rules.
 
 ``add_subcommand(subparsers)`` hangs ``chain demo`` under the main ``infomarket`` parser; the chosen
 handler is stored as ``func`` (``args.func(args)`` returns the exit status). Heavy imports (the
@@ -38,7 +40,7 @@ def add_subcommand(subparsers) -> None:
     demo = commands.add_parser(
         "demo", help="replay a small simulated swarm through the contract and compare the balances",
         description=__doc__.split("\n\n")[1].replace("\n", " "))
-    demo.add_argument("--robots", type=at_least(1), default=10, help="swarm size (default 10)")
+    demo.add_argument("--robots", type=at_least(1), default=25, help="swarm size (default 25)")
     demo.add_argument("--steps", type=at_least(1), default=3000, help="simulation steps (default 3000)")
     demo.add_argument("--scheme", choices=sorted(DEMO_SCHEMES), default="staking",
                       help="payment scheme: delayed, outlier (no stake) or staking (outlier, stake 0.04); "
@@ -47,7 +49,8 @@ def add_subcommand(subparsers) -> None:
                       help="experiment whose swarm composition is scaled down (default fig4C)")
     demo.add_argument("--seed", type=seed_value, default=0, help="simulation seed (default 0)")
     demo.add_argument("--backend", choices=("revm", "py-evm"), default="revm",
-                      help="in-process EVM: revm (fast, default) or py-evm (the pure-Python reference)")
+                      help="in-process EVM: revm (fast, default; its gas keeps storage warm across "
+                           "transactions, below a chain's) or py-evm (the reference: a chain's gas, slow)")
     demo.add_argument("--rpc", type=_rpc_url, metavar="URL",
                       help="JSON-RPC node to use instead of an in-process EVM (needs an unlocked funded account)")
     demo.set_defaults(func=run_demo)
@@ -97,6 +100,10 @@ def run_demo(args: argparse.Namespace) -> int:
     kinds = result.events["kind"].value_counts()
     print(f"simulated in {time.perf_counter() - t0:.1f} s: {kinds.get('purchase', 0)} purchases, "
           f"{kinds.get('refused', 0)} refused, {kinds.get('deposit', 0)} deposits")
+    if not kinds.get("deposit", 0) or not kinds.get("purchase", 0):
+        return report_error(f"the simulation made {kinds.get('purchase', 0)} purchases and {kinds.get('deposit', 0)} "
+                            "deposits: with no purchase paid out by a deposit the comparison would prove nothing; "
+                            "run more --steps or --robots", 2)
     t0 = time.perf_counter()
     try:
         report, rows = replay_result(result, rpc_url=args.rpc, backend=args.backend)
@@ -114,6 +121,9 @@ def _report_text(report, rows) -> str:
     s = report.summary()
     lines = [
         f"  reveals                 {s['reveals']}",
+        f"  gas measured on         {report.backend}" + ("" if report.cold_storage else
+                                                          " (warm storage across transactions: below a chain's gas; "
+                                                          "--backend py-evm or --rpc for a chain's)"),
         f"  gas per reveal          {s['gas_per_reveal']:,.0f} (mean)",
         f"  gas per deposit         {s['gas_per_buy_item']:,.0f} (mean), {s['max_gas_buy_item']:,} (max): buyItem "
         f"and {s['settle_calls']} settle calls in all; largest single transaction {s['largest_tx']:,}",

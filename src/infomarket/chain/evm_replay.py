@@ -14,7 +14,7 @@ comparison allows ``FLOAT_SLACK_UNITS`` on top of the bound and nothing more.
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from statistics import mean
 
 from ..engine.world import SITE_NAMES
@@ -25,6 +25,8 @@ from .market import SCHEMES, ChainMarket, MarketParams, connect, derived_account
 from .protocol import PathInfo
 from .units import TOKEN_UNIT, to_units
 
+#: The stake expiry (blocks) that stands for the simulation's "never": no replay comes near 2^40 blocks.
+REPLAY_NO_EXPIRY = 2**40
 #: Allowance for the simulator's own floating-point error, in units (1e-9 token).
 FLOAT_SLACK_UNITS = 0.5
 SITE_CODES = {**{k: k for k in range(len(SITE_NAMES))}, **{name: k for k, name in enumerate(SITE_NAMES)}}
@@ -62,6 +64,8 @@ class ReplayReport:
     largest_tx: int = 0
     settle_calls: int = 0
     backend: str = ""
+    #: whether the backend charged gas with cold storage per transaction, as a chain does
+    cold_storage: bool = True
     disagreements: list[str] = field(default_factory=list)
     balances: list[int] = field(default_factory=list)
     pots: list[int] = field(default_factory=list)
@@ -120,20 +124,26 @@ def replay_on_chain(events: Iterable[Mapping] | object, *, robots: int, params: 
     until the round trip is settled. A purchase the chain refuses, or a refusal the chain would accept,
     is recorded in ``disagreements`` rather than stopping the replay.
     """
+    records = events.to_dict("records") if hasattr(events, "to_dict") else list(events)
+    if not params.stake_expiry:
+        # The simulation's "no expiry" (0): the contract always has one, so pick one the replay cannot reach.
+        params = replace(params, stake_expiry=REPLAY_NO_EXPIRY)
+        expire = False
+    else:
+        expire = True
     chain = connect(rpc_url, backend)
     market = ChainMarket.deploy(params, backend=chain, seed=seed)
     accounts = [derived_account("robot", i, seed) for i in range(robots)]
     chain.fund([a.address for a in accounts])
     wealth = to_units(initial_wealth)
     for a in accounts:
-        market.grant_wealth(a.address, wealth)
+        market.grant_wealth(a.address, wealth)  # registers every robot, with or without wealth
     base = chain.block_number + 1
     chain.advance_to(base)
 
     report = ReplayReport(robots, first_block=chain.block_number, rounding_bound=[0] * robots,
                           minted=wealth * robots)
     open_steps: list[list[tuple[int, int]]] = [[] for _ in range(robots)]  # (step, seller) per open record
-    records = events.to_dict("records") if hasattr(events, "to_dict") else events
     step = None
     for number, ev in enumerate(records):
         if progress is not None and number % 1000 == 0:
@@ -144,10 +154,10 @@ def replay_on_chain(events: Iterable[Mapping] | object, *, robots: int, params: 
         ev_step = int(ev.get("step", 0))
         if step is None or ev_step > step:
             step = ev_step
-            if params.stake_expiry and chain.block_number > base + step:
+            if expire and chain.block_number > base + step:
                 raise ChainError("stake expiry needs one block per step: replay on the revm backend")
             chain.advance_to(base + step)
-            if params.stake_expiry:
+            if expire:
                 _expire(market, accounts, open_steps, step, params.stake_expiry, report)
         if kind == "deposit":
             buyer = int(ev["buyer"])
@@ -188,6 +198,7 @@ def replay_on_chain(events: Iterable[Mapping] | object, *, robots: int, params: 
     report.pots = [market.locked_stake(a.address) for a in accounts]
     report.total_supply = market.total_supply()
     report.backend = chain.name
+    report.cold_storage = chain.cold_storage
     return report
 
 
@@ -206,15 +217,18 @@ def _expire(market, accounts, open_steps, step: int, expiry: int, report: Replay
 def market_params(config) -> MarketParams:
     """The contract's parameters for an experiment's payment section (``config.payment``).
 
-    The contract implements the two built-in schemes; a plugin scheme, or a fuel cost (money the
-    simulation burns, which the contract has no notion of), cannot be replayed on chain.
+    The contract implements the built-in ``delayed``, ``outlier`` and ``outlier_distinct`` schemes; a
+    plugin scheme, or a fuel cost (money the simulation burns, which the contract has no notion of),
+    cannot be replayed on chain. The simulation's stake expiry 0 (never) becomes, in the replay, one
+    longer than the replay itself (the contract always has one).
     """
     payment = config.payment
     if payment.scheme not in SCHEMES:
         raise ChainError(f"the contract implements the {' and '.join(SCHEMES)} schemes, not {payment.scheme!r}")
     if config.robot.fuel_cost:
         raise ChainError("the contract has no fuel cost: replay a configuration with robot.fuel_cost = 0")
-    theta = config.payment_params().get("theta", default_theta()) if payment.scheme == "outlier" else default_theta()
+    theta = (config.payment_params().get("theta", default_theta()) if payment.scheme != "delayed"
+             else default_theta())
     return MarketParams.from_floats(payment.scheme, reward=payment.reward,
                                     information_share=payment.information_share, stake=payment.stake,
                                     theta_deg=theta, stake_expiry=int(getattr(payment, "stake_expiry", 0) or 0))

@@ -30,18 +30,35 @@ from ..errors import ConfigError
 from ..payments import default_theta
 from .backends import Receipt, RevertedCall, make_backend
 from .errors import ChainError, ContractRevert
-from .protocol import Domain, LightContract, Offer, PathInfo, accept_offer, sign_offer
+from .protocol import Domain, LightContract, Offer, PathInfo, ProtocolError, accept_offer, sign_offer
 from .units import COS_SCALE, share_to_wad, to_units
 
-SCHEMES = {"delayed": 0, "outlier": 1}
+SCHEMES = {"delayed": 0, "outlier": 1, "outlier_distinct": 2}
 #: Most records one seller may sell one buyer per round trip: far above what a paper run reaches
 #: (82 at most in a 25-robot, 15 000-step run), low enough that no seller can crowd out the rest.
 DEFAULT_MAX_RECORDS_PER_SELLER = 256
+#: Most live records one round trip may hold (the contract's hard bound is 512): a 25-robot,
+#: 15 000-step paper run reaches 197. The declared gas bound is measured at this size.
+DEFAULT_MAX_RECORDS_PER_TRIP = 512
+#: Most offers a buyer's client accepts (signs) per round trip. Above the contract's live-record bound
+#: because an accepted offer whose seller cannot lock the stake never lands: a paper run's buyer signs
+#: up to 1 495 per round trip, 197 of which land.
+DEFAULT_MAX_ACCEPTANCES_PER_TRIP = 8 * DEFAULT_MAX_RECORDS_PER_TRIP
 #: Furthest a light contract's last block may lie ahead of its reveal.
 DEFAULT_MAX_VALIDITY = 256
-#: Records ``buyItem`` settles itself; ``settle`` continues in batches of ``SETTLE_BATCH``.
+#: Blocks after which an undeposited record's stake goes back to its seller (on by default; the
+#: contract refuses 0): about 17 hours of 12-second blocks.
+DEFAULT_STAKE_EXPIRY = 5_000
+#: Blocks after a deposit from which an unfinished settlement refunds the stakes instead of weighing.
+DEFAULT_SETTLEMENT_DEADLINE = 1_000
+#: Most initial wealth the market may grant one robot, 1e-9 units (1 000 tokens).
+DEFAULT_MAX_GRANT = 1_000 * 10**9
+#: Work units of one ``buyItem``/``settle``/``refundExpired`` call (the contract caps it at 64).
 DEFAULT_SETTLE_BATCH = 48
 SETTLE_BATCH = 48
+#: The most gas any one call of the contract may take, measured with cold storage (py-evm) at the
+#: largest round trip (512 live records, every pair similar), docs/gas.md; tests check it.
+DECLARED_MAX_TX_GAS = 6_000_000
 
 
 def load_artifact() -> dict:
@@ -66,26 +83,34 @@ class MarketParams:
     information_share: int
     stake: int
     cos_theta: int
-    stake_expiry: int = 0
+    stake_expiry: int = DEFAULT_STAKE_EXPIRY
     max_records_per_seller: int = DEFAULT_MAX_RECORDS_PER_SELLER
+    max_records_per_trip: int = DEFAULT_MAX_RECORDS_PER_TRIP
     max_validity: int = DEFAULT_MAX_VALIDITY
     settle_batch: int = DEFAULT_SETTLE_BATCH
+    settlement_deadline: int = DEFAULT_SETTLEMENT_DEADLINE
+    max_grant: int = DEFAULT_MAX_GRANT
 
     @classmethod
     def from_floats(cls, scheme: str, *, reward: float = 1.0, information_share: float = 0.5,
-                    stake: float = 0.0, theta_deg: float | None = None, stake_expiry: int = 0,
+                    stake: float = 0.0, theta_deg: float | None = None, stake_expiry: int = DEFAULT_STAKE_EXPIRY,
                     max_records_per_seller: int = DEFAULT_MAX_RECORDS_PER_SELLER,
-                    max_validity: int = DEFAULT_MAX_VALIDITY, settle_batch: int = DEFAULT_SETTLE_BATCH) -> MarketParams:
+                    max_records_per_trip: int = DEFAULT_MAX_RECORDS_PER_TRIP,
+                    max_validity: int = DEFAULT_MAX_VALIDITY, settle_batch: int = DEFAULT_SETTLE_BATCH,
+                    settlement_deadline: int = DEFAULT_SETTLEMENT_DEADLINE,
+                    max_grant: float | None = None) -> MarketParams:
         if scheme not in SCHEMES:
             raise ConfigError(f"scheme must be one of {sorted(SCHEMES)}, not {scheme!r}")
         theta = default_theta() if theta_deg is None else theta_deg  # the outlier rule's own default
+        grant = DEFAULT_MAX_GRANT if max_grant is None else to_units(max_grant)
         return cls(scheme, to_units(reward), share_to_wad(information_share), to_units(stake),
-                   cos_theta(theta), stake_expiry, max_records_per_seller, max_validity, settle_batch)
+                   cos_theta(theta), stake_expiry, max_records_per_seller, max_records_per_trip, max_validity,
+                   settle_batch, settlement_deadline, grant)
 
     def constructor_args(self, market: str) -> tuple:
         return (market, SCHEMES[self.scheme], self.reward, self.information_share, self.stake,
-                self.cos_theta, self.stake_expiry, self.max_records_per_seller, self.max_validity,
-                self.settle_batch)
+                self.cos_theta, self.stake_expiry, self.max_records_per_seller, self.max_records_per_trip,
+                self.max_validity, self.settle_batch, self.settlement_deadline, self.max_grant)
 
 
 class Event(NamedTuple):
@@ -167,11 +192,15 @@ def _checksum(value):
 class ChainMarket:
     """One deployed market and the account of its market node."""
 
-    def __init__(self, backend, address: str, market: LocalAccount, abi: list | None = None):
+    def __init__(self, backend, address: str, market: LocalAccount, abi: list | None = None,
+                 max_acceptances_per_trip: int = DEFAULT_MAX_ACCEPTANCES_PER_TRIP):
         self.backend = backend
         self.market = market
         self.address = to_checksum_address(address)
         self.codec = _Codec(abi or load_artifact()["abi"])
+        #: the buyers' clients: acceptances signed per (buyer, round trip), capped
+        self.max_acceptances_per_trip = max_acceptances_per_trip
+        self._accepted: dict[str, tuple[int, int]] = {}
 
     @classmethod
     def deploy(cls, params: MarketParams, *, backend=None, market: LocalAccount | None = None,
@@ -254,14 +283,30 @@ class ChainMarket:
         return Domain(chain_id, to_checksum_address(contract), name, version)
 
     def light_contract(self, seller: LocalAccount, buyer: LocalAccount, site: int, age: int, info: PathInfo,
-                       seller_position: tuple[float, float] = (0.0, 0.0), blocks_valid: int = 8,
-                       domain: Domain | None = None) -> LightContract:
+                       seller_position: tuple[float, float], blocks_valid: int = 8,
+                       domain: Domain | None = None, trip: int | None = None) -> LightContract:
         """Run steps 1-2 of the protocol: the seller offers (valid for ``blocks_valid`` blocks, the
-        block the next transaction lands in being the first), the buyer verifies and accepts."""
+        block the next transaction lands in being the first), the buyer verifies and accepts for its
+        open round trip (``trip``, read from the contract when not given).
+
+        ``seller_position`` (the seller's position in the buyer's frame, as the buyer senses it) has no
+        default: the weight of the sale is computed from the vector minus this position, so a client
+        that left it out would weigh the purchased vector instead. The buyer's client signs at most
+        ``max_acceptances_per_trip`` acceptances per round trip (``ProtocolError`` beyond)."""
+        if seller_position is None or len(seller_position) != 2:
+            raise ProtocolError("seller_position (the seller's position in the buyer's frame) is required")
         domain = domain or self.domain
+        trip = self.round_trip(buyer.address) if trip is None else trip
+        seen_trip, count = self._accepted.get(buyer.address, (trip, 0))
+        count = count if seen_trip == trip else 0
+        if count >= self.max_acceptances_per_trip:
+            raise ProtocolError(f"buyer {buyer.address} already accepted {count} offers in round trip {trip}: "
+                                f"its client accepts at most {self.max_acceptances_per_trip} per round trip")
         offer = Offer(seller.address, site, age, self.backend.block_number - 1 + blocks_valid, info.digest())
         signature = sign_offer(seller.key, domain, offer)
-        return accept_offer(buyer.key, domain, offer, signature, seller_position)
+        lc = accept_offer(buyer.key, domain, offer, signature, seller_position, trip)
+        self._accepted[buyer.address] = (trip, count + 1)
+        return lc
 
     # -- views --------------------------------------------------------------------------------------
 
@@ -278,11 +323,15 @@ class ChainMarket:
     def total_supply(self) -> int:
         return self.view("totalSupply")
 
+    def round_trip(self, buyer: str) -> int:
+        """The buyer's open round trip (what its acceptances name)."""
+        return self.view("roundTrip", buyer)
+
     def pending_settlement(self, robot: str) -> tuple[bool, int, int]:
         return tuple(self.view("pendingSettlement", robot))
 
     def contributors(self, buyer: str) -> list[tuple]:
-        """The open round trip's records: (seller, openedAt, site, dx, dy, weight)."""
+        """The open round trip's records: (seller, openedAt, site, dx, dy, weight, prevGap)."""
         return [(to_checksum_address(r[0]),) + tuple(r[1:]) for r in self.view("contributors", buyer)]
 
 
@@ -302,7 +351,7 @@ def revert_data(exc: BaseException) -> bytes | None:
     """The raw revert bytes, wherever the backend put them.
 
     A JSON-RPC node's answer reaches us as web3's ``ContractCustomError``/``ContractLogicError`` with a
-    hex ``data``. eth-tester raises ``TransactionFailed`` whose message is the bytes' repr, and web3
+    hex ``data`` (Hardhat Network nests it: ``{"message": ..., "data": "0x..."}``). eth-tester raises ``TransactionFailed`` whose message is the bytes' repr, and web3
     re-raises it with a message of its own (sometimes a string it guessed out of the bytes), so the
     repr is looked for along the exception's cause/context chain.
     """
@@ -314,6 +363,8 @@ def revert_data(exc: BaseException) -> bytes | None:
             continue
         seen.add(id(e))
         data = getattr(e, "data", None)
+        if isinstance(data, dict):  # Hardhat Network: {"message": ..., "data": "0x..."}
+            data = data.get("data")
         if isinstance(data, str) and data.startswith("0x"):
             return bytes.fromhex(data[2:])
         first = e.args[0] if e.args else None

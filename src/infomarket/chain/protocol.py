@@ -4,8 +4,9 @@
    frame (``path_in_buyer_frame``), commits to it with a salted hash, and signs an ``Offer`` (site,
    age, max block, hash) as EIP-712 typed data. The offer is addressed to one buyer because the hash
    commits to information in that buyer's frame.
-2. The buyer checks the seller's signature and signs an ``Acceptance`` (the offer, itself, and the
-   seller's position in its own frame). That double-signed pair is the ``LightContract``. The revealed
+2. The buyer checks the seller's signature and signs an ``Acceptance`` (the offer, itself, the
+   seller's position in its own frame, and its own open round trip: a reveal that lands after the
+   buyer's next deposit is refused). That double-signed pair is the ``LightContract``. The revealed
    information is the purchased vector only: the contract derives its direction itself (the vector
    minus the signed seller position), so a seller has nothing to declare and nothing to lie about.
 3. The seller submits ``revealInformation(lightContract, pathInfo)``; the contract checks the buyer's
@@ -47,6 +48,7 @@ _ACCEPTANCE_FIELDS = [
     {"name": "buyer", "type": "address"},
     {"name": "sellerX", "type": "int64"},
     {"name": "sellerY", "type": "int64"},
+    {"name": "trip", "type": "uint64"},
 ]
 _DOMAIN_FIELDS = [
     {"name": "name", "type": "string"},
@@ -67,7 +69,7 @@ class Domain:
     chain_id: int
     verifying_contract: str
     name: str = "InformationMarket"
-    version: str = "2"
+    version: str = "3"
 
     def as_dict(self) -> dict:
         return {
@@ -125,13 +127,14 @@ class LightContract:
     buyer: str
     seller_x: int
     seller_y: int
+    trip: int
     v: int
     r: bytes
     s: bytes
 
     def as_abi(self) -> tuple:
         return (self.offer.as_abi(), to_checksum_address(self.buyer), self.seller_x, self.seller_y,
-                self.v, self.r, self.s)
+                self.trip, self.v, self.r, self.s)
 
 
 def offer_typed_data(domain: Domain, offer: Offer) -> dict:
@@ -144,21 +147,23 @@ def offer_typed_data(domain: Domain, offer: Offer) -> dict:
     }
 
 
-def acceptance_typed_data(domain: Domain, offer: Offer, buyer: str, seller_x: int, seller_y: int) -> dict:
+def acceptance_typed_data(domain: Domain, offer: Offer, buyer: str, seller_x: int, seller_y: int,
+                          trip: int) -> dict:
     """EIP-712 message the buyer signs (the contract's ``acceptanceDigest`` hashes the same thing)."""
     return {
         "types": {"EIP712Domain": _DOMAIN_FIELDS, "Offer": _OFFER_FIELDS, "Acceptance": _ACCEPTANCE_FIELDS},
         "primaryType": "Acceptance",
         "domain": domain.as_dict(),
         "message": {"offer": offer.message(), "buyer": to_checksum_address(buyer),
-                    "sellerX": seller_x, "sellerY": seller_y},
+                    "sellerX": seller_x, "sellerY": seller_y, "trip": trip},
     }
 
 
 _DOMAIN_TYPEHASH = keccak(text="EIP712Domain(string name,string version,uint256 chainId,address verifyingContract)")
 _OFFER_TYPE = "Offer(address seller,uint8 site,uint32 age,uint64 maxBlock,bytes32 pathHash)"
 _OFFER_TYPEHASH = keccak(text=_OFFER_TYPE)
-_ACCEPTANCE_TYPEHASH = keccak(text="Acceptance(Offer offer,address buyer,int64 sellerX,int64 sellerY)" + _OFFER_TYPE)
+_ACCEPTANCE_TYPEHASH = keccak(text="Acceptance(Offer offer,address buyer,int64 sellerX,int64 sellerY,uint64 trip)"
+                                    + _OFFER_TYPE)
 
 
 @functools.lru_cache(maxsize=64)
@@ -178,10 +183,11 @@ def offer_digest(domain: Domain, offer: Offer) -> bytes:
     return keccak(b"\x19\x01" + _separator(domain) + _offer_hash(offer))
 
 
-def acceptance_digest(domain: Domain, offer: Offer, buyer: str, seller_x: int, seller_y: int) -> bytes:
+def acceptance_digest(domain: Domain, offer: Offer, buyer: str, seller_x: int, seller_y: int, trip: int) -> bytes:
     """The EIP-712 digest of ``acceptance_typed_data`` (what the contract's ``acceptanceDigest`` returns)."""
-    struct = keccak(abi_encode(["bytes32", "bytes32", "address", "int64", "int64"],
-                               [_ACCEPTANCE_TYPEHASH, _offer_hash(offer), to_checksum_address(buyer), seller_x, seller_y]))
+    struct = keccak(abi_encode(["bytes32", "bytes32", "address", "int64", "int64", "uint64"],
+                               [_ACCEPTANCE_TYPEHASH, _offer_hash(offer), to_checksum_address(buyer), seller_x, seller_y,
+                                trip]))
     return keccak(b"\x19\x01" + _separator(domain) + struct)
 
 
@@ -200,20 +206,22 @@ def sign_offer(seller_key: bytes, domain: Domain, offer: Offer) -> bytes:
 
 
 def accept_offer(buyer_key: bytes, domain: Domain, offer: Offer, offer_signature: bytes,
-                 seller_position: tuple[float, float]) -> LightContract:
+                 seller_position: tuple[float, float], trip: int) -> LightContract:
     """The buyer's side: check who made the offer, then sign the acceptance.
 
     ``seller_position`` is the seller's position in the buyer's frame, as the buyer senses it; signing
     it lets anyone audit, after the reveal, that the revealed direction is that of the revealed vector
-    minus this position.
+    minus this position. ``trip`` is the buyer's open round trip (the contract's ``roundTrip(buyer)``):
+    the contract refuses the reveal once the buyer has deposited. How many offers a buyer accepts per
+    round trip is capped by its client (``market.AcceptanceBook``), not here.
     """
     signer = Account._recover_hash(offer_digest(domain, offer), signature=offer_signature)
     if signer != to_checksum_address(offer.seller):
         raise ProtocolError(f"offer claims seller {offer.seller} but is signed by {signer}")
     buyer = Account.from_key(buyer_key).address
     sx, sy = to_micro(seller_position[0]), to_micro(seller_position[1])
-    v, r, s = _sign(buyer_key, acceptance_digest(domain, offer, buyer, sx, sy))
-    return LightContract(offer, offer_signature, buyer, sx, sy, v, r, s)
+    v, r, s = _sign(buyer_key, acceptance_digest(domain, offer, buyer, sx, sy, trip))
+    return LightContract(offer, offer_signature, buyer, sx, sy, trip, v, r, s)
 
 
 def path_in_buyer_frame(vector: tuple[float, float], heading_offset_deg: float,

@@ -1,0 +1,60 @@
+"""A real JSON-RPC node for the tests: Hardhat Network, pinned in tools/node (package.json and
+package-lock.json, installed by `make node`, which CI runs), started on a free port and stopped after.
+
+``running_node()`` installs it with ``npm ci`` when tools/node/node_modules is missing and skips the
+calling test only when node or npm is absent from the machine.
+"""
+from __future__ import annotations
+
+import contextlib
+import shutil
+import socket
+import subprocess
+import time
+from pathlib import Path
+
+import pytest
+
+TOOLS = Path(__file__).resolve().parents[2] / "tools" / "node"
+START_TIMEOUT_S = 90
+
+
+def _free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return sock.getsockname()[1]
+
+
+@contextlib.contextmanager
+def running_node():
+    """Yield the URL of a fresh Hardhat node; stop it afterwards."""
+    node, npm = shutil.which("node"), shutil.which("npm")
+    if node is None or npm is None:
+        pytest.skip("node and npm are not installed: cannot start the JSON-RPC node")
+    binary = TOOLS / "node_modules" / ".bin" / "hardhat"
+    if not binary.exists():
+        subprocess.run([npm, "ci", "--no-audit", "--no-fund"], cwd=TOOLS, check=True, capture_output=True)
+    port = _free_port()
+    url = f"http://127.0.0.1:{port}"
+    proc = subprocess.Popen([str(binary), "node", "--hostname", "127.0.0.1", "--port", str(port)], cwd=TOOLS,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    try:
+        from web3 import Web3
+
+        w3 = Web3(Web3.HTTPProvider(url))
+        deadline = time.monotonic() + START_TIMEOUT_S
+        while not w3.is_connected():
+            if proc.poll() is not None:
+                raise RuntimeError(f"the node exited: {proc.stderr.read().decode()[-2000:]}")
+            if time.monotonic() > deadline:
+                raise RuntimeError(f"the node did not answer at {url} within {START_TIMEOUT_S} s")
+            time.sleep(0.2)
+        yield url
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+        proc.stderr.close()
