@@ -105,7 +105,6 @@ def test_the_same_search_on_dask_gives_identical_results(inline, tmp_path):
 
 @pytest.mark.parametrize("option, words", [
     (["--defence", "nope"], ["--defence nope", "allowed: outlier, staking"]),
-    (["--defence", "distinct"], ["--defence distinct", "outlier_distinct"]),
     (["--byzantines", "5"], ["--byzantines 5", "allowed: 1, 3, 8"]),
 ])
 def test_bad_cells_are_refused_before_anything_is_written(tmp_path, capsys, option, words):
@@ -115,3 +114,26 @@ def test_bad_cells_are_refused_before_anything_is_written(tmp_path, capsys, opti
     err = capsys.readouterr().err
     assert all(w in err for w in words) and "Traceback" not in err
     assert not out.exists()
+
+
+def test_a_pending_defence_waits_for_its_scheme(tmp_path, capsys, monkeypatch):
+    """The study's `distinct` cell joins only once `outlier_distinct` is registered: with the scheme
+    hidden it is refused, saying which scheme it waits for (registered, it is a cell: see the next test)."""
+    from infomarket.search import study
+
+    registered = study.payments()
+    monkeypatch.setattr(study, "payments", lambda: {k: v for k, v in registered.items() if k != "outlier_distinct"})
+    out = tmp_path / "never"
+    assert main(["attack-search", "attack_search", "--defence", "distinct", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "--defence distinct" in err and "outlier_distinct" in err and "Traceback" not in err
+    assert not out.exists()
+
+
+def test_with_outlier_distinct_registered_the_distinct_cell_is_searched():
+    import infomarket as im
+    from infomarket.search import study
+
+    s = study.load(im.load_experiment("attack_search"))
+    got = {(c.defence, c.byzantines) for c in study.cells(s, ["distinct"], [3])}
+    assert got == {("distinct", 3)}
