@@ -18,6 +18,12 @@ from .engine import Result, Simulation, simulate  # noqa: E402
 from .errors import ConfigError, InfomarketError, SimulationError  # noqa: E402
 from .registry import behaviour, payment, register_behaviour, register_payment  # noqa: E402
 from . import builtins as _builtins  # noqa: E402, F401  (registers the built-in rules)
+from .checks import explain as _explain  # noqa: E402
+from .engine.simulation import explain_errors_with as _explain_errors_with  # noqa: E402
+
+# An error raised inside the compiled step names the rule, its file and line, and the step, from the
+# Python API as from the command line (the engine cannot import the checkers, which import it).
+_explain_errors_with(_explain)
 
 __all__ = ["ConfigError", "Experiment", "InfomarketError", "Result", "Simulation", "SimulationError",
            "behaviour", "load_experiment", "payment", "register_behaviour", "register_payment", "simulate"]

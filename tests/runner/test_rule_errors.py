@@ -212,3 +212,25 @@ def test_a_weight_rule_giving_negative_weights_is_named_with_the_step(tmp_path, 
     at = f"{tmp_path / 'negative.py'}:{line_of(tmp_path / 'negative.py', '@im.payment')}"
     assert (f"payment scheme 'negative_weights': its weight rule negative_weights ({at}) gave a negative or "
             f"non-finite weight at step {step}") in err
+
+
+def test_the_python_api_names_the_rule_and_the_step_too(tmp_path):
+    """``im.simulate`` / ``Simulation.step`` raise the same RuleRunError as the command line (they raised
+    numba's bare ZeroDivisionError, or its typing error pointing into the generated kernel)."""
+    from infomarket import plugins
+    from infomarket.errors import RuleRunError
+
+    late = LATE.replace('"late_divider"', '"late_divider_api"')
+    exp = experiment(tmp_path, "late_api", late, "late_divider_api", runs=1)
+    plugins.load(str(tmp_path / "late_api.py"))
+    with pytest.raises(RuleRunError) as err:
+        im.simulate(exp, seed=3)
+    at = f"{tmp_path / 'late_api.py'}:{line_of(tmp_path / 'late_api.py', 'x = x / k')}"
+    assert "its sell rule late_divider_sell raised ZeroDivisionError (division by zero) at step 37" in str(err.value)
+    assert at in str(err.value)
+
+    three = THREE.replace('"three_values"', '"three_values_api"')
+    exp = experiment(tmp_path, "three_api", three, "three_values_api", runs=1)
+    plugins.load(str(tmp_path / "three_api.py"))
+    with pytest.raises(RuleRunError, match="three_values_sell.*returns 3 values"):
+        im.Simulation(exp, seed=3)

@@ -64,6 +64,7 @@ class Simulation:
                  history_every: int | None = None):
         config = as_experiment(config)
         self.config = config
+        self.record_events = record_events
         self.seed = _checked_seed(config.seed if seed is None else seed)
         self.rng = np.random.default_rng(self.seed)
         self.kinds = behaviour_kinds(config)
@@ -71,11 +72,14 @@ class Simulation:
         self.world, self.behaviour_names = build_world(config, self.rng, record_events=record_events,
                                                        history_every=hist)
         t0 = time.perf_counter()
-        with compile_notice(self.kinds, config.payment.scheme), ctrl_c_survives_compiling():
-            self._kernel = specialise.kernel_module(self.kinds, config.payment.scheme, config.terrain,
-                                                    config.chain.enabled)
-            self._view = kernel_view(self.world)
-            self._kernel.run_steps(self._view, self.rng, 0)  # compile or load from cache; runs no step
+        try:
+            with compile_notice(self.kinds, config.payment.scheme), ctrl_c_survives_compiling():
+                self._kernel = specialise.kernel_module(self.kinds, config.payment.scheme, config.terrain,
+                                                        config.chain.enabled)
+                self._view = kernel_view(self.world)
+                self._kernel.run_steps(self._view, self.rng, 0)  # compile or load from cache; runs no step
+        except Exception as exc:  # a rule that keeps the kernel from compiling: named
+            raise _explained(config, self.seed, exc) from exc
         self.compile_seconds = time.perf_counter() - t0
         self.run_seconds = 0.0
 
@@ -97,10 +101,13 @@ class Simulation:
     def advance_to(self, t_end: int) -> None:
         t0 = time.perf_counter()
         while True:
-            status = self._kernel.run_steps(self._view, self.rng, t_end)
-            flags = ErrorFlags(int(self.world.flags[0]))
-            if flags:
-                raise SimulationError(f"step {self.clock}: {flags.describe()}")
+            try:
+                status = self._kernel.run_steps(self._view, self.rng, t_end)
+                flags = ErrorFlags(int(self.world.flags[0]))
+                if flags:
+                    raise SimulationError(f"step {self.clock}: {flags.describe()}")
+            except Exception as exc:  # a rule's error, or an error bit a rule set: named with the step
+                raise _explained(self.config, self.seed, exc, self) from exc
             if status == self._kernel.DONE:
                 break
             self.world = make_room(self.world)
@@ -190,6 +197,30 @@ class Simulation:
                 "items": w.items.tolist(), "wealth": w.balance.tolist(),
                 "behaviour": list(self.behaviour_names), "honest": [specs[b].honest for b in self.behaviour_names],
                 "sites": SITE_NAMES}
+
+
+#: How an error raised while compiling or stepping becomes one that names the rule, its file and line,
+#: and the step: ``checks.explain``, installed by the package root (the engine cannot import the
+#: checkers, which import the engine).  Empty: errors pass as they are.
+_EXPLAINERS: list = []
+_explaining = threading.local()
+
+
+def explain_errors_with(explain) -> None:
+    """Install ``explain(cfg, seed, exc, sim=None) -> Exception`` (``checks.explain``)."""
+    _EXPLAINERS[:] = [explain]
+
+
+def _explained(cfg, seed: int, exc: Exception, sim=None) -> Exception:
+    """``exc`` as the installed explainer words it; as it is while explaining (the explainer reruns the
+    run), or when none is installed."""
+    if not _EXPLAINERS or getattr(_explaining, "on", False):
+        return exc
+    _explaining.on = True
+    try:
+        return _EXPLAINERS[0](cfg, seed, exc, sim, record_events=bool(getattr(sim, "record_events", False)))
+    finally:
+        _explaining.on = False
 
 
 #: Seconds after which loading the step kernel is taken to be compiling it, and said so on stderr; the
