@@ -57,6 +57,17 @@ def next_candidate(w, nbrs, site, after_age, after_id):
 
 
 @njit(inline="always")
+def next_younger(w, me, nbrs, site, after):
+    """The candidate after ``after`` (-1 to start) in (offered age, id) order whose offer is younger than
+    the robot's current entry for ``site``, or -1: the walk every buy rule makes (``next_candidate``,
+    stopping at the first offer no fresher than what the robot already has)."""
+    s = next_candidate(w, nbrs, site, -1 if after < 0 else w.off_age[after, site], after)
+    if s >= 0 and w.off_age[s, site] >= w.new_age[me, site]:
+        return -1
+    return s
+
+
+@njit(inline="always")
 def buy(w, me, seller, site):
     """Buy the seller's offer for ``site``: (ok, x, y, age), the vector in the buyer's frame.
 

@@ -34,7 +34,7 @@ import math
 from numba import njit
 
 from ..engine.geometry import rotate
-from .api import buy, combine, confirm_or_wait, current, diff, next_candidate, own_entry, pending_clear, pending_has
+from .api import buy, combine, confirm_or_wait, current, diff, next_younger, own_entry, pending_clear, pending_has
 from .market import sales_settled, seller_reputation
 
 #: Parameters of the policy, in the order of :func:`policy_sell`'s arguments, with their defaults (a
@@ -159,15 +159,12 @@ def sceptical_or_colluding(w, me, nbrs, threshold, collude):
                 s = nbrs[k]
                 if w.kind[s] == mine and w.off_valid[s, site] and not holds(w, me, s, site):
                     buy(w, me, s, site)  # a transaction that settles agreeing with the partner's other lies
-        age_seen, s = -1, -1
+        s = -1
         while True:
-            s = next_candidate(w, nbrs, site, age_seen, s)
+            s = next_younger(w, me, nbrs, site, s)
             if s < 0:
                 break
-            age_seen = w.off_age[s, site]
             valid, ox, oy, oage = current(w, me, site)
-            if age_seen >= oage:
-                break
             if (collude >= 0.5 and w.kind[s] == mine) or pending_has(w, me, site, s):
                 continue
             ok, x, y, age = buy(w, me, s, site)

@@ -1,6 +1,6 @@
 """Sceptical robots: use bought information only when something confirms it (eq. 6, pending list).
 (Registered as ``sceptical`` by ``infomarket.builtins``.)"""
-from .api import buy, combine, confirm_or_wait, current, diff, next_candidate, pending_clear, pending_has
+from .api import buy, combine, confirm_or_wait, current, diff, next_younger, pending_clear, pending_has
 
 
 def sceptical_buy(w, me, nbrs, threshold=0.25):
@@ -8,15 +8,12 @@ def sceptical_buy(w, me, nbrs, threshold=0.25):
     pending is bought; it is used if it agrees with the own entry (diff < threshold, or the entry is
     invalid), or with a pending purchase, which it is then averaged with; otherwise it waits, pending."""
     for site in range(2):
-        age_seen, s = -1, -1
+        s = -1
         while True:
-            s = next_candidate(w, nbrs, site, age_seen, s)
+            s = next_younger(w, me, nbrs, site, s)
             if s < 0:
                 break
-            age_seen = w.off_age[s, site]
             valid, ox, oy, oage = current(w, me, site)
-            if age_seen >= oage:
-                break
             if pending_has(w, me, site, s):
                 continue
             ok, x, y, age = buy(w, me, s, site)

@@ -1,7 +1,7 @@
 """A defence by continuous trust: honest robots that average bought information in with a weight that
 grows with the seller's reputation (issue 23, item 4), instead of the sceptic's yes/no confirmation.
 (Registered as ``reputation_weighted`` by ``infomarket.builtins``.)"""
-from .api import buy, current, install, next_candidate
+from .api import buy, current, install, next_younger
 from .market import seller_reputation
 
 
@@ -12,15 +12,12 @@ def reputation_weighted_buy(w, me, nbrs, power=2.0):
     one with a clean record counts as the paper's weighting says.  An invalid entry takes the purchase;
     ``power`` = 0 is the naive robot."""
     for site in range(2):
-        age_seen, s = -1, -1
+        s = -1
         while True:
-            s = next_candidate(w, nbrs, site, age_seen, s)
+            s = next_younger(w, me, nbrs, site, s)
             if s < 0:
                 break
-            age_seen = w.off_age[s, site]
             valid, ox, oy, oage = current(w, me, site)
-            if age_seen >= oage:
-                break
             ok, x, y, age = buy(w, me, s, site)
             if not ok:
                 continue
