@@ -20,7 +20,8 @@ demo: venv
 # Two processes (CI has 2 cores), tests handed out one by one as a process frees up (worksteal): on a
 # fresh clone most of the time is compiling kernels, and a module that compiles many (the rule checks)
 # must not keep one process busy while the other idles (worksteal: cold 4 min 47 s against 5 min 23 s by module,
-# measured before issues 20-24; on 2026-11-24 a cold fresh clone took 6 min 17 s of pytest, warm 3 min 30 s).
+# measured before issues 20-24; on 2026-11-24, 1 270 tests with the contract's node suite, the attack
+# search and the chain model: a cold fresh clone's `.ci/run` took 7 min 35 s of pytest, 8 min 16 s in all).
 # A kernel one process compiled, the other loads from the disk cache.  TEST_WORKERS=0 runs them inline.
 TEST_WORKERS ?= 2
 test: venv
