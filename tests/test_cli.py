@@ -62,9 +62,11 @@ def test_history_every_k_steps(tmp_path):
 def test_bench_json(capsys):
     assert main(["bench", "--json", "--steps", "300", "--repeats", "2"]) == 0
     report = json.loads(capsys.readouterr().out)
-    assert set(report["setups"]) == {"fig2A", "fig2D", "fig4C"}
+    assert set(report["setups"]) == {"fig2A", "fig2D", "fig4C", "fig4C+chain"}
     for r in report["setups"].values():
         assert r["steps_per_second"] > 0 and r["compile_seconds"] >= 0
+    chain = report["setups"]["fig4C+chain"]  # its speed as a share of the instant ledger's, same run
+    assert chain["ratio_to_instant"] == chain["steps_per_second"] / report["setups"]["fig4C"]["steps_per_second"]
 
 
 def test_list_and_check(capsys):

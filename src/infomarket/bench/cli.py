@@ -6,10 +6,7 @@ import json
 
 from ..cliargs import at_least
 
-SETUPS = ("fig2A", "fig2D", "fig4C")
-#: With --chain: Fig. 4C with every robot a blockchain node (bench.setups.CHAIN_BENCH), beside plain 4C.
-#: Not in the default set: at about 2 % of the instant ledger's speed it would take 20 min at the defaults.
-CHAIN_SETUPS = ("fig4C+chain",)
+SETUPS = ("fig2A", "fig2D", "fig4C", "fig4C+chain")
 
 
 def _sizes(text: str) -> list[int]:
@@ -23,7 +20,7 @@ def _sizes(text: str) -> list[int]:
 
 
 def add_subcommand(sub) -> None:
-    b = sub.add_parser("bench", help="time the Fig. 2A, 2D and 4C setups (--chain: and 4C with the chain model) against "
+    b = sub.add_parser("bench", help="time the Fig. 2A, 2D and 4C setups (and 4C with the chain model) against "
                                      "this machine's floor",
                        description="Single-process runs after compilation (medians), each beside a floor kernel "
                                    "measured in the same run; or, with --robots, robot-steps/s and peak memory "
@@ -31,9 +28,6 @@ def add_subcommand(sub) -> None:
     b.add_argument("--json", action="store_true", help="print one JSON object")
     b.add_argument("--steps", type=at_least(1), default=15000, help="steps per run (default 15000)")
     b.add_argument("--repeats", type=at_least(1), default=7, help="timed runs per setup (median reported)")
-    b.add_argument("--chain", action="store_true",
-                   help="also Fig. 4C with the chain model on (robots as blockchain nodes), with its ratio to "
-                        "the instant ledger; slow (try --steps 3000 --repeats 3)")
     mode = b.add_mutually_exclusive_group()
     mode.add_argument("--robots", type=_sizes, metavar="N,N,...",
                       help="instead: robot-steps/s and peak memory for these swarm sizes (one process each)")
@@ -71,7 +65,7 @@ def run(args) -> int:
             print(f"{args.robots[-1]:,} robots run at {report['largest_vs_smallest']:.0%} of the robot-steps/s "
                   f"of {args.robots[0]:,}")
         return 0
-    report = run_bench(SETUPS + (CHAIN_SETUPS if args.chain else ()), steps=args.steps, repeats=args.repeats)
+    report = run_bench(SETUPS, steps=args.steps, repeats=args.repeats)
     if args.json:
         print(json.dumps(report, indent=2))
         return 0
