@@ -319,6 +319,9 @@ def explain_compile_failure(cfg, exc: BaseException) -> str | None:
         if count is not None and n != count:
             got = f"{n} values ({ret})" if n is not None else f"{ret}"
             return f"{owner}: its {what} {py.__name__} ({where}) returns {got}; a {what} returns {count}: {shape}"
+        if count is not None and not all(isinstance(t, (numba.types.Number, numba.types.Boolean)) for t in ret):
+            return (f"{owner}: its {what} {py.__name__} ({where}) returns {ret}; a {what} returns {count} "
+                    f"numbers: {shape}")
         if count is None and not isinstance(ret, numba.types.NoneType):
             return f"{owner}: its {what} {py.__name__} ({where}) returns {ret}; a {what} returns {shape}"
     return None

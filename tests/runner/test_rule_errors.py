@@ -160,6 +160,26 @@ def test_a_rule_returning_three_values_is_refused_before_anything_is_written(tmp
     assert "three_values_sell" in one_message(capsys) and not out.exists()
 
 
+TEXT_AGE = HEAD + '''
+
+@im.behaviour("text_age", buy="naive", honest=False, description="returns a text age")
+def text_age_sell(w, me, site):
+    valid, x, y, age = own_entry(w, me, site)
+    return valid, x, y, "old"
+'''
+
+
+def test_a_rule_returning_four_values_of_the_wrong_kinds_is_refused_naming_it(tmp_path, capsys):
+    """Four values, one of them text: it compiles alone, so only its return types tell (it gave numba's
+    "During: Pass nopython_type_inference" and exit 1)."""
+    exp = experiment(tmp_path, "textage", TEXT_AGE, "text_age")
+    out = tmp_path / "store"
+    assert main(["run", exp, "--out", str(out), "--quiet"]) == 2
+    err = one_message(capsys)
+    assert "behaviour 'text_age': its sell rule text_age_sell" in err and "a sell rule returns 4 numbers" in err
+    assert "nopython" not in err and not out.exists()
+
+
 def test_a_text_default_is_refused_naming_the_rule_and_the_parameter(tmp_path, capsys):
     exp = experiment(tmp_path, "text", STRING, "string_default")
     assert main(["check", exp]) == 2
