@@ -34,8 +34,9 @@ import math
 from numba import njit
 
 from ..engine.geometry import rotate
-from .api import buy, combine, confirm_or_wait, current, diff, next_younger, own_entry, pending_clear, pending_has
+from .api import buy, own_entry
 from .market import sales_settled, seller_reputation
+from .sceptical import sceptical_site
 
 #: Parameters of the policy, in the order of :func:`policy_sell`'s arguments, with their defaults (a
 #: constant 20° liar) and their ranges (``search.space`` maps a search vector onto them).
@@ -159,22 +160,7 @@ def sceptical_or_colluding(w, me, nbrs, threshold, collude):
                 s = nbrs[k]
                 if w.kind[s] == mine and w.off_valid[s, site] and not holds(w, me, s, site):
                     buy(w, me, s, site)  # a transaction that settles agreeing with the partner's other lies
-        s = -1
-        while True:
-            s = next_younger(w, me, nbrs, site, s)
-            if s < 0:
-                break
-            valid, ox, oy, oage = current(w, me, site)
-            if (collude >= 0.5 and w.kind[s] == mine) or pending_has(w, me, site, s):
-                continue
-            ok, x, y, age = buy(w, me, s, site)
-            if not ok:
-                continue
-            if not valid or diff(ox, oy, x, y) < threshold:
-                combine(w, me, site, x, y, age)
-                pending_clear(w, me, site)
-                continue
-            confirm_or_wait(w, me, site, s, x, y, age, threshold)
+        sceptical_site(w, me, nbrs, site, threshold, mine if collude >= 0.5 else -1)
 
 
 def policy_buy(w, me, nbrs, threshold=0.25, collude=0.0):

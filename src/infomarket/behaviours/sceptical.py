@@ -1,5 +1,7 @@
 """Sceptical robots: use bought information only when something confirms it (eq. 6, pending list).
 (Registered as ``sceptical`` by ``infomarket.builtins``.)"""
+from numba import njit
+
 from .api import buy, combine, confirm_or_wait, current, diff, next_younger, pending_clear, pending_has
 
 
@@ -8,20 +10,26 @@ def sceptical_buy(w, me, nbrs, threshold=0.25):
     pending is bought; it is used if it agrees with the own entry (diff < threshold, or the entry is
     invalid), or with a pending purchase, which it is then averaged with; otherwise it waits, pending."""
     for site in range(2):
-        s = -1
-        while True:
-            s = next_younger(w, me, nbrs, site, s)
-            if s < 0:
-                break
-            valid, ox, oy, oage = current(w, me, site)
-            if pending_has(w, me, site, s):
-                continue
-            ok, x, y, age = buy(w, me, s, site)
-            if not ok:
-                continue
-            if not valid or diff(ox, oy, x, y) < threshold:
-                combine(w, me, site, x, y, age)
-                pending_clear(w, me, site)
-                continue
-            confirm_or_wait(w, me, site, s, x, y, age, threshold)
+        sceptical_site(w, me, nbrs, site, threshold, -1)
 
+
+@njit(inline="always")
+def sceptical_site(w, me, nbrs, site, threshold, ignore_kind):
+    """The sceptical rule for one site, never buying from sellers of behaviour kind ``ignore_kind`` (-1:
+    none; colluders pass their own, ``behaviours.attacks``)."""
+    s = -1
+    while True:
+        s = next_younger(w, me, nbrs, site, s)
+        if s < 0:
+            break
+        valid, ox, oy, oage = current(w, me, site)
+        if w.kind[s] == ignore_kind or pending_has(w, me, site, s):
+            continue
+        ok, x, y, age = buy(w, me, s, site)
+        if not ok:
+            continue
+        if not valid or diff(ox, oy, x, y) < threshold:
+            combine(w, me, site, x, y, age)
+            pending_clear(w, me, site)
+            continue
+        confirm_or_wait(w, me, site, s, x, y, age, threshold)
