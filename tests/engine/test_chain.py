@@ -272,7 +272,7 @@ def _branch_deposits(w, b):
     count = int(w.ck_rep_deposits.sum())
     ck = int(w.chn_ckpt[0])
     while b != ck:
-        count += sum(int(w.mp_kind[w.blk_tx[b, k]]) == mempool.DEPOSIT for k in range(int(w.blk_ntx[b])))
+        count += sum(int(w.mp_kind[w.blk_tx[w.blk_txoff[b] + k]]) == mempool.DEPOSIT for k in range(int(w.blk_ntx[b])))
         b = int(w.blk_parent[b])
     return count
 

@@ -339,26 +339,17 @@ def chain_variant(settle) -> ChainStep:
     def apply_block(w, b, rng):
         """Apply block b's transactions, in order, to the ledger arrays (which hold its parent's state)."""
         for k in range(w.blk_ntx[b]):
-            tx = w.blk_tx[b, k]
+            tx = w.blk_tx[w.blk_txoff[b] + k]
             if _blocks.include_tx(w, b, tx):
                 settle(w, w.mp_buyer[tx], rng)
                 _blocks.finish_deposit(w, b, tx)
 
     @njit
-    def ledger_at(w, target, rng):
-        """Make the ledger arrays hold the state after block ``target``, silently (nothing is logged
-        again): one block on from the current one, else from the checkpoint along target's branch."""
-        if w.chn_cur[0] == target:
-            return
-        _blocks.mute(w, True)
-        if w.blk_parent[target] == w.chn_cur[0]:
-            apply_block(w, target, rng)
-        else:
-            _blocks.restore_checkpoint(w)
-            for k in range(_blocks.path_from_checkpoint(w, target)):
-                apply_block(w, w.chn_path[k], rng)
-        _blocks.set_current(w, target)
-        _blocks.mute(w, False)
+    def ledger_at(w, target):
+        """Make the ledger arrays hold the state after block ``target``: a copy of the state it keeps
+        (``ledger.blocks.save_state``); nothing is applied again."""
+        if w.chn_cur[0] != target:
+            _blocks.load_state(w, target)
 
     @njit
     def make_blocks(w, rng):
@@ -373,10 +364,10 @@ def chain_variant(settle) -> ChainStep:
                 continue
             parent = w.view_head[s]
             b = _blocks.new_block(w, s, t)
-            ledger_at(w, parent, rng)
+            ledger_at(w, parent)
             apply_block(w, b, rng)
             _blocks.set_current(w, b)
-            _blocks.snapshot(w, b)
+            _blocks.save_state(w, b)
             _blocks.adopt(w, s, b)
             if w.chn_backbone and w.chn_latency == 0:
                 _blocks.deliver_block(w, b)
@@ -385,9 +376,9 @@ def chain_variant(settle) -> ChainStep:
             c = _blocks.next_checkpoint(w)
             if c < 0:
                 break
-            ledger_at(w, c, rng)
+            ledger_at(w, c)
             _blocks.move_checkpoint(w, c)
-        ledger_at(w, w.chn_canon[0], rng)
+        ledger_at(w, w.chn_canon[0])
 
     @njit
     def gossip(w):

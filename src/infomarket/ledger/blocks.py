@@ -62,6 +62,10 @@ def gas_schedule(scheme: str, stake: float) -> tuple[float, tuple[int, ...]]:
 #: The checkpoint's copy of each ledger field (``ck_<field>``).
 CHECKPOINTED = ("balance", "pot", "burned", "tx_off", "tx_cap", "tx_count", *TX_POOL, "pool_top", "money",
                 "rep_settled", "rep_reduced", "rep_earned", "rep_stake_lost", "rep_deposits", "gas_paid")
+#: The ledger fields each block keeps (``bs_<field>``; the balances are ``blk_bal``, the open transactions
+#: ``bs_tx_*`` packed), so the state after any live block is a copy away: nothing is replayed.
+BLOCK_STATE = ("pot", "burned", "tx_cap", "tx_count", "money", "rep_settled", "rep_reduced", "rep_earned",
+               "rep_stake_lost", "rep_deposits", "gas_paid")
 _LEDGER_KINDS = {"balance": ("float64", "n"), "pot": ("float64", "n"), "burned": ("float64", "1"),
                  "tx_off": ("int64", "n"), "tx_cap": ("int64", "n"), "tx_count": ("int64", "n"),
                  "tx_seller": ("int64", "P"), "tx_site": ("int64", "P"), "tx_dir": ("float64", "P"),
@@ -70,8 +74,8 @@ _LEDGER_KINDS = {"balance": ("float64", "n"), "pot": ("float64", "n"), "burned":
                  "rep_earned": ("float64", "n"), "rep_stake_lost": ("float64", "n"),
                  "rep_deposits": ("int64", "n"), "gas_paid": ("float64", "n")}
 
-#: Shapes: ``Bc`` block slots, ``T`` mempool slots (a multiple of 64), ``T/64`` words of known-bits,
-#: ``S`` signers, ``G`` points of the deposit-gas table.
+#: Shapes: ``Bc`` block slots, ``Bt`` entries of the blocks' transaction lists, ``T`` mempool slots (a multiple of 64), ``T/64`` words of known-bits,
+#: ``C`` open transactions a block's state can hold, ``S`` signers, ``G`` points of the deposit-gas table.
 SPEC = Spec("chain", [
     *fields("host", [
         ("chn_period", "int", "", "block period P, steps: an in-turn signer makes a block P steps after its head's"),
@@ -108,16 +112,24 @@ SPEC = Spec("chain", [
         ("blk_kids", "int64", "Bc", "blocks made on it"),
         ("blk_bb", "bool", "Bc", "delivered by the backbone"),
         ("blk_ntx", "int64", "Bc", "transactions it includes"),
-        ("blk_tx", "int64", "Bc,T", "the mempool slots it includes, in the order they were sent"),
+        ("blk_txoff", "int64", "Bc", "where its transactions start in blk_tx"),
+        ("blk_tx", "int64", "Bt", "block b's transactions (mempool slots, in the order they were sent) are "
+                                  "blk_tx[blk_txoff[b] : blk_txoff[b] + blk_ntx[b]]"),
+        ("chn_txtop", "int64", "1", "first unused entry of blk_tx (the host packs the live blocks' entries)"),
         ("blk_bal", "float64", "Bc,n", "every robot's balance after it"),
+        *[(f"bs_{f}", _LEDGER_KINDS[f][0], "Bc" if _LEDGER_KINDS[f][1] == "1" else "Bc,n",
+           f"{f} after the block (its ledger state, with blk_bal)") for f in BLOCK_STATE],
+        *[(f"bs_{f}", _LEDGER_KINDS[f][0], "Bc,C", f"{f} of the open transactions after the block, buyer "
+                                                   f"by buyer (bs_tx_count of each), packed") for f in TX_POOL],
+        ("chn_capmax", "int64", "n", "largest transaction-pool block any saved state gave each buyer"),
         ("chn_ckpt", "int64", "1", "the checkpoint's slot"),
         ("chn_canon", "int64", "1", "the canonical head's slot"),
         ("chn_cur", "int64", "1", "the block whose state the ledger arrays hold"),
-        ("chn_mute", "int64", "1", "1 while replaying: logs and measures are not written again"),
+        ("chn_mute", "int64", "1", "1 mutes the event and payment logs and the measures (blocks are applied "
+                                   "once each and never replayed: stays 0)"),
         ("chn_stamp", "int64", "1", "last stamp of mp_mark"),
         ("chn_seq", "int64", "1", "transactions sent so far (their order)"),
         ("chn_nopen", "int64", "1", "reveals the deposit being applied settles"),
-        ("chn_path", "int64", "Bc", "scratch: a branch, oldest block first"),
         ("mp_live", "bool", "T", "slot holds a pending transaction"),
         ("mp_cursor", "int64", "1", "where the next free slot is looked for"),
         ("mp_count", "int64", "1", "pending transactions"),
@@ -156,6 +168,10 @@ SPEC = Spec("chain", [
 #: First capacities: block slots and mempool slots.
 BLOCK_CAPACITY = 16
 MEMPOOL_CAPACITY = 128
+#: First size of the blocks' transaction lists (``blk_tx``).
+TX_ENTRIES = 1024
+#: First capacity of a block's state for open transactions (``bs_tx_*``).
+STATE_CAPACITY = 64
 
 
 def _words(t: int) -> int:
@@ -183,10 +199,10 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
         "blk_live": z(bc, np.bool_), "blk_parent": np.full(bc, -1, np.int64), "blk_height": z(bc, np.int64),
         "blk_weight": z(bc, np.int64), "blk_hash": z(bc, np.int64), "blk_signer": np.full(bc, -1, np.int64),
         "blk_step": z(bc, np.int64), "blk_kids": z(bc, np.int64), "blk_bb": z(bc, np.bool_),
-        "blk_ntx": z(bc, np.int64), "blk_tx": z((bc, t), np.int64), "blk_bal": z((bc, n)),
+        "blk_ntx": z(bc, np.int64), "blk_txoff": z(bc, np.int64), "blk_tx": z(TX_ENTRIES, np.int64), "blk_bal": z((bc, n)),
         "chn_ckpt": z(1, np.int64), "chn_canon": z(1, np.int64), "chn_cur": z(1, np.int64),
         "chn_mute": z(1, np.int64), "chn_stamp": z(1, np.int64), "chn_seq": z(1, np.int64),
-        "chn_nopen": z(1, np.int64), "chn_path": z(bc, np.int64),
+        "chn_nopen": z(1, np.int64), "chn_txtop": z(1, np.int64),
         "mp_live": z(t, np.bool_), "mp_cursor": z(1, np.int64), "mp_count": z(1, np.int64),
         "mp_for_buyer": z(n, np.int64), "mp_own": z(n, np.int64), "mp_kind": z(t, np.int64),
         "mp_origin": z(t, np.int64),
@@ -201,10 +217,19 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
     }
     for f in CHECKPOINTED:
         chain[f"ck_{f}"] = (chain["gas_paid"] if f == "gas_paid" else ledger[f]).copy()
+    for f in BLOCK_STATE:
+        kind, dims = _LEDGER_KINDS[f]
+        chain[f"bs_{f}"] = z(bc if dims == "1" else (bc, n), np.dtype(kind))
+    for f in TX_POOL:
+        chain[f"bs_{f}"] = z((bc, STATE_CAPACITY), ledger[f].dtype)
+    chain["chn_capmax"] = ledger["tx_cap"].copy()
     # genesis: slot 0, height 0, every robot's head, the checkpoint and the canonical head
     chain["blk_live"][0] = True
     chain["blk_hash"][0] = np.int64(int(seed) % (2**62))
     chain["blk_bal"][0] = ledger["balance"]
+    for f in BLOCK_STATE:  # genesis's state: the fresh ledger (no open transaction)
+        v = chain["gas_paid"] if f == "gas_paid" else ledger[f]
+        chain[f"bs_{f}"][0] = v[0] if v.shape == (1,) else v
     assert chain["ck_tx_seller"].shape[0] == pool
     SPEC.check(chain)
     return chain
@@ -218,11 +243,29 @@ def _grown(old: np.ndarray, axis: int, size: int, fill=0) -> np.ndarray:
     return new
 
 
+def _packed_entries(world, changes: dict, entries: int) -> dict:
+    """``blk_tx`` with the live blocks' entries packed to its front (in slot order), grown when the packed
+    entries and what the next step adds (``entries - chn_txtop``) do not fit twice."""
+    live = np.flatnonzero(world.blk_live)
+    off, ntx = world.blk_txoff, world.blk_ntx
+    used = int(ntx[live].sum())
+    size = max(world.blk_tx.shape[0], 2 * (used + entries - int(world.chn_txtop[0])))
+    new = np.zeros(size, np.int64)
+    new_off = changes.get("blk_txoff", off).copy()
+    top = 0
+    for b in live:
+        k = int(ntx[b])
+        new[top:top + k] = world.blk_tx[off[b]:off[b] + k]
+        new_off[b] = top
+        top += k
+    return {"blk_tx": new, "blk_txoff": new_off, "chn_txtop": np.array([top], np.int64)}
+
+
 def grow_chain(world, needs) -> dict:
     """Replacement arrays (field -> array) so the next step fits (``needs``: ``chain_needs`` of the world's
     view), at least doubling what grows; slots keep their numbers (nothing is moved).  Empty when nothing
     is short."""
-    mp, blocks, pool = int(needs[0]), int(needs[1]), int(needs[2])
+    mp, blocks, pool, opened, entries = int(needs[0]), int(needs[1]), int(needs[2]), int(needs[5]), int(needs[6])
     changes: dict = {}
     t = world.mp_live.shape[0]
     if mp > t:
@@ -232,17 +275,26 @@ def grow_chain(world, needs) -> dict:
             changes[f] = _grown(getattr(world, f), 0, size)
         for f in ("mp_known", "mp_old"):
             changes[f] = _grown(getattr(world, f), 1, _words(size))
-        changes["blk_tx"] = _grown(world.blk_tx, 1, size)
     bc = world.blk_live.shape[0]
     if blocks > bc:
         size = max(2 * bc, blocks)
         for f in ("blk_live", "blk_height", "blk_weight", "blk_hash", "blk_step", "blk_kids", "blk_bb", "blk_ntx",
-                  "chn_path"):
+                  "blk_txoff"):
             changes[f] = _grown(getattr(world, f), 0, size)
         for f in ("blk_parent", "blk_signer"):
             changes[f] = _grown(getattr(world, f), 0, size, -1)
-        changes["blk_tx"] = _grown(changes.get("blk_tx", world.blk_tx), 0, size)
         changes["blk_bal"] = _grown(world.blk_bal, 0, size)
+        for f in BLOCK_STATE:
+            changes[f"bs_{f}"] = _grown(getattr(world, f"bs_{f}"), 0, size)
+        for f in TX_POOL:
+            changes[f"bs_{f}"] = _grown(getattr(world, f"bs_{f}"), 0, size)
+    c = world.bs_tx_seller.shape[1]
+    if opened > c:
+        size = max(2 * c, opened)
+        for f in TX_POOL:
+            changes[f"bs_{f}"] = _grown(changes.get(f"bs_{f}", getattr(world, f"bs_{f}")), 1, size)
+    if entries > world.blk_tx.shape[0]:
+        changes.update(_packed_entries(world, changes, entries))
     p = world.tx_seller.shape[0]
     if pool > p:
         size = max(2 * p, pool)
@@ -252,7 +304,7 @@ def grow_chain(world, needs) -> dict:
     return changes
 
 
-@njit
+@njit(cache=True)
 def chain_needs(w):
     """What the next step may need at most, for the kernel's ``has_room`` and the host's growth alike:
     (mempool slots, block slots, transaction-pool entries, event rows, payment rows).  One transaction
@@ -273,23 +325,32 @@ def chain_needs(w):
     for b in range(w.blk_live.shape[0]):
         if w.blk_live[b]:
             live += 1
-    pool = max(w.pool_top[0], w.ck_pool_top[0])
+    pool = 0
+    packed = 0  # a block's state, loaded, packs the buyers' pool blocks at the bottom (load_state)
     open_ = 0
+    opened = 2 * links + n
     for i in range(n):
         grow = max(w.tx_count[i], w.ck_tx_count[i]) + w.mp_for_buyer[i] + 2 * w.nbr_count[i]
-        pool += 4 * (grow + 8) + 2 * max(w.tx_cap[i], w.ck_tx_cap[i])
+        cap = max(w.tx_cap[i], w.chn_capmax[i])
+        packed += cap
+        pool += 4 * (grow + 8) + 2 * cap
         open_ += grow
+        opened += w.ck_tx_count[i] + w.mp_for_buyer[i]
+    pool += max(w.pool_top[0], packed)
     mp = w.mp_count[0] + n + 2 * links
     events = w.ev_count[0] + n + 2 * links + mp
     payments = w.pay_count[0] + 2 * open_
-    return mp, live + due + 1, pool, events, payments
+    entries = w.chn_txtop[0] + (due + 1) * mp  # every block made holds at most the whole mempool
+    return mp, live + due + 1, pool, events, payments, opened, entries
 
 
 @njit
 def room_fits(w):
     """Does the next step fit in the chain's arrays (and, when recording, the logs)?"""
-    mp, blocks, pool, events, payments = chain_needs(w)
+    mp, blocks, pool, events, payments, opened, entries = chain_needs(w)
     if mp > w.mp_live.shape[0] or blocks > w.blk_live.shape[0] or pool > w.tx_seller.shape[0]:
+        return False
+    if opened > w.bs_tx_seller.shape[1] or entries > w.blk_tx.shape[0]:
         return False
     return not w.record or (events <= w.ev_step.shape[0] and payments <= w.pay_step.shape[0])
 
@@ -351,22 +412,6 @@ def due(w, signer, t):
 
 
 @njit
-def path_from_checkpoint(w, target):
-    """The branch from the checkpoint (excluded) to ``target`` in ``chn_path``, oldest first; its length."""
-    path = unlock(w.chn_path)
-    k = 0
-    b = target
-    ck = w.chn_ckpt[0]
-    while b != ck:
-        path[k] = b
-        k += 1
-        b = w.blk_parent[b]
-    for a in range(k // 2):
-        path[a], path[k - 1 - a] = path[k - 1 - a], path[a]
-    return k
-
-
-@njit
 def new_block(w, signer, t):
     """``signer`` makes a block on its head at step t, holding every pending transaction it knows that
     its branch does not include yet, in sending order.  Returns its slot (the ledger is not touched)."""
@@ -392,20 +437,23 @@ def new_block(w, signer, t):
     if w.blk_kids[parent] > 1:
         unlock(w.chn_forks)[0] += 1
     stamp = stamp_path(w, parent)
-    txs = unlock(w.blk_tx)
+    top = w.chn_txtop[0]
+    txs = unlock(w.blk_tx)[top:]
     k = 0
     for tx in range(w.mp_live.shape[0]):
         if w.mp_live[tx] and w.mp_mark[tx] != stamp and knows(w, signer, tx):
-            txs[b, k] = tx
+            txs[k] = tx
             k += 1
     for a in range(1, k):  # insertion sort by sending order (the slots are nearly in order already)
-        v = txs[b, a]
+        v = txs[a]
         c = a - 1
-        while c >= 0 and w.mp_seq[txs[b, c]] > w.mp_seq[v]:
-            txs[b, c + 1] = txs[b, c]
+        while c >= 0 and w.mp_seq[txs[c]] > w.mp_seq[v]:
+            txs[c + 1] = txs[c]
             c -= 1
-        txs[b, c + 1] = v
+        txs[c + 1] = v
+    unlock(w.blk_txoff)[b] = top
     unlock(w.blk_ntx)[b] = k
+    unlock(w.chn_txtop)[0] = top + k
     return b
 
 
@@ -495,21 +543,6 @@ def save_checkpoint(w):
 
 
 @njit
-def restore_checkpoint(w):
-    """The ledger arrays go back to the checkpoint's state (the block ``chn_cur`` is then the checkpoint)."""
-    _copy_ledger(w.ck_balance, w.ck_pot, w.ck_burned, w.ck_tx_off, w.ck_tx_cap, w.ck_tx_count, w.ck_tx_seller,
-                 w.ck_tx_site, w.ck_tx_dir, w.ck_tx_step, w.ck_tx_stake, w.ck_pool_top, w.ck_money,
-                 w.ck_rep_settled, w.ck_rep_reduced, w.ck_rep_earned, w.ck_rep_stake_lost, w.ck_rep_deposits,
-                 w.ck_gas_paid,
-                 unlock(w.balance), unlock(w.pot), unlock(w.burned), unlock(w.tx_off), unlock(w.tx_cap),
-                 unlock(w.tx_count), unlock(w.tx_seller), unlock(w.tx_site), unlock(w.tx_dir), unlock(w.tx_step),
-                 unlock(w.tx_stake), unlock(w.pool_top), unlock(w.money), unlock(w.rep_settled),
-                 unlock(w.rep_reduced), unlock(w.rep_earned), unlock(w.rep_stake_lost), unlock(w.rep_deposits),
-                 unlock(w.gas_paid))
-    unlock(w.chn_cur)[0] = w.chn_ckpt[0]
-
-
-@njit
 def _copy_ledger(balance, pot, burned, tx_off, tx_cap, tx_count, tx_seller, tx_site, tx_dir, tx_step, tx_stake,
                  pool_top, money, rep_settled, rep_reduced, rep_earned, rep_stake_lost, rep_deposits, gas_paid,
                  o_balance, o_pot, o_burned, o_tx_off, o_tx_cap, o_tx_count, o_tx_seller, o_tx_site, o_tx_dir,
@@ -546,16 +579,78 @@ def set_current(w, b):
 
 
 @njit
-def snapshot(w, b):
-    """Block b's balance snapshot: the ledger arrays' balances (they hold b's state)."""
-    bal = unlock(w.blk_bal)
-    for i in range(w.balance.shape[0]):
+def save_state(w, b):
+    """Block b's state (``blk_bal``, ``bs_*``): the ledger arrays' (they hold the state after b), with each
+    buyer's open transactions packed in buyer order."""
+    n = w.balance.shape[0]
+    bal, pot, cap, count = unlock(w.blk_bal), unlock(w.bs_pot), unlock(w.bs_tx_cap), unlock(w.bs_tx_count)
+    settled, reduced, earned = unlock(w.bs_rep_settled), unlock(w.bs_rep_reduced), unlock(w.bs_rep_earned)
+    lost, deposits, gas = unlock(w.bs_rep_stake_lost), unlock(w.bs_rep_deposits), unlock(w.bs_gas_paid)
+    seller, site, dirs = unlock(w.bs_tx_seller), unlock(w.bs_tx_site), unlock(w.bs_tx_dir)
+    step, stake, capmax = unlock(w.bs_tx_step), unlock(w.bs_tx_stake), unlock(w.chn_capmax)
+    k = 0
+    for i in range(n):
         bal[b, i] = w.balance[i]
+        pot[b, i] = w.pot[i]
+        cap[b, i] = w.tx_cap[i]
+        count[b, i] = w.tx_count[i]
+        settled[b, i] = w.rep_settled[i]
+        reduced[b, i] = w.rep_reduced[i]
+        earned[b, i] = w.rep_earned[i]
+        lost[b, i] = w.rep_stake_lost[i]
+        deposits[b, i] = w.rep_deposits[i]
+        gas[b, i] = w.gas_paid[i]
+        if w.tx_cap[i] > capmax[i]:
+            capmax[i] = w.tx_cap[i]
+        a = w.tx_off[i]
+        for x in range(a, a + w.tx_count[i]):
+            seller[b, k] = w.tx_seller[x]
+            site[b, k] = w.tx_site[x]
+            dirs[b, k] = w.tx_dir[x]
+            step[b, k] = w.tx_step[x]
+            stake[b, k] = w.tx_stake[x]
+            k += 1
+    unlock(w.bs_burned)[b] = w.burned[0]
+    unlock(w.bs_money)[b] = w.money[0]
 
 
 @njit
-def mute(w, on):
-    unlock(w.chn_mute)[0] = 1 if on else 0
+def load_state(w, b):
+    """The ledger arrays get block b's state (``save_state``): the same values, with the buyers' blocks of
+    the transaction pool packed from its bottom.  ``chn_cur`` is then b."""
+    n = w.balance.shape[0]
+    balance, pot, off, cap, count = (unlock(w.balance), unlock(w.pot), unlock(w.tx_off), unlock(w.tx_cap),
+                                     unlock(w.tx_count))
+    settled, reduced, earned = unlock(w.rep_settled), unlock(w.rep_reduced), unlock(w.rep_earned)
+    lost, deposits, gas = unlock(w.rep_stake_lost), unlock(w.rep_deposits), unlock(w.gas_paid)
+    seller, site, dirs = unlock(w.tx_seller), unlock(w.tx_site), unlock(w.tx_dir)
+    step, stake = unlock(w.tx_step), unlock(w.tx_stake)
+    k = 0
+    top = 0
+    for i in range(n):
+        balance[i] = w.blk_bal[b, i]
+        pot[i] = w.bs_pot[b, i]
+        cap[i] = w.bs_tx_cap[b, i]
+        count[i] = w.bs_tx_count[b, i]
+        settled[i] = w.bs_rep_settled[b, i]
+        reduced[i] = w.bs_rep_reduced[b, i]
+        earned[i] = w.bs_rep_earned[b, i]
+        lost[i] = w.bs_rep_stake_lost[b, i]
+        deposits[i] = w.bs_rep_deposits[b, i]
+        gas[i] = w.bs_gas_paid[b, i]
+        off[i] = top
+        for x in range(top, top + count[i]):
+            seller[x] = w.bs_tx_seller[b, k]
+            site[x] = w.bs_tx_site[b, k]
+            dirs[x] = w.bs_tx_dir[b, k]
+            step[x] = w.bs_tx_step[b, k]
+            stake[x] = w.bs_tx_stake[b, k]
+            k += 1
+        top += cap[i]
+    unlock(w.pool_top)[0] = top
+    unlock(w.burned)[0] = w.bs_burned[b]
+    unlock(w.money)[0] = w.bs_money[b]
+    unlock(w.chn_cur)[0] = b
 
 
 @njit(inline="always")
@@ -612,7 +707,7 @@ def new_canonical(w, b):
         ck = w.chn_ckpt[0]
         while x != ck:
             for k in range(w.blk_ntx[x]):
-                if w.mp_mark[w.blk_tx[x, k]] != stamp:
+                if w.mp_mark[w.blk_tx[w.blk_txoff[x] + k]] != stamp:
                     dropped += 1
             x = w.blk_parent[x]
         unlock(w.chn_reorgs)[0] += 1
@@ -649,7 +744,7 @@ def move_checkpoint(w, c):
     live, known = unlock(w.mp_live), unlock(w.mp_known)
     n = known.shape[0]
     for k in range(w.blk_ntx[c]):
-        tx = w.blk_tx[c, k]
+        tx = w.blk_tx[w.blk_txoff[c] + k]
         if not live[tx]:
             continue
         live[tx] = False

@@ -102,7 +102,7 @@ def stamp_path(w, target):
     ck = w.chn_ckpt[0]
     while b >= 0 and b != ck:
         for k in range(w.blk_ntx[b]):
-            mark[w.blk_tx[b, k]] = stamp
+            mark[w.blk_tx[w.blk_txoff[b] + k]] = stamp
         b = w.blk_parent[b]
     return stamp
 
