@@ -62,9 +62,10 @@ def gas_schedule(scheme: str, stake: float) -> tuple[float, tuple[int, ...]]:
 #: The checkpoint's copy of each ledger field (``ck_<field>``).
 CHECKPOINTED = ("balance", "pot", "burned", "tx_off", "tx_cap", "tx_count", *TX_POOL, "pool_top", "money",
                 "rep_settled", "rep_reduced", "rep_earned", "rep_stake_lost", "rep_deposits", "gas_paid")
-#: The ledger fields each block keeps (``bs_<field>``; the balances are ``blk_bal``, the open transactions
-#: ``bs_tx_*`` packed), so the state after any live block is a copy away: nothing is replayed.
-BLOCK_STATE = ("pot", "burned", "tx_cap", "tx_count", "money", "rep_settled", "rep_reduced", "rep_earned",
+#: The ledger fields each block keeps (``bs_<field>``; the balances are ``blk_bal``; each buyer's open
+#: transactions are a version of its list, ``bs_ver``), so the state after any live block is a copy away:
+#: nothing is replayed.
+BLOCK_STATE = ("pot", "burned", "tx_count", "money", "rep_settled", "rep_reduced", "rep_earned",
                "rep_stake_lost", "rep_deposits", "gas_paid")
 _LEDGER_KINDS = {"balance": ("float64", "n"), "pot": ("float64", "n"), "burned": ("float64", "1"),
                  "tx_off": ("int64", "n"), "tx_cap": ("int64", "n"), "tx_count": ("int64", "n"),
@@ -119,9 +120,14 @@ SPEC = Spec("chain", [
         ("blk_bal", "float64", "Bc,n", "every robot's balance after it"),
         *[(f"bs_{f}", _LEDGER_KINDS[f][0], "Bc" if _LEDGER_KINDS[f][1] == "1" else "Bc,n",
            f"{f} after the block (its ledger state, with blk_bal)") for f in BLOCK_STATE],
-        *[(f"bs_{f}", _LEDGER_KINDS[f][0], "Bc,C", f"{f} of the open transactions after the block, buyer "
-                                                   f"by buyer (bs_tx_count of each), packed") for f in TX_POOL],
-        ("chn_capmax", "int64", "n", "largest transaction-pool block any saved state gave each buyer"),
+        ("bs_ver", "int64", "Bc,n", "each buyer's open transactions after the block: ls_*[v : v + "
+                                    "bs_tx_count[b, i]] for v = bs_ver[b, i] (-1: none)"),
+        *[(f"ls_{f[3:]}", _LEDGER_KINDS[f][0], "L", f"{f} of saved versions of the buyers' lists of open "
+                                                    f"transactions (append-only; the host packs it)")
+          for f in TX_POOL],
+        ("chn_lstop", "int64", "1", "first unused entry of ls_*"),
+        ("chn_ver", "int64", "n", "version (bs_ver) of each buyer's list the ledger arrays hold; -2: changed "
+                                  "by the block being applied, not saved yet"),
         ("chn_ckpt", "int64", "1", "the checkpoint's slot"),
         ("chn_canon", "int64", "1", "the canonical head's slot"),
         ("chn_cur", "int64", "1", "the block whose state the ledger arrays hold"),
@@ -170,8 +176,8 @@ BLOCK_CAPACITY = 16
 MEMPOOL_CAPACITY = 128
 #: First size of the blocks' transaction lists (``blk_tx``).
 TX_ENTRIES = 1024
-#: First capacity of a block's state for open transactions (``bs_tx_*``).
-STATE_CAPACITY = 64
+#: First size of the saved versions of buyers' lists (``ls_*``).
+LIST_ENTRIES = 1024
 
 
 def _words(t: int) -> int:
@@ -220,9 +226,11 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
     for f in BLOCK_STATE:
         kind, dims = _LEDGER_KINDS[f]
         chain[f"bs_{f}"] = z(bc if dims == "1" else (bc, n), np.dtype(kind))
+    chain["bs_ver"] = np.full((bc, n), -1, np.int64)
     for f in TX_POOL:
-        chain[f"bs_{f}"] = z((bc, STATE_CAPACITY), ledger[f].dtype)
-    chain["chn_capmax"] = ledger["tx_cap"].copy()
+        chain[f"ls_{f[3:]}"] = z(LIST_ENTRIES, ledger[f].dtype)
+    chain["chn_lstop"] = z(1, np.int64)
+    chain["chn_ver"] = np.full(n, -1, np.int64)
     # genesis: slot 0, height 0, every robot's head, the checkpoint and the canonical head
     chain["blk_live"][0] = True
     chain["blk_hash"][0] = np.int64(int(seed) % (2**62))
@@ -261,11 +269,42 @@ def _packed_entries(world, changes: dict, entries: int) -> dict:
     return {"blk_tx": new, "blk_txoff": new_off, "chn_txtop": np.array([top], np.int64)}
 
 
+def _packed_lists(world, lists: int) -> dict:
+    """``ls_*`` with only the versions live blocks use, packed (``bs_ver`` and ``chn_ver`` renumbered),
+    grown when they and what the next step adds (``lists - chn_lstop``) do not fit twice."""
+    live = np.flatnonzero(world.blk_live)
+    ver, count = world.bs_ver[live].ravel(), world.bs_tx_count[live].ravel()
+    keep = ver >= 0
+    used, first = np.unique(ver[keep], return_index=True)
+    sizes = count[keep][first]
+    starts = (np.cumsum(sizes) - sizes).astype(np.int64)
+    total = int(sizes.sum())
+    index = np.repeat(used - starts, sizes) + np.arange(total, dtype=np.int64)
+    size = max(world.ls_seller.shape[0], 2 * (total + lists - int(world.chn_lstop[0])))
+    changes = {}
+    for f in TX_POOL:
+        old = getattr(world, f"ls_{f[3:]}")
+        new = np.zeros(size, old.dtype)
+        new[:total] = old[index]
+        changes[f"ls_{f[3:]}"] = new
+
+    def renumber(v):
+        out = v.copy()
+        hit = v >= 0
+        out[hit] = starts[np.searchsorted(used, v[hit])]
+        return out
+
+    bs_ver = world.bs_ver.copy()
+    bs_ver[live] = renumber(world.bs_ver[live])
+    changes.update(bs_ver=bs_ver, chn_ver=renumber(world.chn_ver), chn_lstop=np.array([total], np.int64))
+    return changes
+
+
 def grow_chain(world, needs) -> dict:
     """Replacement arrays (field -> array) so the next step fits (``needs``: ``chain_needs`` of the world's
     view), at least doubling what grows; slots keep their numbers (nothing is moved).  Empty when nothing
     is short."""
-    mp, blocks, pool, opened, entries = int(needs[0]), int(needs[1]), int(needs[2]), int(needs[5]), int(needs[6])
+    mp, blocks, pool, lists, entries = int(needs[0]), int(needs[1]), int(needs[2]), int(needs[5]), int(needs[6])
     changes: dict = {}
     t = world.mp_live.shape[0]
     if mp > t:
@@ -286,13 +325,9 @@ def grow_chain(world, needs) -> dict:
         changes["blk_bal"] = _grown(world.blk_bal, 0, size)
         for f in BLOCK_STATE:
             changes[f"bs_{f}"] = _grown(getattr(world, f"bs_{f}"), 0, size)
-        for f in TX_POOL:
-            changes[f"bs_{f}"] = _grown(getattr(world, f"bs_{f}"), 0, size)
-    c = world.bs_tx_seller.shape[1]
-    if opened > c:
-        size = max(2 * c, opened)
-        for f in TX_POOL:
-            changes[f"bs_{f}"] = _grown(changes.get(f"bs_{f}", getattr(world, f"bs_{f}")), 1, size)
+        changes["bs_ver"] = _grown(world.bs_ver, 0, size, -1)
+    if lists > world.ls_seller.shape[0]:
+        changes.update(_packed_lists(world, lists))
     if entries > world.blk_tx.shape[0]:
         changes.update(_packed_entries(world, changes, entries))
     p = world.tx_seller.shape[0]
@@ -325,32 +360,27 @@ def chain_needs(w):
     for b in range(w.blk_live.shape[0]):
         if w.blk_live[b]:
             live += 1
-    pool = 0
-    packed = 0  # a block's state, loaded, packs the buyers' pool blocks at the bottom (load_state)
+    pool = max(w.pool_top[0], w.ck_pool_top[0])
     open_ = 0
-    opened = 2 * links + n
-    for i in range(n):
+    for i in range(n):  # any live block's list of buyer i is its list at the checkpoint and pending reveals
         grow = max(w.tx_count[i], w.ck_tx_count[i]) + w.mp_for_buyer[i] + 2 * w.nbr_count[i]
-        cap = max(w.tx_cap[i], w.chn_capmax[i])
-        packed += cap
-        pool += 4 * (grow + 8) + 2 * cap
+        pool += 4 * (grow + 8) + 2 * max(w.tx_cap[i], w.ck_tx_cap[i])
         open_ += grow
-        opened += w.ck_tx_count[i] + w.mp_for_buyer[i]
-    pool += max(w.pool_top[0], packed)
     mp = w.mp_count[0] + n + 2 * links
     events = w.ev_count[0] + n + 2 * links + mp
     payments = w.pay_count[0] + 2 * open_
     entries = w.chn_txtop[0] + (due + 1) * mp  # every block made holds at most the whole mempool
-    return mp, live + due + 1, pool, events, payments, opened, entries
+    lists = w.chn_lstop[0] + (due + 1) * open_  # every block made saves at most every buyer's list
+    return mp, live + due + 1, pool, events, payments, lists, entries
 
 
 @njit
 def room_fits(w):
     """Does the next step fit in the chain's arrays (and, when recording, the logs)?"""
-    mp, blocks, pool, events, payments, opened, entries = chain_needs(w)
+    mp, blocks, pool, events, payments, lists, entries = chain_needs(w)
     if mp > w.mp_live.shape[0] or blocks > w.blk_live.shape[0] or pool > w.tx_seller.shape[0]:
         return False
-    if opened > w.bs_tx_seller.shape[1] or entries > w.blk_tx.shape[0]:
+    if lists > w.ls_seller.shape[0] or entries > w.blk_tx.shape[0]:
         return False
     return not w.record or (events <= w.ev_step.shape[0] and payments <= w.pay_step.shape[0])
 
@@ -466,6 +496,7 @@ def include_tx(w, b, tx):
     buyer = w.mp_buyer[tx]
     if w.mp_kind[tx] == DEPOSIT:
         unlock(w.chn_nopen)[0] = w.tx_count[buyer]
+        unlock(w.chn_ver)[buyer] = -2  # the settlement empties its list
         return True
     seller = w.mp_seller[tx]
     balance, money = unlock(w.balance), unlock(w.money)
@@ -489,6 +520,7 @@ def include_tx(w, b, tx):
         money[0] -= lock
         unlock(w.pot)[buyer] += lock
     x = w.tx_off[buyer] + count
+    unlock(w.chn_ver)[buyer] = -2
     unlock(w.tx_seller)[x] = seller
     unlock(w.tx_site)[x] = w.mp_site[tx]
     unlock(w.tx_dir)[x] = w.mp_dir[tx]
@@ -580,19 +612,17 @@ def set_current(w, b):
 
 @njit
 def save_state(w, b):
-    """Block b's state (``blk_bal``, ``bs_*``): the ledger arrays' (they hold the state after b), with each
-    buyer's open transactions packed in buyer order."""
+    """Block b's state (``blk_bal``, ``bs_*``): the ledger arrays' (they hold the state after b).  A
+    buyer's list of open transactions that the block changed is saved as a new version (``ls_*``); the
+    others keep the version they had."""
     n = w.balance.shape[0]
-    bal, pot, cap, count = unlock(w.blk_bal), unlock(w.bs_pot), unlock(w.bs_tx_cap), unlock(w.bs_tx_count)
+    bal, pot, count, ver = unlock(w.blk_bal), unlock(w.bs_pot), unlock(w.bs_tx_count), unlock(w.bs_ver)
     settled, reduced, earned = unlock(w.bs_rep_settled), unlock(w.bs_rep_reduced), unlock(w.bs_rep_earned)
     lost, deposits, gas = unlock(w.bs_rep_stake_lost), unlock(w.bs_rep_deposits), unlock(w.bs_gas_paid)
-    seller, site, dirs = unlock(w.bs_tx_seller), unlock(w.bs_tx_site), unlock(w.bs_tx_dir)
-    step, stake, capmax = unlock(w.bs_tx_step), unlock(w.bs_tx_stake), unlock(w.chn_capmax)
-    k = 0
+    cur = unlock(w.chn_ver)
     for i in range(n):
         bal[b, i] = w.balance[i]
         pot[b, i] = w.pot[i]
-        cap[b, i] = w.tx_cap[i]
         count[b, i] = w.tx_count[i]
         settled[b, i] = w.rep_settled[i]
         reduced[b, i] = w.rep_reduced[i]
@@ -600,54 +630,66 @@ def save_state(w, b):
         lost[b, i] = w.rep_stake_lost[i]
         deposits[b, i] = w.rep_deposits[i]
         gas[b, i] = w.gas_paid[i]
-        if w.tx_cap[i] > capmax[i]:
-            capmax[i] = w.tx_cap[i]
-        a = w.tx_off[i]
-        for x in range(a, a + w.tx_count[i]):
-            seller[b, k] = w.tx_seller[x]
-            site[b, k] = w.tx_site[x]
-            dirs[b, k] = w.tx_dir[x]
-            step[b, k] = w.tx_step[x]
-            stake[b, k] = w.tx_stake[x]
-            k += 1
+        if cur[i] == -2:
+            cur[i] = _save_list(w, i)
+        ver[b, i] = cur[i]
     unlock(w.bs_burned)[b] = w.burned[0]
     unlock(w.bs_money)[b] = w.money[0]
 
 
 @njit
+def _save_list(w, i):
+    """Buyer i's open transactions, as the ledger arrays hold them, as a new version; its number."""
+    k = w.tx_count[i]
+    if k == 0:
+        return -1
+    top = w.chn_lstop[0]
+    a = w.tx_off[i]
+    seller, site, dirs, step, stake = (unlock(w.ls_seller), unlock(w.ls_site), unlock(w.ls_dir),
+                                       unlock(w.ls_step), unlock(w.ls_stake))
+    for x in range(k):
+        seller[top + x] = w.tx_seller[a + x]
+        site[top + x] = w.tx_site[a + x]
+        dirs[top + x] = w.tx_dir[a + x]
+        step[top + x] = w.tx_step[a + x]
+        stake[top + x] = w.tx_stake[a + x]
+    unlock(w.chn_lstop)[0] = top + k
+    return top
+
+
+@njit
 def load_state(w, b):
-    """The ledger arrays get block b's state (``save_state``): the same values, with the buyers' blocks of
-    the transaction pool packed from its bottom.  ``chn_cur`` is then b."""
+    """The ledger arrays get block b's state (``save_state``); a buyer's list of open transactions is
+    copied only when the arrays hold another version of it.  ``chn_cur`` is then b."""
     n = w.balance.shape[0]
-    balance, pot, off, cap, count = (unlock(w.balance), unlock(w.pot), unlock(w.tx_off), unlock(w.tx_cap),
-                                     unlock(w.tx_count))
+    balance, pot, count = unlock(w.balance), unlock(w.pot), unlock(w.tx_count)
     settled, reduced, earned = unlock(w.rep_settled), unlock(w.rep_reduced), unlock(w.rep_earned)
     lost, deposits, gas = unlock(w.rep_stake_lost), unlock(w.rep_deposits), unlock(w.gas_paid)
     seller, site, dirs = unlock(w.tx_seller), unlock(w.tx_site), unlock(w.tx_dir)
-    step, stake = unlock(w.tx_step), unlock(w.tx_stake)
-    k = 0
-    top = 0
+    step, stake, cur = unlock(w.tx_step), unlock(w.tx_stake), unlock(w.chn_ver)
     for i in range(n):
         balance[i] = w.blk_bal[b, i]
         pot[i] = w.bs_pot[b, i]
-        cap[i] = w.bs_tx_cap[b, i]
-        count[i] = w.bs_tx_count[b, i]
         settled[i] = w.bs_rep_settled[b, i]
         reduced[i] = w.bs_rep_reduced[b, i]
         earned[i] = w.bs_rep_earned[b, i]
         lost[i] = w.bs_rep_stake_lost[b, i]
         deposits[i] = w.bs_rep_deposits[b, i]
         gas[i] = w.bs_gas_paid[b, i]
-        off[i] = top
-        for x in range(top, top + count[i]):
-            seller[x] = w.bs_tx_seller[b, k]
-            site[x] = w.bs_tx_site[b, k]
-            dirs[x] = w.bs_tx_dir[b, k]
-            step[x] = w.bs_tx_step[b, k]
-            stake[x] = w.bs_tx_stake[b, k]
-            k += 1
-        top += cap[i]
-    unlock(w.pool_top)[0] = top
+        v = w.bs_ver[b, i]
+        if v == cur[i]:
+            continue
+        k = w.bs_tx_count[b, i]
+        reserve(w, i, k)  # the host keeps room (chain_needs)
+        a = w.tx_off[i]
+        for x in range(k):
+            seller[a + x] = w.ls_seller[v + x]
+            site[a + x] = w.ls_site[v + x]
+            dirs[a + x] = w.ls_dir[v + x]
+            step[a + x] = w.ls_step[v + x]
+            stake[a + x] = w.ls_stake[v + x]
+        count[i] = k
+        cur[i] = v
     unlock(w.burned)[0] = w.bs_burned[b]
     unlock(w.money)[0] = w.bs_money[b]
     unlock(w.chn_cur)[0] = b
