@@ -166,7 +166,7 @@ def test_lost_messages_follow_the_loss_probability():
         tx = int(np.flatnonzero(w.mp_live)[0])
         sim.step(1)
         got += (int(w.mp_known[1, tx >> 6]) >> (tx & 63)) & 1
-        sim.world.mp_live[:] = False  # (test only) empty the mempool again
+        sim.world.mp_live[:] = False  # (test only) empty the mempool again (its sending order too)
         sim.world.mp_count[0] = 0
         sim.world.mp_known[:] = 0
     assert abs(got / 4000 - 0.7) < 0.035

@@ -101,7 +101,10 @@ SPEC = Spec("chain", [
         ("view_bal", "float64", "n", "each robot's own balance at its head"),
         ("view_old", "int64", "n", "heads at the start of the gossip phase (what neighbours hear)"),
         ("view_avail", "float64", "n", "money each robot's view lets it spend: balance at its head less "
-                                        "its own pending reveals' stakes and gas"),
+                                        "its own pending reveals' stakes and gas (up to date unless view_stale)"),
+        ("view_stale", "bool", "n", "its head moved since view_avail was computed (mempool.refresh_view, "
+                                    "done when the robot next sells or its head is dropped)"),
+        ("chn_nblk", "int64", "1", "live blocks"),
         ("gas_paid", "float64", "n", "gas each robot has paid on the canonical chain"),
         ("blk_live", "bool", "Bc", "slot holds a block (the checkpoint or one after it)"),
         ("blk_parent", "int64", "Bc", "parent slot (-1 for the checkpoint)"),
@@ -138,6 +141,7 @@ SPEC = Spec("chain", [
         ("chn_nopen", "int64", "1", "reveals the deposit being applied settles"),
         ("mp_live", "bool", "T", "slot holds a pending transaction"),
         ("mp_cursor", "int64", "1", "where the next free slot is looked for"),
+        ("mp_order", "int64", "T", "the pending transactions' slots in sending order (the first mp_count)"),
         ("mp_count", "int64", "1", "pending transactions"),
         ("mp_for_buyer", "int64", "n", "pending reveals per buyer"),
         ("mp_own", "int64", "n", "pending reveals per seller (0: its view is its balance at its head)"),
@@ -201,6 +205,7 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
         "chn_final": int(finality), "view_height": z(n, np.int64), "view_weight": z(n, np.int64),
         "view_hash": np.full(n, np.int64(int(seed) % (2**62)), np.int64), "view_bal": ledger["balance"].copy(),
         "view_head": z(n, np.int64), "view_old": z(n, np.int64), "view_avail": ledger["balance"].copy(),
+        "view_stale": z(n, np.bool_), "chn_nblk": np.ones(1, np.int64),
         "gas_paid": z(n),
         "blk_live": z(bc, np.bool_), "blk_parent": np.full(bc, -1, np.int64), "blk_height": z(bc, np.int64),
         "blk_weight": z(bc, np.int64), "blk_hash": z(bc, np.int64), "blk_signer": np.full(bc, -1, np.int64),
@@ -209,7 +214,7 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
         "chn_ckpt": z(1, np.int64), "chn_canon": z(1, np.int64), "chn_cur": z(1, np.int64),
         "chn_mute": z(1, np.int64), "chn_stamp": z(1, np.int64), "chn_seq": z(1, np.int64),
         "chn_nopen": z(1, np.int64), "chn_txtop": z(1, np.int64),
-        "mp_live": z(t, np.bool_), "mp_cursor": z(1, np.int64), "mp_count": z(1, np.int64),
+        "mp_live": z(t, np.bool_), "mp_cursor": z(1, np.int64), "mp_order": z(t, np.int64), "mp_count": z(1, np.int64),
         "mp_for_buyer": z(n, np.int64), "mp_own": z(n, np.int64), "mp_kind": z(t, np.int64),
         "mp_origin": z(t, np.int64),
         "mp_buyer": z(t, np.int64), "mp_seller": z(t, np.int64), "mp_site": z(t, np.int64), "mp_dir": z(t),
@@ -269,7 +274,7 @@ def _packed_entries(world, changes: dict, entries: int) -> dict:
     return {"blk_tx": new, "blk_txoff": new_off, "chn_txtop": np.array([top], np.int64)}
 
 
-def _packed_lists(world, lists: int) -> dict:
+def _packed_lists(world, changes: dict, lists: int) -> dict:
     """``ls_*`` with only the versions live blocks use, packed (``bs_ver`` and ``chn_ver`` renumbered),
     grown when they and what the next step adds (``lists - chn_lstop``) do not fit twice."""
     live = np.flatnonzero(world.blk_live)
@@ -281,12 +286,12 @@ def _packed_lists(world, lists: int) -> dict:
     total = int(sizes.sum())
     index = np.repeat(used - starts, sizes) + np.arange(total, dtype=np.int64)
     size = max(world.ls_seller.shape[0], 2 * (total + lists - int(world.chn_lstop[0])))
-    changes = {}
+    out = {}
     for f in TX_POOL:
         old = getattr(world, f"ls_{f[3:]}")
         new = np.zeros(size, old.dtype)
         new[:total] = old[index]
-        changes[f"ls_{f[3:]}"] = new
+        out[f"ls_{f[3:]}"] = new
 
     def renumber(v):
         out = v.copy()
@@ -294,10 +299,10 @@ def _packed_lists(world, lists: int) -> dict:
         out[hit] = starts[np.searchsorted(used, v[hit])]
         return out
 
-    bs_ver = world.bs_ver.copy()
+    bs_ver = changes.get("bs_ver", world.bs_ver).copy()  # (grown already when the block slots grew)
     bs_ver[live] = renumber(world.bs_ver[live])
-    changes.update(bs_ver=bs_ver, chn_ver=renumber(world.chn_ver), chn_lstop=np.array([total], np.int64))
-    return changes
+    out.update(bs_ver=bs_ver, chn_ver=renumber(world.chn_ver), chn_lstop=np.array([total], np.int64))
+    return out
 
 
 def grow_chain(world, needs) -> dict:
@@ -310,7 +315,7 @@ def grow_chain(world, needs) -> dict:
     if mp > t:
         size = 64 * _words(max(2 * t, mp))
         for f in ("mp_live", "mp_kind", "mp_origin", "mp_buyer", "mp_seller", "mp_site", "mp_dir", "mp_stake",
-                  "mp_gas", "mp_step", "mp_seq", "mp_mark", "mp_bb"):
+                  "mp_gas", "mp_step", "mp_seq", "mp_mark", "mp_bb", "mp_order"):
             changes[f] = _grown(getattr(world, f), 0, size)
         for f in ("mp_known", "mp_old"):
             changes[f] = _grown(getattr(world, f), 1, _words(size))
@@ -327,7 +332,7 @@ def grow_chain(world, needs) -> dict:
             changes[f"bs_{f}"] = _grown(getattr(world, f"bs_{f}"), 0, size)
         changes["bs_ver"] = _grown(world.bs_ver, 0, size, -1)
     if lists > world.ls_seller.shape[0]:
-        changes.update(_packed_lists(world, lists))
+        changes.update(_packed_lists(world, changes, lists))
     if entries > world.blk_tx.shape[0]:
         changes.update(_packed_entries(world, changes, entries))
     p = world.tx_seller.shape[0]
@@ -356,10 +361,7 @@ def chain_needs(w):
         h = w.view_head[w.chn_signers[k]]
         if h >= 0 and t - w.blk_step[h] >= w.chn_period:
             due += 1
-    live = 0
-    for b in range(w.blk_live.shape[0]):
-        if w.blk_live[b]:
-            live += 1
+    live = w.chn_nblk[0]
     pool = max(w.pool_top[0], w.ck_pool_top[0])
     open_ = 0
     for i in range(n):  # any live block's list of buyer i is its list at the checkpoint and pending reveals
@@ -369,8 +371,8 @@ def chain_needs(w):
     mp = w.mp_count[0] + n + 2 * links
     events = w.ev_count[0] + n + 2 * links + mp
     payments = w.pay_count[0] + 2 * open_
-    entries = w.chn_txtop[0] + (due + 1) * mp  # every block made holds at most the whole mempool
-    lists = w.chn_lstop[0] + (due + 1) * open_  # every block made saves at most every buyer's list
+    entries = w.chn_txtop[0] + (due + 2) * mp  # every block made holds at most the whole mempool
+    lists = w.chn_lstop[0] + (due + 2) * open_  # every block made saves at most every buyer's list
     return mp, live + due + 1, pool, events, payments, lists, entries
 
 
@@ -387,20 +389,19 @@ def room_fits(w):
 
 @njit
 def can_make(w):
-    """Is there room for one more block this step (a free slot; log rows for its settlements)?  A signer
-    that finds none makes its block in a later step, after the host has grown the arrays."""
-    free = False
-    for b in range(w.blk_live.shape[0]):
-        if not w.blk_live[b]:
-            free = True
-            break
-    if not free:
+    """Is there room for one more block this step (a free slot, room for its transactions and its
+    buyers' lists, log rows for its settlements)?  A signer that finds none makes its block in a later
+    step, after the host has grown the arrays (``chain_needs`` plans for the signers due at the step's
+    start and two more, so this is rare)."""
+    if w.chn_nblk[0] >= w.blk_live.shape[0] or w.chn_txtop[0] + w.mp_count[0] > w.blk_tx.shape[0]:
+        return False
+    payments = 0  # any branch's open transactions: its checkpoint's and the pending reveals
+    for i in range(w.tx_count.shape[0]):
+        payments += max(w.tx_count[i], w.ck_tx_count[i]) + w.mp_for_buyer[i]
+    if w.chn_lstop[0] + payments > w.ls_seller.shape[0]:
         return False
     if not w.record:
         return True
-    payments = 0
-    for i in range(w.tx_count.shape[0]):
-        payments += max(w.tx_count[i], w.ck_tx_count[i]) + w.mp_for_buyer[i]
     return (w.ev_count[0] + w.mp_count[0] <= w.ev_step.shape[0]
             and w.pay_count[0] + payments <= w.pay_step.shape[0])
 
@@ -452,6 +453,7 @@ def new_block(w, signer, t):
         b += 1  # the host keeps a free slot for every block a step can make
     height = w.blk_height[parent] + 1
     live[b] = True
+    unlock(w.chn_nblk)[0] += 1
     unlock(w.blk_parent)[b] = parent
     unlock(w.blk_height)[b] = height
     unlock(w.blk_weight)[b] = w.blk_weight[parent] + (2 if in_turn(w, height) == signer else 1)
@@ -470,17 +472,11 @@ def new_block(w, signer, t):
     top = w.chn_txtop[0]
     txs = unlock(w.blk_tx)[top:]
     k = 0
-    for tx in range(w.mp_live.shape[0]):
-        if w.mp_live[tx] and w.mp_mark[tx] != stamp and knows(w, signer, tx):
+    for a in range(w.mp_count[0]):  # in sending order
+        tx = w.mp_order[a]
+        if w.mp_mark[tx] != stamp and knows(w, signer, tx):
             txs[k] = tx
             k += 1
-    for a in range(1, k):  # insertion sort by sending order (the slots are nearly in order already)
-        v = txs[a]
-        c = a - 1
-        while c >= 0 and w.mp_seq[txs[c]] > w.mp_seq[v]:
-            txs[c + 1] = txs[c]
-            c -= 1
-        txs[c + 1] = v
     unlock(w.blk_txoff)[b] = top
     unlock(w.blk_ntx)[b] = k
     unlock(w.chn_txtop)[0] = top + k
@@ -713,7 +709,7 @@ def set_head(w, i, b):
     unlock(w.view_weight)[i] = w.blk_weight[b]
     unlock(w.view_hash)[i] = w.blk_hash[b]
     unlock(w.view_bal)[i] = w.blk_bal[b, i]
-    refresh_view(w, i)
+    unlock(w.view_stale)[i] = True
 
 
 @njit
@@ -785,6 +781,7 @@ def move_checkpoint(w, c):
     save_checkpoint(w)
     live, known = unlock(w.mp_live), unlock(w.mp_known)
     n = known.shape[0]
+    pending = w.mp_count[0]
     for k in range(w.blk_ntx[c]):
         tx = w.blk_tx[w.blk_txoff[c] + k]
         if not live[tx]:
@@ -798,16 +795,25 @@ def move_checkpoint(w, c):
         bit = ~(np.uint64(1) << np.uint64(tx & 63))
         for i in range(n):
             known[i, word] &= bit
+    order = unlock(w.mp_order)
+    k = 0
+    for a in range(pending):  # the pending ones, still in sending order
+        if live[order[a]]:
+            order[k] = order[a]
+            k += 1
     hc = w.blk_height[c]
     blive = unlock(w.blk_live)
     for b in range(blive.shape[0]):
         if blive[b] and b != c and ancestor_at(w, b, hc) != c:
             blive[b] = False
+            unlock(w.chn_nblk)[0] -= 1
     unlock(w.blk_parent)[c] = -1
     unlock(w.chn_ckpt)[0] = c
     for i in range(n):
         h = w.view_head[i]
         if h >= 0 and not blive[h]:
+            if w.view_stale[i]:
+                refresh_view(w, i)  # what its view allowed on the dropped head
             unlock(w.view_head)[i] = -1
 
 
@@ -843,8 +849,9 @@ def gossip(w):
         if best >= 0:
             set_head(w, i, best)
     if w.chn_backbone and w.chn_latency > 0:
-        for tx in range(w.mp_live.shape[0]):
-            if w.mp_live[tx] and not w.mp_bb[tx] and w.mp_step[tx] + w.chn_latency <= t:
+        for a in range(w.mp_count[0]):
+            tx = w.mp_order[a]
+            if not w.mp_bb[tx] and w.mp_step[tx] + w.chn_latency <= t:
                 unlock(w.mp_bb)[tx] = True
                 for i in range(n):
                     learn(w, i, tx)

@@ -111,16 +111,29 @@ def stamp_path(w, target):
 def refresh_view(w, i):
     """Robot i's spendable money at its head: its balance there, less the gas and stakes of its own
     reveals that its head's branch does not include yet (in pool order; all of them when its branch was
-    dropped, ``view_head`` -1)."""
+    dropped, ``view_head`` -1).  Done when the robot sells or its head is dropped, if its head moved
+    since (``view_stale``): nothing it reads changes in between except by those."""
+    unlock(w.view_stale)[i] = False
     a = w.view_bal[i]
-    if w.mp_own[i] == 0:  # nothing of its own pending: no branch to look at
+    own = w.mp_own[i]
+    if own == 0:  # nothing of its own pending: no branch to look at
         unlock(w.view_avail)[i] = a
         return
     stamp = stamp_path(w, w.view_head[i])
-    for tx in range(w.mp_live.shape[0]):
-        if w.mp_live[tx] and w.mp_origin[tx] == i and w.mp_kind[tx] == REVEAL and w.mp_mark[tx] != stamp:
-            a -= w.mp_gas[tx]
-            a -= w.mp_stake[tx]
+    slots = np.empty(own, np.int64)
+    k = 0
+    for x in range(w.mp_count[0]):
+        tx = w.mp_order[x]
+        if w.mp_origin[tx] == i and w.mp_kind[tx] == REVEAL and w.mp_mark[tx] != stamp:
+            c = k  # insertion by slot: subtracted in pool order
+            while c > 0 and slots[c - 1] > tx:
+                slots[c] = slots[c - 1]
+                c -= 1
+            slots[c] = tx
+            k += 1
+    for x in range(k):
+        a -= w.mp_gas[slots[x]]
+        a -= w.mp_stake[slots[x]]
     unlock(w.view_avail)[i] = a
 
 
@@ -149,6 +162,7 @@ def new_tx(w, kind, origin, buyer, seller, site, direction, stake, gas):
     unlock(w.mp_seq)[x] = w.chn_seq[0]
     unlock(w.chn_seq)[0] += 1
     unlock(w.mp_mark)[x] = 0
+    unlock(w.mp_order)[w.mp_count[0]] = x
     unlock(w.mp_count)[0] += 1
     if w.chn_backbone and w.chn_latency == 0:
         for i in range(w.view_head.shape[0]):
@@ -169,6 +183,8 @@ def _reveal(w, buyer, seller, site, direction):
     must cover the stake and the reveal's gas (the instant ledger's check, on the view).  The buyer gets
     the vector at once (off-chain light contract); the reveal goes to the mempool."""
     gas = w.chn_gas_price * w.chn_gas_reveal
+    if w.view_stale[seller]:
+        refresh_view(w, seller)
     avail = unlock(w.view_avail)
     lock = 0.0
     if w.stake > 0.0 or gas > 0.0:
