@@ -367,7 +367,7 @@ def chain_variant(settle) -> ChainStep:
             ledger_at(w, parent)
             apply_block(w, b, rng)
             _blocks.set_current(w, b)
-            _blocks.save_state(w, b)
+            _blocks.save_state(w, b, parent)
             _blocks.adopt(w, s, b)
             if w.chn_backbone and w.chn_latency == 0:
                 _blocks.deliver_block(w, b)
@@ -377,8 +377,10 @@ def chain_variant(settle) -> ChainStep:
             if c < 0:
                 break
             ledger_at(w, c)
+            _blocks.materialise_all(w)
             _blocks.move_checkpoint(w, c)
         ledger_at(w, w.chn_canon[0])
+        _blocks.materialise_all(w)
 
     @njit
     def gossip(w):

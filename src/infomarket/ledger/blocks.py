@@ -31,7 +31,7 @@ from numba import njit
 from ..state.spec import Spec, fields
 from ..state.view import unlock
 from .kernels import reserve
-from .mempool import DEPOSIT, REVEAL, STAKE_TOLERANCE, chance, knows, learn, mix, refresh_view, stamp_path
+from .mempool import DEPOSIT, REVEAL, STAKE_TOLERANCE, chance, knows, learn, mix, on_branch, refresh_view
 from .state import TX_POOL
 
 # ---- gas (docs/gas.md, measured on the contract: in-process revm, Cancun rules, solc 0.8.28) ----------
@@ -121,6 +121,8 @@ SPEC = Spec("chain", [
                                   "blk_tx[blk_txoff[b] : blk_txoff[b] + blk_ntx[b]]"),
         ("chn_txtop", "int64", "1", "first unused entry of blk_tx (the host packs the live blocks' entries)"),
         ("blk_bal", "float64", "Bc,n", "every robot's balance after it"),
+        ("blk_inc", "uint64", "Bc,T/64", "bit tx: pending transaction tx is included on its branch after the "
+                                         "checkpoint"),
         *[(f"bs_{f}", _LEDGER_KINDS[f][0], "Bc" if _LEDGER_KINDS[f][1] == "1" else "Bc,n",
            f"{f} after the block (its ledger state, with blk_bal)") for f in BLOCK_STATE],
         ("bs_ver", "int64", "Bc,n", "each buyer's open transactions after the block: ls_*[v : v + "
@@ -136,7 +138,6 @@ SPEC = Spec("chain", [
         ("chn_cur", "int64", "1", "the block whose state the ledger arrays hold"),
         ("chn_mute", "int64", "1", "1 mutes the event and payment logs and the measures (blocks are applied "
                                    "once each and never replayed: stays 0)"),
-        ("chn_stamp", "int64", "1", "last stamp of mp_mark"),
         ("chn_seq", "int64", "1", "transactions sent so far (their order)"),
         ("chn_nopen", "int64", "1", "reveals the deposit being applied settles"),
         ("mp_live", "bool", "T", "slot holds a pending transaction"),
@@ -155,7 +156,6 @@ SPEC = Spec("chain", [
         ("mp_gas", "float64", "T", "gas cost the sender's view set aside"),
         ("mp_step", "int64", "T", "step it was sent"),
         ("mp_seq", "int64", "T", "its place in sending order"),
-        ("mp_mark", "int64", "T", "scratch stamp (mempool.stamp_path)"),
         ("mp_bb", "bool", "T", "delivered by the backbone"),
         ("mp_known", "uint64", "n,T/64", "bit tx of row i: robot i knows transaction tx"),
         ("mp_old", "uint64", "n,T/64", "known-bits at the start of the gossip phase"),
@@ -210,16 +210,16 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
         "blk_live": z(bc, np.bool_), "blk_parent": np.full(bc, -1, np.int64), "blk_height": z(bc, np.int64),
         "blk_weight": z(bc, np.int64), "blk_hash": z(bc, np.int64), "blk_signer": np.full(bc, -1, np.int64),
         "blk_step": z(bc, np.int64), "blk_kids": z(bc, np.int64), "blk_bb": z(bc, np.bool_),
-        "blk_ntx": z(bc, np.int64), "blk_txoff": z(bc, np.int64), "blk_tx": z(TX_ENTRIES, np.int64), "blk_bal": z((bc, n)),
+        "blk_ntx": z(bc, np.int64), "blk_txoff": z(bc, np.int64), "blk_tx": z(TX_ENTRIES, np.int64), "blk_bal": z((bc, n)), "blk_inc": z((bc, _words(t)), np.uint64),
         "chn_ckpt": z(1, np.int64), "chn_canon": z(1, np.int64), "chn_cur": z(1, np.int64),
-        "chn_mute": z(1, np.int64), "chn_stamp": z(1, np.int64), "chn_seq": z(1, np.int64),
+        "chn_mute": z(1, np.int64), "chn_seq": z(1, np.int64),
         "chn_nopen": z(1, np.int64), "chn_txtop": z(1, np.int64),
         "mp_live": z(t, np.bool_), "mp_cursor": z(1, np.int64), "mp_order": z(t, np.int64), "mp_count": z(1, np.int64),
         "mp_for_buyer": z(n, np.int64), "mp_own": z(n, np.int64), "mp_kind": z(t, np.int64),
         "mp_origin": z(t, np.int64),
         "mp_buyer": z(t, np.int64), "mp_seller": z(t, np.int64), "mp_site": z(t, np.int64), "mp_dir": z(t),
         "mp_stake": z(t), "mp_gas": z(t), "mp_step": z(t, np.int64), "mp_seq": z(t, np.int64),
-        "mp_mark": z(t, np.int64), "mp_bb": z(t, np.bool_),
+        "mp_bb": z(t, np.bool_),
         "mp_known": z((n, _words(t)), np.uint64), "mp_old": z((n, _words(t)), np.uint64),
         "chn_blocks": z(1, np.int64), "chn_forks": z(1, np.int64), "chn_reorgs": z(1, np.int64),
         "chn_reorg_tx": z(1, np.int64), "chn_view_reorgs": z(1, np.int64), "chn_failed": z(1, np.int64),
@@ -315,9 +315,9 @@ def grow_chain(world, needs) -> dict:
     if mp > t:
         size = 64 * _words(max(2 * t, mp))
         for f in ("mp_live", "mp_kind", "mp_origin", "mp_buyer", "mp_seller", "mp_site", "mp_dir", "mp_stake",
-                  "mp_gas", "mp_step", "mp_seq", "mp_mark", "mp_bb", "mp_order"):
+                  "mp_gas", "mp_step", "mp_seq", "mp_bb", "mp_order"):
             changes[f] = _grown(getattr(world, f), 0, size)
-        for f in ("mp_known", "mp_old"):
+        for f in ("mp_known", "mp_old", "blk_inc"):
             changes[f] = _grown(getattr(world, f), 1, _words(size))
     bc = world.blk_live.shape[0]
     if blocks > bc:
@@ -328,6 +328,7 @@ def grow_chain(world, needs) -> dict:
         for f in ("blk_parent", "blk_signer"):
             changes[f] = _grown(getattr(world, f), 0, size, -1)
         changes["blk_bal"] = _grown(world.blk_bal, 0, size)
+        changes["blk_inc"] = _grown(changes.get("blk_inc", world.blk_inc), 0, size)
         for f in BLOCK_STATE:
             changes[f"bs_{f}"] = _grown(getattr(world, f"bs_{f}"), 0, size)
         changes["bs_ver"] = _grown(world.bs_ver, 0, size, -1)
@@ -468,15 +469,28 @@ def new_block(w, signer, t):
     unlock(w.chn_blocks)[0] += 1
     if w.blk_kids[parent] > 1:
         unlock(w.chn_forks)[0] += 1
-    stamp = stamp_path(w, parent)
     top = w.chn_txtop[0]
     txs = unlock(w.blk_tx)[top:]
+    inc = unlock(w.blk_inc)
     k = 0
-    for a in range(w.mp_count[0]):  # in sending order
-        tx = w.mp_order[a]
-        if w.mp_mark[tx] != stamp and knows(w, signer, tx):
-            txs[k] = tx
+    for word in range(inc.shape[1]):  # known (so pending) and not on the parent's branch
+        m = w.mp_known[signer, word] & ~inc[parent, word]
+        inc[b, word] = inc[parent, word] | m
+        while m != np.uint64(0):
+            low = m & (~m + np.uint64(1))
+            bit = 0
+            while (low >> np.uint64(bit)) != np.uint64(1):
+                bit += 1
+            txs[k] = word * 64 + bit
             k += 1
+            m ^= low
+    for a in range(1, k):  # insertion sort into sending order (the slots are nearly in order already)
+        v = txs[a]
+        c = a - 1
+        while c >= 0 and w.mp_seq[txs[c]] > w.mp_seq[v]:
+            txs[c + 1] = txs[c]
+            c -= 1
+        txs[c + 1] = v
     unlock(w.blk_txoff)[b] = top
     unlock(w.blk_ntx)[b] = k
     unlock(w.chn_txtop)[0] = top + k
@@ -490,6 +504,7 @@ def include_tx(w, b, tx):
     buyer's open list gets it; else it fails and moves nothing.  A deposit: True, the caller settles it
     (``distribute`` pays the reward and the sellers) and then calls ``finish_deposit``."""
     buyer = w.mp_buyer[tx]
+    materialise(w, buyer)
     if w.mp_kind[tx] == DEPOSIT:
         unlock(w.chn_nopen)[0] = w.tx_count[buyer]
         unlock(w.chn_ver)[buyer] = -2  # the settlement empties its list
@@ -607,10 +622,10 @@ def set_current(w, b):
 
 
 @njit
-def save_state(w, b):
-    """Block b's state (``blk_bal``, ``bs_*``): the ledger arrays' (they hold the state after b).  A
-    buyer's list of open transactions that the block changed is saved as a new version (``ls_*``); the
-    others keep the version they had."""
+def save_state(w, b, parent):
+    """Block b's state (``blk_bal``, ``bs_*``): the ledger arrays' (they hold the state after b, made on
+    ``parent``).  A buyer's list of open transactions that the block changed is saved as a new version
+    (``ls_*``); the others keep their version in the parent."""
     n = w.balance.shape[0]
     bal, pot, count, ver = unlock(w.blk_bal), unlock(w.bs_pot), unlock(w.bs_tx_count), unlock(w.bs_ver)
     settled, reduced, earned = unlock(w.bs_rep_settled), unlock(w.bs_rep_reduced), unlock(w.bs_rep_earned)
@@ -628,7 +643,9 @@ def save_state(w, b):
         gas[b, i] = w.gas_paid[i]
         if cur[i] == -2:
             cur[i] = _save_list(w, i)
-        ver[b, i] = cur[i]
+            ver[b, i] = cur[i]
+        else:
+            ver[b, i] = ver[parent, i]
     unlock(w.bs_burned)[b] = w.burned[0]
     unlock(w.bs_money)[b] = w.money[0]
 
@@ -655,40 +672,55 @@ def _save_list(w, i):
 
 @njit
 def load_state(w, b):
-    """The ledger arrays get block b's state (``save_state``); a buyer's list of open transactions is
-    copied only when the arrays hold another version of it.  ``chn_cur`` is then b."""
+    """The ledger arrays get block b's state (``save_state``), except the buyers' lists of open
+    transactions, which ``materialise`` copies when they are needed.  ``chn_cur`` is then b."""
     n = w.balance.shape[0]
     balance, pot, count = unlock(w.balance), unlock(w.pot), unlock(w.tx_count)
     settled, reduced, earned = unlock(w.rep_settled), unlock(w.rep_reduced), unlock(w.rep_earned)
     lost, deposits, gas = unlock(w.rep_stake_lost), unlock(w.rep_deposits), unlock(w.gas_paid)
-    seller, site, dirs = unlock(w.tx_seller), unlock(w.tx_site), unlock(w.tx_dir)
-    step, stake, cur = unlock(w.tx_step), unlock(w.tx_stake), unlock(w.chn_ver)
     for i in range(n):
         balance[i] = w.blk_bal[b, i]
         pot[i] = w.bs_pot[b, i]
+        count[i] = w.bs_tx_count[b, i]
         settled[i] = w.bs_rep_settled[b, i]
         reduced[i] = w.bs_rep_reduced[b, i]
         earned[i] = w.bs_rep_earned[b, i]
         lost[i] = w.bs_rep_stake_lost[b, i]
         deposits[i] = w.bs_rep_deposits[b, i]
         gas[i] = w.bs_gas_paid[b, i]
-        v = w.bs_ver[b, i]
-        if v == cur[i]:
-            continue
-        k = w.bs_tx_count[b, i]
-        reserve(w, i, k)  # the host keeps room (chain_needs)
-        a = w.tx_off[i]
-        for x in range(k):
-            seller[a + x] = w.ls_seller[v + x]
-            site[a + x] = w.ls_site[v + x]
-            dirs[a + x] = w.ls_dir[v + x]
-            step[a + x] = w.ls_step[v + x]
-            stake[a + x] = w.ls_stake[v + x]
-        count[i] = k
-        cur[i] = v
     unlock(w.burned)[0] = w.bs_burned[b]
     unlock(w.money)[0] = w.bs_money[b]
     unlock(w.chn_cur)[0] = b
+
+
+@njit
+def materialise(w, i):
+    """Buyer i's open transactions in the ledger arrays are those of the current block's state (a copy of
+    that version unless the arrays hold it already, or a block being applied has changed them)."""
+    v = w.bs_ver[w.chn_cur[0], i]
+    cur = unlock(w.chn_ver)
+    if cur[i] == -2 or cur[i] == v:
+        return
+    k = w.bs_tx_count[w.chn_cur[0], i]
+    unlock(w.tx_count)[i] = 0  # (nothing of the other version to move)
+    reserve(w, i, k)  # the host keeps room (chain_needs)
+    a = w.tx_off[i]
+    seller, site, dirs = unlock(w.tx_seller), unlock(w.tx_site), unlock(w.tx_dir)
+    step, stake = unlock(w.tx_step), unlock(w.tx_stake)
+    for x in range(k):
+        seller[a + x] = w.ls_seller[v + x]
+        site[a + x] = w.ls_site[v + x]
+        dirs[a + x] = w.ls_dir[v + x]
+        step[a + x] = w.ls_step[v + x]
+        stake[a + x] = w.ls_stake[v + x]
+    unlock(w.tx_count)[i] = k
+    cur[i] = v
+
+
+@njit
+def materialise_all(w):
+    for i in range(w.balance.shape[0]):
+        materialise(w, i)
 
 
 @njit(inline="always")
@@ -739,13 +771,12 @@ def new_canonical(w, b):
         return old
     unlock(w.chn_canon)[0] = b
     if ancestor_at(w, b, w.blk_height[old]) != old:
-        stamp = stamp_path(w, b)
         dropped = 0
         x = old
         ck = w.chn_ckpt[0]
         while x != ck:
             for k in range(w.blk_ntx[x]):
-                if w.mp_mark[w.blk_tx[w.blk_txoff[x] + k]] != stamp:
+                if not on_branch(w, b, w.blk_tx[w.blk_txoff[x] + k]):
                     dropped += 1
             x = w.blk_parent[x]
         unlock(w.chn_reorgs)[0] += 1
@@ -802,11 +833,17 @@ def move_checkpoint(w, c):
             order[k] = order[a]
             k += 1
     hc = w.blk_height[c]
-    blive = unlock(w.blk_live)
+    blive, inc = unlock(w.blk_live), unlock(w.blk_inc)
     for b in range(blive.shape[0]):
-        if blive[b] and b != c and ancestor_at(w, b, hc) != c:
+        if not blive[b]:
+            continue
+        if b != c and ancestor_at(w, b, hc) != c:
             blive[b] = False
             unlock(w.chn_nblk)[0] -= 1
+            continue
+        for k in range(w.blk_ntx[c]):  # final now: they leave every branch's pending set
+            tx = w.blk_tx[w.blk_txoff[c] + k]
+            inc[b, tx >> 6] &= ~(np.uint64(1) << np.uint64(tx & 63))
     unlock(w.blk_parent)[c] = -1
     unlock(w.chn_ckpt)[0] = c
     for i in range(n):

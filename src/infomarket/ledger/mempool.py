@@ -91,20 +91,11 @@ def learn(w, i, tx):
     unlock(w.mp_known)[i, tx >> 6] |= np.uint64(1) << np.uint64(tx & 63)
 
 
-@njit
-def stamp_path(w, target):
-    """Mark (``mp_mark``) every pending transaction included on the branch from the checkpoint (excluded)
-    to ``target``; returns the stamp: ``mp_mark[tx] == stamp`` iff ``tx`` is on that branch."""
-    stamp = w.chn_stamp[0] + 1
-    unlock(w.chn_stamp)[0] = stamp
-    mark = unlock(w.mp_mark)
-    b = target
-    ck = w.chn_ckpt[0]
-    while b >= 0 and b != ck:
-        for k in range(w.blk_ntx[b]):
-            mark[w.blk_tx[w.blk_txoff[b] + k]] = stamp
-        b = w.blk_parent[b]
-    return stamp
+@njit(inline="always")
+def on_branch(w, b, tx):
+    """Is pending transaction ``tx`` included on block b's branch after the checkpoint (``blk_inc``)?
+    Nothing is for b = -1 (a dropped head)."""
+    return b >= 0 and (w.blk_inc[b, tx >> 6] >> np.uint64(tx & 63)) & np.uint64(1) != np.uint64(0)
 
 
 @njit
@@ -119,12 +110,12 @@ def refresh_view(w, i):
     if own == 0:  # nothing of its own pending: no branch to look at
         unlock(w.view_avail)[i] = a
         return
-    stamp = stamp_path(w, w.view_head[i])
+    h = w.view_head[i]
     slots = np.empty(own, np.int64)
     k = 0
     for x in range(w.mp_count[0]):
         tx = w.mp_order[x]
-        if w.mp_origin[tx] == i and w.mp_kind[tx] == REVEAL and w.mp_mark[tx] != stamp:
+        if w.mp_origin[tx] == i and w.mp_kind[tx] == REVEAL and not on_branch(w, h, tx):
             c = k  # insertion by slot: subtracted in pool order
             while c > 0 and slots[c - 1] > tx:
                 slots[c] = slots[c - 1]
@@ -161,7 +152,6 @@ def new_tx(w, kind, origin, buyer, seller, site, direction, stake, gas):
     unlock(w.mp_step)[x] = w.clock[0]
     unlock(w.mp_seq)[x] = w.chn_seq[0]
     unlock(w.chn_seq)[0] += 1
-    unlock(w.mp_mark)[x] = 0
     unlock(w.mp_order)[w.mp_count[0]] = x
     unlock(w.mp_count)[0] += 1
     if w.chn_backbone and w.chn_latency == 0:
