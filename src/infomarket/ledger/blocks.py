@@ -31,7 +31,8 @@ from numba import njit
 from ..state.spec import Spec, fields
 from ..state.view import unlock
 from .kernels import reserve
-from .mempool import DEPOSIT, REVEAL, STAKE_TOLERANCE, chance, knows, learn, mix, on_branch, refresh_view
+from .mempool import (DEPOSIT, REVEAL, STAKE_TOLERANCE, chance, drop_own, knows, learn, mix, on_branch,
+                      refresh_view)
 from .state import TX_POOL
 
 # ---- gas (docs/gas.md, measured on the contract: in-process revm, Cancun rules, solc 0.8.28) ----------
@@ -143,6 +144,11 @@ SPEC = Spec("chain", [
         ("mp_live", "bool", "T", "slot holds a pending transaction"),
         ("mp_cursor", "int64", "1", "where the next free slot is looked for"),
         ("mp_order", "int64", "T", "the pending transactions' slots in sending order (the first mp_count)"),
+        ("mp_words", "int64", "1", "words of known-bits in use: every pending slot is below 64 x mp_words"),
+        ("mp_onext", "int64", "T", "a pending reveal's sender's next own pending reveal (-1: none)"),
+        ("mp_oprev", "int64", "T", "... and previous one (-1: none)"),
+        ("own_first", "int64", "n", "each robot's oldest own pending reveal (-1: none)"),
+        ("own_last", "int64", "n", "each robot's newest own pending reveal (-1: none)"),
         ("mp_count", "int64", "1", "pending transactions"),
         ("mp_for_buyer", "int64", "n", "pending reveals per buyer"),
         ("mp_own", "int64", "n", "pending reveals per seller (0: its view is its balance at its head)"),
@@ -214,7 +220,9 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
         "chn_ckpt": z(1, np.int64), "chn_canon": z(1, np.int64), "chn_cur": z(1, np.int64),
         "chn_mute": z(1, np.int64), "chn_seq": z(1, np.int64),
         "chn_nopen": z(1, np.int64), "chn_txtop": z(1, np.int64),
-        "mp_live": z(t, np.bool_), "mp_cursor": z(1, np.int64), "mp_order": z(t, np.int64), "mp_count": z(1, np.int64),
+        "mp_live": z(t, np.bool_), "mp_cursor": z(1, np.int64), "mp_order": z(t, np.int64),
+        "mp_words": z(1, np.int64), "mp_onext": np.full(t, -1, np.int64), "mp_oprev": np.full(t, -1, np.int64),
+        "own_first": np.full(n, -1, np.int64), "own_last": np.full(n, -1, np.int64), "mp_count": z(1, np.int64),
         "mp_for_buyer": z(n, np.int64), "mp_own": z(n, np.int64), "mp_kind": z(t, np.int64),
         "mp_origin": z(t, np.int64),
         "mp_buyer": z(t, np.int64), "mp_seller": z(t, np.int64), "mp_site": z(t, np.int64), "mp_dir": z(t),
@@ -315,7 +323,7 @@ def grow_chain(world, needs) -> dict:
     if mp > t:
         size = 64 * _words(max(2 * t, mp))
         for f in ("mp_live", "mp_kind", "mp_origin", "mp_buyer", "mp_seller", "mp_site", "mp_dir", "mp_stake",
-                  "mp_gas", "mp_step", "mp_seq", "mp_bb", "mp_order"):
+                  "mp_gas", "mp_step", "mp_seq", "mp_bb", "mp_order", "mp_onext", "mp_oprev"):
             changes[f] = _grown(getattr(world, f), 0, size)
         for f in ("mp_known", "mp_old", "blk_inc"):
             changes[f] = _grown(getattr(world, f), 1, _words(size))
@@ -474,6 +482,9 @@ def new_block(w, signer, t):
     inc = unlock(w.blk_inc)
     k = 0
     for word in range(inc.shape[1]):  # known (so pending) and not on the parent's branch
+        if word >= w.mp_words[0]:
+            inc[b, word] = 0
+            continue
         m = w.mp_known[signer, word] & ~inc[parent, word]
         inc[b, word] = inc[parent, word] | m
         while m != np.uint64(0):
@@ -822,16 +833,21 @@ def move_checkpoint(w, c):
         if w.mp_kind[tx] == REVEAL:
             unlock(w.mp_for_buyer)[w.mp_buyer[tx]] -= 1
             unlock(w.mp_own)[w.mp_origin[tx]] -= 1
+            drop_own(w, tx)
         word = tx >> 6
         bit = ~(np.uint64(1) << np.uint64(tx & 63))
         for i in range(n):
             known[i, word] &= bit
     order = unlock(w.mp_order)
     k = 0
+    top = 0
     for a in range(pending):  # the pending ones, still in sending order
         if live[order[a]]:
             order[k] = order[a]
+            top = max(top, order[k])
             k += 1
+    unlock(w.mp_words)[0] = (top >> 6) + 1 if k > 0 else 0
+    unlock(w.mp_cursor)[0] = 0  # new transactions take the lowest free slots
     hc = w.blk_height[c]
     blive, inc = unlock(w.blk_live), unlock(w.blk_inc)
     for b in range(blive.shape[0]):
@@ -866,7 +882,7 @@ def gossip(w):
     n = w.view_head.shape[0]
     old, heads = unlock(w.view_old), w.view_head
     mold, known = unlock(w.mp_old), unlock(w.mp_known)
-    words = known.shape[1]
+    words = w.mp_words[0]  # (known-bits beyond are all 0)
     for i in range(n):
         old[i] = heads[i]
         for k in range(words):

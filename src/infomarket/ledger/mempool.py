@@ -101,8 +101,8 @@ def on_branch(w, b, tx):
 @njit
 def refresh_view(w, i):
     """Robot i's spendable money at its head: its balance there, less the gas and stakes of its own
-    reveals that its head's branch does not include yet (in pool order; all of them when its branch was
-    dropped, ``view_head`` -1).  Done when the robot sells or its head is dropped, if its head moved
+    reveals that its head's branch does not include yet (in sending order; all of them when its branch
+    was dropped, ``view_head`` -1).  Done when the robot sells or its head is dropped, if its head moved
     since (``view_stale``): nothing it reads changes in between except by those."""
     unlock(w.view_stale)[i] = False
     a = w.view_bal[i]
@@ -111,20 +111,12 @@ def refresh_view(w, i):
         unlock(w.view_avail)[i] = a
         return
     h = w.view_head[i]
-    slots = np.empty(own, np.int64)
-    k = 0
-    for x in range(w.mp_count[0]):
-        tx = w.mp_order[x]
-        if w.mp_origin[tx] == i and w.mp_kind[tx] == REVEAL and not on_branch(w, h, tx):
-            c = k  # insertion by slot: subtracted in pool order
-            while c > 0 and slots[c - 1] > tx:
-                slots[c] = slots[c - 1]
-                c -= 1
-            slots[c] = tx
-            k += 1
-    for x in range(k):
-        a -= w.mp_gas[slots[x]]
-        a -= w.mp_stake[slots[x]]
+    tx = w.own_first[i]
+    while tx >= 0:  # its own pending reveals, in sending order
+        if not on_branch(w, h, tx):
+            a -= w.mp_gas[tx]
+            a -= w.mp_stake[tx]
+        tx = w.mp_onext[tx]
     unlock(w.view_avail)[i] = a
 
 
@@ -134,13 +126,15 @@ def new_tx(w, kind, origin, buyer, seller, site, direction, stake, gas):
     of zero latency).  The host keeps a free slot for every transaction a step can make."""
     live = unlock(w.mp_live)
     cap = live.shape[0]
-    x = w.mp_cursor[0]
+    x = w.mp_cursor[0]  # the lowest free slot (the cursor goes back to 0 when slots are freed)
     for _ in range(cap):
         if not live[x]:
             break
         x = (x + 1) % cap
     live[x] = True
     unlock(w.mp_cursor)[0] = (x + 1) % cap
+    if x >> 6 >= w.mp_words[0]:
+        unlock(w.mp_words)[0] = (x >> 6) + 1
     unlock(w.mp_kind)[x] = kind
     unlock(w.mp_origin)[x] = origin
     unlock(w.mp_buyer)[x] = buyer
@@ -164,7 +158,30 @@ def new_tx(w, kind, origin, buyer, seller, site, direction, stake, gas):
     if kind == REVEAL:
         unlock(w.mp_for_buyer)[buyer] += 1
         unlock(w.mp_own)[origin] += 1
+        last = w.own_last[origin]
+        unlock(w.mp_oprev)[x] = last
+        unlock(w.mp_onext)[x] = -1
+        if last >= 0:
+            unlock(w.mp_onext)[last] = x
+        else:
+            unlock(w.own_first)[origin] = x
+        unlock(w.own_last)[origin] = x
     return x
+
+
+@njit
+def drop_own(w, tx):
+    """Take reveal ``tx`` out of its sender's list of own pending reveals."""
+    i = w.mp_origin[tx]
+    p, q = w.mp_oprev[tx], w.mp_onext[tx]
+    if p >= 0:
+        unlock(w.mp_onext)[p] = q
+    else:
+        unlock(w.own_first)[i] = q
+    if q >= 0:
+        unlock(w.mp_oprev)[q] = p
+    else:
+        unlock(w.own_last)[i] = p
 
 
 @njit
