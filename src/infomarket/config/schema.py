@@ -176,6 +176,16 @@ class Chain(_Strict):
     #: A block this many blocks below the canonical head is final (earlier, once every robot's head is
     #: on it); branches that do not contain it are dropped.
     finality: PosInt = 32
+    #: [start, end): during steps start <= t < end no chain message (gossip, backbone) passes between the
+    #: two sides of the perpendicular bisector of the first food site and the first nest; none by default.
+    partition: tuple[NonNegInt, NonNegInt] | None = None
+
+    @model_validator(mode="after")
+    def _partition_window(self) -> "Chain":
+        if self.partition is not None and self.partition[1] <= self.partition[0]:
+            raise ConfigError(f"chain.partition = [{self.partition[0]}, {self.partition[1]}]: the end step must "
+                              f"come after the start step")
+        return self
 
     @property
     def enabled(self) -> bool:
@@ -378,4 +388,6 @@ class Experiment(_Strict):
         terrain.drop_defaults(data)  # setups on the paper's plane keep the hashes they always had
         if data.get("chain") == Chain().model_dump():
             data.pop("chain")  # and so do setups on the instant ledger
+        elif data.get("chain", {}).get("partition", 0) is None:
+            data["chain"].pop("partition")  # and chain setups without a partition
         return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:16]

@@ -53,7 +53,7 @@ def chain_of(cfg: Experiment, ledger: dict, rng: np.random.Generator) -> dict:
                               signers=c.signers or list(range(cfg.swarm.robots)), backbone=c.backbone,
                               latency=c.latency, loss=c.loss, gas_price=c.gas_price, gas_reveal=reveal,
                               gas_table=list(zip(blocks.GAS_DEPOSIT_N, deposit)), seed=chain_seed(rng),
-                              finality=c.finality)
+                              finality=c.finality, partition=c.partition)
 
 
 def make_room(world: World, tx_need: np.ndarray | None = None) -> World:

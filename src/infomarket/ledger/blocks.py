@@ -31,8 +31,8 @@ from numba import njit
 from ..state.spec import Spec, fields
 from ..state.view import unlock
 from .kernels import reserve
-from .mempool import (DEPOSIT, REVEAL, STAKE_TOLERANCE, chance, drop_own, knows, learn, mix, on_branch,
-                      refresh_view)
+from .mempool import (DEPOSIT, REVEAL, STAKE_TOLERANCE, chance, drop_own, knows, learn, mix, nest_side, on_branch,
+                      partitioned, refresh_view)
 from .state import TX_POOL
 
 # ---- gas (docs/gas.md, measured on the contract: in-process revm, Cancun rules, solc 0.8.28) ----------
@@ -92,6 +92,8 @@ SPEC = Spec("chain", [
         ("chn_gas_deposit", "float64", "G", "deposit-gas table: gas"),
         ("chn_seed", "int", "", "seed of the chain's own draws (message loss)"),
         ("chn_final", "int", "", "finality depth F: a block F blocks below the canonical head is final"),
+        ("chn_part_start", "int", "", "first step of the partition (-1: none)"),
+        ("chn_part_end", "int", "", "step the partition ends (not partitioned any more)"),
     ]),
     *fields("ledger", [
         ("view_head", "int64", "n", "each robot's head block (a slot of the block store; -1: its branch "
@@ -195,7 +197,7 @@ def _words(t: int) -> int:
 
 
 def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: bool, latency: int, loss: float,
-                gas_price: float, gas_reveal: float, gas_table, seed: int, finality: int) -> dict:
+                gas_price: float, gas_reveal: float, gas_table, seed: int, finality: int, partition=None) -> dict:
     """The chain's state for a fresh ledger: the genesis block (every robot's head), an empty mempool,
     the checkpoint a copy of the ledger."""
     n = ledger["balance"].shape[0]
@@ -208,7 +210,9 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
         "chn_backbone": bool(backbone), "chn_latency": int(latency), "chn_loss": float(loss),
         "chn_gas_price": float(gas_price), "chn_gas_reveal": float(gas_reveal),
         "chn_gas_n": np.array(ns, np.float64), "chn_gas_deposit": np.array(gs, np.float64), "chn_seed": int(seed),
-        "chn_final": int(finality), "view_height": z(n, np.int64), "view_weight": z(n, np.int64),
+        "chn_final": int(finality),
+        "chn_part_start": -1 if partition is None else int(partition[0]),
+        "chn_part_end": -1 if partition is None else int(partition[1]), "view_height": z(n, np.int64), "view_weight": z(n, np.int64),
         "view_hash": np.full(n, np.int64(int(seed) % (2**62)), np.int64), "view_bal": ledger["balance"].copy(),
         "view_head": z(n, np.int64), "view_old": z(n, np.int64), "view_avail": ledger["balance"].copy(),
         "view_stale": z(n, np.bool_), "chn_nblk": np.ones(1, np.int64),
@@ -766,7 +770,14 @@ def adopt(w, i, b):
 
 @njit
 def deliver_block(w, b):
-    """The backbone brings block b to every robot."""
+    """The backbone brings block b to every robot; during a partition only to the robots on its signer's
+    side, and to the others once it ends (``gossip``)."""
+    if partitioned(w, w.clock[0]):
+        side = w.blk_signer[b] >= 0 and nest_side(w, w.blk_signer[b])
+        for i in range(w.view_head.shape[0]):
+            if nest_side(w, i) == side:
+                adopt(w, i, b)
+        return
     unlock(w.blk_bb)[b] = True
     for i in range(w.view_head.shape[0]):
         adopt(w, i, b)
@@ -872,6 +883,8 @@ def move_checkpoint(w, c):
 
 # ---- compiled: gossip ---------------------------------------------------------------------------------
 
+
+
 @njit
 def gossip(w):
     """One gossip round at the start of a step: every robot hears each neighbour's head and pending
@@ -888,12 +901,15 @@ def gossip(w):
         for k in range(words):
             mold[i, k] = known[i, k]
     loss = w.chn_loss
+    cut = partitioned(w, t)
     for i in range(n):
         best = -1
         for a in range(w.nbr_count[i]):
             j = w.nbr[i, a]
             if loss > 0.0 and chance(w.chn_seed, t, j, i) < loss:
                 continue
+            if cut and nest_side(w, i) != nest_side(w, j):
+                continue  # the partition: nothing crosses the bisector
             c = old[j]
             if c >= 0 and c != heads[i] and (heavier(w, c, best) if best >= 0 else heavier_than_view(w, c, i)):
                 best = c
@@ -901,13 +917,16 @@ def gossip(w):
                 known[i, k] |= mold[j, k]
         if best >= 0:
             set_head(w, i, best)
-    if w.chn_backbone and w.chn_latency > 0:
+    if w.chn_backbone and (w.chn_latency > 0 or w.chn_part_start >= 0):
         for a in range(w.mp_count[0]):
             tx = w.mp_order[a]
             if not w.mp_bb[tx] and w.mp_step[tx] + w.chn_latency <= t:
-                unlock(w.mp_bb)[tx] = True
+                side = nest_side(w, w.mp_origin[tx])
+                if not cut:
+                    unlock(w.mp_bb)[tx] = True
                 for i in range(n):
-                    learn(w, i, tx)
+                    if not cut or nest_side(w, i) == side:
+                        learn(w, i, tx)
         for b in range(w.blk_live.shape[0]):
             if w.blk_live[b] and not w.blk_bb[b] and w.blk_step[b] + w.chn_latency <= t:
                 deliver_block(w, b)

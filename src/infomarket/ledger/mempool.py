@@ -120,6 +120,28 @@ def refresh_view(w, i):
     unlock(w.view_avail)[i] = a
 
 
+@njit(inline="always")
+def partitioned(w, t):
+    """Is the chain's network partitioned at step t (``[chain] partition``)?"""
+    return w.chn_part_start <= t < w.chn_part_end
+
+
+@njit
+def nest_side(w, i):
+    """Is robot i on the nest's side of the perpendicular bisector of the first food site and the first
+    nest (on it counts as the nest's side)?"""
+    f = -1
+    m = -1
+    for s in range(w.sites_kind.shape[0]):
+        if w.sites_kind[s] == 0 and f < 0:
+            f = s
+        elif w.sites_kind[s] == 1 and m < 0:
+            m = s
+    fx, fy = w.sites_xy[f, 0], w.sites_xy[f, 1]
+    nx, ny = w.sites_xy[m, 0], w.sites_xy[m, 1]
+    return ((w.pos[i, 0] - 0.5 * (fx + nx)) * (nx - fx) + (w.pos[i, 1] - 0.5 * (fy + ny)) * (ny - fy)) >= 0.0
+
+
 @njit
 def new_tx(w, kind, origin, buyer, seller, site, direction, stake, gas):
     """Put a transaction in the mempool, known to its sender (and to everyone at once through a backbone
@@ -148,10 +170,16 @@ def new_tx(w, kind, origin, buyer, seller, site, direction, stake, gas):
     unlock(w.chn_seq)[0] += 1
     unlock(w.mp_order)[w.mp_count[0]] = x
     unlock(w.mp_count)[0] += 1
-    if w.chn_backbone and w.chn_latency == 0:
+    if w.chn_backbone and w.chn_latency == 0 and not partitioned(w, w.clock[0]):
         for i in range(w.view_head.shape[0]):
             learn(w, i, x)
         unlock(w.mp_bb)[x] = True
+    elif w.chn_backbone and w.chn_latency == 0:  # partitioned: its side at once, the rest when it ends
+        side = nest_side(w, origin)
+        for i in range(w.view_head.shape[0]):
+            if nest_side(w, i) == side:
+                learn(w, i, x)
+        unlock(w.mp_bb)[x] = False
     else:
         learn(w, origin, x)
         unlock(w.mp_bb)[x] = False
