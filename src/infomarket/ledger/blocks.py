@@ -274,7 +274,7 @@ def _packed_entries(world, changes: dict, entries: int) -> dict:
     live = np.flatnonzero(world.blk_live)
     off, ntx = world.blk_txoff, world.blk_ntx
     used = int(ntx[live].sum())
-    size = max(world.blk_tx.shape[0], 2 * (used + entries - int(world.chn_txtop[0])))
+    size = max(world.blk_tx.shape[0], 4 * (used + entries - int(world.chn_txtop[0])))
     new = np.zeros(size, np.int64)
     new_off = changes.get("blk_txoff", off).copy()
     top = 0
@@ -297,7 +297,7 @@ def _packed_lists(world, changes: dict, lists: int) -> dict:
     starts = (np.cumsum(sizes) - sizes).astype(np.int64)
     total = int(sizes.sum())
     index = np.repeat(used - starts, sizes) + np.arange(total, dtype=np.int64)
-    size = max(world.ls_seller.shape[0], 2 * (total + lists - int(world.chn_lstop[0])))
+    size = max(world.ls_seller.shape[0], 4 * (total + lists - int(world.chn_lstop[0])))
     out = {}
     for f in TX_POOL:
         old = getattr(world, f"ls_{f[3:]}")
@@ -377,15 +377,18 @@ def chain_needs(w):
     live = w.chn_nblk[0]
     pool = max(w.pool_top[0], w.ck_pool_top[0])
     open_ = 0
+    saved = 0
     for i in range(n):  # any live block's list of buyer i is its list at the checkpoint and pending reveals
         grow = max(w.tx_count[i], w.ck_tx_count[i]) + w.mp_for_buyer[i] + 2 * w.nbr_count[i]
         pool += 4 * (grow + 8) + 2 * max(w.tx_cap[i], w.ck_tx_cap[i])
         open_ += grow
+        if w.mp_for_buyer[i] > 0 or w.nbr_count[i] > 0:  # a block saves only lists its reveals grow
+            saved += grow
     mp = w.mp_count[0] + n + 2 * links
     events = w.ev_count[0] + n + 2 * links + mp
     payments = w.pay_count[0] + 2 * open_
     entries = w.chn_txtop[0] + (due + 2) * mp  # every block made holds at most the whole mempool
-    lists = w.chn_lstop[0] + (due + 2) * open_  # every block made saves at most every buyer's list
+    lists = w.chn_lstop[0] + (due + 2) * saved  # every block made saves at most the lists it grows
     return mp, live + due + 1, pool, events, payments, lists, entries
 
 
@@ -409,9 +412,13 @@ def can_make(w):
     if w.chn_nblk[0] >= w.blk_live.shape[0] or w.chn_txtop[0] + w.mp_count[0] > w.blk_tx.shape[0]:
         return False
     payments = 0  # any branch's open transactions: its checkpoint's and the pending reveals
+    saved = 0
     for i in range(w.tx_count.shape[0]):
-        payments += max(w.tx_count[i], w.ck_tx_count[i]) + w.mp_for_buyer[i]
-    if w.chn_lstop[0] + payments > w.ls_seller.shape[0]:
+        k = max(w.tx_count[i], w.ck_tx_count[i]) + w.mp_for_buyer[i]
+        payments += k
+        if w.mp_for_buyer[i] > 0:
+            saved += k
+    if w.chn_lstop[0] + saved > w.ls_seller.shape[0]:
         return False
     if not w.record:
         return True
