@@ -362,3 +362,18 @@ def test_the_bench_chain_setup_is_fig4C_with_gossip_only_blocks():
     base = bench_config("fig4C", 200)
     assert cfg.chain.enabled and not cfg.chain.backbone and cfg.chain.period == 10
     assert cfg.model_copy(update={"chain": base.chain}) == base and not base.chain.enabled
+
+
+def test_the_swarm_size_bench_runs_every_robot_as_a_node_with_25_signers():
+    """``bench --robots N --chain`` (docs/chain-model.md, "Speed"): the bench's chain section with the first
+    25 robots as signers (all of them below 25), at the paper's density."""
+    from infomarket.bench.setups import CHAIN_BENCH, chain_at
+    from infomarket.bench.swarm import scaled_config
+
+    assert chain_at(10) == {**CHAIN_BENCH, "signers": list(range(10))}
+    cfg = scaled_config(60, 40, chain=chain_at(60))
+    assert cfg.chain.enabled and cfg.chain.signers == list(range(25)) and cfg.swarm.robots == 60
+    sim = im.Simulation(cfg, 3)
+    sim.run()
+    assert set(sim.world.blk_signer[sim.world.blk_live].tolist()) <= set(range(25)) | {-1}
+    assert sim.chain_measures()["blocks"] >= 25 * (40 // 15)  # every signer makes one at least every 15 steps

@@ -31,6 +31,8 @@ def add_subcommand(sub) -> None:
     mode = b.add_mutually_exclusive_group()
     mode.add_argument("--robots", type=_sizes, metavar="N,N,...",
                       help="instead: robot-steps/s and peak memory for these swarm sizes (one process each)")
+    b.add_argument("--chain", action="store_true",
+                   help="with --robots: every robot a blockchain node (25 signers, blocks every 10 steps)")
     mode.add_argument("--scaling", action="store_true",
                       help="instead: sweep throughput with 1 and 2 local workers and a local Dask cluster of 2")
     b.set_defaults(func=run)
@@ -56,7 +58,8 @@ def run(args) -> int:
                 print(f"{n:>7,} robots  {r['robot_steps_per_second']:>12,.0f} robot-steps/s  "
                       f"peak {r['peak_rss_mb']:8.1f} MB  ({r['seconds']:.1f} s for {r['steps']} steps)", flush=True)
 
-        report = {"steps": args.steps, "robots": run_swarm_sizes(args.robots, args.steps, on_done=shout)}
+        report = {"steps": args.steps, "chain": args.chain,
+                  "robots": run_swarm_sizes(args.robots, args.steps, on_done=shout, chain=args.chain)}
         first, last = report["robots"][args.robots[0]], report["robots"][args.robots[-1]]
         report["largest_vs_smallest"] = last["robot_steps_per_second"] / first["robot_steps_per_second"]
         if args.json:

@@ -20,6 +20,17 @@ CHAIN_SUFFIX = "+chain"
 CHAIN_BENCH = {"consensus": "poa", "period": 10, "out_of_turn_delay": 5}
 
 
+#: Signers of the swarm-size benchmark with the chain on (``chain_at``): a Clique-like authority set of the
+#: paper's swarm size, whatever the number of robots (every robot is still a node with its own view).
+CHAIN_SCALING_SIGNERS = 25
+
+
+def chain_at(robots: int) -> dict:
+    """The ``[chain]`` section of ``bench --robots N --chain``: ``CHAIN_BENCH`` with the first
+    ``CHAIN_SCALING_SIGNERS`` robots as the signers (all of them up to 25 robots)."""
+    return {**CHAIN_BENCH, "signers": list(range(min(robots, CHAIN_SCALING_SIGNERS)))}
+
+
 def bench_config(name: str, steps: int):
     """The configuration a bench setup runs: a shipped experiment, or one with the chain model on."""
     if name.endswith(CHAIN_SUFFIX):

@@ -17,9 +17,9 @@ from ..config.schema import Experiment
 from ..errors import SimulationError
 
 
-def scaled_config(robots: int, steps: int, base: str = "fig2A") -> Experiment:
+def scaled_config(robots: int, steps: int, base: str = "fig2A", chain: dict | None = None) -> Experiment:
     """``base`` with ``robots`` robots at the paper's density (every group scaled, the largest absorbs
-    rounding), run for ``steps`` steps."""
+    rounding), run for ``steps`` steps; with ``chain``, that ``[chain]`` section (``setups.chain_at``)."""
     cfg = load_experiment(base)
     k = math.sqrt(robots / cfg.swarm.robots)
     data = cfg.model_dump(exclude={"sweep"})
@@ -35,17 +35,19 @@ def scaled_config(robots: int, steps: int, base: str = "fig2A") -> Experiment:
     for g, c in zip(groups, counts):
         g["count"] = c
     data["swarm"]["robots"] = robots
+    if chain is not None:
+        data["chain"] = chain
     return Experiment.model_validate(data)
 
 
-def measure(robots: int, steps: int, seed: int = 1) -> dict:
+def measure(robots: int, steps: int, seed: int = 1, chain: dict | None = None) -> dict:
     """Runs in this process, after the kernel is loaded: robot-steps/s (the median of 5 runs when a run
     is short, else one run) and the peak RSS of the process."""
     import statistics
 
     from ..engine.simulation import Simulation
 
-    cfg = scaled_config(robots, steps)
+    cfg = scaled_config(robots, steps, chain=chain)
     repeats = 5 if robots * steps < 5_000_000 else 1
     seconds, items = [], 0
     for k in range(repeats):
@@ -59,11 +61,15 @@ def measure(robots: int, steps: int, seed: int = 1) -> dict:
             "steps": steps, "peak_rss_mb": rss_kb / 1024.0, "items": items}
 
 
-def run_swarm_sizes(sizes: list[int], steps: int, on_done=None) -> dict:
-    """``measure`` for each size, each in a fresh interpreter (peak memory must not carry over)."""
+def run_swarm_sizes(sizes: list[int], steps: int, on_done=None, chain: bool = False) -> dict:
+    """``measure`` for each size, each in a fresh interpreter (peak memory must not carry over); with
+    ``chain``, every robot a blockchain node (``setups.chain_at``)."""
+    from .setups import chain_at
+
     out = {}
     for n in sizes:
-        proc = subprocess.run([sys.executable, "-m", "infomarket.bench.swarm", str(n), str(steps)],
+        extra = [json.dumps(chain_at(n))] if chain else []
+        proc = subprocess.run([sys.executable, "-m", "infomarket.bench.swarm", str(n), str(steps), *extra],
                               capture_output=True, text=True)
         if proc.returncode != 0:
             raise SimulationError(f"bench of {n} robots failed:\n{proc.stderr.strip()[-2000:]}")
@@ -74,4 +80,5 @@ def run_swarm_sizes(sizes: list[int], steps: int, on_done=None) -> dict:
 
 
 if __name__ == "__main__":
-    print(json.dumps(measure(int(sys.argv[1]), int(sys.argv[2]))))
+    print(json.dumps(measure(int(sys.argv[1]), int(sys.argv[2]),
+                             chain=json.loads(sys.argv[3]) if len(sys.argv) > 3 else None)))

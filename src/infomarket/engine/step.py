@@ -12,7 +12,7 @@ turn off before it types them (a kernel neither compiles nor runs a variant it d
              waypoints are dead-reckoned, a bump marks the site.  Implies ``terrain``.
 
 The chain model (docs/chain-model.md) adds three pieces, ``chain_variant(settle)``: gossip, the deposit
-transaction, and block making with its ledger replays.  A kernel without the chain never builds them.
+transaction, and block making (each block applied once, on a copy of its parent's ledger state).  A kernel without the chain never builds them.
 
 Nothing here depends on the configured rules; the loop's generated dispatch calls the rules.
 """

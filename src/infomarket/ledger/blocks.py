@@ -5,8 +5,10 @@ State (``SPEC``, the ``chain`` domain; only ledger operations write it, like the
 
 * **Blocks**, a store of the blocks that are not final yet: parent, height, weight (total difficulty:
   2 per in-turn block, 1 per out-of-turn one, as Clique), hash, signer, step, the transactions it
-  includes (mempool slots, in the order they were sent) and every robot's balance after it
-  (``blk_bal``, the snapshot a robot's view reads).  The **checkpoint** (``chn_ckpt``) is the newest
+  includes (mempool slots, in the order they were sent: ``blk_tx[blk_txoff[b]:][:blk_ntx[b]]``), a bit
+  per pending transaction on its branch (``blk_inc``), every robot's balance after it (``blk_bal``, the
+  snapshot a robot's view reads) and the rest of the ledger's state after it (``bs_*``; each buyer's open
+  transactions as a version of its list in ``ls_*``).  The **checkpoint** (``chn_ckpt``) is the newest
   final block (every robot's head descends from it, or it lies ``chn_final`` blocks below the canonical
   head): nothing before it can change, so it is the root of the store.
 * **Mempool** (``ledger.mempool``): transactions not yet in a final block, with a bit per robot
@@ -15,13 +17,15 @@ State (``SPEC``, the ``chain`` domain; only ledger operations write it, like the
   weight and hash and its own balance there (``view_*``), and its spendable money (``view_avail``).
 * **Ledgers**: the engine's ledger arrays (``ledger.state``) hold the state at the **canonical head**
   (``chn_canon``: the heaviest block, ties to the lower hash), which the run reports; ``ck_*`` hold the
-  state at the checkpoint.  The state at any other block is the checkpoint's with the blocks on its branch
-  applied again (``engine.step.chain_variant``): a reorganisation undoes and redoes payments that way.
+  state at the checkpoint.  The state at any other block is a copy away (``load_state``, then
+  ``materialise`` for the lists a block touches): a block's transactions are applied once, on its parent's
+  state, and a reorganisation undoes and redoes payments by switching states.
 * **Measures** (the log): blocks made, forks, reorganisations and the transactions they dropped, failed
   transactions, deposit-to-payment delays, every robot's summed view lag.
 
-Memory: the blocks since the checkpoint (each with a balance snapshot, O(n)), the mempool with its
-known-bits (O(n x transactions in flight)), two ledgers.  Nothing grows with the run's history.
+Memory: the blocks since the checkpoint (each with an O(n) state and O(pending / 64) bits), the list
+versions they use, the mempool with its known-bits (O(n x transactions in flight)), two ledgers.  Every
+array is sized by what is live (the host packs the arenas); nothing grows with the run's history.
 """
 from __future__ import annotations
 
