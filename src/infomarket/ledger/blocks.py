@@ -466,6 +466,13 @@ def due(w, signer, t):
     return t - w.blk_step[h] >= wait
 
 
+#: The lowest set bit of a 64-bit word by de Bruijn multiplication: _LOWEST_BIT[(x & -x) * _DE_BRUIJN >> 58].
+_DE_BRUIJN = np.uint64(0x03F79D71B4CB0A89)
+_LOWEST_BIT = np.zeros(64, np.int64)
+for _b in range(64):
+    _LOWEST_BIT[((1 << _b) * 0x03F79D71B4CB0A89 % 2**64) >> 58] = _b
+
+
 @njit
 def new_block(w, signer, t):
     """``signer`` makes a block on its head at step t, holding every pending transaction it knows that
@@ -504,19 +511,24 @@ def new_block(w, signer, t):
         inc[b, word] = inc[parent, word] | m
         while m != np.uint64(0):
             low = m & (~m + np.uint64(1))
-            bit = 0
-            while (low >> np.uint64(bit)) != np.uint64(1):
-                bit += 1
-            txs[k] = word * 64 + bit
+            txs[k] = word * 64 + _LOWEST_BIT[(low * _DE_BRUIJN) >> np.uint64(58)]
             k += 1
             m ^= low
-    for a in range(1, k):  # insertion sort into sending order (the slots are nearly in order already)
-        v = txs[a]
-        c = a - 1
-        while c >= 0 and w.mp_seq[txs[c]] > w.mp_seq[v]:
-            txs[c + 1] = txs[c]
-            c -= 1
-        txs[c + 1] = v
+    if k * k > w.mp_count[0]:  # many: take them in sending order from the pending list
+        j = 0
+        for a in range(w.mp_count[0]):
+            tx = w.mp_order[a]
+            if (inc[b, tx >> 6] >> np.uint64(tx & 63)) & np.uint64(1) != np.uint64(0) and not on_branch(w, parent, tx):
+                txs[j] = tx
+                j += 1
+    else:
+        for a in range(1, k):  # few: insertion sort into sending order
+            v = txs[a]
+            c = a - 1
+            while c >= 0 and w.mp_seq[txs[c]] > w.mp_seq[v]:
+                txs[c + 1] = txs[c]
+                c -= 1
+            txs[c + 1] = v
     unlock(w.blk_txoff)[b] = top
     unlock(w.blk_ntx)[b] = k
     unlock(w.chn_txtop)[0] = top + k
