@@ -84,6 +84,10 @@ NOT_RUN = {
     "--heldout-runs 16 --best 2 --out /tmp/attack-reduced": "~460 full runs; tests/search runs a tiny search",
     "infomarket attack-search attack_search --defence staking,theta20 --byzantines 3 --dask tcp://head:8786 "
     "--out results/as-dask": "needs a Dask scheduler at that address; tests/search runs one on a LocalCluster",
+    # docs/rl.md
+    "infomarket bench --env --json": "5 timed episodes of 64 runs; tests/bench/test_bench_env.py runs it with --steps 60",
+    "infomarket rl-train --steps 10000 --transitory 5000 --iterations 60 --pairs 16 --eval-runs 32 --seed 0 "
+    "--out rl-train.json": "about 7 min of training; tests/rl/test_cli.py runs a tiny one",
 }
 
 
