@@ -86,8 +86,8 @@ NOT_RUN = {
     "--out results/as-dask": "needs a Dask scheduler at that address; tests/search runs one on a LocalCluster",
     # docs/rl.md
     "infomarket bench --env --json": "5 timed episodes of 64 runs; tests/bench/test_bench_env.py runs it with --steps 60",
-    "infomarket rl-train --steps 10000 --transitory 5000 --iterations 60 --pairs 16 --eval-runs 32 --seed 0 "
-    "--out rl-train.json": "about 7 min of training; tests/rl/test_cli.py runs a tiny one",
+    "infomarket rl-train --steps 4000 --transitory 1000 --iterations 60 --pairs 32 --eval-runs 32 --seed 0 "
+    "--out rl-train.json": "minutes of training; tests/rl/test_cli.py runs a tiny one",
 }
 
 

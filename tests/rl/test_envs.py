@@ -94,18 +94,20 @@ def test_sub_environment_i_is_the_single_env_seeded_with_seed_plus_i():
 
 
 def test_next_step_autoreset_starts_a_fresh_episode_and_ignores_the_action():
-    venv = AttackVectorEnv(num_envs=2, steps=30, transitory=10, interval=10)
+    venv = AttackVectorEnv(num_envs=2, steps=300, transitory=10, interval=100, reward="liar_wealth")
     venv.reset(seed=1)
     for _ in range(3):
         obs, r, term, trunc, info = venv.step(venv.action_space.sample())
-    assert trunc.all() and (venv.runs.clocks == 30).all()
+    assert trunc.all() and (venv.runs.clocks == 300).all()
+    ended = venv.runs.shares.sum(axis=1)
+    assert (ended != 3 / 25).all()  # the episodes moved wealth: a fresh run's shares differ from them
     first = info["seed"].copy()
     obs, r, term, trunc, info = venv.step(venv.action_space.sample())
     assert (venv.runs.clocks == 0).all() and (r == 0).all() and not trunc.any()
     assert (info["seed"] != first).all()
     assert (obs[:, :, 6] == 0).all()  # the time column of a fresh run
     obs, r, term, trunc, info = venv.step(venv.action_space.sample())
-    assert (venv.runs.clocks == 10).all()
+    assert (venv.runs.clocks == 100).all()
 
 
 def test_the_same_seed_gives_the_same_episode():

@@ -32,7 +32,7 @@ def test_the_antithetic_estimate_points_along_the_better_perturbation():
 
 
 class _Runs:  # what initial_theta reads of rl.runs.Runs
-    actions = ("rot_base", "withhold")
+    actions = ("rot_base", "collude")
     low, high = np.array([0.0, 0.0]), np.array([180.0, 1.0])
     default_action = np.array([[20.0, 0.0]] * 3)
     obs = np.zeros((1, 3, 19))
@@ -42,7 +42,7 @@ def test_the_policy_starts_at_the_configured_attack():
     theta = initial_theta(_Runs)
     assert theta.shape == (20, 2) and not theta[:-1].any()
     assert 180 * sigmoid(theta[-1, 0]) == pytest.approx(20.0)  # the constant 20° liar
-    assert sigmoid(theta[-1, 1]) == pytest.approx(0.01)  # withhold: at the edge margin, below 0.5 (off)
+    assert sigmoid(theta[-1, 1]) == pytest.approx(0.01)  # collude: at the edge margin, below 0.5 (off)
 
 
 def test_tiny_training_is_deterministic_and_improves_on_the_constant_liar():

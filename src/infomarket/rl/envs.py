@@ -88,8 +88,8 @@ class AttackEnv(gym.Env):
     """One run of ``experiment`` with its ``attacker`` robots controlled together.
 
     Observation [agents, len(OBSERVATION)] in [0, 1]; action [agents, len(actions)], each column one of
-    the attacker's parameters in its own range (default ``rot_base`` in [0, 180] degrees and ``withhold``,
-    >= 0.5 to offer nothing instead of the truth); reward ``REWARDS[reward]``; ``info["seed"]`` is the
+    the attacker's parameters in its own range (default ``rot_base`` in [0, 180] degrees and ``collude``,
+    >= 0.5 to share one rotation and buy each other's offers); reward ``REWARDS[reward]``; ``info["seed"]`` is the
     episode's run seed."""
 
     metadata = {"render_modes": []}

@@ -1,8 +1,7 @@
 """B runs of one experiment stepped together in one compiled call: the core of every RL interface.
 
 The agents are the robots whose behaviour is ``attacker`` (``behaviours.attacks``).  An action is a row of
-the attacker's own parameters (``ACTIONS`` picks which, default the lie's rotation and whether to withhold
-the truth): it is written into the run's per-robot parameter array (``bparams``, which the compiled sell
+the attacker's own parameters (``ACTIONS`` picks which, default the lie's rotation and whether to collude): it is written into the run's per-robot parameter array (``bparams``, which the compiled sell
 and buy rules read every step), so actions change between calls without recompiling anything and the
 engine itself is untouched.  All B runs' ``bparams`` are slices of one [B, n, P] array, so one numpy
 assignment sets every agent of every run.
@@ -34,8 +33,9 @@ from .observe import OBSERVATION
 #: The behaviour whose robots are the agents.
 AGENT_BEHAVIOUR = "attacker"
 #: The attacker's parameters an action sets by default: the lie's rotation (degrees; 0 is the truth) and
-#: whether to withhold (offer nothing) when not lying.
-ACTIONS = ("rot_base", "withhold")
+#: whether to collude (>= 0.5: the liars share one rotation and buy each other's offers).  (``withhold``
+#: alone would do nothing: an attacker whose gates are all open always lies, rotation 0 included.)
+ACTIONS = ("rot_base", "collude")
 #: What the attacker knows of the contract, read by the observation (``behaviours.attacks.KNOWN``).
 _KNOWN = ("theta", "theta_min", "adaptive")
 
