@@ -58,3 +58,23 @@ def test_tiny_training_is_deterministic_and_improves_on_the_constant_liar():
     assert a.fitness == b.fitness
     r = compare(env, a, 16, seed=3)
     assert r["learned_mean"] < r["liar_mean"]  # fewer honest items on the same held-out seeds
+
+
+def test_ascending_the_return_does_more_damage_than_descending_it(monkeypatch):
+    """The direction of the update matters: the same loop made to descend its return (the ES estimate
+    negated) ends at an attack that leaves the honest robots more items than the ascending one.  At 5
+    iterations ES is noisy (of training seeds 3-6, 3 separate this way), so one seed is used."""
+    pytest.importorskip("gymnasium")
+    from infomarket.rl import train as train_mod
+    from infomarket.rl.envs import AttackVectorEnv
+    from infomarket.rl.run import held_out_seeds
+
+    env = AttackVectorEnv(num_envs=16, steps=4000, transitory=1000, interval=10)
+    up = train_mod.train(env, iterations=5, pairs=8, seed=3)
+    ascend = train_mod.es_gradient
+    monkeypatch.setattr(train_mod, "es_gradient", lambda f, e, s: -ascend(f, e, s))
+    down = train_mod.train(env, iterations=5, pairs=8, seed=3)
+    seeds = held_out_seeds(3, 16)
+    _, items_up = train_mod.episodes(env, np.repeat(up.theta[None], 16, axis=0), seeds)
+    _, items_down = train_mod.episodes(env, np.repeat(down.theta[None], 16, axis=0), seeds)
+    assert items_up.mean() < items_down.mean()

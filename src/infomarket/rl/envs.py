@@ -160,14 +160,17 @@ class AttackVectorEnv(gym.vector.VectorEnv):
         self.runs.reset(np.arange(self.num_envs), [episode_seed(r) for r in self._env_rngs])
         self._rewards.mark()
         self._autoreset[:] = False
-        return self.runs.obs.copy(), {"seed": self.runs.seeds.copy()}
+        return self.runs.obs.copy(), self._info()
 
     def step(self, actions):
         again = np.flatnonzero(self._autoreset)
         if len(again):
             self.runs.reset(again, [episode_seed(self._env_rngs[b]) for b in again], observe=False)
         go = ~self._autoreset
-        self.runs.act(np.asarray(actions)[go], np.flatnonzero(go))
+        if len(again):
+            self.runs.act(np.asarray(actions)[go], np.flatnonzero(go))
+        else:
+            self.runs.act(actions)
         clocks = self.runs.clocks
         self.runs.advance(np.where(go, clocks + self.interval, clocks))
         rewards = self._rewards.team()
@@ -176,4 +179,8 @@ class AttackVectorEnv(gym.vector.VectorEnv):
         truncated = go & (self.runs.clocks >= self.runs.steps)
         self._autoreset = truncated.copy()
         terminated = np.zeros(self.num_envs, bool)
-        return self.runs.obs.copy(), rewards, terminated, truncated, {"seed": self.runs.seeds.copy()}
+        return self.runs.obs.copy(), rewards, terminated, truncated, self._info()
+
+    def _info(self) -> dict:
+        """Each sub-environment's episode seed, with Gymnasium's vector-info mask (every entry set)."""
+        return {"seed": self.runs.seeds.copy(), "_seed": np.ones(self.num_envs, bool)}
