@@ -9,7 +9,7 @@ pytest.importorskip("gymnasium")
 pytest.importorskip("pettingzoo")
 
 from gymnasium.utils.env_checker import check_env  # noqa: E402
-from pettingzoo.test import parallel_api_test  # noqa: E402
+from pettingzoo.test import parallel_api_test, parallel_seed_test  # noqa: E402
 
 from infomarket.config import load_experiment  # noqa: E402
 from infomarket.engine.simulation import simulate  # noqa: E402
@@ -29,6 +29,10 @@ def test_pettingzoo_parallel_api_test_passes():
     env = AttackParallelEnv(**SMALL)
     parallel_api_test(env, num_cycles=40)  # 40 decisions > 30 per episode: the end is crossed
     assert env.possible_agents == ["robot_22", "robot_23", "robot_24"]  # the 3 `attacker` robots of 25
+
+
+def test_pettingzoo_parallel_seed_test_passes():
+    parallel_seed_test(lambda: AttackParallelEnv(**SMALL), num_cycles=10)
 
 
 def _episode(env, action):

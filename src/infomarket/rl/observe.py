@@ -28,7 +28,8 @@ def _capped(x, scale):
     return min(x / scale, 1.0)
 
 
-@njit(cache=True)
+@njit  # not cached on its own: numba would not see a change in the helpers it calls (behaviours.*); the
+# generated ``step_all`` (rl.runs), whose file name hashes the package's source, caches it with itself
 def observe_run(w, agents, known, honest, steps, obs, shares):
     """Fill ``obs[a]`` (float32, len(OBSERVATION)) and ``shares[a]`` (the wealth share) for each agent
     robot ``agents[a]``; ``known`` = the attacker's columns of theta, theta_min, adaptive in ``w.bparams``.
