@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..errors import ArgumentError
 from ..seeds import MAX_SEED
 
 #: A logit never further from 0 than this when the policy is started at a parameter on its range's edge.
@@ -117,7 +118,7 @@ def train(env, *, iterations: int, pairs: int, sigma: float = 0.5, lr: float = 0
           on_iteration=None) -> Training:
     """Evolution strategies on ``env`` (an ``AttackVectorEnv`` with ``2 * pairs`` sub-environments)."""
     if env.num_envs != 2 * pairs:
-        raise ValueError(f"the vector env must hold 2 x pairs = {2 * pairs} runs, has {env.num_envs}")
+        raise ArgumentError(f"the vector env must hold 2 x pairs = {2 * pairs} runs, has {env.num_envs}")
     rng = np.random.default_rng(seed)
     theta = initial_theta(env.runs)
     out = Training(theta.copy(), theta.copy())
