@@ -30,3 +30,8 @@ def test_bench_env_is_exclusive_with_the_other_modes(capsys):
     with pytest.raises(SystemExit) as exc:
         main(["bench", "--env", "--scaling"])
     assert exc.value.code == 2
+
+
+def test_batch_and_interval_without_env_are_refused(capsys):
+    assert main(["bench", "--batch", "8", "--steps", "10"]) == 2
+    assert "--batch and --interval go with --env" in capsys.readouterr().err

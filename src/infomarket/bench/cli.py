@@ -36,9 +36,8 @@ def add_subcommand(sub) -> None:
     mode.add_argument("--env", action="store_true",
                       help="instead: the RL vector environment's agent-steps/s and env-steps/s beside the engine's "
                            "own env-steps/s on the attack_search setup (docs/rl.md; --steps default 3000 here)")
-    b.add_argument("--batch", type=at_least(1), default=64, help="with --env: runs per vector env (B, default 64)")
-    b.add_argument("--interval", type=at_least(1), default=10,
-                   help="with --env: engine steps per decision (K, default 10)")
+    b.add_argument("--batch", type=at_least(1), help="with --env: runs per vector env (B, default 64)")
+    b.add_argument("--interval", type=at_least(1), help="with --env: engine steps per decision (K, default 10)")
     b.set_defaults(func=run)
 
 
@@ -47,6 +46,10 @@ def run(args) -> int:
 
     if args.env:
         return _env(args)
+    if args.batch is not None or args.interval is not None:
+        from ..errors import UsageError
+
+        raise UsageError("--batch and --interval go with --env (the RL vector environment's benchmark)")
     args.steps = 15000 if args.steps is None else args.steps
     args.repeats = 7 if args.repeats is None else args.repeats
     if args.scaling:
@@ -107,8 +110,8 @@ def _env(args) -> int:
         import gymnasium  # noqa: F401
     except ModuleNotFoundError as exc:
         raise UsageError(f"bench --env needs {exc.name}: pip install 'infomarket[rl]'") from exc
-    r = run_env_bench(steps=3000 if args.steps is None else args.steps, batch=args.batch,
-                      interval=args.interval, repeats=5 if args.repeats is None else args.repeats)
+    r = run_env_bench(steps=3000 if args.steps is None else args.steps, batch=args.batch or 64,
+                      interval=args.interval or 10, repeats=5 if args.repeats is None else args.repeats)
     if args.json:
         print(json.dumps(r, indent=2))
         return 0
