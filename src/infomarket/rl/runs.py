@@ -125,7 +125,7 @@ class Runs:
         with compile_notice(self.kinds, cfg.payment.scheme):
             self._kernel = specialise.kernel_module(self.kinds, cfg.payment.scheme, cfg.terrain, False)
             self._batch = _batch_module(self._kernel)
-        self._build(0, 0)  # one world to learn the layout (robots, behaviours, parameter rows)
+        self._build(0)  # one world to learn the layout (robots, behaviours, parameter rows)
         names = self._names
         specs = behaviours()
         self.agents = np.array([i for i, b in enumerate(names) if b == AGENT_BEHAVIOUR], np.int64)
@@ -149,7 +149,7 @@ class Runs:
         self._status = np.zeros(self.size, np.int64)
         self.reset(np.arange(self.size), np.arange(self.size))
 
-    def _build(self, b: int, seed: int):
+    def _build(self, seed: int):
         rng = np.random.default_rng(seed)
         world, self._names = build_world(self.config, rng)
         self._first = world
@@ -164,7 +164,7 @@ class Runs:
         parameters, and (``observe``) observe every run (nothing is stepped)."""
         for b, seed in zip(np.asarray(which, np.int64), seeds):
             seed = _checked_seed(int(seed))
-            world, rng = self._build(int(b), seed)
+            world, rng = self._build(seed)
             self.bparams[b] = world.bparams
             world = world._replace(bparams=self.bparams[b])
             self.worlds[b] = world
