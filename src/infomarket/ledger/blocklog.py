@@ -44,6 +44,8 @@ from ..errors import SimulationError
 from .mempool import DEPOSIT, REVEAL, mix
 
 KINDS = {REVEAL: "reveal", DEPOSIT: "deposit"}
+#: ``chain_views``' branch of a robot whose head was dropped (``view_head`` -1).
+DROPPED = 255
 
 
 @dataclass(frozen=True)
@@ -211,3 +213,31 @@ class BlockLog:
             if kids[blk.parent] > 1:
                 out.append(blk.id)
         return out
+
+
+def chain_views(w) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each robot's head height, lag (canonical height minus its head's) and branch, from the world's
+    arrays now: branch 0 when its head is on the canonical branch (however far behind), 1, 2, ... for each
+    other branch (numbered by the block where it leaves the canonical one, in slot order, so a number
+    may change from one step to the next), ``DROPPED`` when its head's branch was dropped."""
+    heads = w.view_head.astype(np.int64)
+    canon = int(w.chn_canon[0])
+    on_canon = np.zeros(w.blk_live.shape[0], bool)
+    b = canon
+    while b >= 0:
+        on_canon[b] = True
+        b = int(w.blk_parent[b])
+    cur = heads.copy()
+    leaf = np.full(heads.shape, -1, np.int64)  # the block where each robot's branch leaves the canonical one
+    off = (cur >= 0) & ~on_canon[np.maximum(cur, 0)]
+    while off.any():
+        leaf[off] = cur[off]
+        cur[off] = w.blk_parent[cur[off]]
+        off &= cur >= 0
+        off[off] = ~on_canon[cur[off]]
+    branch = np.zeros(heads.shape, np.int64)
+    leaves = np.unique(leaf[leaf >= 0])
+    branch[leaf >= 0] = np.minimum(np.searchsorted(leaves, leaf[leaf >= 0]) + 1, DROPPED - 1)
+    branch[heads < 0] = DROPPED
+    height = w.view_height.astype(np.float64)
+    return height, w.blk_height[canon] - height, branch
