@@ -96,6 +96,8 @@ class BlockLog:
         self.blocks: list[Block] = []
         self.txs: dict[int, ChainTx] = {}
         self._slot: dict[int, tuple[int, int, int]] = {}  # slot -> (id, hash, step) of its block
+        self._hash = np.zeros(0, np.int64)  # the same as arrays by slot, to find new blocks at numpy speed
+        self._step = np.full(0, -1, np.int64)
         self._seen_seq = 0
         self.canon_by_step: list[int] = []  # canonical head's id after each observed step
         self._last_step = -1
@@ -113,9 +115,11 @@ class BlockLog:
                                   "unobserved; step it one step at a time (BlockLog.run) ")
         self._last_step = step
         self._record_txs(w)
-        live = np.flatnonzero(w.blk_live)
-        new = [int(b) for b in live
-               if self._slot.get(int(b), (None, None, None))[1:] != (int(w.blk_hash[b]), int(w.blk_step[b]))]
+        cap = w.blk_live.shape[0]
+        if self._hash.shape[0] < cap:  # the block store grew (slots keep their numbers)
+            self._hash = np.concatenate([self._hash, np.zeros(cap - self._hash.shape[0], np.int64)])
+            self._step = np.concatenate([self._step, np.full(cap - self._step.shape[0], -1, np.int64)])
+        new = np.flatnonzero(w.blk_live & ((w.blk_hash != self._hash) | (w.blk_step != self._step))).tolist()
         order = {int(s): k for k, s in enumerate(w.chn_signers)}
         new.sort(key=lambda b: (int(w.blk_step[b]), order.get(int(w.blk_signer[b]), -1)))
         previous = dict(self._slot)
@@ -131,9 +135,9 @@ class BlockLog:
         for x in slots:
             self._tx(w, int(x))
         # a transaction sent and made final this step is no longer live: it is in a block made this step
-        for b in np.flatnonzero(w.blk_live):
-            if int(w.blk_step[b]) == int(w.clock[0]):
-                for x in w.blk_tx[b, :int(w.blk_ntx[b])]:
+        for b in np.flatnonzero(w.blk_live & (w.blk_step == w.clock[0])):
+            for x in w.blk_tx[b, :int(w.blk_ntx[b])]:
+                if int(w.mp_seq[x]) >= self._seen_seq:
                     self._tx(w, int(x))
         missing = set(range(self._seen_seq, top)) - self.txs.keys()
         if missing:
@@ -165,6 +169,7 @@ class BlockLog:
         block = Block(len(self.blocks), parent, height, h, signer, step, txs, w.blk_bal[b].copy())
         self.blocks.append(block)
         self._slot[b] = (block.id, h, step)
+        self._hash[b], self._step[b] = h, step
 
     def _lost_parent(self, previous: dict, height: int, signer: int, step: int, h: int) -> int:
         """The parent of a block that became the checkpoint in the step it was made (its parent slot is
