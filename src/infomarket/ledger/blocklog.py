@@ -139,7 +139,7 @@ class BlockLog:
             for x in w.blk_tx[b, :int(w.blk_ntx[b])]:
                 if int(w.mp_seq[x]) >= self._seen_seq:
                     self._tx(w, int(x))
-        missing = set(range(self._seen_seq, top)) - self.txs.keys()
+        missing = [seq for seq in range(self._seen_seq, top) if seq not in self.txs]
         if missing:
             raise SimulationError(f"BlockLog: transactions {sorted(missing)[:5]} were sent but never seen "
                                   "(the mempool's meaning changed? see ledger/blocklog.py)")
