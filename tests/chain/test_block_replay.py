@@ -162,3 +162,32 @@ def test_chain_demo_refuses_what_it_cannot_do(capsys, argv, message):
     assert main(["chain", "demo", *argv]) == 2
     err = capsys.readouterr().err
     assert message in err and "Traceback" not in err
+
+
+def test_an_experiment_with_a_chain_section_is_replayed_block_by_block(tmp_path, capsys):
+    (tmp_path / "poa.toml").write_text("""
+name = "poa"
+steps = 3000
+
+[swarm]
+robots = 25
+
+[[swarm.groups]]
+behaviour = "sceptical"
+count = 20
+
+[[swarm.groups]]
+behaviour = "scaboteur"
+count = 5
+
+[payment]
+scheme = "outlier"
+stake = 0.04
+
+[chain]
+consensus = "poa"
+period = 4
+""")
+    assert main(["chain", "demo", "--experiment", str(tmp_path / "poa.toml")]) == 0
+    out = capsys.readouterr().out
+    assert "a block every 4 steps" in out and "matches the modelled ledger at all" in out
