@@ -183,3 +183,18 @@ def test_reads_and_refusals_leave_no_account_or_slot_warm_on_revm():
     coinbase = "0x" + "00" * 20
     assert set(twin.fast.evm.journal_state) <= {coinbase}
     assert twin.fast.evm.journal_depth == 0
+
+
+@pytest.mark.parametrize("backend", ["py-evm", "revm"])
+def test_transient_storage_does_not_outlive_its_transaction(backend):
+    """EIP-1153: transient storage is cleared after every transaction. A contract that logs its
+    transient slot 0 and then sets it to 1 logs 0 every time (the market's contract uses none; pyrevm
+    never clears it by itself, the checkpoint each transaction runs in undoes it)."""
+    runtime = bytes.fromhex("60005c600052" "600160005d" "60206000a000")  # log0(tload(0)); tstore(0, 1)
+    init = bytes([0x60 + len(runtime) - 1]) + runtime + bytes.fromhex(f"60005260{len(runtime):02x}60{32 - len(runtime):02x}f3")
+    chain = connect(backend=backend)
+    deployer = derived_account("transient", 0)
+    chain.fund([deployer.address])
+    address, _ = chain.deploy(deployer, init)
+    logged = [chain.transact(deployer, address, b"").logs for _ in range(3)]
+    assert [[int.from_bytes(lg.data, "big") for lg in logs] for logs in logged] == [[0], [0], [0]]

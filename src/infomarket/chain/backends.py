@@ -11,12 +11,25 @@
   land in block ``n`` until the next call), which is what the replay of a simulation needs: one block
   per simulated step, however many transactions the step holds. Transactions execute as their sender
   without an Ethereum transaction signature (the buyers' EIP-712 signatures inside the light contracts
-  are still checked by the contract itself). **Its gas is not a chain's**: pyrevm 0.3.7 keeps one
-  journal for the life of the EVM (its ``commit`` does not finalise it and storage it inserts goes
-  into the journal too), so accounts and storage slots stay warm from one transaction to the next and
-  each slot's "original value" is the one it had when first loaded. A reveal costs about 20 000 gas
-  less than on py-evm and a large settlement a third of it. ``cold_storage`` says which backends
-  charge gas as a chain does; gas figures (docs/gas.md, the declared bound) come from py-evm.
+  are still checked by the contract itself).
+
+Both charge gas as a chain does (``cold_storage``): every transaction starts with cold accounts and
+storage slots (EIP-2929), and each slot's "original value" (EIP-2200, and the refunds of EIP-3529) is
+the value it had before the transaction. py-evm does so by itself. pyrevm 0.3.7 (the newest release)
+does not: it keeps one journaled state for the EVM's life and never finalises it between
+transactions, so whatever a transaction loaded would stay warm for the next, and a reveal would cost
+about 20 000 gas less. So ``RevmBackend`` keeps the journal empty between transactions and the
+chain's state in revm's database: each transaction runs inside a journal checkpoint; its changes
+are read from the journal (``journal_str``, revm's print of the journaled state: every account and
+slot the transaction loaded, with the value it was loaded with and its present one); the checkpoint
+is reverted, which drops every loaded account and slot from the journal (cold again) and undoes the
+changes; then the changes are written into the database (``insert_account_info`` and
+``insert_account_storage``, which write the database only for an account out of the journal), where
+the next transaction loads them cold, with these values as originals. A reverted transaction keeps
+nothing and warms nothing. Views and dry runs run in a checkpoint that is reverted too. The
+database writes are logged once ``snapshot`` is first called, so that ``revert`` can undo them.
+``tests/chain/test_revm_gas.py`` sends the same transactions to both backends and finds the same gas
+for each. The block's coinbase stays in the journal, as it is warm for every transaction (EIP-3651).
 
 Both raise ``ContractRevert`` (with the custom error's name and arguments) through
 ``market.decode_revert``, and both return a ``Receipt`` whose logs are raw (address, topics, data).
@@ -171,11 +184,15 @@ class RevmBackend:
     """revm through pyrevm: an in-process chain whose blocks the caller sets, with cold storage per
     transaction (see the module docstring: every transaction runs in a checkpoint of an empty journal,
     its changes are read from the journal, the checkpoint is reverted and the changes are written to
-    the database, so the next transaction loads them cold, as a chain's would)."""
+    the database, from which the next transaction loads them cold, as a chain's would)."""
 
     name = "revm"
     #: gas as a chain charges it: every transaction starts with cold accounts and storage (EIP-2929)
     cold_storage = True
+    #: when True, number blocks as py-evm and a node do: each transaction, and each funding (a
+    #: transaction there), lands in a block of its own (the gas report uses it, so that block numbers
+    #: written to storage and calldata are those of py-evm); the replay sets its blocks itself
+    automine = False
 
     def __init__(self):
         try:
@@ -213,6 +230,7 @@ class RevmBackend:
             key = a.lower()
             _, nonce, code_hash = self._accounts.get(key, _NO_ACCOUNT)
             self._write_info(key, (amount, nonce, code_hash))
+            self._mined()
 
     def call(self, sender: str, to: str, data: bytes, static: bool = False) -> bytes:
         """Execute without keeping any change (a view runs static), inside a checkpoint that is
@@ -223,11 +241,19 @@ class RevmBackend:
     def transact(self, sender, to: str, data: bytes) -> Receipt:
         """Execute and keep: a reverted call changes nothing (and warms nothing), so no dry run is needed."""
         self._isolated(lambda: self.evm.message_call(sender.address, to, data, gas=self.gas_limit), keep=True)
-        return self._receipt()
+        receipt = self._receipt()
+        self._mined()
+        return receipt
 
     def deploy(self, sender, code: bytes) -> tuple[str, Receipt]:
         address = self._isolated(lambda: self.evm.deploy(sender.address, code, gas=self.gas_limit), keep=True)
-        return to_checksum_address(address), self._receipt()
+        receipt = self._receipt()
+        self._mined()
+        return to_checksum_address(address), receipt
+
+    def _mined(self) -> None:
+        if self.automine:
+            self.advance_to(self._block + 1)
 
     def snapshot(self) -> list:
         """A handle to the current state that ``revert`` can go back to any number of times: the
