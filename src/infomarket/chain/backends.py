@@ -170,11 +170,12 @@ class Web3Backend:
 
 
 _REVERT_OUTPUT = re.compile(r"output: 0x([0-9a-fA-F]*)")
-#: In pyrevm's ``journal_str`` (revm's Debug print of the journaled state): an account of the state map,
-#: and one storage slot of it with the value it was loaded with and the value it holds now.
-_ACCOUNT = re.compile(r"(0x[0-9a-f]{40}): Account \{ info: AccountInfo \{ balance: (\d+), nonce: (\d+), "
-                      r"code_hash: 0x([0-9a-f]{64})")
-_SLOT = re.compile(r"(\d+): StorageSlot \{ previous_or_original_value: (\d+), present_value: (\d+) \}")
+#: In pyrevm's ``journal_str`` (revm's Debug print of the journaled state): what follows an account's
+#: address in the state map, its info, and one storage slot with the value it was loaded with and the
+#: value it holds now. (The print holds the contract's code too: found with str.find, not a regex scan.)
+_ACCOUNT = ": Account { info: AccountInfo { balance: "
+_INFO = re.compile(r"(\d+), nonce: (\d+), code_hash: 0x([0-9a-f]{64})")
+_SLOT = re.compile(r"[{ ](\d+): StorageSlot \{ previous_or_original_value: (\d+), present_value: (\d+) \}")
 _EMPTY_CODE_HASH = keccak(b"")
 #: (balance, nonce, code hash) of an account that was never written
 _NO_ACCOUNT = (0, 0, _EMPTY_CODE_HASH)
@@ -305,22 +306,25 @@ class RevmBackend:
         only what it loaded): accounts whose (balance, nonce, code hash) differ from the database's,
         and slots whose present value differs from the value they were loaded with."""
         text = self.evm.journal_str
-        text = text[:text.index(", transient_storage: ")]
+        end = text.index(", transient_storage: ")
         infos, slots = {}, []
-        for found in _ACCOUNT.finditer(text):
-            address = found.group(1)
-            info = (int(found.group(2)), int(found.group(3)), bytes.fromhex(found.group(4)))
+        at = text.find(_ACCOUNT, 0, end)
+        while at >= 0:
+            address = text[at - 42:at]
+            found = _INFO.match(text, at + len(_ACCOUNT))
+            if not address.startswith("0x") or found is None:
+                raise ChainError("revm: unexpected journal print (is pyrevm newer than 0.3.7?)")
+            info = (int(found.group(1)), int(found.group(2)), bytes.fromhex(found.group(3)))
             old = self._accounts.get(address, _NO_ACCOUNT)
             if info != old:
-                code = None
-                if info[2] != old[2]:
-                    code = self._deployed_code(address, info[2])
+                code = self._deployed_code(address, info[2]) if info[2] != old[2] else None
                 infos[address] = (info, code)
             begin = text.index("storage: {", found.end())
             stop = text.index(", status: AccountStatus", begin)
             for slot in _SLOT.finditer(text, begin, stop):
                 if slot.group(2) != slot.group(3):
                     slots.append((address, int(slot.group(1)), int(slot.group(3)), int(slot.group(2))))
+            at = text.find(_ACCOUNT, stop, end)
         return infos, slots
 
     def _deployed_code(self, address: str, code_hash: bytes) -> bytes:
