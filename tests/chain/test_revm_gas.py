@@ -45,7 +45,8 @@ class Twin:
         #: (what, gas on py-evm, gas on revm) of every transaction, in order
         self.gas: list[tuple[str, int, int]] = []
         self._align()
-        (ref_address, ref_receipt), (fast_address, fast_receipt) = (b.deploy(owner, code) for b in (self.ref, self.fast))
+        (ref_address, ref_receipt), (fast_address, fast_receipt) = (b.deploy(owner, code)
+                                                                    for b in (self.ref, self.fast))
         assert ref_address == fast_address  # same deployer, same nonce: the light contracts sign alike
         self.gas.append(("deploy", ref_receipt.gas_used, fast_receipt.gas_used))
         self.markets = [ChainMarket(b, ref_address, owner, artifact["abi"]) for b in (self.ref, self.fast)]
@@ -76,7 +77,8 @@ class Twin:
 
     def sell(self, seller, buyer, age: int, direction_deg: float = 10.0, site: int = FOOD):
         """A light contract signed once (on py-evm's domain, the same contract address) and revealed on both."""
-        info = PathInfo.from_floats(30 * math.cos(math.radians(direction_deg)), 30 * math.sin(math.radians(direction_deg)))
+        angle = math.radians(direction_deg)
+        info = PathInfo.from_floats(30 * math.cos(angle), 30 * math.sin(angle))
         self._align()
         lc = self.markets[0].light_contract(seller, buyer, site, age, info, (0.5, -0.5))
         return self.tx("revealInformation", seller, lc.as_abi(), info.as_abi(), label="reveal")
@@ -191,7 +193,8 @@ def test_transient_storage_does_not_outlive_its_transaction(backend):
     transient slot 0 and then sets it to 1 logs 0 every time (the market's contract uses none; pyrevm
     never clears it by itself, the checkpoint each transaction runs in undoes it)."""
     runtime = bytes.fromhex("60005c600052" "600160005d" "60206000a000")  # log0(tload(0)); tstore(0, 1)
-    init = bytes([0x60 + len(runtime) - 1]) + runtime + bytes.fromhex(f"60005260{len(runtime):02x}60{32 - len(runtime):02x}f3")
+    size = len(runtime)  # init code: mstore(0, push<size>(runtime)); return(32 - size, size)
+    init = bytes([0x60 + size - 1]) + runtime + bytes.fromhex(f"60005260{size:02x}60{32 - size:02x}f3")
     chain = connect(backend=backend)
     deployer = derived_account("transient", 0)
     chain.fund([deployer.address])
