@@ -307,6 +307,8 @@ class RevmBackend:
         and slots whose present value differs from the value they were loaded with."""
         text = self.evm.journal_str
         end = text.index(", transient_storage: ")
+        if text.find("SelfDestructed", 0, end) >= 0:  # the market's contract never self-destructs
+            raise ChainError("revm backend: a transaction that self-destructs an account is not supported")
         infos, slots = {}, []
         at = text.find(_ACCOUNT, 0, end)
         while at >= 0:
