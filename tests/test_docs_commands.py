@@ -43,7 +43,8 @@ NOT_RUN = {
     "infomarket sweep my.toml --out store --scheduler tcp://head:8786": "needs a Dask scheduler at that address",
     "infomarket run examples/age_liar.toml": "a full run; the example is tested in tests/test_extending.py",
     "infomarket chain demo --robots 25 --steps 15000 --scheme staking":
-        "a paper-length replay on the EVM (about 3 min on revm, 2026-11-24); tests/chain/test_cli.py runs short ones",
+        "a paper-length replay on the EVM (revm, cold storage: 86 s CPU, 7 min wall on the busy machine, "
+        "2026-11-24); tests/chain/test_cli.py runs short ones",
     "infomarket chain demo --chain-period 5":
         "a 3 000-step chain run replayed block by block (~15 s); tests/chain/test_block_replay.py runs this very command",
     "infomarket store verify STORE": "a placeholder store; verify is tested in tests/store/test_integrity.py",

@@ -55,8 +55,8 @@ def add_subcommand(subparsers) -> None:
                       help="experiment whose swarm composition is scaled down (default fig4C)")
     demo.add_argument("--seed", type=seed_value, default=0, help="simulation seed (default 0)")
     demo.add_argument("--backend", choices=("revm", "py-evm"), default="revm",
-                      help="in-process EVM: revm (fast, default; its gas keeps storage warm across "
-                           "transactions, below a chain's) or py-evm (the reference: a chain's gas, slow)")
+                      help="in-process EVM: revm (fast, default) or py-evm (the reference, slow); both "
+                           "charge gas as a chain does (cold storage per transaction)")
     demo.add_argument("--rpc", type=_rpc_url, metavar="URL",
                       help="JSON-RPC node to use instead of an in-process EVM (needs an unlocked funded account)")
     demo.add_argument("--chain-period", type=at_least(1), metavar="P",
