@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import textwrap
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -173,14 +174,30 @@ def wealth_question(runs: pd.DataFrame, decl: dict, setting: str) -> Verdict:
             y = _sel(runs, PAPER, chain="instant", payment=payment, byzantines=k)
             fig = "3" if payment == "outlier" else "4"
             pairs.append((f"Fig. {fig}{'ABC'[(k - 1) // 2]} ({k} Byz.)", x, y, _margin(decl, k)))
-    return wealth_verdict(pairs, decl["study"]["alpha"], decl["study"]["power_target"])
+    v = wealth_verdict(pairs, decl["study"]["alpha"], decl["study"]["power_target"])
+    for payment in ("outlier", "staking"):  # the paper's own claim on the chain (descriptive, declared)
+        for k in (1, 3, 5):
+            gap = _sel(runs, PAPER, "gap", chain=setting, payment=payment, byzantines=k)
+            if len(gap) and "gap" in runs.columns and not np.isnan(gap).all():
+                fig = "3" if payment == "outlier" else "4"
+                v.details.append(f"(descriptive) Fig. {fig}{'ABC'[(k - 1) // 2]} on {setting}, honest minus Byzantine "
+                                 f"mean share: {st.paired(gap).describe(' pp')}")
+    return v
 
 
 def fig7_question(runs: pd.DataFrame, decl: dict, setting: str, angles=(45.0, 90.0)) -> Verdict:
     rows = [(f"{a:g} deg", _sel(runs, FIG7, "items", chain=setting, market="staking", rotation_angle=a),
              _sel(runs, FIG7, "items", chain=setting, market="no_staking", rotation_angle=a), _d(runs, decl, a))
             for a in angles]
-    return fig7_verdict(rows, decl["study"]["alpha"], decl["study"]["power_target"])
+    v = fig7_verdict(rows, decl["study"]["alpha"], decl["study"]["power_target"])
+    for a in angles:  # descriptive (declared): staking on the chain vs staking on the instant ledger
+        x = _sel(runs, FIG7, "items", chain=setting, market="staking", rotation_angle=a)
+        y = _sel(runs, FIG7, "items", chain="instant", market="staking", rotation_angle=a)
+        if len(x) and len(y):
+            e = st.effect(x, y)
+            v.details.append(f"(descriptive) {a:g} deg, staking on {setting} vs on the instant ledger: medians "
+                             f"{np.median(x):.4g} vs {np.median(y):.4g}, HL {e.hl:+.3g} items [{e.hl_low:.3g}, {e.hl_high:.3g}]")
+    return v
 
 
 def axis_values(decl: dict, axis: str) -> list[tuple[float, str]]:
@@ -385,9 +402,10 @@ def figure(a: Answers, path: Path, decl: dict | None = None) -> None:
         ax.set_xticks(xs, [f"{v:g}" for v, _ in pts])
         ax.set_xlabel(xlabels[axis])
         ax.set_ylabel("Byzantines' wealth share, % (median, IQR)")
-        ax.set_title(f"5 Byzantines vs {axis}: {st.shown(a.verdicts[f'breaks_{axis}'].answer)}", fontsize=10)
+        shown = a.table.set_index("question").loc[f"breaks_{axis}", "answer"].split(" (")[0]
+        ax.set_title(f"Figs. 3C/4C vs {axis}; breaks: {shown}", fontsize=10)
         ax.text(0.01, 0.99, f"n per point: {max(ns)}", transform=ax.transAxes, va="top", fontsize=8)
-        ax.legend(fontsize=7, loc="upper right")
+        ax.legend(fontsize=7, loc="best")
         ax = axes[1, j]
         for market, colour, mk in (("staking", "tab:blue", "s"), ("no_staking", "tab:red", "^")):
             med, lo, hi, ns = [], [], [], []
@@ -410,7 +428,7 @@ def figure(a: Answers, path: Path, decl: dict | None = None) -> None:
         ax.set_title(f"Fig. 7, 3 Byzantines at 90 deg vs {axis}", fontsize=10)
         ax.text(0.01, 0.02, f"n per point: {max(ns) if ns else 0}" + ("" if max(ns or [0]) else " (not run)"),
                 transform=ax.transAxes, fontsize=8)
-        ax.legend(fontsize=7, loc="upper right")
+        ax.legend(fontsize=7, loc="best")
     # the named settings
     ax = axes[2, 0]
     settings = ("instant", "toychain", "geth_argos")
@@ -422,8 +440,8 @@ def figure(a: Answers, path: Path, decl: dict | None = None) -> None:
         ok = [d if len(d) else np.array([np.nan]) for d in data]
         bp = ax.boxplot(ok, positions=pos, widths=width * 0.9, patch_artist=True, showfliers=False)
         for b in bp["boxes"]:
-            b.set_facecolor(("white", "tab:green", "tab:purple")[i])
-        ax.plot([], [], "s", color=("grey", "tab:green", "tab:purple")[i],
+            b.set_facecolor(("lightgrey", "tab:green", "tab:purple")[i])
+        ax.plot([], [], "s", color=("lightgrey", "tab:green", "tab:purple")[i],
                 label=f"{s} (n={max(len(d) for d in data)})")
     ax.set_xticks(np.arange(len(conds)), [f"{'3' if p == 'outlier' else '4'}{'ABC'[(k - 1) // 2]}" for p, k in conds])
     ax.set_xlabel("paper condition (Fig. 3: no stake, Fig. 4: staking; A/B/C: 1/3/5 Byzantines)")
@@ -439,8 +457,8 @@ def figure(a: Answers, path: Path, decl: dict | None = None) -> None:
         ok = [d if len(d) else np.array([np.nan]) for d in data]
         bp = ax.boxplot(ok, positions=pos, widths=width * 0.9, patch_artist=True, showfliers=False)
         for b in bp["boxes"]:
-            b.set_facecolor(("white", "tab:green", "tab:purple")[i])
-        ax.plot([], [], "s", color=("grey", "tab:green", "tab:purple")[i],
+            b.set_facecolor(("lightgrey", "tab:green", "tab:purple")[i])
+        ax.plot([], [], "s", color=("lightgrey", "tab:green", "tab:purple")[i],
                 label=f"{s} (n={max(len(d) for d in data)})")
     ax.set_xticks(np.arange(len(conds7)), [f"{m.replace('_', ' ')}\n{ang:g} deg" for m, ang in conds7])
     ax.set_ylabel("swarm items, last 10 000 steps")
@@ -451,9 +469,9 @@ def figure(a: Answers, path: Path, decl: dict | None = None) -> None:
     pf, pr = a.verdicts["partition_forks"], a.verdicts["partition_rich"]
     ax.set_axis_off()
     ax.text(0.02, 0.95, "Partition (food side | nest side)", fontsize=11, va="top", transform=ax.transAxes)
-    ax.text(0.02, 0.80, f"forks that undo payments: {st.shown(pf.answer, '')}\n{pf.note}\n\n"
-                        f"changes who gets rich: {st.shown(pr.answer, '')}\n{pr.note}",
-            fontsize=9, va="top", wrap=True, transform=ax.transAxes)
+    ax.text(0.02, 0.80, f"forks that undo payments: {pf.answer}\n{textwrap.fill(pf.note, 50)}\n\n"
+                        f"changes who gets rich: {pr.answer}\n{textwrap.fill(pr.note, 50)}",
+            fontsize=9, va="top", transform=ax.transAxes)
     fig.suptitle("The paper's result on the robots' own chain (chain_questions.toml)", fontsize=12)
     fig.savefig(path, dpi=110)
     plt.close(fig)
