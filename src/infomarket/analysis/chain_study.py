@@ -177,8 +177,8 @@ def wealth_question(runs: pd.DataFrame, decl: dict, setting: str) -> Verdict:
     v = wealth_verdict(pairs, decl["study"]["alpha"], decl["study"]["power_target"])
     for payment in ("outlier", "staking"):  # the paper's own claim on the chain (descriptive, declared)
         for k in (1, 3, 5):
-            gap = _sel(runs, PAPER, "gap", chain=setting, payment=payment, byzantines=k)
-            if len(gap) and "gap" in runs.columns and not np.isnan(gap).all():
+            gap = _sel(runs, PAPER, "gap", chain=setting, payment=payment, byzantines=k) if "gap" in runs.columns else []
+            if len(gap) and not np.isnan(gap).all():
                 fig = "3" if payment == "outlier" else "4"
                 v.details.append(f"(descriptive) Fig. {fig}{'ABC'[(k - 1) // 2]} on {setting}, honest minus Byzantine "
                                  f"mean share: {st.paired(gap).describe(' pp')}")
