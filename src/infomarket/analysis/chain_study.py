@@ -249,7 +249,9 @@ def breaks_question(runs: pd.DataFrame, decl: dict, axis: str) -> Verdict:
     for v, label in axis_values(decl, axis):
         state, w, f = axis_point(runs, decl, label)
         states.append((v, state, w, f))
-        details.append(f"{axis} {v:g} ({label}): {state} (wealth: {w.answer}; Fig. 7 at 90 deg: {f.answer})")
+        details.append(f"{axis} {v:g} ({label}): {state} (wealth: {st.shown(w.answer, w.note)}; Fig. 7 at 90 deg: "
+                       f"{st.shown(f.answer, f.note)})")
+        details.extend(f"  {axis} {v:g}, {d}" for d in w.details + f.details)
     ran = [s for s in states if s[1] != NOT_RUN]
     if not ran:
         return Verdict(NOT_RUN, details=details)
