@@ -236,3 +236,27 @@ def test_fig7_no_when_staking_helps_at_one_angle_only():
     v = cs.fig7_question(runs, DECL, "toychain")
     assert v.answer == st.NO
     assert any(d.startswith("45 deg: helps") for d in v.details) and any(d.startswith("90 deg: does NOT") for d in v.details)
+
+
+def partition_runs(rng, shift: float, col="byz_share", centre=4.0, sd=0.5, n=24) -> pd.DataFrame:
+    frames = []
+    for base in ("toychain", "backbone"):
+        frames.append(_rows(cs.PARTITION, n, rng, centre=centre, sd=sd, col=col, base=base, partition="none"))
+        frames.append(_rows(cs.PARTITION, n, rng, centre=centre + shift, sd=sd, col=col, base=base, partition="on"))
+    return pd.concat(frames, ignore_index=True)
+
+
+def test_partition_rules_once_its_runs_exist():
+    rng = np.random.default_rng(15)
+    # the Byzantines' share 10 pp higher with the partition (margin 5): who gets rich changes -> yes;
+    # reorganised transactions 50 with it, 0 without -> forks that undo payments -> yes
+    chain = partition_runs(rng, 50.0, col="reorganised_tx", centre=0.0, sd=0.0)
+    chain["reorganised_tx"] = chain["reorganised_tx"] + np.where(chain["partition"] == "on", rng.integers(0, 5, len(chain)), 0)
+    forks, rich = cs.partition_questions(partition_runs(rng, 10.0), chain, DECL)
+    assert (forks.answer, rich.answer) == (st.YES, st.YES)
+    # the same share with and without (equivalent within 5 pp) and no chain measures stored
+    forks, rich = cs.partition_questions(partition_runs(rng, 0.0), None, DECL)
+    assert (forks.answer, rich.answer) == (cs.PENDING, st.NO)
+    # reorganised transactions unchanged by the partition (200 +- 5 either way): shown below none + 20
+    chain = partition_runs(rng, 0.0, col="reorganised_tx", centre=200.0, sd=5.0)
+    assert cs.partition_questions(partition_runs(rng, 0.0), chain, DECL)[0].answer == st.NO
