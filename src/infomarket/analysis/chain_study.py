@@ -405,8 +405,8 @@ def figure(a: Answers, path: Path, decl: dict | None = None) -> None:
         ax.set_xlabel(xlabels[axis])
         ax.set_ylabel("Byzantines' wealth share, % (median, IQR)")
         shown = a.table.set_index("question").loc[f"breaks_{axis}", "answer"].split(" (")[0]
-        ax.set_title(f"Figs. 3C/4C vs {axis}; breaks: {shown}", fontsize=10)
-        ax.text(0.01, 0.99, f"n per point: {max(ns)}", transform=ax.transAxes, va="top", fontsize=8)
+        ax.set_title(f"Figs. 3C/4C vs {axis}; the result breaks: {shown}", fontsize=10)
+        ax.text(0.01, 0.99, f"runs per point: {min(ns)}-{max(ns)}", transform=ax.transAxes, va="top", fontsize=8)
         ax.legend(fontsize=7, loc="best")
         ax = axes[1, j]
         for market, colour, mk in (("staking", "tab:blue", "s"), ("no_staking", "tab:red", "^")):
@@ -428,7 +428,7 @@ def figure(a: Answers, path: Path, decl: dict | None = None) -> None:
         ax.set_xlabel(xlabels[axis])
         ax.set_ylabel("swarm items, last 10 000 steps (median, IQR)")
         ax.set_title(f"Fig. 7, 3 Byzantines at 90 deg vs {axis}", fontsize=10)
-        ax.text(0.01, 0.02, f"n per point: {max(ns) if ns else 0}" + ("" if max(ns or [0]) else " (not run)"),
+        ax.text(0.01, 0.02, f"runs per point: {min(ns)}-{max(ns)}" + ("" if max(ns or [0]) else " (not run)"),
                 transform=ax.transAxes, fontsize=8)
         ax.legend(fontsize=7, loc="best")
     # the named settings
