@@ -21,6 +21,7 @@ RUN = {
     "infomarket check corridor",
     "infomarket check corridor_waypoints",
     "infomarket check attack_search",
+    "infomarket check chain_paper",
 }
 #: Parsed only, with the reason they are not run here.
 NOT_RUN = {
@@ -78,6 +79,16 @@ NOT_RUN = {
         "320 runs; tests/analysis/test_sensitivity.py runs the study with --samples 2",
     "infomarket sensitivity /tmp/sens-quick --out /tmp/sens-quick-report":
         "needs the store above; tests/analysis/test_sensitivity.py runs it on --samples 2",
+    # docs/research.md, the chain study
+    "infomarket sweep chain_paper --out results/chain/chain_paper --workers 2":
+        "432 runs (288 on the chain model); tests/analysis/test_chain_study.py answers synthetic stores",
+    "infomarket sweep chain_fig7 --out results/chain/chain_fig7 --workers 2 --runs 12": "144 runs of 30 000 steps",
+    "infomarket sweep chain_sweep --out results/chain/chain_sweep --workers 2 --runs 12": "336 chain runs",
+    "infomarket sweep chain_fig7_sweep --out results/chain/chain_fig7_sweep --workers 2 --runs 12":
+        "336 chain runs of 30 000 steps",
+    "infomarket chain-study results/chain/chain_paper results/chain/chain_fig7 results/chain/chain_sweep "
+    "results/chain/chain_fig7_sweep --out results/chain/report":
+        "needs the study's stores; tests/analysis/test_chain_study.py runs it on a synthetic one",
     # docs/attack-search.md
     "infomarket attack-search attack_search --defence staking,reputation_sceptic,adaptive_theta --byzantines 3 "
     "--budget 48 --popsize 8 --runs 4 --heldout-runs 16 --best 2 --workers 2 --out /tmp/attack-reduced":
