@@ -11,7 +11,7 @@ venv: $(STAMP)
 $(STAMP): pyproject.toml Makefile
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
 	$(BIN)/python -m pip install -q --upgrade pip
-	$(BIN)/python -m pip install -q -e ".[dask,chain,dev,sql]"
+	$(BIN)/python -m pip install -q -e ".[dask,chain,dev,rl,sql]"
 	touch $(STAMP)
 
 demo: venv
@@ -41,7 +41,7 @@ tools/solc/node_modules: tools/solc/package.json tools/solc/package-lock.json
 	cd tools/solc && npm ci --no-audit --no-fund
 	touch $@
 
-# Gas with cold storage per transaction (py-evm; a few minutes): docs/gas.md and the declared bound.
+# Gas with cold storage per transaction (revm, small sizes cross-checked on py-evm; under 2 min): docs/gas.md, the bound.
 gas: venv
 	$(BIN)/python -m infomarket.chain.gasreport
 

@@ -21,6 +21,7 @@ RUN = {
     "infomarket check corridor",
     "infomarket check corridor_waypoints",
     "infomarket check attack_search",
+    "infomarket check chain_paper",
 }
 #: Parsed only, with the reason they are not run here.
 NOT_RUN = {
@@ -43,7 +44,10 @@ NOT_RUN = {
     "infomarket sweep my.toml --out store --scheduler tcp://head:8786": "needs a Dask scheduler at that address",
     "infomarket run examples/age_liar.toml": "a full run; the example is tested in tests/test_extending.py",
     "infomarket chain demo --robots 25 --steps 15000 --scheme staking":
-        "a paper-length replay on the EVM (about 3 min on revm, 2026-11-24); tests/chain/test_cli.py runs short ones",
+        "a paper-length replay on the EVM (revm, cold storage: 86 s CPU, 7 min wall on the busy machine, "
+        "2026-11-24); tests/chain/test_cli.py runs short ones",
+    "infomarket chain demo --chain-period 5":
+        "a 3 000-step chain run replayed block by block (~15 s); tests/chain/test_block_replay.py runs this very command",
     "infomarket store verify STORE": "a placeholder store; verify is tested in tests/store/test_integrity.py",
     "infomarket store repair STORE": "a placeholder store; repair is tested in tests/store/test_integrity.py",
     "infomarket sweep EXP --out STORE": "a placeholder experiment; sweeps are tested in tests/runner",
@@ -75,6 +79,16 @@ NOT_RUN = {
         "320 runs; tests/analysis/test_sensitivity.py runs the study with --samples 2",
     "infomarket sensitivity /tmp/sens-quick --out /tmp/sens-quick-report":
         "needs the store above; tests/analysis/test_sensitivity.py runs it on --samples 2",
+    # docs/research.md, the chain study
+    "infomarket sweep chain_paper --out results/chain/chain_paper --workers 2":
+        "432 runs (288 on the chain model); tests/analysis/test_chain_study.py answers synthetic stores",
+    "infomarket sweep chain_fig7 --out results/chain/chain_fig7 --workers 2 --runs 12": "144 runs of 30 000 steps",
+    "infomarket sweep chain_sweep --out results/chain/chain_sweep --workers 2 --runs 12": "336 chain runs",
+    "infomarket sweep chain_fig7_sweep --out results/chain/chain_fig7_sweep --workers 2 --runs 12":
+        "336 chain runs of 30 000 steps",
+    "infomarket chain-study results/chain/chain_paper results/chain/chain_fig7 results/chain/chain_sweep "
+    "results/chain/chain_fig7_sweep --out results/chain/report":
+        "needs the study's stores; tests/analysis/test_chain_study.py runs it on a synthetic one",
     # docs/attack-search.md
     "infomarket attack-search attack_search --defence staking,reputation_sceptic,adaptive_theta --byzantines 3 "
     "--budget 48 --popsize 8 --runs 4 --heldout-runs 16 --best 2 --workers 2 --out /tmp/attack-reduced":
@@ -84,6 +98,10 @@ NOT_RUN = {
     "--heldout-runs 16 --best 2 --out /tmp/attack-reduced": "~460 full runs; tests/search runs a tiny search",
     "infomarket attack-search attack_search --defence staking,theta20 --byzantines 3 --dask tcp://head:8786 "
     "--out results/as-dask": "needs a Dask scheduler at that address; tests/search runs one on a LocalCluster",
+    # docs/rl.md
+    "infomarket bench --env --json": "5 timed episodes of 64 runs; tests/bench/test_bench_env.py runs it with --steps 60",
+    "infomarket rl-train --steps 4000 --transitory 1000 --iterations 60 --pairs 32 --eval-runs 32 --seed 0 "
+    "--out rl-train.json": "minutes of training; tests/rl/test_cli.py runs a tiny one",
 }
 
 

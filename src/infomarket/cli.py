@@ -21,6 +21,7 @@ SUBCOMMAND_MODULES = ("infomarket.runner.cli", "infomarket.analysis.cli", "infom
                       "infomarket.chain.cli", "infomarket.analysis.sensitivity_cli")
 SUBCOMMAND_MODULES += ("infomarket.analysis.terrain",)  # terrain-report (docs/terrain.md)
 SUBCOMMAND_MODULES += ("infomarket.search.cli",)  # attack-search (docs/attack-search.md)
+SUBCOMMAND_MODULES += ("infomarket.rl.cli",)  # rl-train (docs/rl.md)
 EXIT_INTERRUPTED = 130
 
 

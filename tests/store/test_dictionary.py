@@ -7,6 +7,7 @@ import re
 import shlex
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pyarrow.parquet as pq
 import pytest
@@ -60,6 +61,37 @@ stake = 0.04
 "swarm.groups[1].params.rotation_angle" = [10.0, 60.0]
 """
 
+# the chain model (the chain table and the robots' chain columns): a grid key too
+CHAIN = """
+name = "chained"
+steps = 2000
+runs = 2
+seed = 4
+
+[swarm]
+robots = 25
+
+[[swarm.groups]]
+behaviour = "sceptical"
+count = 20
+
+[[swarm.groups]]
+behaviour = "scaboteur"
+count = 5
+
+[payment]
+scheme = "outlier"
+stake = 0.04
+
+[chain]
+consensus = "poa"
+period = 5
+gas_price = 1e-7
+
+[sweep.grid]
+"swarm.groups[1].params.rotation_angle" = [60.0]
+"""
+
 SAMPLED = """
 name = "design"
 steps = 3
@@ -94,8 +126,10 @@ def store(tmp_path_factory) -> Store:
     tmp = tmp_path_factory.mktemp("dictionary")
     (tmp / "all.toml").write_text(ALL)
     (tmp / "design.toml").write_text(SAMPLED)
+    (tmp / "chained.toml").write_text(CHAIN)
     s = Store(tmp / "store")
     run_sweep(conditions(im.load_experiment(tmp / "all.toml")), s, record_events=True)
+    run_sweep(conditions(im.load_experiment(tmp / "chained.toml")), s)
     with s.lock():
         save(s, make_design(im.load_experiment(tmp / "design.toml")))
     return s
@@ -139,15 +173,52 @@ def test_the_listed_columns_are_the_written_ones(store):
     for name, t in TABLES.items():
         listed = {c.name for c in t.columns if c.name not in ("NAME", "NAME_raw")}
         assert listed <= written[name], f"{name}: listed but never written: {listed - written[name]}"
-    for table in ("robots", "events", "payments", "sites", "runs"):
+    for table in ("robots", "events", "payments", "sites", "chain", "runs"):
         assert "rotation_angle" in written[table]
         assert describe(table, "rotation_angle", ["rotation_angle"]) == CONDITION_KEY
     assert {"point", "noise_sd_raw", "noise_sd", "byzantines_raw", "byzantines"} == written["designs"]
 
 
+def test_the_chain_table_holds_each_chain_runs_measures_and_nothing_else_changes(store):
+    chain = store.chain()
+    assert len(chain) == 2 and set(chain.experiment) == {"chained"}
+    robots = store.robots()
+    for row in chain.itertuples():
+        rerun = im.Simulation(store.config("chained", row.condition), int(row.seed))
+        rerun.run()
+        m = rerun.chain_measures()
+        for k in ("blocks", "height", "forks", "reorgs", "reorganised_tx", "view_reorgs", "failed_tx",
+                  "pending_tx", "deposits_paid"):
+            assert getattr(row, k) == m[k], k
+        mine = robots[(robots.experiment == "chained") & (robots.run == row.run)].sort_values("robot")
+        assert mine.gas_paid.tolist() == m["gas_paid"] and mine.mean_lag.tolist() == m["mean_lag"]
+        assert row.gas_paid == pytest.approx(sum(m["gas_paid"])) and row.gas_paid > 0  # gas_price > 0
+        assert row.mean_lag == pytest.approx(np.mean(m["mean_lag"]))
+    # runs on the instant ledger: no chain columns in their robots files, none in their commit records
+    for pid in store.committed():
+        record = pd.read_parquet(store.part_path("runs", pid))
+        names = set(pq.read_schema(store.part_path("robots", pid)).names)
+        chained = set(record.experiment) == {"chained"}
+        assert ("chain_sha256" in record.columns) == chained == store.part_path("chain", pid).exists()
+        assert ({"gas_paid", "mean_lag"} <= names) == chained
+    df = store.sql("SELECT r.behaviour, avg(r.gas_paid) AS gas, count(*) AS n FROM robots r "
+                   "JOIN chain USING (experiment, condition, run) GROUP BY ALL ORDER BY r.behaviour")
+    assert df.n.tolist() == [10, 40] and (df.gas > 0).all()
+
+
+def test_a_chain_part_its_record_does_not_list_is_damage(store, tmp_path):
+    s = _copy(store, tmp_path / "copy")
+    plain = next(pid for pid in s.committed()
+                 if set(pd.read_parquet(s.part_path("runs", pid)).experiment) == {"all"})
+    chained = next(pid for pid in s.committed() if s.part_path("chain", pid).exists())
+    s.part_path("chain", plain).write_bytes(s.part_path("chain", chained).read_bytes())
+    with pytest.raises(StoreDamaged, match="does not list it"):
+        s.chain()
+
+
 def test_wealth_share_is_a_fraction_in_the_files(store):
     robots = store.robots()
-    per_run = robots.groupby(["condition", "run"]).wealth_share.sum()
+    per_run = robots.groupby(["experiment", "condition", "run"]).wealth_share.sum()
     assert per_run.round(12).eq(1.0).all()  # fractions of the run's wealth add up to 1, not to 100
     assert "fraction" in describe("robots", "wealth_share").unit
 
@@ -177,7 +248,7 @@ def test_sql_reads_the_committed_parts(store):
     counts = store.events().kind.value_counts()
     assert dict(zip(df.kind, df.n)) == {k: int(v) for k, v in counts.items() if v}
     n = store.sql("SELECT count(*) AS n FROM robots JOIN runs USING (experiment, condition, run)").n[0]
-    assert n == len(store.robots()) == 20
+    assert n == len(store.robots()) == 70  # 2 runs of 10 on the instant ledger, 2 of 25 on the chain
 
 
 def test_the_documented_sql_command_runs(store, tmp_path, monkeypatch, capsys):
@@ -217,7 +288,8 @@ def test_sql_ignores_orphans_and_refuses_or_skips_damaged_parts(store, tmp_path)
     left = s.sql("SELECT count(*) AS n FROM robots", skip_damaged=True).n[0]
     assert left == total - rows_of_one
     runs_left = s.sql("SELECT count(*) AS n FROM runs", skip_damaged=True).n[0]
-    assert runs_left == len(pd.read_parquet(s.part_path("runs", s.committed()[1])))  # the other part only
+    others = sum(len(pd.read_parquet(s.part_path("runs", pid))) for pid in s.committed() if pid != one)
+    assert runs_left == others  # the other parts only
 
 
 def test_sql_reads_and_writes_no_other_file(store, tmp_path, capsys):

@@ -17,6 +17,9 @@ def add_subcommand(subparsers) -> None:
     p.add_argument("--vector", choices=("svg", "pdf"), default="svg", help="vector format besides PNG")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.set_defaults(func=cmd_figures)
+    from .chain_study import add_subcommand as add_chain_study  # `infomarket chain-study` (docs/research.md)
+
+    add_chain_study(subparsers)
 
 
 def cmd_figures(args: argparse.Namespace) -> int:

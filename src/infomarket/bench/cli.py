@@ -26,8 +26,8 @@ def add_subcommand(sub) -> None:
                                    "measured in the same run; or, with --robots, robot-steps/s and peak memory "
                                    "by swarm size at the paper's density; or, with --scaling, sweep throughput.")
     b.add_argument("--json", action="store_true", help="print one JSON object")
-    b.add_argument("--steps", type=at_least(1), default=15000, help="steps per run (default 15000)")
-    b.add_argument("--repeats", type=at_least(1), default=7, help="timed runs per setup (median reported)")
+    b.add_argument("--steps", type=at_least(1), help="steps per run (default 15000; 3000 with --env)")
+    b.add_argument("--repeats", type=at_least(1), help="timed runs per setup (median reported; default 7, 5 with --env)")
     mode = b.add_mutually_exclusive_group()
     mode.add_argument("--robots", type=_sizes, metavar="N,N,...",
                       help="instead: robot-steps/s and peak memory for these swarm sizes (one process each)")
@@ -35,12 +35,25 @@ def add_subcommand(sub) -> None:
                    help="with --robots: every robot a blockchain node (25 signers, blocks every 10 steps)")
     mode.add_argument("--scaling", action="store_true",
                       help="instead: sweep throughput with 1 and 2 local workers and a local Dask cluster of 2")
+    mode.add_argument("--env", action="store_true",
+                      help="instead: the RL vector environment's agent-steps/s and env-steps/s beside the engine's "
+                           "own env-steps/s on the attack_search setup (docs/rl.md; --steps default 3000 here)")
+    b.add_argument("--batch", type=at_least(1), help="with --env: runs per vector env (B, default 64)")
+    b.add_argument("--interval", type=at_least(1), help="with --env: engine steps per decision (K, default 10)")
     b.set_defaults(func=run)
 
 
 def run(args) -> int:
     from . import run_bench, run_scaling, run_swarm_sizes
 
+    if args.env:
+        return _env(args)
+    if args.batch is not None or args.interval is not None:
+        from ..errors import UsageError
+
+        raise UsageError("--batch and --interval go with --env (the RL vector environment's benchmark)")
+    args.steps = 15000 if args.steps is None else args.steps
+    args.repeats = 7 if args.repeats is None else args.repeats
     if args.scaling:
         report = run_scaling(steps=args.steps)
         if args.json:
@@ -89,4 +102,26 @@ def run(args) -> int:
             print(f"{name}: {r['ratio_to_instant']:.2f} x the env-steps/s of the instant ledger (goal: >= 0.5)")
     print("x floor: how many times the floor kernel's time per step (neighbour search, one Gaussian draw, "
           "the rotation and dead reckoning per robot) each setup takes, measured in this run")
+    return 0
+
+
+def _env(args) -> int:
+    from ..errors import UsageError
+
+    try:
+        from .env import run_env_bench
+        import gymnasium  # noqa: F401
+    except ModuleNotFoundError as exc:
+        raise UsageError(f"bench --env needs {exc.name}: pip install 'infomarket[rl]'") from exc
+    r = run_env_bench(steps=3000 if args.steps is None else args.steps, batch=args.batch or 64,
+                      interval=args.interval or 10, repeats=5 if args.repeats is None else args.repeats)
+    if args.json:
+        print(json.dumps(r, indent=2))
+        return 0
+    print(f"{r['setup']}: {r['robots']} robots, {r['agents']} agents, B = {r['batch']} runs, K = {r['interval']} "
+          f"steps per decision, {r['steps']} steps per episode (median of {r['repeats']})")
+    print(f"vector env  {r['agent_steps_per_second']:>12,.0f} agent-steps/s  "
+          f"{r['vector_env_steps_per_second']:>12,.0f} env-steps/s")
+    print(f"engine      {'':>12}                {r['engine_env_steps_per_second']:>12,.0f} env-steps/s")
+    print(f"ratio {r['ratio_to_engine']:.2f} of the engine's env-steps/s (goal: >= {r['goal']})")
     return 0

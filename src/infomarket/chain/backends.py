@@ -11,12 +11,25 @@
   land in block ``n`` until the next call), which is what the replay of a simulation needs: one block
   per simulated step, however many transactions the step holds. Transactions execute as their sender
   without an Ethereum transaction signature (the buyers' EIP-712 signatures inside the light contracts
-  are still checked by the contract itself). **Its gas is not a chain's**: pyrevm 0.3.7 keeps one
-  journal for the life of the EVM (its ``commit`` does not finalise it and storage it inserts goes
-  into the journal too), so accounts and storage slots stay warm from one transaction to the next and
-  each slot's "original value" is the one it had when first loaded. A reveal costs about 20 000 gas
-  less than on py-evm and a large settlement a third of it. ``cold_storage`` says which backends
-  charge gas as a chain does; gas figures (docs/gas.md, the declared bound) come from py-evm.
+  are still checked by the contract itself).
+
+Both charge gas as a chain does (``cold_storage``): every transaction starts with cold accounts and
+storage slots (EIP-2929), and each slot's "original value" (EIP-2200, and the refunds of EIP-3529) is
+the value it had before the transaction. py-evm does so by itself. pyrevm 0.3.7 (the newest release)
+does not: it keeps one journaled state for the EVM's life and never finalises it between
+transactions, so whatever a transaction loaded would stay warm for the next, and a reveal would cost
+about 20 000 gas less. So ``RevmBackend`` keeps the journal empty between transactions and the
+chain's state in revm's database: each transaction runs inside a journal checkpoint; its changes
+are read from the journal (``journal_str``, revm's print of the journaled state: every account and
+slot the transaction loaded, with the value it was loaded with and its present one); the checkpoint
+is reverted, which drops every loaded account and slot from the journal (cold again) and undoes the
+changes; then the changes are written into the database (``insert_account_info`` and
+``insert_account_storage``, which write the database only for an account out of the journal), where
+the next transaction loads them cold, with these values as originals. A reverted transaction keeps
+nothing and warms nothing. Views and dry runs run in a checkpoint that is reverted too. The
+database writes are logged once ``snapshot`` is first called, so that ``revert`` can undo them.
+``tests/chain/test_revm_gas.py`` sends the same transactions to both backends and finds the same gas
+for each. The block's coinbase stays in the journal, as it is warm for every transaction (EIP-3651).
 
 Both raise ``ContractRevert`` (with the custom error's name and arguments) through
 ``market.decode_revert``, and both return a ``Receipt`` whose logs are raw (address, topics, data).
@@ -26,7 +39,7 @@ from __future__ import annotations
 import re
 from typing import NamedTuple
 
-from eth_utils import to_checksum_address
+from eth_utils import keccak, to_checksum_address
 
 from .errors import ChainError
 
@@ -157,14 +170,30 @@ class Web3Backend:
 
 
 _REVERT_OUTPUT = re.compile(r"output: 0x([0-9a-fA-F]*)")
+#: In pyrevm's ``journal_str`` (revm's Debug print of the journaled state): what follows an account's
+#: address in the state map, its info, and one storage slot with the value it was loaded with and the
+#: value it holds now. (The print holds the contract's code too: found with str.find, not a regex scan.)
+_ACCOUNT = ": Account { info: AccountInfo { balance: "
+_INFO = re.compile(r"(\d+), nonce: (\d+), code_hash: 0x([0-9a-f]{64})")
+_SLOT = re.compile(r"[{ ](\d+): StorageSlot \{ previous_or_original_value: (\d+), present_value: (\d+) \}")
+_EMPTY_CODE_HASH = keccak(b"")
+#: (balance, nonce, code hash) of an account that was never written
+_NO_ACCOUNT = (0, 0, _EMPTY_CODE_HASH)
 
 
 class RevmBackend:
-    """revm through pyrevm: an in-process chain whose blocks the caller sets. Its state and results
-    are exact; its gas is not (storage stays warm across transactions, see the module docstring)."""
+    """revm through pyrevm: an in-process chain whose blocks the caller sets, with cold storage per
+    transaction (see the module docstring: every transaction runs in a checkpoint of an empty journal,
+    its changes are read from the journal, the checkpoint is reverted and the changes are written to
+    the database, from which the next transaction loads them cold, as a chain's would)."""
 
     name = "revm"
-    cold_storage = False
+    #: gas as a chain charges it: every transaction starts with cold accounts and storage (EIP-2929)
+    cold_storage = True
+    #: when True, number blocks as py-evm and a node do: each transaction, and each funding (a
+    #: transaction there), lands in a block of its own (the gas report uses it, so that block numbers
+    #: written to storage and calldata are those of py-evm); the replay sets its blocks itself
+    automine = False
 
     def __init__(self):
         try:
@@ -178,6 +207,13 @@ class RevmBackend:
                          block=pyrevm.BlockEnv(number=1, timestamp=1, gas_limit=REVM_BLOCK_GAS))
         self.evm = pyrevm.EVM(env=env, spec_id="CANCUN", gas_limit=REVM_BLOCK_GAS)
         self._block = 1
+        #: what the database holds for every account written so far: (balance, nonce, code hash), and
+        #: the code of the accounts that have some (the database's account info is replaced whole)
+        self._accounts: dict[str, tuple[int, int, bytes]] = {}
+        self._code: dict[str, bytes] = {}
+        #: undo log of the database writes, kept from the first ``snapshot`` on: ("info", address, old)
+        #: or ("slot", address, key, old)
+        self._undo: list[tuple] | None = None
 
     @property
     def block_number(self) -> int:
@@ -190,41 +226,138 @@ class RevmBackend:
                                                          gas_limit=REVM_BLOCK_GAS))
 
     def fund(self, addresses: list[str], amount: int = GAS_ALLOWANCE_WEI) -> None:
+        """Give each address ``amount`` wei, written straight into the database (nothing warmed)."""
         for a in addresses:
-            self.evm.set_balance(a, amount)
+            key = a.lower()
+            _, nonce, code_hash = self._accounts.get(key, _NO_ACCOUNT)
+            self._write_info(key, (amount, nonce, code_hash))
+            self._mined()
 
     def call(self, sender: str, to: str, data: bytes, static: bool = False) -> bytes:
-        """Execute without keeping any change: a view runs static; a dry run of a transaction runs
-        inside a checkpoint that is reverted."""
-        if static:
-            return bytes(self._run(lambda: self.evm.message_call(sender, to, data, gas=self.gas_limit,
-                                                                 is_static=True)))
-        checkpoint = self.evm.snapshot()
-        try:
-            return bytes(self._run(lambda: self.evm.message_call(sender, to, data, gas=self.gas_limit)))
-        finally:
-            self.evm.revert(checkpoint)
+        """Execute without keeping any change (a view runs static), inside a checkpoint that is
+        reverted, so that nothing it loads stays warm."""
+        return bytes(self._isolated(lambda: self.evm.message_call(sender, to, data, gas=self.gas_limit,
+                                                                  is_static=static)))
 
     def transact(self, sender, to: str, data: bytes) -> Receipt:
-        """Execute and keep: a reverted call changes nothing, so no dry run is needed."""
-        self._run(lambda: self.evm.message_call(sender.address, to, data, gas=self.gas_limit))
-        return self._receipt()
+        """Execute and keep: a reverted call changes nothing (and warms nothing), so no dry run is needed."""
+        self._isolated(lambda: self.evm.message_call(sender.address, to, data, gas=self.gas_limit), keep=True)
+        receipt = self._receipt()
+        self._mined()
+        return receipt
 
     def deploy(self, sender, code: bytes) -> tuple[str, Receipt]:
-        address = self._run(lambda: self.evm.deploy(sender.address, code, gas=self.gas_limit))
-        return to_checksum_address(address), self._receipt()
+        address = self._isolated(lambda: self.evm.deploy(sender.address, code, gas=self.gas_limit), keep=True)
+        receipt = self._receipt()
+        self._mined()
+        return to_checksum_address(address), receipt
+
+    def _mined(self) -> None:
+        if self.automine:
+            self.advance_to(self._block + 1)
 
     def snapshot(self) -> list:
-        """A handle to the current state that ``revert`` can go back to any number of times (revm's
-        checkpoints are single-use, so each revert takes a fresh one at the same point)."""
-        return [self.evm.snapshot(), self._block]
+        """A handle to the current state that ``revert`` can go back to any number of times: the
+        length of the undo log of database writes, which is kept from the first snapshot on."""
+        if self._undo is None:
+            self._undo = []
+        return [len(self._undo), self._block]
 
     def revert(self, snapshot: list) -> None:
-        checkpoint, block = snapshot
-        self.evm.revert(checkpoint)
-        snapshot[0] = self.evm.snapshot()
+        mark, block = snapshot
+        slots = []
+        while len(self._undo) > mark:
+            entry = self._undo.pop()
+            if entry[0] == "info":
+                _, address, old = entry
+                self._write_info(address, old or _NO_ACCOUNT, undo=False)
+                if old is None:
+                    del self._accounts[address]
+            else:
+                slots.append(entry[1:])
+        self._write_slots(slots, undo=False)
         self._block = 0
         self.advance_to(block)
+
+    # -- one transaction, cold ----------------------------------------------------------------------
+
+    def _isolated(self, execute, keep: bool = False):
+        """Run ``execute`` in a checkpoint of the (empty) journal and revert it, so that every account
+        and slot it loaded is cold again; with ``keep``, write what it changed into the database."""
+        checkpoint = self.evm.snapshot()
+        try:
+            out = self._run(execute)
+            changes = self._changes() if keep else None
+        finally:
+            self.evm.revert(checkpoint)
+            if self.evm.journal_depth != 0:  # pragma: no cover - would mean pyrevm left a frame open
+                raise ChainError(f"revm: the journal was left at depth {self.evm.journal_depth}")
+        if changes is not None:
+            infos, slots = changes
+            for address, (info, code) in infos.items():
+                if code is not None:
+                    self._code[address] = code
+                self._write_info(address, info)
+            self._write_slots(slots)
+        return out
+
+    def _changes(self) -> tuple[dict, list]:
+        """What the transaction just executed changed, read from the journaled state (which holds
+        only what it loaded): accounts whose (balance, nonce, code hash) differ from the database's,
+        and slots whose present value differs from the value they were loaded with."""
+        text = self.evm.journal_str
+        end = text.index(", transient_storage: ")
+        if text.find("SelfDestructed", 0, end) >= 0:  # the market's contract never self-destructs
+            raise ChainError("revm backend: a transaction that self-destructs an account is not supported")
+        infos, slots = {}, []
+        at = text.find(_ACCOUNT, 0, end)
+        while at >= 0:
+            address = text[at - 42:at]
+            found = _INFO.match(text, at + len(_ACCOUNT))
+            if not address.startswith("0x") or found is None:
+                raise ChainError("revm: unexpected journal print (is pyrevm newer than 0.3.7?)")
+            info = (int(found.group(1)), int(found.group(2)), bytes.fromhex(found.group(3)))
+            old = self._accounts.get(address, _NO_ACCOUNT)
+            if info != old:
+                code = self._deployed_code(address, info[2]) if info[2] != old[2] else None
+                infos[address] = (info, code)
+            begin = text.index("storage: {", found.end())
+            stop = text.index(", status: AccountStatus", begin)
+            for slot in _SLOT.finditer(text, begin, stop):
+                if slot.group(2) != slot.group(3):
+                    slots.append((address, int(slot.group(1)), int(slot.group(3)), int(slot.group(2))))
+            at = text.find(_ACCOUNT, stop, end)
+        return infos, slots
+
+    def _deployed_code(self, address: str, code_hash: bytes) -> bytes:
+        """The code an account was just given: revm pads it with zeros, the hash tells how many."""
+        code = bytes(self.evm.get_code(address) or b"")
+        for end in range(len(code), max(-1, len(code) - 64), -1):
+            if keccak(code[:end]) == code_hash:
+                return code[:end]
+        raise ChainError(f"revm: the code of {address} does not match its hash")
+
+    def _write_info(self, address: str, info: tuple[int, int, bytes], undo: bool = True) -> None:
+        """Write an account into the database: it must be cold (out of the journal), as it is between
+        transactions, or revm would write into the journal instead."""
+        if undo and self._undo is not None:
+            self._undo.append(("info", address, self._accounts.get(address)))
+        balance, nonce, code_hash = info
+        code = self._code.get(address) if code_hash != _EMPTY_CODE_HASH else None
+        self.evm.insert_account_info(address, self._pyrevm.AccountInfo(balance=balance, nonce=nonce, code=code))
+        self._accounts[address] = info
+
+    def _write_slots(self, slots: list[tuple], undo: bool = True) -> None:
+        """Write (address, key, value, old value) slots into the database. pyrevm's
+        ``insert_account_storage`` writes the database only when the account is out of the journal,
+        and loads it into the journal as it does; so each write runs in a checkpoint of its own, reverted."""
+        if undo and self._undo is not None:
+            self._undo += [("slot", address, key, old) for address, key, _, old in slots]
+        evm = self.evm
+        for address, key, value, *_ in slots:
+            checkpoint = evm.snapshot()
+            evm.insert_account_storage(address, key, value)
+            evm.revert(checkpoint)
 
     def _run(self, execute):
         try:

@@ -9,6 +9,12 @@ than the fixed-point rounding allows, see ``evm_replay``). A run without deposit
 replay (exit status 2): with no deposit nothing is ever weighed or paid, and the comparison would pass
 whatever the contract's rules.
 
+With the chain model on (``--chain-period P``, or an experiment whose ``[chain]`` section has
+``consensus = "poa"``) the robots run their own Proof-of-Authority chain (docs/chain-model.md): the
+demo records every block the model makes (``ledger.blocklog``) and replays the canonical chain on the
+EVM one block per modelled block, checking every robot's balance against the modelled ledger after
+every block, and names the first block that differs (``chain.block_replay``).
+
 ``add_subcommand(subparsers)`` hangs ``chain demo`` under the main ``infomarket`` parser; the chosen
 handler is stored as ``func`` (``args.func(args)`` returns the exit status). Heavy imports (the
 simulator, web3) happen only when the command runs.
@@ -49,10 +55,17 @@ def add_subcommand(subparsers) -> None:
                       help="experiment whose swarm composition is scaled down (default fig4C)")
     demo.add_argument("--seed", type=seed_value, default=0, help="simulation seed (default 0)")
     demo.add_argument("--backend", choices=("revm", "py-evm"), default="revm",
-                      help="in-process EVM: revm (fast, default; its gas keeps storage warm across "
-                           "transactions, below a chain's) or py-evm (the reference: a chain's gas, slow)")
+                      help="in-process EVM: revm (fast, default) or py-evm (the reference, slow); both "
+                           "charge gas as a chain does (cold storage per transaction)")
     demo.add_argument("--rpc", type=_rpc_url, metavar="URL",
                       help="JSON-RPC node to use instead of an in-process EVM (needs an unlocked funded account)")
+    demo.add_argument("--chain-period", type=at_least(1), metavar="P",
+                      help="run the chain model (robots as Proof-of-Authority nodes, a block every P steps; "
+                           "docs/chain-model.md) and replay its blocks one by one on the EVM, checking every "
+                           "balance after every block (revm only)")
+    demo.add_argument("--gas-price", type=non_negative_float, metavar="G",
+                      help="with the chain model: money per unit of gas the model charges (default: the "
+                           "experiment's [chain] gas_price, 0 without one)")
     demo.set_defaults(func=run_demo)
 
 
@@ -74,6 +87,30 @@ def demo_config(base, robots: int, steps: int, scheme: str):
         payment=payment)
 
 
+def non_negative_float(text: str) -> float:
+    """A float option that must be finite and >= 0."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+    if not value >= 0 or value == float("inf"):
+        raise argparse.ArgumentTypeError(f"must be a finite number >= 0, got {text}")
+    return value
+
+
+def chain_config(config, period: int | None, gas_price: float | None):
+    """``config`` with the chain model on when ``period`` is given (its other ``[chain]`` keys kept), and
+    the gas price set when given; unchanged when neither is."""
+    if period is None and gas_price is None:
+        return config
+    chain = config.chain.model_dump()
+    if period is not None:
+        chain.update(consensus="poa", period=period)
+    if gas_price is not None:
+        chain.update(gas_price=gas_price)
+    return config.with_overrides(chain=chain)
+
+
 def run_demo(args: argparse.Namespace) -> int:
     """Handler of ``infomarket chain demo``; returns the exit status."""
     try:
@@ -86,6 +123,12 @@ def run_demo(args: argparse.Namespace) -> int:
         return report_error(f"infomarket chain needs the chain extra (pip install 'infomarket[chain]'): {exc}", 1)
     try:
         config = demo_config(load_experiment(args.experiment), args.robots, args.steps, args.scheme)
+        config = chain_config(config, getattr(args, "chain_period", None), getattr(args, "gas_price", None))
+        if config.chain.gas_price and not config.chain.enabled:
+            raise ConfigError("--gas-price needs the chain model: give --chain-period P too")
+        if config.chain.enabled and (args.rpc or args.backend != "revm"):
+            raise ConfigError("the block-by-block replay of the chain model needs the revm backend (its blocks "
+                              "are set by the replay): drop --rpc and --backend py-evm")
         if args.rpc:
             connect(args.rpc)  # fail before simulating if the node is not there
         if config.payment.scheme == "outlier" and config.payment_params()["theta"] > 180:
@@ -95,6 +138,8 @@ def run_demo(args: argparse.Namespace) -> int:
     composition = ", ".join(f"{g.count} {g.behaviour}" for g in config.swarm.groups if g.count)
     print(f"chain demo: {args.robots} robots ({composition}), {args.steps} steps, scheme {args.scheme} "
           f"(stake {config.payment.stake:g}), seed {args.seed}")
+    if config.chain.enabled:
+        return _run_chain_demo(config, args)
     t0 = time.perf_counter()
     result = simulate(config, seed=args.seed, record_events=True)
     kinds = result.events["kind"].value_counts()
@@ -115,6 +160,64 @@ def run_demo(args: argparse.Namespace) -> int:
     print("on-chain balances match the simulated ledger (within the fixed-point rounding bound)" if good else
           "on-chain balances DO NOT match the simulated ledger")
     return 0 if good else 1
+
+
+def _run_chain_demo(config, args) -> int:
+    """The chain model's demo: simulate with a block log, then replay the canonical chain block by block."""
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from ..engine.simulation import Simulation
+    from ..ledger.blocklog import BlockLog
+    from .block_replay import match_purchases, replay_blocks
+    from .errors import ChainError
+
+    c = config.chain
+    print(f"chain model: Proof-of-Authority, a block every {c.period} steps (out of turn +{c.out_of_turn_delay}), "
+          f"{'a backbone of latency ' + str(c.latency) + ', ' if c.backbone else ''}loss {c.loss:g}, "
+          f"gas price {c.gas_price:g}")
+    columns = (TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn())
+    with Progress(*columns, transient=True, disable=not sys.stderr.isatty()) as bar:
+        sim = Simulation(config, args.seed, record_events=True)
+        t0 = time.perf_counter()
+        log = BlockLog(sim)
+        task = bar.add_task("simulating (observing every block)", total=config.steps)
+        log.run(progress=lambda t: bar.update(task, completed=t))
+        observed = time.perf_counter() - t0
+        result = sim.result()
+        m = result.totals["chain"]
+        blocks = log.canonical()
+        print(f"simulated in {observed:.1f} s, observing every step: {m['blocks']} blocks made "
+              f"({len(log.blocks)} seen), canonical height {m['height']}, {m['forks']} forks, {m['reorgs']} "
+              f"reorganisations taking out {m['reorganised_tx']} transactions, {m['failed_tx']} failed, "
+              f"{m['pending_tx']} pending at the end, mean payment delay {m['mean_payment_delay']:.1f} steps")
+        deposits = sum(1 for b in blocks for tx in b.txs if tx.kind == "deposit")
+        reveals = sum(1 for b in blocks for tx in b.txs if tx.kind == "reveal")
+        if not deposits or not reveals:
+            return report_error(f"the canonical chain holds {reveals} reveals and {deposits} deposits: with no "
+                                "purchase paid out by a deposit the comparison would prove nothing; run more "
+                                "--steps or --robots", 2)
+        t0 = time.perf_counter()
+        task = bar.add_task("replaying blocks on the EVM", total=len(blocks))
+        try:
+            report = replay_blocks(blocks, match_purchases(log.txs, result.events), config, seed=args.seed,
+                                   progress=lambda k: bar.update(task, completed=k))
+        except ChainError as exc:
+            return report_error(exc, 1)
+    print(f"replayed {len(blocks)} blocks ({reveals} reveals, {deposits} deposits) on the in-process EVM "
+          f"({report.backend}) in {time.perf_counter() - t0:.1f} s, checking every balance after every block")
+    g = report.gas_summary()
+    print(f"  reveals landed          {report.reveals}; refused by the contract {len(report.refused)}; "
+          f"refused by the model's gas check (not sent) {report.gas_refused}")
+    print(f"  gas per reveal          {g['reveal_evm']:,.0f} measured (mean), {g['reveal_model']:,.0f} modelled; "
+          f"equal for {g['reveal_equal']} of {report.reveals}")
+    print(f"  gas per deposit         {g['deposit_evm']:,.0f} measured (mean), {g['deposit_model']:,.0f} modelled; "
+          f"equal for {g['deposit_equal']} of {report.deposits}")
+    print(f"  money conserved         {'yes' if report.conserved else 'NO'}")
+    if report.first_mismatch is not None:
+        print(f"first mismatch: {report.first_mismatch}")
+    print(f"every robot's balance matches the modelled ledger at all {report.blocks_checked} blocks" if report.ok
+          else f"balances DO NOT match the modelled ledger (checked {report.blocks_checked} blocks before)")
+    return 0 if report.ok else 1
 
 
 def _report_text(report, rows) -> str:

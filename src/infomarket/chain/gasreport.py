@@ -1,7 +1,7 @@
 """Gas of ``revealInformation`` and of a whole deposit as a round trip grows, and of the largest call
-the contract allows, all measured with cold storage per transaction (py-evm), as a chain charges it.
+the contract allows, all measured with cold storage per transaction, as a chain charges it.
 
-    python -m infomarket.chain.gasreport [--out docs/gas.md] [--backend py-evm|revm] [--rpc URL]
+    python -m infomarket.chain.gasreport [--out docs/gas.md] [--backend revm|py-evm] [--rpc URL]
 
 For each payment scheme and each round-trip size n, one buyer receives n reveals from 16 sellers
 (all for the same site, all within Theta of each other: the outlier weighting's worst case), then
@@ -12,14 +12,19 @@ of the settled list, the steady state of a running swarm.
 The bound: the largest call is a weighing call at the largest round trip the contract accepts
 (512 live records): it loads all 512 and compares a batch of them with all. ``worst_call`` fills a
 round trip to 512 records and measures ``buyItem`` and the first weighing ``settle`` calls; every
-call must stay under ``DECLARED_MAX_TX_GAS`` (the command exits 1 otherwise). revm's gas is not a
-chain's (its storage stays warm across transactions, see ``backends``): measure on py-evm or a node.
+call must stay under ``DECLARED_MAX_TX_GAS`` (the command exits 1 otherwise).
+
+It runs on revm by default (seconds; cold storage per transaction, see ``backends``), one block per
+transaction as on py-evm, and cross-checks the small sizes on py-evm, the reference EVM: every figure
+must agree within ``CROSS_CHECK_TOLERANCE`` (the command exits 1 otherwise). They differ only by the
+signatures, which are not deterministic: a zero byte of calldata costs 12 gas less than another.
 """
 from __future__ import annotations
 
 import argparse
 import math
 import random
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 from statistics import mean
@@ -36,6 +41,17 @@ SCHEMES = {"delayed": ("delayed", 0.0), "outlier": ("outlier", 0.0), "outlier + 
 SELLERS = 16
 #: Weighing calls measured after ``buyItem`` at the largest round trip (all weighing calls do the same work).
 WORST_SETTLES = 2
+#: Sizes measured again on py-evm when the report runs on revm, and how far apart (relative) any figure may be.
+CROSS_CHECK_SIZES = (1, 4, 16)
+CROSS_CHECK_TOLERANCE = 0.01
+
+
+def gas_backend(name: str | None = "revm", rpc_url: str | None = None):
+    """A chain to measure on: revm numbers its blocks as py-evm does (a block per transaction)."""
+    backend = connect(rpc_url, name)
+    if hasattr(backend, "automine"):
+        backend.automine = True
+    return backend
 
 
 @dataclass(frozen=True)
@@ -95,7 +111,7 @@ def _reveal_all(market, sellers, buyer, n: int, rng: random.Random, first_age: i
 def measure(scheme: str, sizes=SIZES, *, trips: int = 2, backend=None, seed: int = 0) -> list[GasRow]:
     """Deploy a market for ``scheme`` (a key of ``SCHEMES``) and measure every size in ``sizes`` over
     ``trips`` round trips (``deposit_later`` is the last one's; with one trip it equals the first)."""
-    backend = backend or connect(backend="py-evm")
+    backend = backend or gas_backend()
     market, sellers, buyers = _market(scheme, backend, seed, len(sizes))
     rng = random.Random(seed)
     rows = []
@@ -114,7 +130,7 @@ def measure(scheme: str, sizes=SIZES, *, trips: int = 2, backend=None, seed: int
 def worst_call(scheme: str, n: int = DEFAULT_MAX_RECORDS_PER_TRIP, *, backend=None, seed: int = 0) -> WorstCall:
     """Fill one round trip to ``n`` records (every pair similar) and measure ``buyItem`` and the first
     ``WORST_SETTLES`` weighing calls, the most expensive calls the contract allows at that size."""
-    backend = backend or connect(backend="py-evm")
+    backend = backend or gas_backend()
     market, sellers, (buyer,) = _market(scheme, backend, seed, 1)
     reveals = _reveal_all(market, sellers, buyer, n, random.Random(seed))
     buy = market.buy_item(buyer.address).gas_used
@@ -124,15 +140,29 @@ def worst_call(scheme: str, n: int = DEFAULT_MAX_RECORDS_PER_TRIP, *, backend=No
     return WorstCall(scheme, n, max(reveals), buy, max(settles, default=0))
 
 
-def render(rows: list[GasRow], worst: list[WorstCall], backend: str = "py-evm") -> str:
-    """The Markdown of docs/gas.md."""
+def cross_check(rows: list[GasRow], sizes=CROSS_CHECK_SIZES, *, seed: int = 0) -> float:
+    """Measure ``sizes`` of every scheme in ``rows`` again on py-evm, the reference EVM, and return the
+    largest relative difference of any figure (the number of transactions must be equal)."""
+    largest = 0.0
+    for scheme in dict.fromkeys(r.scheme for r in rows):
+        mine = {r.n: r for r in rows if r.scheme == scheme}
+        for ref in measure(scheme, sizes, backend=connect(backend="py-evm"), seed=seed):
+            row = mine[ref.n]
+            if row.transactions != ref.transactions:
+                return math.inf
+            for name in ("reveal_mean", "reveal_max", "deposit_first", "deposit_later", "largest_tx"):
+                largest = max(largest, abs(getattr(row, name) - getattr(ref, name)) / getattr(ref, name))
+    return largest
+
+
+def render(rows: list[GasRow], worst: list[WorstCall], backend: str = "revm", checked: float | None = None) -> str:
+    """The Markdown of docs/gas.md (``checked``: the cross-check's largest relative difference)."""
     lines = [
         "# Gas of the on-chain market",
         "",
         f"Generated by `python -m infomarket.chain.gasreport` (`make gas`) on {backend}, which starts every",
         "transaction with cold accounts and storage (EIP-2929), as a chain does; Cancun rules; solc-js",
-        "0.8.28, optimizer 200 runs, via-IR. (revm's gas is lower: it keeps storage warm across",
-        "transactions, see `chain/backends.py`.) One buyer, `n` reveals from 16 sellers for one site, every",
+        "0.8.28, optimizer 200 runs, via-IR. One buyer, `n` reveals from 16 sellers for one site, every",
         "vector within Theta of every other (the outlier weighting's worst case), then a deposit:",
         f"`buyItem` and `settle(robot, {SETTLE_BATCH})` calls until the round trip is settled; then a second",
         "round trip of the same size. *First trip* writes fresh storage; *later trips* reuse the settled",
@@ -140,6 +170,12 @@ def render(rows: list[GasRow], worst: list[WorstCall], backend: str = "py-evm") 
         "*Largest tx* is the most gas one transaction of the deposit took.",
         "",
     ]
+    if checked is not None:
+        lines += [f"Cross-check: the sizes {', '.join(map(str, CROSS_CHECK_SIZES))} measured again on py-evm, "
+                        "the reference EVM: every figure", f"within {checked:.3%} (tolerance "
+                        f"{CROSS_CHECK_TOLERANCE:.0%}; the signatures differ between runs, and a zero byte of calldata",
+                        "costs 12 gas less than another). `tests/chain/test_revm_gas.py` compares every transaction.",
+                        ""]
     for scheme in dict.fromkeys(r.scheme for r in rows):
         lines += [f"## {scheme}", "",
                   "| n | reveal, mean | reveal, max | deposit, first trip | deposit, later trips | transactions | largest tx |",
@@ -162,16 +198,21 @@ def render(rows: list[GasRow], worst: list[WorstCall], backend: str = "py-evm") 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m infomarket.chain.gasreport", description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=Path("docs/gas.md"), help="Markdown file to write")
-    parser.add_argument("--backend", choices=("py-evm", "revm"), default="py-evm",
-                        help="in-process EVM (py-evm: cold storage per transaction, as a chain; revm: warm, lower)")
+    parser.add_argument("--backend", choices=("revm", "py-evm"), default="revm",
+                        help="in-process EVM, both with cold storage per transaction as a chain: revm (default, "
+                             "seconds; its small sizes cross-checked on py-evm) or py-evm (the reference, minutes)")
     parser.add_argument("--rpc", metavar="URL", help="JSON-RPC node to measure on instead")
     args = parser.parse_args(argv)
-    rows = [row for scheme in SCHEMES for row in measure(scheme, backend=connect(args.rpc, args.backend))]
-    worst = [worst_call(scheme, backend=connect(args.rpc, args.backend))
+    rows = [row for scheme in SCHEMES for row in measure(scheme, backend=gas_backend(args.backend, args.rpc))]
+    worst = [worst_call(scheme, backend=gas_backend(args.backend, args.rpc))
              for scheme in ("outlier + staking", "outlier_distinct + staking")]
+    checked = cross_check(rows) if args.rpc is None and args.backend == "revm" else None
     args.out.parent.mkdir(parents=True, exist_ok=True)
-    args.out.write_text(render(rows, worst, args.rpc or args.backend))
+    args.out.write_text(render(rows, worst, args.rpc or args.backend, checked))
     print(f"wrote {args.out}")
+    if checked is not None and checked > CROSS_CHECK_TOLERANCE:
+        print(f"revm and py-evm differ by {checked:.2%}, more than {CROSS_CHECK_TOLERANCE:.0%}", file=sys.stderr)
+        return 1
     return 1 if any(r.largest_tx > DECLARED_MAX_TX_GAS for r in rows) or any(
         w.largest > DECLARED_MAX_TX_GAS for w in worst) else 0
 

@@ -188,15 +188,26 @@ class Simulation:
                  "items": int(c)} for xy, r, k, c in zip(w.sites_xy, w.sites_r, w.sites_kind, w.site_items)]
 
     def snapshot(self) -> dict:
-        """Plain-Python view of the current state, for viewers and inspection."""
+        """Plain-Python view of the current state, for viewers and inspection.  With the chain model on,
+        ``chain`` holds the canonical height, the forks and reorganisations so far, and per robot its
+        head's height, its lag (canonical height minus its head's) and its branch (0: on the canonical
+        branch; ``ledger.blocklog.chain_views``); else None."""
         w = self.world
         specs = behaviours()
-        return {"step": self.clock, "pos": w.pos.tolist(), "heading": headings(w).tolist(),
+        snap = {"step": self.clock, "pos": w.pos.tolist(), "heading": headings(w).tolist(),
                 "state": [STATE_NAMES[s] for s in w.state], "carrying": w.carrying.tolist(),
                 "last_site": [SITE_NAMES[s] if s >= 0 else None for s in w.last_site],
                 "items": w.items.tolist(), "wealth": w.balance.tolist(),
                 "behaviour": list(self.behaviour_names), "honest": [specs[b].honest for b in self.behaviour_names],
-                "sites": SITE_NAMES}
+                "sites": SITE_NAMES, "chain": None}
+        if self.config.chain.enabled:
+            from ..ledger.blocklog import chain_views
+
+            height, lag, branch = chain_views(w)
+            snap["chain"] = {"height": int(w.blk_height[w.chn_canon[0]]), "forks": int(w.chn_forks[0]),
+                             "reorgs": int(w.chn_reorgs[0]), "head_height": height.astype(int).tolist(),
+                             "lag": lag.astype(int).tolist(), "branch": branch.tolist()}
+        return snap
 
 
 #: How an error raised while compiling or stepping becomes one that names the rule, its file and line,

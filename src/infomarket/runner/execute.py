@@ -60,6 +60,8 @@ class RunOutput:
     steps: int = 0
     error: str | None = None
     sites: pd.DataFrame = field(default_factory=pd.DataFrame)
+    #: the chain model's measures, one row (runs with ``[chain]`` only), else empty
+    chain: pd.DataFrame = field(default_factory=pd.DataFrame)
     #: the error is a user's rule's (RuleRunError): the message names the rule, its file and line, the step
     rule_error: bool = False
 
@@ -86,8 +88,23 @@ def run_one(cfg: Experiment, run: int, seed: int, record_events: bool = False) -
         sites.insert(0, "run", np.int64(run))
         sites.insert(1, "seed", np.uint64(seed))
         sites.insert(2, "site", np.arange(len(sites), dtype=np.int64))
+    chain = pd.DataFrame()
+    if "chain" in r.totals:  # the chain model's measures (docs/chain-model.md): per robot and per run
+        robots["gas_paid"], robots["mean_lag"], chain = chain_tables(r.totals["chain"], run, seed)
     return RunOutput(run, seed, robots, hist, events, payments, r.compile_seconds, r.run_seconds, r.steps,
-                     sites=sites)  # events and payments are empty unless recorded
+                     sites=sites, chain=chain)  # events and payments are empty unless recorded
+
+
+def chain_tables(m: dict, run: int, seed: int) -> tuple[np.ndarray, np.ndarray, pd.DataFrame]:
+    """A chain run's measures (``Simulation.chain_measures``) as the store keeps them: each robot's gas paid
+    and mean view lag (robots table), and the run's row of the chain table."""
+    gas, lag = np.asarray(m["gas_paid"], np.float64), np.asarray(m["mean_lag"], np.float64)
+    row = {"run": np.int64(run), "seed": np.uint64(seed),
+           **{k: np.int64(m[k]) for k in ("blocks", "height", "forks", "reorgs", "reorganised_tx", "view_reorgs",
+                                          "failed_tx", "pending_tx", "deposits_paid")},
+           "mean_payment_delay": float(m["mean_payment_delay"]), "gas_paid": float(gas.sum()),
+           "mean_lag": float(lag.mean()) if len(lag) else float("nan")}
+    return gas, lag, pd.DataFrame([row])
 
 
 def _failed(run: int, seed: int, exc: BaseException) -> RunOutput:

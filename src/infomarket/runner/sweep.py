@@ -110,7 +110,7 @@ def _frames(task: Task, outputs: list[RunOutput]) -> dict[str, pd.DataFrame | No
                 df[k] = v
         return df
 
-    robots, hists, events, payments, sites, rows = [], [], [], [], [], []
+    robots, hists, events, payments, sites, chains, rows = [], [], [], [], [], [], []
     for o, run in zip(outputs, task.runs):
         if o.error is None:
             robots.append(label(o.robots, True))
@@ -123,6 +123,8 @@ def _frames(task: Task, outputs: list[RunOutput]) -> dict[str, pd.DataFrame | No
                 payments.append(label(o.payments, True))
             if len(o.sites):
                 sites.append(label(o.sites, True))
+            if len(o.chain):
+                chains.append(label(o.chain, True))
         rows.append({"experiment": c.experiment, "condition": c.id, "run": np.int64(run),
                      "seed": np.uint64(c.seed(run)), "master_seed": np.int64(c.master_seed),
                      "config_hash": c.config.config_hash(), "package_version": __version__,
@@ -131,7 +133,8 @@ def _frames(task: Task, outputs: list[RunOutput]) -> dict[str, pd.DataFrame | No
     configs = pd.DataFrame([{"experiment": c.experiment, "condition": c.id, "config_hash": c.config.config_hash(),
                              "config": config_json(c.config)}])
     return {"robots": _concat(robots), "history": _concat(hists), "events": _concat(events),
-            "payments": _concat(payments), "sites": _concat(sites), "configs": configs, "runs": pd.DataFrame(rows)}
+            "payments": _concat(payments), "sites": _concat(sites), "configs": configs, "chain": _concat(chains),
+            "runs": pd.DataFrame(rows)}
 
 
 def config_json(cfg: Experiment) -> str:

@@ -65,6 +65,8 @@ CONDITION_KEY = Column("(condition key)", "as the key", "as the configuration ke
 SITE_CODES = "0 = food, 1 = nest"
 
 _DATA = ("robots", "history", "events", "payments", "sites", "configs")
+CHAIN_ONLY = "Runs with the chain model only (`[chain] consensus = \"poa\"`, docs/chain-model.md); absent from " \
+             "other runs' files (NULL in SQL over a store holding both)"
 
 TABLES: dict[str, Table] = {t.name: t for t in (
     Table("robots", "robots/part-*.parquet", "one robot at the end of one run",
@@ -83,6 +85,10 @@ TABLES: dict[str, Table] = {t.name: t for t in (
               _c("wealth_share", "float64", "fraction (0 to 1)",
                  "wealth over the total wealth of the robots of its run; a FRACTION in the files (0.04 is "
                  "an equal share among 25), shown as a PERCENTAGE in printed tables and figures"),
+              _c("gas_paid", "float64", "money", "gas the robot paid on the canonical chain (gas_price x the "
+                                                 f"measured gas of its reveals and deposits). {CHAIN_ONLY}"),
+              _c("mean_lag", "float64", "blocks", "the robot's mean view lag: canonical height minus its head's "
+                                                  f"height, averaged over the run's steps. {CHAIN_ONLY}"),
           ), True),
     Table("history", "history/part-*.parquet", "one robot's wealth at one recorded step of one run "
                                                "(runs made with `history_every = K` / `--history K`)",
@@ -138,6 +144,30 @@ TABLES: dict[str, Table] = {t.name: t for t in (
               _c("items", "int64", "items", "items picked up at this food site, or deposited at this nest, after "
                                             "the transitory period"),
           ), True),
+    Table("chain", "chain/part-*.parquet", "the chain model's measures of one run (runs with `[chain] "
+                                           "consensus = \"poa\"` only, docs/chain-model.md)",
+          ("experiment", "condition", "run"), (
+              EXPERIMENT, CONDITION, RUN, SEED,
+              _c("blocks", "int64", "blocks", "blocks made on every branch"),
+              _c("height", "int64", "blocks", "the canonical chain's height at the end (genesis 0)"),
+              _c("forks", "int64", "blocks", "blocks made on a parent that already had a child"),
+              _c("reorgs", "int64", "reorganisations", "times the canonical head moved to a block not descending "
+                                                       "from it"),
+              _c("reorganised_tx", "int64", "transactions", "transactions those moves took out of the canonical "
+                                                            "chain (payments undone, redone if included again)"),
+              _c("view_reorgs", "int64", "reorganisations", "times a robot's head moved to a block not descending "
+                                                            "from it, summed over the robots"),
+              _c("failed_tx", "int64", "transactions", "included transactions that failed (the branch could not "
+                                                       "pay the stake and gas), at their first application"),
+              _c("pending_tx", "int64", "transactions", "transactions not yet in a final block at the end"),
+              _c("deposits_paid", "int64", "payments", "deposits paid by a block (once per paying block: a "
+                                                       "payment redone on another branch counts again)"),
+              _c("mean_payment_delay", "float64", "steps", "mean steps from a deposit to the block that paid it "
+                                                           "(NaN when no deposit was paid)"),
+              _c("gas_paid", "float64", "money", "gas paid on the canonical chain by all robots together"),
+              _c("mean_lag", "float64", "blocks", "the robots' mean view lag (robots.mean_lag averaged over the "
+                                                  "run's robots)"),
+          ), True),
     Table("configs", "configs/part-*.parquet", "the configuration one condition ran (one per part; "
                                                "`Store.configs()` drops duplicates)",
           ("experiment", "condition", "config_hash"), (
@@ -162,6 +192,8 @@ TABLES: dict[str, Table] = {t.name: t for t in (
                   _c(f"{t}_sha256", "string", "", f"SHA-256 of the part's {t} file (empty: the part has no "
                                                   f"{t} rows)"),
                   _c(f"{t}_rows", "int64", "rows", f"rows of the part's {t} file"))),
+              _c("chain_sha256", "string", "", f"SHA-256 of the part's chain file. {CHAIN_ONLY}"),
+              _c("chain_rows", "int64", "rows", f"rows of the part's chain file. {CHAIN_ONLY}"),
           ), True),
     Table("designs", "designs/EXPERIMENT.parquet", "one point of a sampled design (`[sweep.sample]`); the "
                                                    "settings are beside it in designs/EXPERIMENT.json",

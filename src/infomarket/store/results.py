@@ -10,6 +10,7 @@ Layout (each part file written atomically, see ``files``)::
     STORE/events/part-ID.parquet   the ledger's event log: purchases, refusals, deposits (``--events``)
     STORE/payments/part-ID.parquet what each seller received at each deposit (``--events``)
     STORE/sites/part-ID.parquet    items per site per run (setups with terrain, docs/terrain.md)
+    STORE/chain/part-ID.parquet    the chain model's measures per run (runs with [chain], docs/chain-model.md)
     STORE/configs/part-ID.parquet  the configuration each condition ran (JSON text), see ``config``
     STORE/runs/part-ID.parquet     one row per run: the commit record of its part
     STORE/damaged/...              parts that ``repair`` moved aside
@@ -60,7 +61,10 @@ from .dictionary import annotate
 from .files import sha256_file, write_atomic, write_text_atomic
 
 FORMAT = 1
-DATA_TABLES = ("robots", "history", "events", "payments", "sites", "configs")
+DATA_TABLES = ("robots", "history", "events", "payments", "sites", "configs", "chain")
+#: Tables whose checksum and row count a commit record holds only when its part has rows: parts without
+#: them keep the commit records (and digests) they had before the table existed.
+OPTIONAL_TABLES = ("chain",)
 TABLES = DATA_TABLES + ("runs",)
 KEY = ["experiment", "condition", "run"]
 OK, FAILED = "ok", "failed"
@@ -300,8 +304,9 @@ class Store:
     def write_part(self, part_id: str, robots: pd.DataFrame | None, runs: pd.DataFrame,
                    history: pd.DataFrame | None = None, events: pd.DataFrame | None = None,
                    payments: pd.DataFrame | None = None, sites: pd.DataFrame | None = None,
-                   configs: pd.DataFrame | None = None, keys: Iterable[str] = ()) -> None:
-        """Write one part: the data tables (robots, history, events, payments, sites, configs) first, then
+                   configs: pd.DataFrame | None = None, chain: pd.DataFrame | None = None,
+                   keys: Iterable[str] = ()) -> None:
+        """Write one part: the data tables (robots, history, events, payments, sites, configs, chain) first, then
         the runs record with their checksums and row counts, last.  ``keys``: the condition keys' columns.
         Every column's unit and description (``store.dictionary``) go into the Parquet field metadata."""
         keys = list(keys)
@@ -309,9 +314,11 @@ class Store:
             raise StoreError(f"{self.root}: part {part_id} is already committed")
         runs = runs.copy()
         tables = {"robots": robots, "history": history, "events": events, "payments": payments,
-                  "sites": sites, "configs": configs}
+                  "sites": sites, "configs": configs, "chain": chain}
         for t in DATA_TABLES:
             df = tables[t]
+            if t in OPTIONAL_TABLES and (df is None or not len(df)):
+                continue
             sha, rows = "", 0
             if df is not None and len(df):
                 path = self.part_path(t, part_id)
@@ -359,6 +366,8 @@ class Store:
         if sha_col not in record.columns:  # a store written before checksums: readable is all we know
             if not path.exists():
                 return None
+            if table in OPTIONAL_TABLES and self._record_checksums():
+                return "exists but its commit record does not list it"
             try:
                 pq.read_metadata(path)
             except Exception as exc:  # noqa: BLE001 - any reader error means damage
@@ -474,7 +483,7 @@ class Store:
         """Run a DuckDB SQL ``query`` over the store's verified parts; returns a pandas DataFrame.
 
         The tables are views named as in the store (``robots``, ``history``, ``events``, ``payments``,
-        ``sites``, ``configs``, ``runs``; docs/data.md) over the committed parts that pass ``verify`` now:
+        ``sites``, ``configs``, ``chain``, ``runs``; docs/data.md) over the committed parts that pass ``verify`` now:
         orphans of an interrupted sweep are never read, and a damaged part raises ``StoreDamaged`` like
         every read (``skip_damaged=True``: leave the damaged parts out and read the others).  The query can
         read those parts' files only and write no file (DuckDB's external access is switched off).  A table
@@ -536,6 +545,10 @@ class Store:
     def sites(self) -> pd.DataFrame:
         """Items per site per run (setups with terrain: food sites and nests, docs/terrain.md)."""
         return self._read("sites")
+
+    def chain(self) -> pd.DataFrame:
+        """The chain model's measures, one row per run (runs with ``[chain] consensus = "poa"``)."""
+        return self._read("chain")
 
     def configs(self) -> pd.DataFrame:
         """One row per (experiment, condition, config_hash): the configuration its runs used, as JSON."""

@@ -19,6 +19,7 @@ import numpy as np
 from ..engine import geometry as kernels  # to_world: the robot-frame rotation the engine uses
 from ..engine.world import EVENT_NAMES, FOOD, NEST, SITE_NAMES, STATE_NAMES, headings, open_transactions
 from ..errors import FormatError
+from ..ledger.blocklog import DROPPED, chain_views
 from ..registry import behaviours
 
 #: The engine's own robot-frame -> world rotation, as plain Python (it also takes arrays of robots).
@@ -36,6 +37,15 @@ COLUMNS = (
     ("state", "u1"), ("flags", "u1"), ("pending_food", "u1"), ("pending_nest", "u1"),
 )
 
+#: With the chain model on (docs/chain-model.md) frames carry more: the canonical height and the forks
+#: and reorganisations so far in the header, and per robot its head's height, its lag (canonical height
+#: minus its head's) and its branch: 0 when its head is on the canonical branch (however far behind),
+#: 1, 2, ... for each other branch (numbered by the block where it leaves the canonical one, in slot
+#: order, so the number may change from frame to frame), ``DROPPED`` when its branch was dropped.
+CHAIN_HEADER = ("chain_height", "chain_forks", "chain_reorgs")
+CHAIN_FLOAT_COLUMNS = (("chain_height", "<f4"), ("chain_lag", "<f4"))
+CHAIN_BYTE_COLUMNS = (("branch", "u1"),)
+
 #: Bits of the ``flags`` column.
 CARRYING, FOOD_VALID, NEST_VALID, LAST_FOOD, LAST_NEST = 1, 2, 4, 8, 16
 
@@ -43,9 +53,23 @@ CARRYING, FOOD_VALID, NEST_VALID, LAST_FOOD, LAST_NEST = 1, 2, 4, 8, 16
 LAST_EVENTS = 8
 
 
-def frame_size(n: int) -> int:
+def layout(chain: bool = False) -> tuple[tuple[str, ...], tuple[tuple[str, str], ...]]:
+    """(header, columns) of a frame: ``HEADER``/``COLUMNS``, with the chain's fields when ``chain``
+    (float32 columns still first, then the uint8 ones, so every column stays aligned)."""
+    if not chain:
+        return HEADER, COLUMNS
+    floats = tuple(c for c in COLUMNS if c[1] == "<f4") + CHAIN_FLOAT_COLUMNS
+    return HEADER + CHAIN_HEADER, floats + tuple(c for c in COLUMNS if c[1] != "<f4") + CHAIN_BYTE_COLUMNS
+
+
+def chain_on(sim) -> bool:
+    return bool(sim.config.chain.enabled)
+
+
+def frame_size(n: int, chain: bool = False) -> int:
     """Bytes in one frame of ``n`` robots."""
-    return 8 * len(HEADER) + n * sum(np.dtype(t).itemsize for _, t in COLUMNS)
+    header, columns = layout(chain)
+    return 8 * len(header) + n * sum(np.dtype(t).itemsize for _, t in columns)
 
 
 def honest_mask(sim) -> np.ndarray:
@@ -80,9 +104,17 @@ def scene(sim) -> dict:
         "bias": [round(float(b), 5) for b in sim.world.bias],
         "states": list(STATE_NAMES),
         "events": list(EVENT_NAMES),
-        "header": list(HEADER),
-        "columns": [[c, np.dtype(t).str] for c, t in COLUMNS],
+        "header": list(layout(chain_on(sim))[0]),
+        "columns": [[c, np.dtype(t).str] for c, t in layout(chain_on(sim))[1]],
+        "chain": _chain_scene(cfg) if chain_on(sim) else None,
     }
+
+
+def _chain_scene(cfg) -> dict:
+    c = cfg.chain
+    return {"consensus": c.consensus, "period": c.period, "out_of_turn_delay": c.out_of_turn_delay,
+            "backbone": c.backbone, "latency": c.latency, "loss": c.loss, "gas_price": c.gas_price,
+            "finality": c.finality}
 
 
 def _believed(w, site: int) -> tuple[np.ndarray, np.ndarray]:
@@ -106,14 +138,20 @@ def encode(sim, honest: np.ndarray | None = None) -> bytes:
              | (w.last_site == FOOD).astype(np.uint8) * LAST_FOOD
              | (w.last_site == NEST).astype(np.uint8) * LAST_NEST)
     pend = np.minimum(w.pend_count, 255)
+    chain = chain_on(sim)
+    if chain:
+        header = np.concatenate([header, np.array([w.blk_height[w.chn_canon[0]], w.chn_forks[0], w.chn_reorgs[0]],
+                                                  dtype="<f8")])
     values = {
         "x": w.pos[:, 0], "y": w.pos[:, 1], "heading": headings(w), "wealth": w.balance, "items": items,
         "food_x": fx, "food_y": fy, "nest_x": nx, "nest_y": ny,
         "food_age": w.tab_age[:, 0], "nest_age": w.tab_age[:, 1],
         "state": w.state, "flags": flags, "pending_food": pend[:, 0], "pending_nest": pend[:, 1],
     }
+    if chain:
+        values["chain_height"], values["chain_lag"], values["branch"] = chain_views(w)
     return header.tobytes() + b"".join(np.ascontiguousarray(values[c], dtype=t).tobytes()
-                                       for c, t in COLUMNS)
+                                       for c, t in layout(chain)[1])
 
 
 @dataclass(frozen=True)
@@ -128,16 +166,18 @@ class Frame:
         return int(self.header["step"])
 
 
-def decode(data: bytes, n: int) -> Frame:
-    """Inverse of ``encode`` for a swarm of ``n`` robots (what the page does, in Python)."""
-    if len(data) != frame_size(n):
-        raise FormatError(f"a frame of {n} robots has {frame_size(n)} bytes, got {len(data)}")
-    head = np.frombuffer(data, "<f8", len(HEADER))
-    offset, cols = 8 * len(HEADER), {}
-    for c, t in COLUMNS:
+def decode(data: bytes, n: int, chain: bool = False) -> Frame:
+    """Inverse of ``encode`` for a swarm of ``n`` robots (what the page does, in Python); ``chain``: the
+    frame has the chain model's fields (the scene's ``chain`` is not null)."""
+    header, columns = layout(chain)
+    if len(data) != frame_size(n, chain):
+        raise FormatError(f"a frame of {n} robots has {frame_size(n, chain)} bytes, got {len(data)}")
+    head = np.frombuffer(data, "<f8", len(header))
+    offset, cols = 8 * len(header), {}
+    for c, t in columns:
         cols[c] = np.frombuffer(data, t, n, offset)
         offset += n * np.dtype(t).itemsize
-    return Frame(dict(zip(HEADER, head.tolist(), strict=True)), cols)
+    return Frame(dict(zip(header, head.tolist(), strict=True)), cols)
 
 
 def event_columns(sim, start: int = 0) -> dict[str, np.ndarray]:
@@ -184,6 +224,16 @@ def robot_detail(sim, i: int, last: int = LAST_EVENTS) -> dict:
     sellers, sites, directions = open_transactions(w, i)
     open_tx = [{"seller": int(a), "site": SITE_NAMES[int(b)], "direction": round(float(d), 1)}
                for a, b, d in zip(sellers, sites, directions)]
-    return {"type": "robot", "id": i, "step": sim.clock, "behaviour": sim.behaviour_names[i],
-            "state": STATE_NAMES[int(w.state[i])], "pot": round(float(w.pot[i]), 6),
-            "pending": pending, "open_transactions": open_tx, "events": _last_events(w, i, last)}
+    out = {"type": "robot", "id": i, "step": sim.clock, "behaviour": sim.behaviour_names[i],
+           "state": STATE_NAMES[int(w.state[i])], "pot": round(float(w.pot[i]), 6),
+           "pending": pending, "open_transactions": open_tx, "events": _last_events(w, i, last)}
+    if chain_on(sim):
+        height, lag, branch = chain_views(w)
+        steps = max(sim.clock, 1)
+        out["chain"] = {"height": int(height[i]), "canonical_height": int(w.blk_height[w.chn_canon[0]]),
+                        "lag": int(lag[i]), "branch": int(branch[i]), "head_dropped": bool(w.view_head[i] < 0),
+                        "balance_at_head": round(float(w.view_bal[i]), 6),
+                        "spendable": round(float(w.view_avail[i]), 6),
+                        "gas_paid": round(float(w.gas_paid[i]), 6),
+                        "mean_lag": round(float(w.chn_lag_sum[i]) / steps, 3)}
+    return out

@@ -42,7 +42,7 @@ class Recording:
     every: int
 
     def frame(self, k: int) -> Frame:
-        return decode(self.frames[k], self.scene["n"])
+        return decode(self.frames[k], self.scene["n"], self.scene.get("chain") is not None)
 
 
 def default_every(steps: int, robots: int = 25) -> int:

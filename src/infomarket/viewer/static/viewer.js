@@ -10,6 +10,10 @@
 (() => {
   const COLOUR = { honest: "#2f6fd6", byzantine: "#d62f2f", food: "#2ca02c", nest: "#e8b100",
                    none: "#666666", heading: "#ffffff", obstacle: "#5a5a5a", contact: "#111111", comm: "rgba(110,110,110,0.35)" };
+  // the chain model (docs/chain-model.md): a robot whose head is off the canonical branch gets a ring in
+  // its branch's colour; one whose branch was dropped, a grey dashed ring
+  const BRANCH = ["#9467bd", "#ff7f0e", "#17becf", "#8c564b", "#e377c2", "#bcbd22"];
+  const DROPPED = 255;
   const FLAG = { carrying: 1, foodValid: 2, nestValid: 4, lastFood: 8, lastNest: 16 };
   const TYPED = { "<f8": Float64Array, "<f4": Float32Array, "|u1": Uint8Array, "<i4": Int32Array };
   const MAX_HISTORY = 4000;
@@ -81,8 +85,12 @@
     if (obstacles.length) terrain.push(`${obstacles.length} obstacle${obstacles.length > 1 ? "s" : ""}`);
     if (scene.robot.collisions) terrain.push("collisions");
     if (scene.robot.line_of_sight) terrain.push("line of sight");
+    if (scene.chain) terrain.push(`chain: PoA, a block every ${scene.chain.period} steps` +
+      (scene.chain.backbone ? `, backbone latency ${scene.chain.latency}` : "") +
+      (scene.chain.loss ? `, loss ${scene.chain.loss}` : "") + (scene.chain.gas_price ? `, gas price ${scene.chain.gas_price}` : ""));
     $("subtitle").textContent = `${groups} · ${scene.scheme} payment · seed ${scene.seed_text ?? scene.seed}` +
       terrain.map((t) => ` · ${t}`).join("");
+    $("legend-chain").hidden = !scene.chain;
     if (V.mode === "live") $("seed").placeholder = `random (now ${scene.seed_text ?? scene.seed})`;
     fit();
   }
@@ -186,6 +194,7 @@
     }
     ctx.fillStyle = "#222"; ctx.fill();
     V.contacts = drawContacts(s, x, y, r, px);
+    V.offCanonical = s.chain ? drawBranches(s, f.c, r, px) : 0;
     V.robotsDrawn = n;
     if (V.selected !== null) drawSelected(V.selected, px, r);
   }
@@ -220,6 +229,29 @@
     ctx.beginPath();
     for (let i = 0; i < s.n; i++) if (touching[i]) { count++; ctx.moveTo(x[i] + r + 1.5 * px, y[i]); ctx.arc(x[i], y[i], r + 1.5 * px, 0, 2 * Math.PI); }
     ctx.lineWidth = 1.5 * px; ctx.strokeStyle = COLOUR.contact; ctx.stroke();
+    return count;
+  }
+
+  /** The chain model: a ring around each robot whose head is off the canonical branch, coloured by branch. */
+  function drawBranches(s, c, r, px) {
+    const { x, y, branch } = c;
+    let count = 0;
+    const groups = new Map();
+    for (let i = 0; i < s.n; i++) {
+      if (!branch[i]) continue;
+      count++;
+      if (!groups.has(branch[i])) groups.set(branch[i], []);
+      groups.get(branch[i]).push(i);
+    }
+    ctx.lineWidth = 2 * px;
+    for (const [b, members] of groups) {
+      ctx.beginPath();
+      for (const i of members) { ctx.moveTo(x[i] + r + 3 * px, y[i]); ctx.arc(x[i], y[i], r + 3 * px, 0, 2 * Math.PI); }
+      ctx.setLineDash(b === DROPPED ? [2 * px, 2 * px] : []);
+      ctx.strokeStyle = b === DROPPED ? COLOUR.none : BRANCH[(b - 1) % BRANCH.length];
+      ctx.stroke();
+    }
+    ctx.setLineDash([]);
     return count;
   }
 
@@ -313,6 +345,13 @@
     const pct = (v) => (wsum > 0 ? (100 * v / wsum).toFixed(1) : "0.0");
     $("cap-wealth").textContent = `wealth share per robot, % (dashed: equal share) — groups: honest ${pct(hd.wealth_honest)} %` +
       (byz ? `, Byzantine ${pct(hd.wealth_byzantine)} %` : "");
+    if (V.scene.chain) {
+      let off = 0, branches = new Set();
+      for (let i = 0; i < V.scene.n; i++) if (f.c.branch[i]) { off++; if (f.c.branch[i] !== DROPPED) branches.add(f.c.branch[i]); }
+      $("chain-status").textContent = `chain: canonical height ${hd.chain_height}, ${hd.chain_forks} forks, ` +
+        `${hd.chain_reorgs} reorganisations so far; ${off} robot${off === 1 ? "" : "s"} off the canonical branch` +
+        (branches.size ? ` (${branches.size} other branch${branches.size === 1 ? "" : "es"})` : "");
+    }
   }
 
   // ------------------------------------------------------------------------------------- panel
@@ -344,6 +383,12 @@
       ["items collected", `${c.items[i]}`],
       ["last site visited", last],
     ];
+    if (s.chain) {
+      const br = c.branch[i];
+      rows.push(["chain height", `${c.chain_height[i]} (canonical ${f.header.chain_height})`],
+                ["chain lag", `${c.chain_lag[i]} block${c.chain_lag[i] === 1 ? "" : "s"}`],
+                ["branch", br === 0 ? "canonical" : br === DROPPED ? "dropped (waits for a heavier block)" : `fork ${br}`]);
+    }
     let html = `<h2>robot #${i}</h2><table>${rows.map(([k, v]) => `<tr><th>${k}</th><td>${v}</td></tr>`).join("")}</table>`;
     html += "<h3>navigation table</h3><table><tr><th>site</th><th>believed at</th><th>age</th><th>off by</th></tr>";
     s.sites.forEach((site, k) => {
@@ -358,6 +403,12 @@
     html += "</table>";
     const pf = c.pending_food[i], pn = c.pending_nest[i];
     const d = V.detail && V.detail.id === i ? V.detail : null;
+    if (d && d.chain) {
+      html += `<h3>its chain view</h3><table><tr><th>balance at its head</th><td>${d.chain.balance_at_head.toFixed(3)}</td></tr>` +
+        `<tr><th>spendable (less its pending reveals)</th><td>${d.chain.spendable.toFixed(3)}</td></tr>` +
+        `<tr><th>gas paid</th><td>${d.chain.gas_paid.toFixed(4)}</td></tr>` +
+        `<tr><th>mean lag so far</th><td>${d.chain.mean_lag} blocks</td></tr></table>`;
+    }
     if (pf || pn || (d && d.pending.length)) {
       html += `<h3>pending information (unconfirmed): food ${pf}, nest ${pn}</h3>`;
       if (d) html += "<ul>" + d.pending.map((p) => `<li>${p.site} from #${p.seller}, age ${p.age}, points at (${p.x.toFixed(0)}, ${p.y.toFixed(0)})</li>`).join("") + "</ul>";

@@ -1,0 +1,64 @@
+"""The RL interface's throughput (``infomarket bench --env``): the vector environment
+(``rl.AttackVectorEnv``, B runs stepped K engine steps per ``step`` in one compiled call) against the
+engine alone (``Simulation.run``) on the same setup, in the same process.
+
+Rates, each a median over ``repeats``:
+
+- engine env-steps/s: one run of ``steps`` steps, timed by ``Simulation`` (world building excluded);
+- vector env-steps/s: B x ``steps`` over the wall time of ``reset(seed=...)`` plus the ``steps / K`` calls
+  of ``step`` of one episode, through the Gymnasium API (worlds built, actions written, observations and
+  rewards computed: everything an RL loop pays, except the policy);
+- agent-steps/s: agent decisions per second, vector env-steps/s x agents / K;
+- ratio: vector env-steps/s over engine env-steps/s (issue 23's goal: at least 0.5 at B = 64, K = 10).
+"""
+from __future__ import annotations
+
+import statistics
+import time
+
+import numpy as np
+
+from .. import __version__
+from ..engine.simulation import Simulation
+from ..seeds import run_seed
+
+#: The setup: the attack search's base cell (22 sceptics, 3 `attacker` robots, outlier penalisation with
+#: staking), whose attackers are the environments' agents.
+ENV_SETUP = "attack_search"
+GOAL = 0.5
+
+
+def run_env_bench(*, steps: int = 3000, batch: int = 64, interval: int = 10, repeats: int = 5,
+                  setup: str = ENV_SETUP) -> dict:
+    from ..rl.envs import AttackVectorEnv, configured
+
+    cfg = configured(setup, None, steps, min(1000, steps // 3))
+    t0 = time.perf_counter()
+    env = AttackVectorEnv(cfg, batch, interval=interval)
+    compile_seconds = time.perf_counter() - t0
+    Simulation(cfg, run_seed(cfg.seed, 0))  # the kernel is loaded already; this warms the view module too
+    action = np.tile(env.runs.default_action, (batch, 1, 1)).astype(np.float32)  # the constant 20° liar
+    calls = -(-steps // interval)
+    engine, vector = [], []
+    for i in range(repeats):  # the two interleaved, so a busy machine slows both alike
+        sim = Simulation(cfg, run_seed(cfg.seed, i))
+        sim.run()
+        engine.append(sim.run_seconds)
+        t = time.perf_counter()
+        env.reset(seed=run_seed(cfg.seed, i))
+        for _ in range(calls):
+            env.step(action)
+        vector.append(time.perf_counter() - t)
+    e_rate = steps / statistics.median(engine)
+    v_wall = statistics.median(vector)
+    v_rate = batch * steps / v_wall
+    agents = len(env.runs.agents)
+    return {"version": __version__, "setup": setup, "robots": cfg.swarm.robots, "agents": agents,
+            "batch": batch, "interval": interval, "steps": steps, "repeats": repeats,
+            "engine_env_steps_per_second": e_rate,
+            "vector_env_steps_per_second": v_rate,
+            "agent_steps_per_second": v_rate * agents / interval,
+            "vector_calls_per_second": calls / v_wall,
+            "ratio_to_engine": v_rate / e_rate, "goal": GOAL,
+            "vector_seconds_per_episode": v_wall, "engine_seconds_per_run": statistics.median(engine),
+            "compile_seconds": compile_seconds}

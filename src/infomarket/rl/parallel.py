@@ -1,0 +1,78 @@
+"""A PettingZoo ``ParallelEnv``: each Byzantine robot (behaviour ``attacker``) is an agent, named
+``robot_<id>``, with its own observation row, its own action and its own reward (docs/rl.md)."""
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+from gymnasium import spaces
+from pettingzoo import ParallelEnv
+
+from ..errors import UsageError
+from .envs import AttackEnv
+from .observe import OBSERVATION
+from .runs import ACTIONS
+
+
+class AttackParallelEnv(ParallelEnv):
+    """One run of ``experiment``; every ``step`` is a decision interval of ``interval`` engine steps.
+
+    ``observation_space(agent)``: Box [len(OBSERVATION)] in [0, 1]; ``action_space(agent)``: Box
+    [len(actions)] of the attacker's parameters; rewards per agent: ``items`` (shared by all) or
+    ``liar_wealth`` (each agent's own gain in wealth share).  All agents are truncated together at the
+    end of the run, and then leave ``agents``."""
+
+    metadata = {"name": "infomarket_attack_v0", "render_modes": [], "is_parallelizable": True}
+
+    def __init__(self, experiment="attack_search", *, cell: dict | None = None, steps: int | None = None,
+                 transitory: int | None = None, interval: int = 10, actions=ACTIONS, reward: str = "items"):
+        self._env = AttackEnv(experiment, cell=cell, steps=steps, transitory=transitory, interval=interval,
+                              actions=actions, reward=reward)
+        self.runs = self._env.runs
+        self.possible_agents = [f"robot_{i}" for i in self.runs.agents]
+        self.agents: list[str] = []
+        self._low = self.runs.low.astype(np.float32)
+        self._high = self.runs.high.astype(np.float32)
+
+    @functools.lru_cache(maxsize=None)
+    def observation_space(self, agent):
+        return spaces.Box(0.0, 1.0, (len(OBSERVATION),), np.float32)
+
+    @functools.lru_cache(maxsize=None)
+    def action_space(self, agent):
+        return spaces.Box(self._low, self._high, (len(self.runs.actions),), np.float32)
+
+    def _split(self, rows) -> dict:
+        return {a: rows[k] for k, a in enumerate(self.possible_agents)}
+
+    def reset(self, seed: int | None = None, options: dict | None = None):
+        obs, info = self._env.reset(seed=seed, options=options)
+        self.agents = list(self.possible_agents)
+        return self._split(obs), {a: dict(info) for a in self.agents}
+
+    def step(self, actions: dict):
+        if not self.agents:
+            raise UsageError("every agent is done (or the env was never reset): call reset() first")
+        unknown = set(actions) - set(self.agents)
+        if unknown:
+            raise UsageError(f"actions for agents that are not acting: {sorted(unknown)}")
+        act = self.runs.default_action.copy()
+        current = self.runs.bparams[0][self.runs.agents][:, self.runs.columns]
+        for k, a in enumerate(self.possible_agents):
+            act[k] = actions[a] if a in actions else current[k]  # an agent given no action keeps its last
+        obs, _, _, truncated, info = self._env.step(act)
+        rewards = self._env._rewards_last
+        out = (self._split(obs), self._split(rewards.astype(float).tolist()),
+               {a: False for a in self.agents}, {a: truncated for a in self.agents},
+               {a: dict(info) for a in self.agents})
+        if truncated:
+            self.agents = []
+        return out
+
+    def state(self) -> np.ndarray:
+        """Every agent's observation row, stacked (the global state a centralised critic may use)."""
+        return self.runs.obs[0].copy()
+
+    @property
+    def state_space(self):
+        return spaces.Box(0.0, 1.0, (len(self.possible_agents), len(OBSERVATION)), np.float32)
