@@ -12,7 +12,7 @@ here, so a change of a field is a change of this module only):
 * ``blk_live[b]``: slot b holds a block (the checkpoint or one made after it).  A block in a slot is
   known by its ``blk_hash``, ``blk_step`` and ``blk_signer``: a slot whose hash or step changed since
   the last look holds a new block.  ``blk_height``, ``blk_signer``, ``blk_step``, ``blk_ntx``,
-  ``blk_tx[b, :ntx]`` (mempool slots, in the block's order) and ``blk_bal[b]`` (every robot's balance
+  ``blk_tx[blk_txoff[b]:][:ntx]`` (mempool slots, in the block's order) and ``blk_bal[b]`` (every robot's balance
   after the block) are written once, when the block is made, and read here at the end of that step.
 * ``blk_parent[b]``: the parent's slot; the parent of a live block is live, except the checkpoint's
   (``chn_ckpt``), which is -1.  A block that was made and became the checkpoint in the same step (a
@@ -46,6 +46,13 @@ from .mempool import DEPOSIT, REVEAL, mix
 KINDS = {REVEAL: "reveal", DEPOSIT: "deposit"}
 #: ``chain_views``' branch of a robot whose head was dropped (``view_head`` -1).
 DROPPED = 255
+
+
+def _block_txs(w, b):
+    """Block b's transactions (mempool slots, in its order): ``blk_tx`` holds every block's, packed
+    (docs/chain-model.md, "State arrays")."""
+    a = int(w.blk_txoff[b])
+    return w.blk_tx[a:a + int(w.blk_ntx[b])]
 
 
 @dataclass(frozen=True)
@@ -136,7 +143,7 @@ class BlockLog:
             self._tx(w, int(x))
         # a transaction sent and made final this step is no longer live: it is in a block made this step
         for b in np.flatnonzero(w.blk_live & (w.blk_step == w.clock[0])):
-            for x in w.blk_tx[b, :int(w.blk_ntx[b])]:
+            for x in _block_txs(w, b):
                 if int(w.mp_seq[x]) >= self._seen_seq:
                     self._tx(w, int(x))
         missing = [seq for seq in range(self._seen_seq, top) if seq not in self.txs]
@@ -165,7 +172,7 @@ class BlockLog:
             parent = self._slot[p][0]
         else:
             parent = self._lost_parent(previous, height, signer, step, h)
-        txs = tuple(self._tx(w, int(x)) for x in w.blk_tx[b, :int(w.blk_ntx[b])])
+        txs = tuple(self._tx(w, int(x)) for x in _block_txs(w, b))
         block = Block(len(self.blocks), parent, height, h, signer, step, txs, w.blk_bal[b].copy())
         self.blocks.append(block)
         self._slot[b] = (block.id, h, step)
