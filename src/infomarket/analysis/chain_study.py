@@ -278,7 +278,7 @@ def partition_questions(runs: pd.DataFrame, chain: pd.DataFrame | None, decl: di
     for the forks, the per-run chain measures)."""
     part = runs[runs["experiment"] == PARTITION] if "experiment" in runs.columns else runs.iloc[0:0]
     if part.empty or "partition" not in part.columns:
-        why = "chain.partition is not in this branch yet: chain_partition has no runs"
+        why = "the store holds no runs of chain_partition (infomarket sweep chain_partition)"
         return Verdict(PENDING, note=why), Verdict(PENDING, note=why)
     bases = sorted(part["base"].unique()) if "base" in part.columns else ["all"]
     sel = lambda df, b, p: df[((df["base"] == b) if "base" in df.columns else True) & (df["partition"] == p)]  # noqa: E731
