@@ -422,3 +422,33 @@ def test_the_client_needs_the_seller_position_and_caps_its_acceptances(make_mark
         market.light_contract(seller, buyer, FOOD, age, PathInfo.from_floats(1.0, 1.0), (0.0, 0.0))
     with pytest.raises(ProtocolError, match="at most 2"):
         market.light_contract(seller, buyer, FOOD, 5, PathInfo.from_floats(1.0, 1.0), (0.0, 0.0))
+
+
+@pytest.mark.parametrize("honest, gain", [(6, 18_918_919), (3, -26_000_000)], ids=["6-honest", "3-honest"])
+def test_withholding_an_outlier_reveal_gains_at_most_the_stake(make_market, robots, honest, gain):
+    """Withholding is not recorded (docs/chain.md, "Reveal timing and withholding"); this measures what it
+    gains on the contract. A seller whose vector would be an outlier (100 degrees against honest sellers
+    within 5 degrees of each other) either reveals it or keeps its accepted contract unrevealed. By hand
+    (outlier weighting, staking 0.04, share 0.5, 1 token = 10**9 units): against 6 honest sellers the
+    outlier's reveal weighs 1 of 6 * 6 + 1 = 37 in a pot of 0.5 + 7 * 0.04 = 0.78, so revealing nets
+    780_000_000 // 37 - 40_000_000 = -18_918_919 and withholding (net 0) gains 18_918_919 units, less
+    than the stake (against 10 honest sellers, as docs/chain.md computes, 0.031 token); against 3 honest sellers the reveal nets 660_000_000 // 10 - 40_000_000 = +26 000 000,
+    so withholding loses that."""
+    outcome = {}
+    for withhold in (False, True):
+        market = make_market("outlier", stake=0.04)
+        buyer, outlier = robots[0], robots[honest + 1]
+        for age, seller in enumerate(robots[1:honest + 1]):
+            _sell(market, seller, buyer, 10.0 + age, age)
+        import math
+
+        info = PathInfo.from_floats(0.5 + 7 * math.cos(math.radians(100.0)), 0.5 + 7 * math.sin(math.radians(100.0)))
+        lc = market.light_contract(outlier, buyer, FOOD, 50, info, (0.5, 0.5))  # accepted: the buyer signed
+        if not withhold:
+            market.reveal(outlier, lc, info)
+        market.deposit(buyer.address)
+        outcome[withhold] = market.balance_of(outlier.address) - 1_000_000_000
+        assert market.locked_stake(outlier.address) == 0
+    assert outcome[True] == 0  # a withheld sale moves nothing: no record, no stake, no share
+    assert outcome[True] - outcome[False] == gain
+    assert gain < 40_000_000  # never more than the stake
