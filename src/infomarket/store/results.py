@@ -204,7 +204,8 @@ class Store:
             if meta.get("format") != FORMAT:
                 raise StoreError(f"{self.root}: store format {meta.get('format')} is not {FORMAT}")
             for t in TABLES:
-                (self.root / t).mkdir(exist_ok=True)
+                if t not in OPTIONAL_TABLES:
+                    (self.root / t).mkdir(exist_ok=True)
             return self
         self.refuse_foreign()
         self.root.mkdir(parents=True, exist_ok=True)
@@ -213,8 +214,9 @@ class Store:
         self._write_meta({"format": FORMAT, "package_version": __version__,
                           "created": time.strftime("%Y-%m-%dT%H:%M:%S%z"), "seeds": {},
                           "record_checksums": True, "declarations": _declarations()})
-        for t in TABLES:
-            (self.root / t).mkdir(exist_ok=True)
+        for t in TABLES:  # an optional table's folder appears with its first part: a store of runs
+            if t not in OPTIONAL_TABLES:  # without the chain looks as it always did
+                (self.root / t).mkdir(exist_ok=True)
         return self
 
     def foreign(self) -> list[Path]:
@@ -322,6 +324,7 @@ class Store:
             sha, rows = "", 0
             if df is not None and len(df):
                 path = self.part_path(t, part_id)
+                path.parent.mkdir(exist_ok=True)
                 write_atomic(path, lambda tmp, df=df, t=t: write_table(t, df, tmp, keys))
                 sha, rows = sha256_file(path), len(df)
             runs[f"{t}_sha256"] = sha
