@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from infomarket import load_experiment
-from infomarket.chain.block_replay import deposit_gas, match_purchases, replay_blocks
+from infomarket.chain.block_replay import match_purchases, replay_blocks
+from infomarket.ledger.blocks import table_gas
 from infomarket.chain.cli import chain_config, demo_config, main
 from infomarket.engine.simulation import Simulation
 from infomarket.ledger.blocklog import Block, BlockLog, ChainTx
@@ -116,7 +117,7 @@ def test_gas_is_billed_by_the_models_rule():
     # gas price 1e-7: a reveal 1e-7 x 94 038 = 0.0094038 (docs/gas.md, reveal with staking; its sender's view
     # set it aside), a deposit settling one record 1e-7 x 114 496 (outlier with staking, n = 1) = 0.0114496
     config = _tiny(gas_price=1e-7)
-    assert deposit_gas(1, [1, 4], [114_496, 135_168]) == 114_496
+    assert table_gas(np.array([1.0, 4.0]), np.array([114_496.0, 135_168.0]), 1.0) == 114_496
     blocks = [_block(0, [], [1.0, 1.0]),
               _block(1, [_reveal(0, 1, gas=0.0094038)], [1.0 - 0.04 - 0.0094038, 1.0]),
               # buyer: +1 reward +0.04 pot -(0.5 + 0.04) to the seller, then the deposit's gas

@@ -25,35 +25,22 @@ balances differ and reports it: block, height, step, robot, both balances.
 """
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from statistics import mean
 
 from .errors import ChainError, ContractRevert
-from .evm_replay import FLOAT_SLACK_UNITS, REPLAY_NO_EXPIRY, SITE_CODES, _count_rounding, market_params
+from .evm_replay import FLOAT_SLACK_UNITS, REPLAY_NO_EXPIRY, BalanceRow, SITE_CODES, _count_rounding, market_params
 from .market import ChainMarket, connect, derived_account
 from .protocol import PathInfo
 from .units import TOKEN_UNIT, to_units
 
-#: The model's reveal check allows this much short of stake + gas (``ledger.mempool.STAKE_TOLERANCE``).
-STAKE_TOLERANCE = 1e-9
-
-
 @dataclass(frozen=True)
-class BlockMismatch:
+class BlockMismatch(BalanceRow):
     """The first block after which a robot's EVM balance is not the modelled one."""
 
-    block: int
-    height: int
-    step: int
-    robot: int
-    chain_units: int
-    expected: float
-    bound_units: int
-
-    @property
-    def diff_units(self) -> float:
-        return self.chain_units - self.expected * TOKEN_UNIT
+    block: int = 0
+    height: int = 0
+    step: int = 0
 
     def __str__(self) -> str:
         return (f"block {self.block} (height {self.height}, made at step {self.step}): robot {self.robot} has "
@@ -97,18 +84,6 @@ class BlockReplayReport:
                 "deposit_model": avg(self.model_deposit_gas), "deposit_equal": same_deposit}
 
 
-def deposit_gas(n: int, table_n: Sequence[float], table_gas: Sequence[float]) -> float:
-    """The model's gas of a deposit settling n records (docs/chain-model.md, "Gas"): the measured table,
-    linear between its points and beyond its last two; below the first point, the first point's gas."""
-    if n <= table_n[0]:
-        return float(table_gas[0])
-    k = 1
-    while k < len(table_n) - 1 and n > table_n[k]:
-        k += 1
-    x0, x1, y0, y1 = table_n[k - 1], table_n[k], table_gas[k - 1], table_gas[k]
-    return y0 + (y1 - y0) * (n - x0) / (x1 - x0)
-
-
 def match_purchases(txs, events) -> dict:
     """Each reveal the model sent (``txs``: seq -> ``ChainTx``, e.g. ``BlockLog.txs``) with its purchase
     event: the k-th reveal in sending order is the k-th purchase logged.  Checked to agree on buyer,
@@ -135,14 +110,17 @@ def replay_blocks(blocks, purchase_of: dict, config, *, seed: int = 0, backend: 
     """Replay ``blocks`` (the canonical chain, genesis first: ``ledger.blocklog.Block``) on a fresh market,
     one EVM block per modelled block, checking every balance after every block.  ``purchase_of``: each
     reveal's purchase event by transaction seq (``match_purchases``); ``config``: the run's experiment."""
-    from ..ledger.blocks import GAS_DEPOSIT_N, gas_schedule
+    import numpy as np
+
+    from ..ledger.blocks import GAS_DEPOSIT_N, gas_schedule, table_gas
+    from ..ledger.mempool import STAKE_TOLERANCE
 
     robots = config.swarm.robots
     params = market_params(config)
     params = replace(params, stake_expiry=REPLAY_NO_EXPIRY)  # the chain model refuses stake expiry
     price = config.chain.gas_price
     _, table = gas_schedule(config.payment.scheme, config.payment.stake)
-    table_n = [float(x) for x in GAS_DEPOSIT_N]
+    table_n, table = np.asarray(GAS_DEPOSIT_N, dtype=np.float64), np.asarray(table, dtype=np.float64)
     stake = config.payment.stake
 
     chain = connect(None, backend)
@@ -174,7 +152,7 @@ def replay_blocks(blocks, purchase_of: dict, config, *, seed: int = 0, backend: 
                 minted += params.reward
                 report.deposits += 1
                 report.deposit_gas.append(sum(r.gas_used for r in results))
-                report.model_deposit_gas.append(deposit_gas(n, table_n, table))
+                report.model_deposit_gas.append(float(table_gas(table_n, table, float(n))))
                 _count_rounding(bound, buyer, open_sellers[buyer])
                 open_sellers[buyer] = []
                 if price > 0:
@@ -203,9 +181,9 @@ def replay_blocks(blocks, purchase_of: dict, config, *, seed: int = 0, backend: 
             gas_bill[seller] += tx.gas
         for i in range(robots):
             expected = float(blk.balances[i]) + gas_bill[i]
-            units = balance(i)
-            if abs(units - expected * TOKEN_UNIT) > bound[i] + FLOAT_SLACK_UNITS:
-                report.first_mismatch = BlockMismatch(blk.id, blk.height, blk.step, i, units, expected, bound[i])
+            row = BlockMismatch(i, balance(i), expected, bound[i], blk.id, blk.height, blk.step)
+            if not row.ok:
+                report.first_mismatch = row
                 return _finish(report, market, accounts, minted)
         report.blocks_checked += 1
     return _finish(report, market, accounts, minted)

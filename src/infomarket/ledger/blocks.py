@@ -581,10 +581,15 @@ def include_tx(w, b, tx):
 
 @njit
 def deposit_gas(w, n):
-    """Gas of a deposit that settles n reveals: the measured table, linear between its points and beyond
-    its last two; n below the first point costs the first point's gas."""
-    xs = w.chn_gas_n
-    ys = w.chn_gas_deposit
+    """Gas of a deposit that settles n reveals (the world's deposit-gas table)."""
+    return table_gas(w.chn_gas_n, w.chn_gas_deposit, n)
+
+
+@njit
+def table_gas(xs, ys, n):
+    """Gas of a deposit that settles n reveals by the table (xs reveals, ys gas): linear between its points
+    and beyond its last two; n below the first point costs the first point's gas.  Also the chain demo's
+    model figure (chain.block_replay), so both read one rule."""
     m = xs.shape[0]
     if n <= xs[0]:
         return ys[0]
