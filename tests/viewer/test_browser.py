@@ -150,6 +150,33 @@ def test_live_page_draws_plays_steps_and_inspects_a_robot(driver, server_2b, tmp
     assert not js_errors(driver)
 
 
+# Holds every binary message (a frame) back for 1.5 s, so the scene has been drawn long before the first frame.
+DELAY_FRAMES = """
+const set = Object.getOwnPropertyDescriptor(WebSocket.prototype, 'onmessage').set;
+Object.defineProperty(WebSocket.prototype, 'onmessage', { configurable: true, set(handler) {
+  set.call(this, (ev) => typeof ev.data === 'string' ? handler(ev) : setTimeout(() => handler(ev), 1500));
+}});
+"""
+
+
+def test_frames_drawn_counts_only_drawings_with_robots(driver, fig2b):
+    """framesDrawn > 0 promises robots on the canvas: passes drawn while the scene waits for its first frame
+    do not count (they did, and the live test once read a blank canvas under CI's load)."""
+    server = ServerThread(fig2b, seed=2)
+    script = driver.execute_cdp_cmd("Page.addScriptToEvaluateOnNewDocument", {"source": DELAY_FRAMES})
+    try:
+        driver.get(server.url)
+        wait_for(driver, "window.infomarketViewer && infomarketViewer.robots === 25", what="the scene")
+        time.sleep(0.4)  # several animation frames with the scene and no frame yet
+        assert driver.execute_script("return [infomarketViewer.ready, infomarketViewer.framesDrawn]") == [False, 0]
+        wait_for(driver, "infomarketViewer.framesDrawn > 0", what="the first frame drawn")
+        blue, red = driver.execute_script(COUNT_COLOURS)
+        assert blue > 24 * 15 and red > 10, f"robot discs on the canvas: {blue} blue, {red} red pixels"
+    finally:
+        driver.execute_cdp_cmd("Page.removeScriptToEvaluateOnNewDocument", {"identifier": script["identifier"]})
+        server.stop()
+
+
 @pytest.mark.parametrize("robots, least", [(25, 30), (1000, 10)])
 def test_frame_rate(driver, fig2b, robots, least, record_property):
     server = ServerThread(fig2b if robots == 25 else thousand_robots(), seed=1)

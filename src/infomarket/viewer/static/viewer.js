@@ -139,7 +139,7 @@
 
   function drawArena() {
     const s = V.scene, f = V.frame;
-    if (!s || !f || !V.view) return;
+    if (!s || !f || !V.view) return false;
     const { scale, dpr } = V.view;
     ctx.setTransform(1, 0, 0, 1, 0, 0);
     ctx.clearRect(0, 0, arena.width, arena.height);
@@ -197,6 +197,7 @@
     V.offCanonical = s.chain ? drawBranches(s, f.c, r, px) : 0;
     V.robotsDrawn = n;
     if (V.selected !== null) drawSelected(V.selected, px, r);
+    return true;
   }
 
   /** Obstacles (docs/terrain.md): rectangles and circles filled, segments as walls. */
@@ -441,7 +442,9 @@
   function tick(now) {
     V.rafs++;
     if (V.source && V.source.tick) V.source.tick(now);
-    if (V.dirty) { drawArena(); V.dirty = false; V.drawn++; V.totalDrawn++; }
+    // a pass before the first frame has arrived draws nothing and is not counted: framesDrawn > 0 must
+    // mean robots are on the canvas (the browser test polled ready && framesDrawn and read a blank canvas)
+    if (V.dirty) { if (drawArena()) { V.drawn++; V.totalDrawn++; } V.dirty = false; }
     if (V.panelDirty && now - lastPanel > 150) { renderPanel(); V.panelDirty = false; lastPanel = now; }
     if (V.chartsDirty && now - lastCharts > 250) { drawCharts(); V.chartsDirty = false; lastCharts = now; }
     if (now - V.fpsSince >= 1000) {
