@@ -112,7 +112,7 @@ def replay_blocks(blocks, purchase_of: dict, config, *, seed: int = 0, backend: 
     reveal's purchase event by transaction seq (``match_purchases``); ``config``: the run's experiment."""
     import numpy as np
 
-    from ..ledger.blocks import GAS_DEPOSIT_N, gas_schedule, table_gas
+    from ..ledger.gas import GAS_DEPOSIT_N, gas_schedule, table_gas
     from ..ledger.mempool import STAKE_TOLERANCE
 
     robots = config.swarm.robots

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..config.schema import Experiment
-from ..ledger import blocks
+from ..ledger import blocks, gas
 from ..ledger.state import grow_ledger, ledger_of
 from ..state.log import build_log, grow_log
 from .params import behaviour_kinds, behaviour_table, build_params  # noqa: F401  (behaviour_kinds re-exported)
@@ -48,11 +48,11 @@ def chain_seed(rng: np.random.Generator) -> int:
 def chain_of(cfg: Experiment, ledger: dict, rng: np.random.Generator) -> dict:
     """The chain model's state for a run of ``cfg`` (``ledger.blocks``)."""
     c = cfg.chain
-    reveal, deposit = blocks.gas_schedule(cfg.payment.scheme, cfg.payment.stake)
+    reveal, deposit = gas.gas_schedule(cfg.payment.scheme, cfg.payment.stake)
     return blocks.build_chain(ledger, period=c.period, delay=c.out_of_turn_delay,
                               signers=c.signers or list(range(cfg.swarm.robots)), backbone=c.backbone,
                               latency=c.latency, loss=c.loss, gas_price=c.gas_price, gas_reveal=reveal,
-                              gas_table=list(zip(blocks.GAS_DEPOSIT_N, deposit)), seed=chain_seed(rng),
+                              gas_table=list(zip(gas.GAS_DEPOSIT_N, deposit)), seed=chain_seed(rng),
                               finality=c.finality, partition=c.partition)
 
 
