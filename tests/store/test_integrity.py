@@ -135,3 +135,54 @@ def test_one_value_edited_in_a_commit_record_fails_verify(store, tmp_path, capsy
 def test_an_untouched_store_verifies(store, capsys):
     assert main(["store", "verify", str(store.root)]) == 0
     assert len(store.runs()) == 6
+
+
+def test_a_caching_store_reads_each_part_once_and_still_sees_damage(store, tiny, monkeypatch):
+    """``Store(root, cache=True)`` (the attack search's store, read after every generation) reads and
+    verifies each part once; a part changed on disk afterwards is read again and refused."""
+    import infomarket.store.results as results
+
+    def on_disk():  # (commit records, data parts): what one full check and read must open, counted by glob
+        records = len(list((store.root / "runs").glob("part-*.parquet")))
+        data = sum(len(list((store.root / t).glob("part-*.parquet"))) for t in results.DATA_TABLES)
+        return records, data
+
+    cached = Store(store.root, cache=True)
+    calls = {"files": 0, "sha256": 0}  # files read (commit records and robots parts), data parts hashed
+    read_table, sha = results.pq.read_table, results.sha256_file
+
+    def counting_read(*a, **kw):
+        calls["files"] += counting
+        return read_table(*a, **kw)
+
+    def counting_sha(path):
+        calls["sha256"] += counting
+        return sha(path)
+
+    monkeypatch.setattr(results.pq, "read_table", counting_read)
+    monkeypatch.setattr(results, "sha256_file", counting_sha)
+
+    def read_all():
+        cached.check()
+        done = cached.completed_runs()
+        return cached.robots(), done
+
+    counting = True  # off while the sweep below writes
+    records, data = on_disk()
+    first, done = read_all()
+    assert calls == {"files": 2 * records, "sha256": data}
+    again, done_again = read_all()
+    pd.testing.assert_frame_equal(again, first)
+    assert done_again == done
+    assert calls == {"files": 2 * records, "sha256": data}, "a second read went back to the files"
+    # a sweep adds parts: only they are read
+    counting = False
+    assert sweep(tiny(runs=5), store.root) == 0
+    counting = True
+    records2, data2 = on_disk()
+    more, more_done = read_all()
+    assert records2 > records and len(more) > len(first) and more_done > done
+    assert calls == {"files": 2 * records2, "sha256": data2}
+    truncate(first_part(store, "robots"))
+    with pytest.raises(StoreDamaged, match="checksum mismatch"):
+        cached.robots()

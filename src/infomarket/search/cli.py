@@ -38,7 +38,7 @@ def cmd_attack_search(args) -> int:
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {out}: exists and is not a directory")
-    store = Store(out / "store")
+    store = Store(out / "store", cache=True)  # read after every generation: each part read once
     store.refuse_foreign()
     s = st.settings
     per_cell = (s.generations * s.popsize + len(st.baselines) - bool(st.reference)) * s.runs + (

@@ -173,11 +173,40 @@ def _rel(root: Path, path: Path) -> str:
     return str(path.relative_to(root))
 
 
-class Store:
-    """A results store rooted at ``root`` (created on first write)."""
+def _signature(path: Path) -> tuple[int, int, int, int] | None:
+    """What identifies a file's content for the read cache: a committed part is written once, through a
+    rename (a new inode), so inode, size and change times tell a rewritten or altered file from the one read."""
+    try:
+        st = path.stat()
+    except OSError:
+        return None
+    return st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns
 
-    def __init__(self, root: str | Path):
+
+class Store:
+    """A results store rooted at ``root`` (created on first write).
+
+    ``cache=True``: remember what this object has read and verified (commit records, checksums of data
+    parts, data frames), keyed by each file's signature (``_signature``), so a long-lived reader of a
+    growing store (the attack search reads its store after every generation) reads each part once
+    instead of the whole store each time.  A file replaced or changed on disk is read and verified again;
+    a same-size edit within one clock tick would go unseen, hence off by default."""
+
+    def __init__(self, root: str | Path, *, cache: bool = False):
         self.root = Path(root)
+        self._cache: dict | None = {} if cache else None
+
+    def _cached(self, kind: str, path: Path, compute):
+        """``compute()``, remembered under (kind, path, the file's signature) when caching."""
+        if self._cache is None:
+            return compute()
+        sig = _signature(path)
+        if sig is None:
+            return compute()
+        hit = self._cache.get((kind, path))
+        if hit is None or hit[0] != sig:
+            hit = self._cache[(kind, path)] = (sig, compute())
+        return hit[1]
 
     # ------------------------------------------------------------------ creation and checks
     @property
@@ -345,6 +374,9 @@ class Store:
         return f"run `infomarket store repair {self.root}` to move damaged parts aside (their runs are then rerun)"
 
     def _read_runs_part(self, path: Path) -> pd.DataFrame:
+        return self._cached("record", path, lambda: self._read_runs_part_now(path)).copy()
+
+    def _read_runs_part_now(self, path: Path) -> pd.DataFrame:
         table = pq.read_table(path, page_checksum_verification=True)
         stored = (table.schema.metadata or {}).get(RECORD_SHA)
         if stored is None:
@@ -381,7 +413,7 @@ class Store:
             return "exists but its commit record says it has no rows" if path.exists() else None
         if not path.exists():
             return f"missing (the commit record says {rows} rows)"
-        if sha256_file(path) != sha:
+        if self._cached("sha256", path, lambda: sha256_file(path)) != sha:
             return f"checksum mismatch: truncated or altered (the commit record says {rows} rows)"
         return None
 
@@ -474,7 +506,7 @@ class Store:
                                    f"{why}; {self._repair_hint()}")
             path = self.part_path(table, pid)
             if path.exists():
-                frames.append(pd.read_parquet(path))
+                frames.append(self._cached("frame", path, lambda path=path: pd.read_parquet(path)))
         frames = [f for f in frames if len(f)]
         if not frames:
             return pd.DataFrame()
