@@ -374,7 +374,8 @@ class Store:
         return f"run `infomarket store repair {self.root}` to move damaged parts aside (their runs are then rerun)"
 
     def _read_runs_part(self, path: Path) -> pd.DataFrame:
-        return self._cached("record", path, lambda: self._read_runs_part_now(path)).copy()
+        """A verified commit record (when caching, the cached frame itself: callers must not modify it)."""
+        return self._cached("record", path, lambda: self._read_runs_part_now(path))
 
     def _read_runs_part_now(self, path: Path) -> pd.DataFrame:
         table = pq.read_table(path, page_checksum_verification=True)
@@ -510,9 +511,18 @@ class Store:
         frames = [f for f in frames if len(f)]
         if not frames:
             return pd.DataFrame()
+        if self._cache is not None:  # the same part objects as last time (kept alive below): that table again
+            parts = tuple(id(f) for f in frames)
+            last = self._cache.get(("table", table))
+            if last is not None and last[0] == parts:
+                return last[2].copy()
         df = pd.concat(frames, ignore_index=True)
         sort = [c for c in KEY + ["step", "robot"] if c in df.columns]
-        return df.sort_values(sort, kind="stable").reset_index(drop=True)
+        df = df.sort_values(sort, kind="stable").reset_index(drop=True)
+        if self._cache is not None:
+            self._cache[("table", table)] = (parts, frames, df)
+            return df.copy()
+        return df
 
     def sql(self, query: str, *, skip_damaged: bool = False) -> pd.DataFrame:
         """Run a DuckDB SQL ``query`` over the store's verified parts; returns a pandas DataFrame.
