@@ -396,8 +396,18 @@ class Store:
         return self._sums
 
     def _check_data_part(self, table: str, part_id: str, record: pd.DataFrame) -> str | None:
-        """Why the ``table`` part of ``part_id`` does not match its commit record, or None."""
+        """Why the ``table`` part of ``part_id`` does not match its commit record, or None (when caching,
+        a verdict stands while the record is the same object and the part's file the same file)."""
         path = self.part_path(table, part_id)
+        if self._cache is None:
+            return self._check_data_part_now(table, path, record)
+        key, sig = ("verdict", path), (id(record), _signature(path))
+        hit = self._cache.get(key)
+        if hit is None or hit[0] != sig:
+            hit = self._cache[key] = (sig, self._check_data_part_now(table, path, record), record)
+        return hit[1]
+
+    def _check_data_part_now(self, table: str, path: Path, record: pd.DataFrame) -> str | None:
         sha_col, rows_col = f"{table}_sha256", f"{table}_rows"
         if sha_col not in record.columns:  # a store written before checksums: readable is all we know
             if not path.exists():
