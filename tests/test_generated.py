@@ -56,3 +56,25 @@ def test_a_ctrl_c_inside_an_llvm_callback_is_lost_without_the_guard():
 def test_a_ctrl_c_inside_an_llvm_callback_interrupts_the_compile_with_the_guard():
     what, calls = _run("guarded")
     assert int(calls) >= 1 and what == "interrupted"
+
+
+def test_source_edited_under_a_running_process_is_compiled_but_not_cached(tmp_path, monkeypatch):
+    """The cache name hashes the source this process imported; if the files change afterwards, what the
+    process compiles comes from the old code and must not be stored where the new code would load it."""
+    import pytest
+
+    from infomarket import generated
+
+    monkeypatch.setenv("INFOMARKET_CACHE_DIR", str(tmp_path))
+    source = "import numba\n\n@numba.njit(cache=True)\ndef f(x):\n    return x + 1\n"
+    assert not generated.source_changed_since_import()  # nothing edited: cached as before
+    m = generated.load_generated("testcache", "unchanged", source)
+    assert Path(m.__file__).parent == tmp_path / "kernels" and m.f(1) == 2
+
+    imported = generated.freeze_package_digest()
+    monkeypatch.setattr(generated, "_digest_now", lambda: "not " + imported)  # an edit on disk
+    assert generated.source_changed_since_import()
+    with pytest.warns(RuntimeWarning, match="not cached"):
+        m = generated.load_generated("testcache", "edited", source)
+    assert Path(m.__file__).parent != tmp_path / "kernels" and m.f(2) == 3
+    assert not (tmp_path / "kernels" / "testcache_edited.py").exists()

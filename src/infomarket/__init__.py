@@ -25,5 +25,10 @@ from .engine.simulation import explain_errors_with as _explain_errors_with  # no
 # Python API as from the command line (the engine cannot import the checkers, which import it).
 _explain_errors_with(_explain)
 
+# The engine is imported: fix the digest of the code this process runs (generated kernels are cached by it).
+from .generated import freeze_package_digest as _freeze  # noqa: E402
+
+_freeze()
+
 __all__ = ["ConfigError", "Experiment", "InfomarketError", "Result", "Simulation", "SimulationError",
            "behaviour", "load_experiment", "payment", "register_behaviour", "register_payment", "simulate"]

@@ -29,19 +29,32 @@ _PACKAGE_DIGEST: list[str] = []
 COMPILED_PARTS = ("engine", "behaviours", "payments", "ledger", "state", "space")
 
 
-def _package_digest() -> str:
-    """Hash of the source that compiled code comes from: the generated kernel inlines engine code from
-    many modules, and numba only checks the generated file itself for staleness, so any change there
-    must change the kernel's name."""
+def _digest_now() -> str:
+    """Hash of the compiled parts' source as it is on disk now."""
+    h = hashlib.sha256()
+    files = [f for part in COMPILED_PARTS for f in (_PACKAGE / part).rglob("*.py")]
+    files.append(_PACKAGE / "builtins.py")
+    for f in sorted(files):
+        h.update(str(f.relative_to(_PACKAGE)).encode())
+        h.update(f.read_bytes())
+    return h.hexdigest()
+
+
+def freeze_package_digest() -> str:
+    """Hash of the source that compiled code comes from, taken once, when ``import infomarket`` has
+    imported the engine (the code this process runs): the generated kernel inlines engine code from many
+    modules, and numba only checks the generated file itself for staleness, so any change there must
+    change the kernel's name."""
     if not _PACKAGE_DIGEST:
-        h = hashlib.sha256()
-        files = [f for part in COMPILED_PARTS for f in (_PACKAGE / part).rglob("*.py")]
-        files.append(_PACKAGE / "builtins.py")
-        for f in sorted(files):
-            h.update(str(f.relative_to(_PACKAGE)).encode())
-            h.update(f.read_bytes())
-        _PACKAGE_DIGEST.append(h.hexdigest())
+        _PACKAGE_DIGEST.append(_digest_now())
     return _PACKAGE_DIGEST[0]
+
+
+def source_changed_since_import() -> bool:
+    """The compiled parts' source on disk is no longer what this process imported (edited while it ran):
+    what it compiles now comes from the old code, so it must not be cached under the new code's name.  A
+    helper's test run once cached old code that way and later runs of the new code loaded it."""
+    return _digest_now() != freeze_package_digest()
 
 
 def cache_dir() -> Path:
@@ -58,6 +71,13 @@ def load_generated(prefix: str, key: str, source: str, cacheable: bool = True) -
     name = f"{prefix}_{key}"
     if name in _LOADED:
         return _LOADED[name]
+    if cacheable and source_changed_since_import():
+        import warnings
+
+        warnings.warn("infomarket's source changed on disk since this process imported it: kernels compiled "
+                      "now come from the old code and are not cached (restart the process to cache again)",
+                      RuntimeWarning, stacklevel=2)
+        cacheable = False
     folder = cache_dir() if cacheable else Path(tempfile.mkdtemp(prefix="infomarket-kernel-"))
     folder.mkdir(parents=True, exist_ok=True)
     path = folder / f"{name}.py"
@@ -77,7 +97,7 @@ def load_generated(prefix: str, key: str, source: str, cacheable: bool = True) -
 def generated_digest(source: str):
     """sha256 of ``source`` with the versions and the compiled package's own source mixed in."""
     digest = hashlib.sha256(source.encode())
-    digest.update(f"{__version__} {numba.__version__} {sys.version} {_package_digest()}".encode())
+    digest.update(f"{__version__} {numba.__version__} {sys.version} {freeze_package_digest()}".encode())
     return digest
 
 
