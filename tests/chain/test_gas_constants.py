@@ -74,3 +74,21 @@ def test_the_report_prints_the_constants_it_was_rendered_from():
         "GAS_REVEAL = {", '    "delayed": 100_016,', '    "outlier + staking": 100_023,', "}",
         "GAS_DEPOSIT_N = (1, 16)", "GAS_DEPOSIT = {", '    "delayed": (10, 160),',
         '    "outlier + staking": (17, 167),', "}"])
+
+
+def test_constants_from_a_missing_or_tableless_report_is_a_clear_error(tmp_path, capsys):
+    from infomarket.chain.gasreport import main
+
+    assert main(["--constants", "--out", str(tmp_path / "none.md")]) == 2
+    assert "none.md: no such report" in capsys.readouterr().err
+    (tmp_path / "empty.md").write_text("# Gas\n\nnothing measured\n")
+    assert main(["--constants", "--out", str(tmp_path / "empty.md")]) == 2
+    assert "empty.md: no gas table in it" in capsys.readouterr().err
+    rows = [GasRow("delayed", 1, 1.0, 1, 1, 1, 1, 1), GasRow("outlier", 4, 1.0, 1, 1, 1, 1, 1)]
+    (tmp_path / "uneven.md").write_text(render(rows, []))
+    assert main(["--constants", "--out", str(tmp_path / "uneven.md")]) == 2
+    assert "measured at different sizes" in capsys.readouterr().err
+    (tmp_path / "no16.md").write_text(render(rows[:1], []))
+    assert main(["--constants", "--out", str(tmp_path / "no16.md")]) == 2
+    assert "no n = 16 row" in capsys.readouterr().err
+    assert not (tmp_path / "none.md").exists()

@@ -233,6 +233,8 @@ def constants(rows: list[GasRow]) -> str:
     sizes = [r.n for r in rows if r.scheme == schemes[0]]
     if any([r.n for r in rows if r.scheme == s] != sizes for s in schemes):
         raise ValueError("the report's schemes were measured at different sizes")
+    if MODEL_REVEAL_N not in sizes:
+        raise ValueError(f"the report has no n = {MODEL_REVEAL_N} row, whose mean reveal the model charges")
     reveal = {s: round(r.reveal_mean) for s in schemes for r in rows if r.scheme == s and r.n == MODEL_REVEAL_N}
     lines = ["GAS_REVEAL = {"] + [f'    "{s}": {reveal[s]:_},' for s in schemes] + ["}"]
     lines.append(f"GAS_DEPOSIT_N = ({', '.join(map(str, sizes))})")
@@ -262,7 +264,11 @@ def main(argv: list[str] | None = None) -> int:
         if not rows:
             print(f"--out {args.out}: no gas table in it", file=sys.stderr)
             return 2
-        print(constants(rows))
+        try:
+            print(constants(rows))
+        except ValueError as err:
+            print(f"--out {args.out}: {err}", file=sys.stderr)
+            return 2
         return 0
     rows = [row for scheme in SCHEMES for row in measure(scheme, backend=gas_backend(args.backend, args.rpc))]
     worst = [worst_call(scheme, backend=gas_backend(args.backend, args.rpc))
