@@ -34,6 +34,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from statistics import mean
 
+from ..errors import FormatError
 from .market import (DECLARED_MAX_TX_GAS, DEFAULT_MAX_RECORDS_PER_TRIP, SETTLE_BATCH, ChainMarket, MarketParams,
                      connect, derived_account)
 from .protocol import FOOD, PathInfo
@@ -232,9 +233,9 @@ def constants(rows: list[GasRow]) -> str:
     schemes = list(dict.fromkeys(r.scheme for r in rows))
     sizes = [r.n for r in rows if r.scheme == schemes[0]]
     if any([r.n for r in rows if r.scheme == s] != sizes for s in schemes):
-        raise ValueError("the report's schemes were measured at different sizes")
+        raise FormatError("the report's schemes were measured at different sizes")
     if MODEL_REVEAL_N not in sizes:
-        raise ValueError(f"the report has no n = {MODEL_REVEAL_N} row, whose mean reveal the model charges")
+        raise FormatError(f"the report has no n = {MODEL_REVEAL_N} row, whose mean reveal the model charges")
     reveal = {s: round(r.reveal_mean) for s in schemes for r in rows if r.scheme == s and r.n == MODEL_REVEAL_N}
     lines = ["GAS_REVEAL = {"] + [f'    "{s}": {reveal[s]:_},' for s in schemes] + ["}"]
     lines.append(f"GAS_DEPOSIT_N = ({', '.join(map(str, sizes))})")
@@ -266,7 +267,7 @@ def main(argv: list[str] | None = None) -> int:
             return 2
         try:
             print(constants(rows))
-        except ValueError as err:
+        except FormatError as err:
             print(f"--out {args.out}: {err}", file=sys.stderr)
             return 2
         return 0
