@@ -202,10 +202,13 @@ def fig7_question(runs: pd.DataFrame, decl: dict, setting: str, angles=(45.0, 90
 
 def axis_values(decl: dict, axis: str) -> list[tuple[float, str]]:
     """(value, setting label) along an axis, in the declared order; the toychain value's label is
-    "toychain"."""
+    "toychain".  The gas axis's labels are the amended ones (``[amendment_gas]``: the conditions rerun
+    with the cold gas table) when the declaration has them."""
     s = decl["study"]
     values = s["period"] if axis == "period" else s["loss"] if axis == "loss" else s["gas_ratio"]
     fmt, base = AXES[axis]
+    if axis == "gas" and "amendment_gas" in decl:  # the gas conditions rerun with the cold gas table
+        values, fmt = decl["amendment_gas"]["gas_ratio"], decl["amendment_gas"]["label"]
     out = []
     for v in values:
         if float(v) == float(base):

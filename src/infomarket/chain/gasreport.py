@@ -2,6 +2,11 @@
 the contract allows, all measured with cold storage per transaction, as a chain charges it.
 
     python -m infomarket.chain.gasreport [--out docs/gas.md] [--backend revm|py-evm] [--rpc URL]
+    python -m infomarket.chain.gasreport --constants [--out docs/gas.md]
+
+``--constants`` measures nothing: it reads the report at ``--out`` and prints the constants of
+``infomarket.ledger.gas`` (the chain model's gas) as they must read; ``tests/chain/test_gas_constants.py``
+checks that they do.
 
 For each payment scheme and each round-trip size n, one buyer receives n reveals from 16 sellers
 (all for the same site, all within Theta of each other: the outlier weighting's worst case), then
@@ -29,15 +34,20 @@ from dataclasses import dataclass
 from pathlib import Path
 from statistics import mean
 
+from ..errors import FormatError
 from .market import (DECLARED_MAX_TX_GAS, DEFAULT_MAX_RECORDS_PER_TRIP, SETTLE_BATCH, ChainMarket, MarketParams,
                      connect, derived_account)
 from .protocol import FOOD, PathInfo
 from .units import to_units
 
-SIZES = (1, 4, 16, 64)
+#: Round-trip sizes measured: up to the contract's bound of live records per round trip (the chain model's
+#: deposit table, ``ledger.gas``, reads "deposit, later trips" at these sizes).
+SIZES = (1, 4, 16, 64, 128, 256, DEFAULT_MAX_RECORDS_PER_TRIP)
 #: name -> (contract scheme, stake)
 SCHEMES = {"delayed": ("delayed", 0.0), "outlier": ("outlier", 0.0), "outlier + staking": ("outlier", 0.04),
-           "outlier_distinct + staking": ("outlier_distinct", 0.04)}
+           "outlier_distinct": ("outlier_distinct", 0.0), "outlier_distinct + staking": ("outlier_distinct", 0.04)}
+#: The round-trip size whose mean reveal the chain model charges for every reveal.
+MODEL_REVEAL_N = 16
 SELLERS = 16
 #: Weighing calls measured after ``buyItem`` at the largest round trip (all weighing calls do the same work).
 WORST_SETTLES = 2
@@ -170,6 +180,13 @@ def render(rows: list[GasRow], worst: list[WorstCall], backend: str = "revm", ch
         "*Largest tx* is the most gas one transaction of the deposit took.",
         "",
     ]
+    lines += ["The chain model (docs/chain-model.md, `ledger.gas`) charges every reveal the *reveal, mean* at",
+              f"n = {MODEL_REVEAL_N} and a deposit the *deposit, later trips* figure at the number of reveals it settles,",
+              "linear between the sizes measured; a deposit of more than "
+              f"{SIZES[-1]} reveals (the contract refuses reveals beyond",
+              f"{DEFAULT_MAX_RECORDS_PER_TRIP} live records per round trip; the model does not) costs the "
+              f"n = {SIZES[-1]} figure. `python -m",
+              "infomarket.chain.gasreport --constants` prints those constants from this file.", ""]
     if checked is not None:
         lines += [f"Cross-check: the sizes {', '.join(map(str, CROSS_CHECK_SIZES))} measured again on py-evm, "
                         "the reference EVM: every figure", f"within {checked:.3%} (tolerance "
@@ -195,6 +212,41 @@ def render(rows: list[GasRow], worst: list[WorstCall], backend: str = "revm", ch
     return "\n".join(lines)
 
 
+def parse(text: str) -> list[GasRow]:
+    """The per-scheme rows of a report ``render`` wrote (the bound's table is not read)."""
+    rows, scheme = [], None
+    for line in text.splitlines():
+        if line.startswith("## "):
+            scheme = line[3:].strip()
+            scheme = scheme if scheme in SCHEMES else None
+        elif scheme and line.startswith("| ") and line[2:3].isdigit():
+            cells = [c.strip().replace(",", "") for c in line.strip("|").split("|")]
+            n, mean_, top, first, later, count, largest = cells
+            rows.append(GasRow(scheme, int(n), float(mean_), int(top), int(first), int(later), int(count),
+                               int(largest)))
+    return rows
+
+
+def constants(rows: list[GasRow]) -> str:
+    """The constants of ``infomarket.ledger.gas`` as they must read for ``rows`` (a report's rows): the
+    mean reveal at ``MODEL_REVEAL_N`` and the later trips' deposit at every size, per scheme."""
+    schemes = list(dict.fromkeys(r.scheme for r in rows))
+    sizes = [r.n for r in rows if r.scheme == schemes[0]]
+    if any([r.n for r in rows if r.scheme == s] != sizes for s in schemes):
+        raise FormatError("the report's schemes were measured at different sizes")
+    if MODEL_REVEAL_N not in sizes:
+        raise FormatError(f"the report has no n = {MODEL_REVEAL_N} row, whose mean reveal the model charges")
+    reveal = {s: round(r.reveal_mean) for s in schemes for r in rows if r.scheme == s and r.n == MODEL_REVEAL_N}
+    lines = ["GAS_REVEAL = {"] + [f'    "{s}": {reveal[s]:_},' for s in schemes] + ["}"]
+    lines.append(f"GAS_DEPOSIT_N = ({', '.join(map(str, sizes))})")
+    lines.append("GAS_DEPOSIT = {")
+    for s in schemes:
+        later = ", ".join(f"{r.deposit_later:_}" for r in rows if r.scheme == s)
+        lines.append(f'    "{s}": ({later}),')
+    lines.append("}")
+    return "\n".join(lines)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m infomarket.chain.gasreport", description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=Path("docs/gas.md"), help="Markdown file to write")
@@ -202,7 +254,23 @@ def main(argv: list[str] | None = None) -> int:
                         help="in-process EVM, both with cold storage per transaction as a chain: revm (default, "
                              "seconds; its small sizes cross-checked on py-evm) or py-evm (the reference, minutes)")
     parser.add_argument("--rpc", metavar="URL", help="JSON-RPC node to measure on instead")
+    parser.add_argument("--constants", action="store_true",
+                        help="measure nothing: print infomarket.ledger.gas's constants from the report at --out")
     args = parser.parse_args(argv)
+    if args.constants:
+        if not args.out.is_file():
+            print(f"--out {args.out}: no such report (run without --constants to measure it)", file=sys.stderr)
+            return 2
+        rows = parse(args.out.read_text())
+        if not rows:
+            print(f"--out {args.out}: no gas table in it", file=sys.stderr)
+            return 2
+        try:
+            print(constants(rows))
+        except FormatError as err:
+            print(f"--out {args.out}: {err}", file=sys.stderr)
+            return 2
+        return 0
     rows = [row for scheme in SCHEMES for row in measure(scheme, backend=gas_backend(args.backend, args.rpc))]
     worst = [worst_call(scheme, backend=gas_backend(args.backend, args.rpc))
              for scheme in ("outlier + staking", "outlier_distinct + staking")]

@@ -17,7 +17,8 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parents[1] / "analysis"
 #: the files that declare questions or decision rules, by the name the store records them under
 FILES = {"tolerances.toml": HERE / "tolerances.toml", "terrain_questions.toml": HERE / "terrain_questions.toml",
-         "sensitivity_questions.toml": HERE / "sensitivity_questions.toml"}
+         "sensitivity_questions.toml": HERE / "sensitivity_questions.toml",
+         "chain_questions.toml": HERE / "chain_questions.toml"}
 SECTIONS = ("rows", "questions")
 
 
