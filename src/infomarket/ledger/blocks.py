@@ -168,6 +168,7 @@ SPEC = Spec("chain", [
         ("mp_bb", "bool", "T", "delivered by the backbone"),
         ("mp_known", "uint64", "n,T/64", "bit tx of row i: robot i knows transaction tx"),
         ("mp_old", "uint64", "n,T/64", "known-bits at the start of the gossip phase"),
+        ("mp_mask", "uint64", "T/64", "scratch of move_checkpoint (all 0 between calls)"),
         *[(f"ck_{f}", _LEDGER_KINDS[f][0], _LEDGER_KINDS[f][1], f"{f} at the checkpoint")
           for f in CHECKPOINTED],
     ]),
@@ -184,15 +185,24 @@ SPEC = Spec("chain", [
     ]),
 ])
 
-#: First capacities: block slots and mempool slots.
-BLOCK_CAPACITY = 16
-MEMPOOL_CAPACITY = 128
+#: First capacities: block slots (at least 16, at most 512, as many as ``BLOCK_STATE_BYTES`` of block
+#: states hold: each is O(robots)) and mempool slots.  Generous first sizes spare a run most of the host's
+#: growth calls, which cost as much as many steps; they change no number.
+BLOCK_CAPACITY = (16, 512)
+BLOCK_STATE_BYTES = 32 << 20
+MEMPOOL_CAPACITY = 1024
 #: First size of the blocks' transaction lists (``blk_tx``).
-TX_ENTRIES = 1024
+TX_ENTRIES = 16384
 #: First number of nodes of the buyers' lists (``ls_*``).
-LIST_ENTRIES = 1024
+LIST_ENTRIES = 16384
 #: First size of the settlement cache (``chn_wt``).
-WEIGHT_ENTRIES = 1024
+WEIGHT_ENTRIES = 16384
+
+
+def first_block_slots(n: int) -> int:
+    """Block slots a fresh chain of n robots starts with (``BLOCK_CAPACITY``, ``BLOCK_STATE_BYTES``)."""
+    per_block = 8 * n * (len(BLOCK_STATE) + 2)  # blk_bal, bs_*, bs_ver
+    return int(min(BLOCK_CAPACITY[1], max(BLOCK_CAPACITY[0], BLOCK_STATE_BYTES // per_block)))
 
 
 def _words(t: int) -> int:
@@ -206,7 +216,7 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
     the checkpoint a copy of the ledger.  ``cache_weights``: the payment scheme's weights depend only on the
     list it weighs (it takes neither ``market`` nor ``rng``), so a settled list's weights may be reused."""
     n = ledger["balance"].shape[0]
-    bc, t = BLOCK_CAPACITY, MEMPOOL_CAPACITY
+    bc, t = first_block_slots(n), MEMPOOL_CAPACITY
     z = np.zeros
     ns, gs = zip(*gas_table)
     chain = {
@@ -238,6 +248,7 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
         "mp_stake": z(t), "mp_gas": z(t), "mp_step": z(t, np.int64), "mp_seq": z(t, np.int64),
         "mp_bb": z(t, np.bool_),
         "mp_known": z((n, _words(t)), np.uint64), "mp_old": z((n, _words(t)), np.uint64),
+        "mp_mask": z(_words(t), np.uint64),
         "chn_blocks": z(1, np.int64), "chn_forks": z(1, np.int64), "chn_reorgs": z(1, np.int64),
         "chn_reorg_tx": z(1, np.int64), "chn_view_reorgs": z(1, np.int64), "chn_failed": z(1, np.int64),
         "chn_delay_sum": z(1, np.int64),
@@ -287,13 +298,11 @@ def _packed_entries(world, changes: dict, entries: int) -> dict:
     size = max(world.blk_tx.shape[0], 4 * (used + entries - int(world.chn_txtop[0])))
     new = np.zeros(size, np.int64)
     new_off = changes.get("blk_txoff", off).copy()
-    top = 0
-    for b in live:
-        k = int(ntx[b])
-        new[top:top + k] = world.blk_tx[off[b]:off[b] + k]
-        new_off[b] = top
-        top += k
-    return {"blk_tx": new, "blk_txoff": new_off, "chn_txtop": np.array([top], np.int64)}
+    sizes = ntx[live]
+    starts = (np.cumsum(sizes) - sizes).astype(np.int64)
+    new[:used] = world.blk_tx[np.repeat(off[live] - starts, sizes) + np.arange(used, dtype=np.int64)]
+    new_off[live] = starts
+    return {"blk_tx": new, "blk_txoff": new_off, "chn_txtop": np.array([used], np.int64)}
 
 
 def _packed_lists(world, changes: dict, lists: int) -> dict:
@@ -383,6 +392,7 @@ def grow_chain(world, needs) -> dict:
             changes[f] = _grown(getattr(world, f), 0, size)
         for f in ("mp_known", "mp_old", "blk_inc"):
             changes[f] = _grown(getattr(world, f), 1, _words(size))
+        changes["mp_mask"] = _grown(world.mp_mask, 0, _words(size))
     bc = world.blk_live.shape[0]
     if blocks > bc:
         size = max(2 * bc, blocks)
@@ -908,9 +918,10 @@ def move_checkpoint(w, c):
     head is dropped keeps its head's height, weight, hash and its own balance (``view_head`` -1) until
     it hears a heavier block."""
     save_checkpoint(w)
-    live, known = unlock(w.mp_live), unlock(w.mp_known)
+    live, known, mask = unlock(w.mp_live), unlock(w.mp_known), unlock(w.mp_mask)
     n = known.shape[0]
     pending = w.mp_count[0]
+    lo, hi = mask.shape[0], -1  # the words of c's transactions: mask their bits, word by word
     for k in range(w.blk_ntx[c]):
         tx = w.blk_tx[w.blk_txoff[c] + k]
         if not live[tx]:
@@ -921,10 +932,13 @@ def move_checkpoint(w, c):
             unlock(w.mp_for_buyer)[w.mp_buyer[tx]] -= 1
             unlock(w.mp_own)[w.mp_origin[tx]] -= 1
             drop_own(w, tx)
-        word = tx >> 6
-        bit = ~(np.uint64(1) << np.uint64(tx & 63))
-        for i in range(n):
-            known[i, word] &= bit
+        mask[tx >> 6] |= np.uint64(1) << np.uint64(tx & 63)
+        lo, hi = min(lo, tx >> 6), max(hi, tx >> 6)
+    for i in range(n):  # nobody knows them any more
+        for word in range(lo, hi + 1):
+            known[i, word] &= ~mask[word]
+    for word in range(lo, hi + 1):
+        mask[word] = 0
     order = unlock(w.mp_order)
     k = 0
     top = 0
@@ -935,6 +949,11 @@ def move_checkpoint(w, c):
             k += 1
     unlock(w.mp_words)[0] = (top >> 6) + 1 if k > 0 else 0
     unlock(w.mp_cursor)[0] = 0  # new transactions take the lowest free slots
+    lo, hi = mask.shape[0], -1
+    for k in range(w.blk_ntx[c]):
+        tx = w.blk_tx[w.blk_txoff[c] + k]
+        mask[tx >> 6] |= np.uint64(1) << np.uint64(tx & 63)
+        lo, hi = min(lo, tx >> 6), max(hi, tx >> 6)
     hc = w.blk_height[c]
     blive, inc, mark = unlock(w.blk_live), unlock(w.blk_inc), unlock(w.blk_mark)
     for b in range(blive.shape[0]):  # 1: descends from c, 2: does not, 0: not known yet
@@ -959,9 +978,10 @@ def move_checkpoint(w, c):
             blive[b] = False
             unlock(w.chn_nblk)[0] -= 1
             continue
-        for k in range(w.blk_ntx[c]):  # final now: they leave every branch's pending set
-            tx = w.blk_tx[w.blk_txoff[c] + k]
-            inc[b, tx >> 6] &= ~(np.uint64(1) << np.uint64(tx & 63))
+        for word in range(lo, hi + 1):  # final now: they leave every branch's pending set
+            inc[b, word] &= ~mask[word]
+    for word in range(lo, hi + 1):
+        mask[word] = 0
     unlock(w.blk_parent)[c] = -1
     unlock(w.chn_ckpt)[0] = c
     for i in range(n):
