@@ -319,14 +319,15 @@ def _packed_lists(world, changes: dict, lists: int) -> dict:
     new_of = np.full(top + 1, -1, np.int64)  # index top + 1 - 1 = -1 -> -1
     new_of[old] = np.arange(total, dtype=np.int64)
     size = max(world.ls_seller.shape[0], 4 * (total + lists - top))
-    out = {}
+    out = {}  # (nodes from total on are written whole when they are made: their memory is left untouched)
     for f in TX_POOL:
         o = getattr(world, f"ls_{f[3:]}")
-        new = np.zeros(size, o.dtype)
+        new = np.empty(size, o.dtype)
         new[:total] = o[old]
         out[f"ls_{f[3:]}"] = new
     for f in ("ls_prev", "ls_len", "ls_seq", "ls_buyer", "ls_kid", "ls_sib", "ls_wt"):
-        out[f] = np.full(size, -1, np.int64)
+        out[f] = np.empty(size, np.int64)
+        out[f][:total] = -1
     out["ls_prev"][:total] = new_of[world.ls_prev[old]]
     for f in ("ls_len", "ls_seq", "ls_buyer"):
         out[f][:total] = getattr(world, f)[old]
@@ -337,7 +338,7 @@ def _packed_lists(world, changes: dict, lists: int) -> dict:
     used = int(lens.sum())
     src = np.repeat(wt_old[cached] - starts, lens) + np.arange(used, dtype=np.int64)
     wsize = max(world.chn_wt.shape[0], 4 * used, 2 * lists)
-    wt = np.zeros(wsize)
+    wt = np.empty(wsize)
     wt[:used] = world.chn_wt[src]
     out["ls_wt"][:total][cached] = starts
     roots = np.full(world.chn_lroot.shape[0], -1, np.int64)
