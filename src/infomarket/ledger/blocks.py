@@ -94,6 +94,8 @@ SPEC = Spec("chain", [
         ("view_stale", "bool", "n", "its head moved since view_avail was computed (mempool.refresh_view, "
                                     "done when the robot next sells or its head is dropped)"),
         ("chn_nblk", "int64", "1", "live blocks"),
+        ("chn_free", "int64", "1", "every block slot below it is taken (where new_block looks for the lowest "
+                                   "free one)"),
         ("gas_paid", "float64", "n", "gas each robot has paid on the canonical chain"),
         ("blk_live", "bool", "Bc", "slot holds a block (the checkpoint or one after it)"),
         ("blk_parent", "int64", "Bc", "parent slot (-1 for the checkpoint)"),
@@ -144,6 +146,8 @@ SPEC = Spec("chain", [
                                    "once each and never replayed: stays 0)"),
         ("chn_seq", "int64", "1", "transactions sent so far (their order)"),
         ("chn_nopen", "int64", "1", "reveals the deposit being applied settles"),
+        ("chn_behind", "int64", "1", "the robot whose head kept next_checkpoint from moving the checkpoint "
+                                     "last time (checked first next time)"),
         ("mp_live", "bool", "T", "slot holds a pending transaction"),
         ("mp_cursor", "int64", "1", "where the next free slot is looked for"),
         ("mp_order", "int64", "T", "the pending transactions' slots in sending order (the first mp_count)"),
@@ -229,7 +233,7 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
         "chn_part_end": -1 if partition is None else int(partition[1]), "chn_cache": bool(cache_weights), "view_height": z(n, np.int64), "view_weight": z(n, np.int64),
         "view_hash": np.full(n, np.int64(int(seed) % (2**62)), np.int64), "view_bal": ledger["balance"].copy(),
         "view_head": z(n, np.int64), "view_old": z(n, np.int64), "view_avail": ledger["balance"].copy(),
-        "view_stale": z(n, np.bool_), "chn_nblk": np.ones(1, np.int64),
+        "view_stale": z(n, np.bool_), "chn_nblk": np.ones(1, np.int64), "chn_free": np.ones(1, np.int64),
         "gas_paid": z(n),
         "blk_live": z(bc, np.bool_), "blk_parent": np.full(bc, -1, np.int64), "blk_height": z(bc, np.int64),
         "blk_weight": z(bc, np.int64), "blk_hash": z(bc, np.int64), "blk_signer": np.full(bc, -1, np.int64),
@@ -238,7 +242,7 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
         "blk_ntx": z(bc, np.int64), "blk_txoff": z(bc, np.int64), "blk_tx": z(TX_ENTRIES, np.int64), "blk_bal": z((bc, n)), "blk_inc": z((bc, _words(t)), np.uint64),
         "chn_ckpt": z(1, np.int64), "chn_canon": z(1, np.int64), "chn_cur": z(1, np.int64),
         "chn_mute": z(1, np.int64), "chn_seq": z(1, np.int64),
-        "chn_nopen": z(1, np.int64), "chn_txtop": z(1, np.int64),
+        "chn_nopen": z(1, np.int64), "chn_behind": z(1, np.int64), "chn_txtop": z(1, np.int64),
         "mp_live": z(t, np.bool_), "mp_cursor": z(1, np.int64), "mp_order": z(t, np.int64),
         "mp_words": z(1, np.int64), "mp_onext": np.full(t, -1, np.int64), "mp_oprev": np.full(t, -1, np.int64),
         "own_first": np.full(n, -1, np.int64), "own_last": np.full(n, -1, np.int64), "mp_count": z(1, np.int64),
@@ -535,9 +539,10 @@ def new_block(w, signer, t):
     its branch does not include yet, in sending order.  Returns its slot (the ledger is not touched)."""
     parent = w.view_head[signer]
     live = unlock(w.blk_live)
-    b = 0
+    b = w.chn_free[0]  # every slot below it is taken: the lowest free slot is at or above it
     while live[b]:
         b += 1  # the host keeps a free slot for every block a step can make
+    unlock(w.chn_free)[0] = b + 1
     height = w.blk_height[parent] + 1
     live[b] = True
     unlock(w.chn_nblk)[0] += 1
@@ -905,9 +910,13 @@ def next_checkpoint(w):
     hc = w.blk_height[c]
     if w.blk_height[canon] - hc >= w.chn_final:
         return c  # final by depth, whoever has not heard of it
-    for i in range(w.view_head.shape[0]):
+    n = w.view_head.shape[0]
+    first = w.chn_behind[0]  # the robot that was behind last time is likely to be still
+    for a in range(n):
+        i = (first + a) % n
         h = w.view_head[i]
         if h < 0 or w.blk_height[h] < hc or ancestor_at(w, h, hc) != c:
+            unlock(w.chn_behind)[0] = i
             return -1
     return c
 
@@ -951,8 +960,13 @@ def move_checkpoint(w, c):
     unlock(w.mp_words)[0] = (top >> 6) + 1 if k > 0 else 0
     unlock(w.mp_cursor)[0] = 0  # new transactions take the lowest free slots
     lo, hi = mask.shape[0], -1
+    words = np.empty(w.blk_ntx[c], np.int64)  # the words with bits to clear
+    nw = 0
     for k in range(w.blk_ntx[c]):
         tx = w.blk_tx[w.blk_txoff[c] + k]
+        if mask[tx >> 6] == np.uint64(0):
+            words[nw] = tx >> 6
+            nw += 1
         mask[tx >> 6] |= np.uint64(1) << np.uint64(tx & 63)
         lo, hi = min(lo, tx >> 6), max(hi, tx >> 6)
     hc = w.blk_height[c]
@@ -978,8 +992,10 @@ def move_checkpoint(w, c):
         if mark[b] != 1:
             blive[b] = False
             unlock(w.chn_nblk)[0] -= 1
+            unlock(w.chn_free)[0] = min(w.chn_free[0], b)
             continue
-        for word in range(lo, hi + 1):  # final now: they leave every branch's pending set
+        for a in range(nw):  # final now: they leave every branch's pending set
+            word = words[a]
             inc[b, word] &= ~mask[word]
     for word in range(lo, hi + 1):
         mask[word] = 0
