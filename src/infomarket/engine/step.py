@@ -333,14 +333,15 @@ class ChainStep(NamedTuple):
 
 
 @functools.cache
-def chain_variant(weigh) -> ChainStep:
-    """The chain's step pieces around ``weigh(w, buyer, weights, rng)``, the kernel's payment rule (a
-    settlement: it weighs, ``ledger.kernels.distribute`` pays).  Every write goes through ``ledger.blocks``."""
+def chain_settle(weigh):
+    """A deposit's settlement on the branch being applied, around ``weigh(w, buyer, weights, rng)``:
+    the weights of the buyer's list (``chn_bver``; the ledger arrays' pool holds it, ``materialise``) are
+    those cached when any branch settled the same list (the same node), if the scheme reads nothing but
+    the list (``chn_cache``); else the scheme weighs it (and the weights are cached).  Then
+    ``ledger.kernels.distribute`` pays."""
 
     @njit
     def settle(w, buyer, rng):
-        """The buyer's deposit on the branch being applied: its list's weights (those cached when another
-        branch settled the same list, if the scheme reads nothing but the list: ``chn_cache``), then pay."""
         v = w.chn_bver[buyer]
         k = w.tx_count[buyer]
         if w.chn_cache and v >= 0 and w.ls_wt[v] >= 0:
@@ -351,6 +352,15 @@ def chain_variant(weigh) -> ChainStep:
             if w.chn_cache and v >= 0:
                 _blocks.cache_weights(w, v, weights)
         distribute(w, buyer, weights)
+
+    return settle
+
+
+@functools.cache
+def chain_variant(weigh) -> ChainStep:
+    """The chain's step pieces around ``weigh(w, buyer, weights, rng)``, the kernel's payment rule (a
+    settlement: it weighs, ``ledger.kernels.distribute`` pays).  Every write goes through ``ledger.blocks``."""
+    settle = chain_settle(weigh)
 
     @njit
     def apply_block(w, b, rng):
