@@ -1026,8 +1026,9 @@ def gossip(w):
     words = w.mp_words[0]  # (known-bits beyond are all 0)
     for i in range(n):
         old[i] = heads[i]
-        for k in range(words):
-            mold[i, k] = known[i, k]
+        if w.nbr_count[i] > 0:  # (neighbours are mutual: only a robot with one is heard)
+            for k in range(words):
+                mold[i, k] = known[i, k]
     loss = w.chn_loss
     cut = partitioned(w, t)
     for i in range(n):
