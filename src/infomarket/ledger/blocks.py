@@ -286,9 +286,10 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
 
 
 def _grown(old: np.ndarray, axis: int, size: int, fill=0) -> np.ndarray:
+    """``old`` grown to ``size`` along ``axis``, the new part ``fill`` (None: left as allocated)."""
     shape = list(old.shape)
     shape[axis] = size
-    new = np.full(shape, fill, old.dtype)
+    new = np.empty(shape, old.dtype) if fill is None else np.full(shape, fill, old.dtype)
     new[tuple(slice(0, k) for k in old.shape)] = old
     return new
 
@@ -406,11 +407,13 @@ def grow_chain(world, needs) -> dict:
             changes[f] = _grown(getattr(world, f), 0, size)
         for f in ("blk_parent", "blk_signer"):
             changes[f] = _grown(getattr(world, f), 0, size, -1)
-        changes["blk_bal"] = _grown(world.blk_bal, 0, size)
-        changes["blk_inc"] = _grown(changes.get("blk_inc", world.blk_inc), 0, size)
+        # a new slot's state and bits are written whole when a block is made in it (new_block, save_state),
+        # and nothing reads a free slot's: the new rows are left untouched (no memory until used)
+        changes["blk_bal"] = _grown(world.blk_bal, 0, size, None)
+        changes["blk_inc"] = _grown(changes.get("blk_inc", world.blk_inc), 0, size, None)
         for f in BLOCK_STATE:
-            changes[f"bs_{f}"] = _grown(getattr(world, f"bs_{f}"), 0, size)
-        changes["bs_ver"] = _grown(world.bs_ver, 0, size, -1)
+            changes[f"bs_{f}"] = _grown(getattr(world, f"bs_{f}"), 0, size, None)
+        changes["bs_ver"] = _grown(world.bs_ver, 0, size, None)
     if lists > world.ls_seller.shape[0]:
         changes.update(_packed_lists(world, changes, lists))
     if entries > world.blk_tx.shape[0]:
