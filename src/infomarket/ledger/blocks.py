@@ -94,6 +94,7 @@ SPEC = Spec("chain", [
         ("view_stale", "bool", "n", "its head moved since view_avail was computed (mempool.refresh_view, "
                                     "done when the robot next sells or its head is dropped)"),
         ("chn_nblk", "int64", "1", "live blocks"),
+        ("chn_slots", "int64", "1", "1 + the highest block slot ever used (slots from it on are untouched)"),
         ("chn_free", "int64", "1", "every block slot below it is taken (where new_block looks for the lowest "
                                    "free one)"),
         ("gas_paid", "float64", "n", "gas each robot has paid on the canonical chain"),
@@ -189,11 +190,13 @@ SPEC = Spec("chain", [
     ]),
 ])
 
-#: First capacities: block slots (at least 16, at most 512, as many as ``BLOCK_STATE_BYTES`` of block
-#: states hold: each is O(robots)) and mempool slots.  Generous first sizes spare a run most of the host's
-#: growth calls, which cost as much as many steps; they change no number.
-BLOCK_CAPACITY = (16, 512)
-BLOCK_STATE_BYTES = 32 << 20
+#: First capacities: block slots (at least 16, at most 1024, as many as ``BLOCK_STATE_BYTES`` of block
+#: states hold: each is O(robots); the arrays are allocated zeroed, so a slot takes memory only once a
+#: block has been made in it) and mempool slots.  Generous first sizes spare a run most of the host's
+#: growth calls, which cost as much as many steps (at 10 000 robots, each copies every live block's
+#: state); they change no number.
+BLOCK_CAPACITY = (16, 1024)
+BLOCK_STATE_BYTES = 1 << 30
 MEMPOOL_CAPACITY = 1024
 #: First size of the blocks' transaction lists (``blk_tx``).
 TX_ENTRIES = 16384
@@ -233,7 +236,7 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
         "chn_part_end": -1 if partition is None else int(partition[1]), "chn_cache": bool(cache_weights), "view_height": z(n, np.int64), "view_weight": z(n, np.int64),
         "view_hash": np.full(n, np.int64(int(seed) % (2**62)), np.int64), "view_bal": ledger["balance"].copy(),
         "view_head": z(n, np.int64), "view_old": z(n, np.int64), "view_avail": ledger["balance"].copy(),
-        "view_stale": z(n, np.bool_), "chn_nblk": np.ones(1, np.int64), "chn_free": np.ones(1, np.int64),
+        "view_stale": z(n, np.bool_), "chn_nblk": np.ones(1, np.int64), "chn_free": np.ones(1, np.int64), "chn_slots": np.ones(1, np.int64),
         "gas_paid": z(n),
         "blk_live": z(bc, np.bool_), "blk_parent": np.full(bc, -1, np.int64), "blk_height": z(bc, np.int64),
         "blk_weight": z(bc, np.int64), "blk_hash": z(bc, np.int64), "blk_signer": np.full(bc, -1, np.int64),
@@ -291,6 +294,13 @@ def _grown(old: np.ndarray, axis: int, size: int, fill=0) -> np.ndarray:
     shape[axis] = size
     new = np.empty(shape, old.dtype) if fill is None else np.full(shape, fill, old.dtype)
     new[tuple(slice(0, k) for k in old.shape)] = old
+    return new
+
+
+def _grown_rows(old: np.ndarray, rows: np.ndarray, size: int) -> np.ndarray:
+    """``old`` grown to ``size`` rows, holding only ``rows`` of it (the rest left as allocated)."""
+    new = np.empty((size, *old.shape[1:]), old.dtype)
+    new[rows] = old[rows]
     return new
 
 
@@ -352,7 +362,8 @@ def _packed_lists(world, changes: dict, lists: int) -> dict:
     def renumber(v):
         return new_of[v]
 
-    bs_ver = changes.get("bs_ver", world.bs_ver).copy()  # (grown already when the block slots grew)
+    bs_ver = changes.get("bs_ver", world.bs_ver)  # (grown already when the block slots grew; renumbered in
+    # place: the world this packs is replaced by the one make_room returns)
     bs_ver[live] = renumber(world.bs_ver[live])
     out.update(bs_ver=bs_ver, chn_ver=renumber(world.chn_ver), chn_bver=renumber(world.chn_bver),
                chn_lroot=roots, chn_lstop=np.array([total], np.int64), chn_wt=wt,
@@ -409,11 +420,13 @@ def grow_chain(world, needs) -> dict:
             changes[f] = _grown(getattr(world, f), 0, size, -1)
         # a new slot's state and bits are written whole when a block is made in it (new_block, save_state),
         # and nothing reads a free slot's: the new rows are left untouched (no memory until used)
-        changes["blk_bal"] = _grown(world.blk_bal, 0, size, None)
-        changes["blk_inc"] = _grown(changes.get("blk_inc", world.blk_inc), 0, size, None)
+        # (and only the live slots' rows are copied: a free slot's are never read)
+        live = np.flatnonzero(world.blk_live)
+        changes["blk_bal"] = _grown_rows(world.blk_bal, live, size)
+        changes["blk_inc"] = _grown_rows(changes.get("blk_inc", world.blk_inc), live, size)
         for f in BLOCK_STATE:
-            changes[f"bs_{f}"] = _grown(getattr(world, f"bs_{f}"), 0, size, None)
-        changes["bs_ver"] = _grown(world.bs_ver, 0, size, None)
+            changes[f"bs_{f}"] = _grown_rows(getattr(world, f"bs_{f}"), live, size)
+        changes["bs_ver"] = _grown_rows(world.bs_ver, live, size)
     if lists > world.ls_seller.shape[0]:
         changes.update(_packed_lists(world, changes, lists))
     if entries > world.blk_tx.shape[0]:
@@ -546,6 +559,8 @@ def new_block(w, signer, t):
     while live[b]:
         b += 1  # the host keeps a free slot for every block a step can make
     unlock(w.chn_free)[0] = b + 1
+    if b >= w.chn_slots[0]:
+        unlock(w.chn_slots)[0] = b + 1
     height = w.blk_height[parent] + 1
     live[b] = True
     unlock(w.chn_nblk)[0] += 1
@@ -974,10 +989,10 @@ def move_checkpoint(w, c):
         lo, hi = min(lo, tx >> 6), max(hi, tx >> 6)
     hc = w.blk_height[c]
     blive, inc, mark = unlock(w.blk_live), unlock(w.blk_inc), unlock(w.blk_mark)
-    for b in range(blive.shape[0]):  # 1: descends from c, 2: does not, 0: not known yet
+    for b in range(w.chn_slots[0]):  # 1: descends from c, 2: does not, 0: not known yet
         mark[b] = 0
     mark[c] = 1
-    for b in range(blive.shape[0]):
+    for b in range(w.chn_slots[0]):
         if not blive[b] or mark[b] != 0:
             continue
         x = b  # up to the first block whose answer is known (c, or any block at c's height or below)
@@ -989,7 +1004,7 @@ def move_checkpoint(w, c):
         while x != end:  # every block on the way has the same answer: each block is walked once
             mark[x] = 1 if keep else 2
             x = w.blk_parent[x]
-    for b in range(blive.shape[0]):
+    for b in range(w.chn_slots[0]):
         if not blive[b]:
             continue
         if mark[b] != 1:
