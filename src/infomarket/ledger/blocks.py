@@ -8,7 +8,9 @@ State (``SPEC``, the ``chain`` domain; only ledger operations write it, like the
   includes (mempool slots, in the order they were sent: ``blk_tx[blk_txoff[b]:][:blk_ntx[b]]``), a bit
   per pending transaction on its branch (``blk_inc``), every robot's balance after it (``blk_bal``, the
   snapshot a robot's view reads) and the rest of the ledger's state after it (``bs_*``; each buyer's open
-  transactions as a version of its list in ``ls_*``).  The **checkpoint** (``chn_ckpt``) is the newest
+  transactions as a node of the list store ``ls_*``: its last transaction, ``ls_prev`` the rest; the same
+  reveal appended to the same list is the same node on every branch, so a node is a list's content and
+  a settled list's weights are cached by it, ``ls_wt``).  The **checkpoint** (``chn_ckpt``) is the newest
   final block (every robot's head descends from it, or it lies ``chn_final`` blocks below the canonical
   head): nothing before it can change, so it is the root of the store.
 * **Mempool** (``ledger.mempool``): transactions not yet in a final block, with a bit per robot
@@ -24,7 +26,8 @@ State (``SPEC``, the ``chain`` domain; only ledger operations write it, like the
   transactions, deposit-to-payment delays, every robot's summed view lag.
 
 Memory: the blocks since the checkpoint (each with an O(n) state and O(pending / 64) bits), the list
-versions they use, the mempool with its known-bits (O(n x transactions in flight)), two ledgers.  Every
+nodes they use and their cached weights, the mempool with its known-bits (O(n x transactions in flight)),
+two ledgers (the checkpoint's without its lists: its block keeps them).  Every
 array is sized by what is live (the host packs the arenas); nothing grows with the run's history.
 """
 from __future__ import annotations
