@@ -10,6 +10,7 @@ import numpy as np
 from ..config.schema import Experiment
 from ..ledger import blocks, gas
 from ..ledger.state import grow_ledger, ledger_of
+from ..registry import get_payment
 from ..state.log import build_log, grow_log
 from .params import behaviour_kinds, behaviour_table, build_params  # noqa: F401  (behaviour_kinds re-exported)
 from .swarm import build_swarm, grow_swarm
@@ -49,11 +50,13 @@ def chain_of(cfg: Experiment, ledger: dict, rng: np.random.Generator) -> dict:
     """The chain model's state for a run of ``cfg`` (``ledger.blocks``)."""
     c = cfg.chain
     reveal, deposit = gas.gas_schedule(cfg.payment.scheme, cfg.payment.stake)
+    rule = get_payment(cfg.payment.scheme).weights  # weights of a list, nothing else: cached per list
     return blocks.build_chain(ledger, period=c.period, delay=c.out_of_turn_delay,
                               signers=c.signers or list(range(cfg.swarm.robots)), backbone=c.backbone,
                               latency=c.latency, loss=c.loss, gas_price=c.gas_price, gas_reveal=reveal,
                               gas_table=list(zip(gas.GAS_DEPOSIT_N, deposit)), seed=chain_seed(rng),
-                              finality=c.finality, partition=c.partition)
+                              finality=c.finality, partition=c.partition,
+                              cache_weights=not (rule.wants_market or rule.wants_rng))
 
 
 def make_room(world: World, tx_need: np.ndarray | None = None) -> World:

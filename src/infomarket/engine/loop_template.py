@@ -71,16 +71,22 @@ def has_room(w):
 
 
 @njit(cache=True)
+def weigh(w, i, weights, rng):
+    """The scheme's weights of robot i's open transactions (ledger.kernels.settlement), into ``weights``."""
+    sellers, sites, directions = settlement(w, i)
+    pay_dispatch(w, i, sellers, sites, directions, weights, rng)
+
+
+@njit(cache=True)
 def settle(w, i, rng):
     """Robot i deposited: weigh its open transactions with the scheme, then pay (ledger.kernels)."""
-    sellers, sites, directions = settlement(w, i)
-    weights = np.zeros(sellers.shape[0])
-    pay_dispatch(w, i, sellers, sites, directions, weights, rng)
+    weights = np.zeros(w.tx_count[i])
+    weigh(w, i, weights, rng)
     distribute(w, i, weights)
 
 
-#: The chain model's pieces around this kernel's settlement (engine.step.chain_variant), when it has one.
-chain_gossip, chain_deposit, make_blocks = chain_variant(settle) if CHAIN else (None, None, None)
+#: The chain model's pieces around this kernel's weighing (engine.step.chain_variant), when it has one.
+chain_gossip, chain_deposit, make_blocks = chain_variant(weigh) if CHAIN else (None, None, None)
 
 
 @njit(cache=True)

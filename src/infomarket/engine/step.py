@@ -20,9 +20,11 @@ import functools
 import math
 from typing import Callable, NamedTuple
 
+import numpy as np
 from numba import njit
 
 from ..ledger import blocks as _blocks
+from ..ledger.kernels import distribute
 from ..ledger.mempool import chain_deposit
 from ..state.view import unlock
 from .draws import normal, uniform
@@ -331,9 +333,34 @@ class ChainStep(NamedTuple):
 
 
 @functools.cache
-def chain_variant(settle) -> ChainStep:
-    """The chain's step pieces around ``settle(w, buyer, rng)``, the kernel's settlement (the payment rule
-    weighs, ``ledger.kernels.distribute`` pays).  Every write goes through ``ledger.blocks``."""
+def chain_settle(weigh):
+    """A deposit's settlement on the branch being applied, around ``weigh(w, buyer, weights, rng)``:
+    the weights of the buyer's list (``chn_bver``; the ledger arrays' pool holds it, ``materialise``) are
+    those cached when any branch settled the same list (the same node), if the scheme reads nothing but
+    the list (``chn_cache``); else the scheme weighs it (and the weights are cached).  Then
+    ``ledger.kernels.distribute`` pays."""
+
+    @njit
+    def settle(w, buyer, rng):
+        v = w.chn_bver[buyer]
+        k = w.tx_count[buyer]
+        if w.chn_cache and v >= 0 and w.ls_wt[v] >= 0:
+            weights = unlock(w.chn_wt)[w.ls_wt[v]:w.ls_wt[v] + k]
+        else:
+            weights = np.zeros(k)
+            weigh(w, buyer, weights, rng)
+            if w.chn_cache and v >= 0:
+                _blocks.cache_weights(w, v, weights)
+        distribute(w, buyer, weights)
+
+    return settle
+
+
+@functools.cache
+def chain_variant(weigh) -> ChainStep:
+    """The chain's step pieces around ``weigh(w, buyer, weights, rng)``, the kernel's payment rule (a
+    settlement: it weighs, ``ledger.kernels.distribute`` pays).  Every write goes through ``ledger.blocks``."""
+    settle = chain_settle(weigh)
 
     @njit
     def apply_block(w, b, rng):
@@ -376,8 +403,7 @@ def chain_variant(settle) -> ChainStep:
             c = _blocks.next_checkpoint(w)
             if c < 0:
                 break
-            ledger_at(w, c)
-            _blocks.materialise_all(w)
+            ledger_at(w, c)  # (the lists stay where they are: the checkpoint's block keeps its own)
             _blocks.move_checkpoint(w, c)
         ledger_at(w, w.chn_canon[0])
         _blocks.materialise_all(w)

@@ -8,7 +8,9 @@ State (``SPEC``, the ``chain`` domain; only ledger operations write it, like the
   includes (mempool slots, in the order they were sent: ``blk_tx[blk_txoff[b]:][:blk_ntx[b]]``), a bit
   per pending transaction on its branch (``blk_inc``), every robot's balance after it (``blk_bal``, the
   snapshot a robot's view reads) and the rest of the ledger's state after it (``bs_*``; each buyer's open
-  transactions as a version of its list in ``ls_*``).  The **checkpoint** (``chn_ckpt``) is the newest
+  transactions as a node of the list store ``ls_*``: its last transaction, ``ls_prev`` the rest; the same
+  reveal appended to the same list is the same node on every branch, so a node is a list's content and
+  a settled list's weights are cached by it, ``ls_wt``).  The **checkpoint** (``chn_ckpt``) is the newest
   final block (every robot's head descends from it, or it lies ``chn_final`` blocks below the canonical
   head): nothing before it can change, so it is the root of the store.
 * **Mempool** (``ledger.mempool``): transactions not yet in a final block, with a bit per robot
@@ -24,10 +26,13 @@ State (``SPEC``, the ``chain`` domain; only ledger operations write it, like the
   transactions, deposit-to-payment delays, every robot's summed view lag.
 
 Memory: the blocks since the checkpoint (each with an O(n) state and O(pending / 64) bits), the list
-versions they use, the mempool with its known-bits (O(n x transactions in flight)), two ledgers.  Every
+nodes they use and their cached weights, the mempool with its known-bits (O(n x transactions in flight)),
+two ledgers (the checkpoint's without its lists: its block keeps them).  Every
 array is sized by what is live (the host packs the arenas); nothing grows with the run's history.
 """
 from __future__ import annotations
+
+import math
 
 import numpy as np
 from numba import njit
@@ -40,8 +45,10 @@ from .mempool import (DEPOSIT, REVEAL, STAKE_TOLERANCE, chance, drop_own, knows,
 from .gas import table_gas
 from .state import TX_POOL
 
-#: The checkpoint's copy of each ledger field (``ck_<field>``).
-CHECKPOINTED = ("balance", "pot", "burned", "tx_off", "tx_cap", "tx_count", *TX_POOL, "pool_top", "money",
+#: The checkpoint's copy of each ledger field (``ck_<field>``) but the buyers' lists of open transactions
+#: (the checkpoint's block state keeps those, ``bs_ver``; ``ck_tx_off``, ``ck_tx_cap`` and ``ck_pool_top``
+#: only bound what the transaction pool may need, ``chain_needs``).
+CHECKPOINTED = ("balance", "pot", "burned", "tx_off", "tx_cap", "tx_count", "pool_top", "money",
                 "rep_settled", "rep_reduced", "rep_earned", "rep_stake_lost", "rep_deposits", "gas_paid")
 #: The ledger fields each block keeps (``bs_<field>``; the balances are ``blk_bal``; each buyer's open
 #: transactions are a version of its list, ``bs_ver``), so the state after any live block is a copy away:
@@ -74,6 +81,8 @@ SPEC = Spec("chain", [
         ("chn_final", "int", "", "finality depth F: a block F blocks below the canonical head is final"),
         ("chn_part_start", "int", "", "first step of the partition (-1: none)"),
         ("chn_part_end", "int", "", "step the partition ends (not partitioned any more)"),
+        ("chn_cache", "bool", "", "the payment scheme reads neither the market nor rng: a list's weights are "
+                                  "kept and reused when another branch settles the same list"),
     ]),
     *fields("ledger", [
         ("view_head", "int64", "n", "each robot's head block (a slot of the block store; -1: its branch "
@@ -88,6 +97,9 @@ SPEC = Spec("chain", [
         ("view_stale", "bool", "n", "its head moved since view_avail was computed (mempool.refresh_view, "
                                     "done when the robot next sells or its head is dropped)"),
         ("chn_nblk", "int64", "1", "live blocks"),
+        ("chn_slots", "int64", "1", "1 + the highest block slot ever used (slots from it on are untouched)"),
+        ("chn_free", "int64", "1", "every block slot below it is taken (where new_block looks for the lowest "
+                                   "free one)"),
         ("gas_paid", "float64", "n", "gas each robot has paid on the canonical chain"),
         ("blk_live", "bool", "Bc", "slot holds a block (the checkpoint or one after it)"),
         ("blk_parent", "int64", "Bc", "parent slot (-1 for the checkpoint)"),
@@ -98,6 +110,7 @@ SPEC = Spec("chain", [
         ("blk_step", "int64", "Bc", "step it was made"),
         ("blk_kids", "int64", "Bc", "blocks made on it"),
         ("blk_bb", "bool", "Bc", "delivered by the backbone"),
+        ("blk_mark", "int8", "Bc", "scratch of move_checkpoint: 1 descends from the new checkpoint, 2 not"),
         ("blk_ntx", "int64", "Bc", "transactions it includes"),
         ("blk_txoff", "int64", "Bc", "where its transactions start in blk_tx"),
         ("blk_tx", "int64", "Bt", "block b's transactions (mempool slots, in the order they were sent) are "
@@ -108,14 +121,28 @@ SPEC = Spec("chain", [
                                          "checkpoint"),
         *[(f"bs_{f}", _LEDGER_KINDS[f][0], "Bc" if _LEDGER_KINDS[f][1] == "1" else "Bc,n",
            f"{f} after the block (its ledger state, with blk_bal)") for f in BLOCK_STATE],
-        ("bs_ver", "int64", "Bc,n", "each buyer's open transactions after the block: ls_*[v : v + "
-                                    "bs_tx_count[b, i]] for v = bs_ver[b, i] (-1: none)"),
-        *[(f"ls_{f[3:]}", _LEDGER_KINDS[f][0], "L", f"{f} of saved versions of the buyers' lists of open "
-                                                    f"transactions (append-only; the host packs it)")
-          for f in TX_POOL],
-        ("chn_lstop", "int64", "1", "first unused entry of ls_*"),
-        ("chn_ver", "int64", "n", "version (bs_ver) of each buyer's list the ledger arrays hold; -2: changed "
-                                  "by the block being applied, not saved yet"),
+        ("bs_ver", "int64", "Bc,n", "each buyer's open transactions after the block: the list node "
+                                    "bs_ver[b, i] and its predecessors (ls_prev), the last one first "
+                                    "(-1: none)"),
+        *[(f"ls_{f[3:]}", _LEDGER_KINDS[f][0], "L", f"{f} of a node of the buyers' lists of open transactions "
+                                                    f"(one open transaction)") for f in TX_POOL],
+        ("ls_prev", "int64", "L", "the node before it in its list (-1: it is the first)"),
+        ("ls_len", "int64", "L", "length of the list that ends with it"),
+        ("ls_seq", "int64", "L", "sending order (mp_seq) of the reveal it records"),
+        ("ls_buyer", "int64", "L", "the buyer whose list it is in"),
+        ("ls_kid", "int64", "L", "first node made after it (-1: none); the others are its ls_sib chain"),
+        ("ls_sib", "int64", "L", "next node with the same predecessor (-1: none)"),
+        ("ls_wt", "int64", "L", "where the payment scheme's weights of the list ending here start in "
+                                "chn_wt (-1: not weighed yet)"),
+        ("chn_lroot", "int64", "n", "each buyer's first node of a list (-1: none); the others, its ls_sib chain"),
+        ("chn_lstop", "int64", "1", "first unused node (the host packs the nodes live blocks use)"),
+        ("chn_wt", "float64", "W", "weights of settled lists, ls_len[v] of them from ls_wt[v] (the settlement "
+                                   "cache)"),
+        ("chn_wttop", "int64", "1", "first unused entry of chn_wt"),
+        ("chn_bver", "int64", "n", "each buyer's list (a node) in the state the ledger arrays hold, or in the "
+                                   "block being applied"),
+        ("chn_ver", "int64", "n", "the list (a node) of each buyer whose transactions the ledger arrays' "
+                                  "pool holds (materialise)"),
         ("chn_ckpt", "int64", "1", "the checkpoint's slot"),
         ("chn_canon", "int64", "1", "the canonical head's slot"),
         ("chn_cur", "int64", "1", "the block whose state the ledger arrays hold"),
@@ -123,6 +150,8 @@ SPEC = Spec("chain", [
                                    "once each and never replayed: stays 0)"),
         ("chn_seq", "int64", "1", "transactions sent so far (their order)"),
         ("chn_nopen", "int64", "1", "reveals the deposit being applied settles"),
+        ("chn_behind", "int64", "1", "the robot whose head kept next_checkpoint from moving the checkpoint "
+                                     "last time (checked first next time)"),
         ("mp_live", "bool", "T", "slot holds a pending transaction"),
         ("mp_cursor", "int64", "1", "where the next free slot is looked for"),
         ("mp_order", "int64", "T", "the pending transactions' slots in sending order (the first mp_count)"),
@@ -147,6 +176,7 @@ SPEC = Spec("chain", [
         ("mp_bb", "bool", "T", "delivered by the backbone"),
         ("mp_known", "uint64", "n,T/64", "bit tx of row i: robot i knows transaction tx"),
         ("mp_old", "uint64", "n,T/64", "known-bits at the start of the gossip phase"),
+        ("mp_mask", "uint64", "T/64", "scratch of move_checkpoint (all 0 between calls)"),
         *[(f"ck_{f}", _LEDGER_KINDS[f][0], _LEDGER_KINDS[f][1], f"{f} at the checkpoint")
           for f in CHECKPOINTED],
     ]),
@@ -163,13 +193,26 @@ SPEC = Spec("chain", [
     ]),
 ])
 
-#: First capacities: block slots and mempool slots.
-BLOCK_CAPACITY = 16
-MEMPOOL_CAPACITY = 128
+#: First capacities: block slots (at least 16, at most 1024, as many as ``BLOCK_STATE_BYTES`` of block
+#: states hold: each is O(robots); the arrays are allocated zeroed, so a slot takes memory only once a
+#: block has been made in it) and mempool slots.  Generous first sizes spare a run most of the host's
+#: growth calls, which cost as much as many steps (at 10 000 robots, each copies every live block's
+#: state); they change no number.
+BLOCK_CAPACITY = (16, 1024)
+BLOCK_STATE_BYTES = 1 << 30
+MEMPOOL_CAPACITY = 1024
 #: First size of the blocks' transaction lists (``blk_tx``).
-TX_ENTRIES = 1024
-#: First size of the saved versions of buyers' lists (``ls_*``).
-LIST_ENTRIES = 1024
+TX_ENTRIES = 16384
+#: First number of nodes of the buyers' lists (``ls_*``).
+LIST_ENTRIES = 16384
+#: First size of the settlement cache (``chn_wt``).
+WEIGHT_ENTRIES = 16384
+
+
+def first_block_slots(n: int) -> int:
+    """Block slots a fresh chain of n robots starts with (``BLOCK_CAPACITY``, ``BLOCK_STATE_BYTES``)."""
+    per_block = 8 * n * (len(BLOCK_STATE) + 2)  # blk_bal, bs_*, bs_ver
+    return int(min(BLOCK_CAPACITY[1], max(BLOCK_CAPACITY[0], BLOCK_STATE_BYTES // per_block)))
 
 
 def _words(t: int) -> int:
@@ -177,13 +220,14 @@ def _words(t: int) -> int:
 
 
 def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: bool, latency: int, loss: float,
-                gas_price: float, gas_reveal: float, gas_table, seed: int, finality: int, partition=None) -> dict:
+                gas_price: float, gas_reveal: float, gas_table, seed: int, finality: int, partition=None,
+                cache_weights: bool = False) -> dict:
     """The chain's state for a fresh ledger: the genesis block (every robot's head), an empty mempool,
-    the checkpoint a copy of the ledger."""
+    the checkpoint a copy of the ledger.  ``cache_weights``: the payment scheme's weights depend only on the
+    list it weighs (it takes neither ``market`` nor ``rng``), so a settled list's weights may be reused."""
     n = ledger["balance"].shape[0]
-    bc, t = BLOCK_CAPACITY, MEMPOOL_CAPACITY
+    bc, t = first_block_slots(n), MEMPOOL_CAPACITY
     z = np.zeros
-    pool = ledger["tx_seller"].shape[0]
     ns, gs = zip(*gas_table)
     chain = {
         "chn_period": int(period), "chn_delay": int(delay), "chn_signers": np.asarray(signers, np.int64),
@@ -192,18 +236,19 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
         "chn_gas_n": np.array(ns, np.float64), "chn_gas_deposit": np.array(gs, np.float64), "chn_seed": int(seed),
         "chn_final": int(finality),
         "chn_part_start": -1 if partition is None else int(partition[0]),
-        "chn_part_end": -1 if partition is None else int(partition[1]), "view_height": z(n, np.int64), "view_weight": z(n, np.int64),
+        "chn_part_end": -1 if partition is None else int(partition[1]), "chn_cache": bool(cache_weights), "view_height": z(n, np.int64), "view_weight": z(n, np.int64),
         "view_hash": np.full(n, np.int64(int(seed) % (2**62)), np.int64), "view_bal": ledger["balance"].copy(),
         "view_head": z(n, np.int64), "view_old": z(n, np.int64), "view_avail": ledger["balance"].copy(),
-        "view_stale": z(n, np.bool_), "chn_nblk": np.ones(1, np.int64),
+        "view_stale": z(n, np.bool_), "chn_nblk": np.ones(1, np.int64), "chn_free": np.ones(1, np.int64), "chn_slots": np.ones(1, np.int64),
         "gas_paid": z(n),
         "blk_live": z(bc, np.bool_), "blk_parent": np.full(bc, -1, np.int64), "blk_height": z(bc, np.int64),
         "blk_weight": z(bc, np.int64), "blk_hash": z(bc, np.int64), "blk_signer": np.full(bc, -1, np.int64),
         "blk_step": z(bc, np.int64), "blk_kids": z(bc, np.int64), "blk_bb": z(bc, np.bool_),
+        "blk_mark": z(bc, np.int8),
         "blk_ntx": z(bc, np.int64), "blk_txoff": z(bc, np.int64), "blk_tx": z(TX_ENTRIES, np.int64), "blk_bal": z((bc, n)), "blk_inc": z((bc, _words(t)), np.uint64),
         "chn_ckpt": z(1, np.int64), "chn_canon": z(1, np.int64), "chn_cur": z(1, np.int64),
         "chn_mute": z(1, np.int64), "chn_seq": z(1, np.int64),
-        "chn_nopen": z(1, np.int64), "chn_txtop": z(1, np.int64),
+        "chn_nopen": z(1, np.int64), "chn_behind": z(1, np.int64), "chn_txtop": z(1, np.int64),
         "mp_live": z(t, np.bool_), "mp_cursor": z(1, np.int64), "mp_order": z(t, np.int64),
         "mp_words": z(1, np.int64), "mp_onext": np.full(t, -1, np.int64), "mp_oprev": np.full(t, -1, np.int64),
         "own_first": np.full(n, -1, np.int64), "own_last": np.full(n, -1, np.int64), "mp_count": z(1, np.int64),
@@ -213,6 +258,7 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
         "mp_stake": z(t), "mp_gas": z(t), "mp_step": z(t, np.int64), "mp_seq": z(t, np.int64),
         "mp_bb": z(t, np.bool_),
         "mp_known": z((n, _words(t)), np.uint64), "mp_old": z((n, _words(t)), np.uint64),
+        "mp_mask": z(_words(t), np.uint64),
         "chn_blocks": z(1, np.int64), "chn_forks": z(1, np.int64), "chn_reorgs": z(1, np.int64),
         "chn_reorg_tx": z(1, np.int64), "chn_view_reorgs": z(1, np.int64), "chn_failed": z(1, np.int64),
         "chn_delay_sum": z(1, np.int64),
@@ -226,8 +272,14 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
     chain["bs_ver"] = np.full((bc, n), -1, np.int64)
     for f in TX_POOL:
         chain[f"ls_{f[3:]}"] = z(LIST_ENTRIES, ledger[f].dtype)
+    for f in ("ls_prev", "ls_len", "ls_seq", "ls_buyer", "ls_kid", "ls_sib", "ls_wt"):
+        chain[f] = np.full(LIST_ENTRIES, -1, np.int64)
+    chain["chn_lroot"] = np.full(n, -1, np.int64)
     chain["chn_lstop"] = z(1, np.int64)
+    chain["chn_wt"] = z(WEIGHT_ENTRIES)
+    chain["chn_wttop"] = z(1, np.int64)
     chain["chn_ver"] = np.full(n, -1, np.int64)
+    chain["chn_bver"] = np.full(n, -1, np.int64)
     # genesis: slot 0, height 0, every robot's head, the checkpoint and the canonical head
     chain["blk_live"][0] = True
     chain["blk_hash"][0] = np.int64(int(seed) % (2**62))
@@ -235,16 +287,23 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
     for f in BLOCK_STATE:  # genesis's state: the fresh ledger (no open transaction)
         v = chain["gas_paid"] if f == "gas_paid" else ledger[f]
         chain[f"bs_{f}"][0] = v[0] if v.shape == (1,) else v
-    assert chain["ck_tx_seller"].shape[0] == pool
     SPEC.check(chain)
     return chain
 
 
 def _grown(old: np.ndarray, axis: int, size: int, fill=0) -> np.ndarray:
+    """``old`` grown to ``size`` along ``axis``, the new part ``fill`` (None: left as allocated)."""
     shape = list(old.shape)
     shape[axis] = size
-    new = np.full(shape, fill, old.dtype)
+    new = np.empty(shape, old.dtype) if fill is None else np.full(shape, fill, old.dtype)
     new[tuple(slice(0, k) for k in old.shape)] = old
+    return new
+
+
+def _grown_rows(old: np.ndarray, rows: np.ndarray, size: int) -> np.ndarray:
+    """``old`` grown to ``size`` rows, holding only ``rows`` of it (the rest left as allocated)."""
+    new = np.empty((size, *old.shape[1:]), old.dtype)
+    new[rows] = old[rows]
     return new
 
 
@@ -257,44 +316,86 @@ def _packed_entries(world, changes: dict, entries: int) -> dict:
     size = max(world.blk_tx.shape[0], 4 * (used + entries - int(world.chn_txtop[0])))
     new = np.zeros(size, np.int64)
     new_off = changes.get("blk_txoff", off).copy()
-    top = 0
-    for b in live:
-        k = int(ntx[b])
-        new[top:top + k] = world.blk_tx[off[b]:off[b] + k]
-        new_off[b] = top
-        top += k
-    return {"blk_tx": new, "blk_txoff": new_off, "chn_txtop": np.array([top], np.int64)}
+    sizes = ntx[live]
+    starts = (np.cumsum(sizes) - sizes).astype(np.int64)
+    new[:used] = world.blk_tx[np.repeat(off[live] - starts, sizes) + np.arange(used, dtype=np.int64)]
+    new_off[live] = starts
+    return {"blk_tx": new, "blk_txoff": new_off, "chn_txtop": np.array([used], np.int64)}
 
 
 def _packed_lists(world, changes: dict, lists: int) -> dict:
-    """``ls_*`` with only the versions live blocks use, packed (``bs_ver`` and ``chn_ver`` renumbered),
-    grown when they and what the next step adds (``lists - chn_lstop``) do not fit twice."""
+    """The list nodes that live blocks and the ledger arrays use, packed in their order (``ls_prev``,
+    ``bs_ver``, ``chn_ver``, ``chn_bver`` renumbered; ``ls_kid``, ``ls_sib``, ``chn_lroot`` rebuilt; the kept
+    nodes' cached weights packed too), grown when they and what the next step adds (``lists - chn_lstop``)
+    do not fit twice."""
     live = np.flatnonzero(world.blk_live)
-    ver, count = world.bs_ver[live].ravel(), world.bs_tx_count[live].ravel()
-    keep = ver >= 0
-    used, first = np.unique(ver[keep], return_index=True)
-    sizes = count[keep][first]
-    starts = (np.cumsum(sizes) - sizes).astype(np.int64)
-    total = int(sizes.sum())
-    index = np.repeat(used - starts, sizes) + np.arange(total, dtype=np.int64)
-    size = max(world.ls_seller.shape[0], 4 * (total + lists - int(world.chn_lstop[0])))
-    out = {}
+    top = int(world.chn_lstop[0])
+    keep = np.zeros(top, np.bool_)
+    _reachable(world.ls_prev, np.concatenate([world.bs_ver[live].ravel(), world.chn_ver, world.chn_bver]), keep)
+    old = np.flatnonzero(keep)
+    total = old.shape[0]
+    new_of = np.full(top + 1, -1, np.int64)  # index top + 1 - 1 = -1 -> -1
+    new_of[old] = np.arange(total, dtype=np.int64)
+    size = max(world.ls_seller.shape[0], 4 * (total + lists - top))
+    out = {}  # (nodes from total on are written whole when they are made: their memory is left untouched)
     for f in TX_POOL:
-        old = getattr(world, f"ls_{f[3:]}")
-        new = np.zeros(size, old.dtype)
-        new[:total] = old[index]
+        o = getattr(world, f"ls_{f[3:]}")
+        new = np.empty(size, o.dtype)
+        new[:total] = o[old]
         out[f"ls_{f[3:]}"] = new
+    for f in ("ls_prev", "ls_len", "ls_seq", "ls_buyer", "ls_kid", "ls_sib", "ls_wt"):
+        out[f] = np.empty(size, np.int64)
+        out[f][:total] = -1
+    out["ls_prev"][:total] = new_of[world.ls_prev[old]]
+    for f in ("ls_len", "ls_seq", "ls_buyer"):
+        out[f][:total] = getattr(world, f)[old]
+    wt_old = world.ls_wt[old]
+    cached = wt_old >= 0
+    lens = out["ls_len"][:total][cached]
+    starts = (np.cumsum(lens) - lens).astype(np.int64)
+    used = int(lens.sum())
+    src = np.repeat(wt_old[cached] - starts, lens) + np.arange(used, dtype=np.int64)
+    wsize = max(world.chn_wt.shape[0], 4 * used, 2 * lists)
+    wt = np.empty(wsize)
+    wt[:used] = world.chn_wt[src]
+    out["ls_wt"][:total][cached] = starts
+    roots = np.full(world.chn_lroot.shape[0], -1, np.int64)
+    _relink(out["ls_prev"], out["ls_buyer"], out["ls_kid"], out["ls_sib"], roots, total)
 
     def renumber(v):
-        out = v.copy()
-        hit = v >= 0
-        out[hit] = starts[np.searchsorted(used, v[hit])]
-        return out
+        return new_of[v]
 
-    bs_ver = changes.get("bs_ver", world.bs_ver).copy()  # (grown already when the block slots grew)
+    bs_ver = changes.get("bs_ver", world.bs_ver)  # (grown already when the block slots grew; renumbered in
+    # place: the world this packs is replaced by the one make_room returns)
     bs_ver[live] = renumber(world.bs_ver[live])
-    out.update(bs_ver=bs_ver, chn_ver=renumber(world.chn_ver), chn_lstop=np.array([total], np.int64))
+    out.update(bs_ver=bs_ver, chn_ver=renumber(world.chn_ver), chn_bver=renumber(world.chn_bver),
+               chn_lroot=roots, chn_lstop=np.array([total], np.int64), chn_wt=wt,
+               chn_wttop=np.array([used], np.int64))
     return out
+
+
+@njit(cache=True)
+def _reachable(prev, ends, keep):
+    """keep[x] for every node on a list ending at one of ``ends`` (-1: the empty list)."""
+    for e in ends:
+        x = e
+        while x >= 0 and not keep[x]:
+            keep[x] = True
+            x = prev[x]
+
+
+@njit(cache=True)
+def _relink(prev, buyer, kid, sib, roots, total):
+    """Rebuild the first-successor and sibling links of the first ``total`` nodes (``roots``: each buyer's
+    first nodes).  Newer nodes come first in a chain, as when they were made."""
+    for x in range(total):
+        p = prev[x]
+        if p >= 0:
+            sib[x] = kid[p]
+            kid[p] = x
+        else:
+            sib[x] = roots[buyer[x]]
+            roots[buyer[x]] = x
 
 
 def grow_chain(world, needs) -> dict:
@@ -311,19 +412,24 @@ def grow_chain(world, needs) -> dict:
             changes[f] = _grown(getattr(world, f), 0, size)
         for f in ("mp_known", "mp_old", "blk_inc"):
             changes[f] = _grown(getattr(world, f), 1, _words(size))
+        changes["mp_mask"] = _grown(world.mp_mask, 0, _words(size))
     bc = world.blk_live.shape[0]
     if blocks > bc:
         size = max(2 * bc, blocks)
-        for f in ("blk_live", "blk_height", "blk_weight", "blk_hash", "blk_step", "blk_kids", "blk_bb", "blk_ntx",
+        for f in ("blk_live", "blk_height", "blk_weight", "blk_hash", "blk_step", "blk_kids", "blk_bb", "blk_mark", "blk_ntx",
                   "blk_txoff"):
             changes[f] = _grown(getattr(world, f), 0, size)
         for f in ("blk_parent", "blk_signer"):
             changes[f] = _grown(getattr(world, f), 0, size, -1)
-        changes["blk_bal"] = _grown(world.blk_bal, 0, size)
-        changes["blk_inc"] = _grown(changes.get("blk_inc", world.blk_inc), 0, size)
+        # a new slot's state and bits are written whole when a block is made in it (new_block, save_state),
+        # and nothing reads a free slot's: the new rows are left untouched (no memory until used)
+        # (and only the live slots' rows are copied: a free slot's are never read)
+        live = np.flatnonzero(world.blk_live)
+        changes["blk_bal"] = _grown_rows(world.blk_bal, live, size)
+        changes["blk_inc"] = _grown_rows(changes.get("blk_inc", world.blk_inc), live, size)
         for f in BLOCK_STATE:
-            changes[f"bs_{f}"] = _grown(getattr(world, f"bs_{f}"), 0, size)
-        changes["bs_ver"] = _grown(world.bs_ver, 0, size, -1)
+            changes[f"bs_{f}"] = _grown_rows(getattr(world, f"bs_{f}"), live, size)
+        changes["bs_ver"] = _grown_rows(world.bs_ver, live, size)
     if lists > world.ls_seller.shape[0]:
         changes.update(_packed_lists(world, changes, lists))
     if entries > world.blk_tx.shape[0]:
@@ -333,7 +439,6 @@ def grow_chain(world, needs) -> dict:
         size = max(2 * p, pool)
         for f in TX_POOL:
             changes[f] = _grown(getattr(world, f), 0, size)
-            changes[f"ck_{f}"] = _grown(getattr(world, f"ck_{f}"), 0, size)
     return changes
 
 
@@ -342,8 +447,9 @@ def chain_needs(w):
     """What the next step may need at most, for the kernel's ``has_room`` and the host's growth alike:
     (mempool slots, block slots, transaction-pool entries, event rows, payment rows).  One transaction
     per purchase and deposit; a block for every signer due now (one more may wait a step:
-    ``can_make``); for the ledgers replayed from the checkpoint, every buyer's block moved as often as
-    its pending reveals can make it grow; the logs of one block's settlements on top of the step's."""
+    ``can_make``); for the ledger arrays, every buyer's block of the pool moved as often as its pending
+    reveals can make it grow; a list node per pending reveal per block; the logs of one block's
+    settlements on top of the step's."""
     n = w.nbr_count.shape[0]
     links = 0
     for i in range(n):
@@ -357,18 +463,17 @@ def chain_needs(w):
     live = w.chn_nblk[0]
     pool = max(w.pool_top[0], w.ck_pool_top[0])
     open_ = 0
-    saved = 0
+    reveals = 2 * links  # pending reveals by the end of the step
     for i in range(n):  # any live block's list of buyer i is its list at the checkpoint and pending reveals
         grow = max(w.tx_count[i], w.ck_tx_count[i]) + w.mp_for_buyer[i] + 2 * w.nbr_count[i]
         pool += 4 * (grow + 8) + 2 * max(w.tx_cap[i], w.ck_tx_cap[i])
         open_ += grow
-        if w.mp_for_buyer[i] > 0 or w.nbr_count[i] > 0:  # a block saves only lists its reveals grow
-            saved += grow
+        reveals += w.mp_for_buyer[i]
     mp = w.mp_count[0] + n + 2 * links
     events = w.ev_count[0] + n + 2 * links + mp
     payments = w.pay_count[0] + 2 * open_
     entries = w.chn_txtop[0] + (due + 2) * mp  # every block made holds at most the whole mempool
-    lists = w.chn_lstop[0] + (due + 2) * saved  # every block made saves at most the lists it grows
+    lists = w.chn_lstop[0] + (due + 2) * reveals  # a block makes at most a node per pending reveal
     return mp, live + due + 1, pool, events, payments, lists, entries
 
 
@@ -392,13 +497,11 @@ def can_make(w):
     if w.chn_nblk[0] >= w.blk_live.shape[0] or w.chn_txtop[0] + w.mp_count[0] > w.blk_tx.shape[0]:
         return False
     payments = 0  # any branch's open transactions: its checkpoint's and the pending reveals
-    saved = 0
+    reveals = 0
     for i in range(w.tx_count.shape[0]):
-        k = max(w.tx_count[i], w.ck_tx_count[i]) + w.mp_for_buyer[i]
-        payments += k
-        if w.mp_for_buyer[i] > 0:
-            saved += k
-    if w.chn_lstop[0] + saved > w.ls_seller.shape[0]:
+        payments += max(w.tx_count[i], w.ck_tx_count[i]) + w.mp_for_buyer[i]
+        reveals += w.mp_for_buyer[i]
+    if w.chn_lstop[0] + reveals > w.ls_seller.shape[0]:
         return False
     if not w.record:
         return True
@@ -455,9 +558,12 @@ def new_block(w, signer, t):
     its branch does not include yet, in sending order.  Returns its slot (the ledger is not touched)."""
     parent = w.view_head[signer]
     live = unlock(w.blk_live)
-    b = 0
+    b = w.chn_free[0]  # every slot below it is taken: the lowest free slot is at or above it
     while live[b]:
         b += 1  # the host keeps a free slot for every block a step can make
+    unlock(w.chn_free)[0] = b + 1
+    if b >= w.chn_slots[0]:
+        unlock(w.chn_slots)[0] = b + 1
     height = w.blk_height[parent] + 1
     live[b] = True
     unlock(w.chn_nblk)[0] += 1
@@ -518,10 +624,9 @@ def include_tx(w, b, tx):
     buyer's open list gets it; else it fails and moves nothing.  A deposit: True, the caller settles it
     (``distribute`` pays the reward and the sellers) and then calls ``finish_deposit``."""
     buyer = w.mp_buyer[tx]
-    materialise(w, buyer)
     if w.mp_kind[tx] == DEPOSIT:
+        materialise(w, buyer)  # the settlement weighs its list in the ledger arrays
         unlock(w.chn_nopen)[0] = w.tx_count[buyer]
-        unlock(w.chn_ver)[buyer] = -2  # the settlement empties its list
         return True
     seller = w.mp_seller[tx]
     balance, money = unlock(w.balance), unlock(w.money)
@@ -532,8 +637,6 @@ def include_tx(w, b, tx):
                 unlock(w.chn_failed)[0] += 1
             return False
     count = w.tx_count[buyer]
-    if not reserve(w, buyer, count + 1):
-        return False  # the host keeps room (grow_chain); unreachable
     if gas > 0.0:
         balance[seller] -= gas
         money[0] -= gas
@@ -544,15 +647,58 @@ def include_tx(w, b, tx):
         balance[seller] -= lock
         money[0] -= lock
         unlock(w.pot)[buyer] += lock
-    x = w.tx_off[buyer] + count
-    unlock(w.chn_ver)[buyer] = -2
-    unlock(w.tx_seller)[x] = seller
-    unlock(w.tx_site)[x] = w.mp_site[tx]
-    unlock(w.tx_dir)[x] = w.mp_dir[tx]
-    unlock(w.tx_step)[x] = w.mp_step[tx]
-    unlock(w.tx_stake)[x] = lock
-    unlock(w.tx_count)[buyer] = count + 1
+    unlock(w.chn_bver)[buyer] = append_node(w, buyer, w.chn_bver[buyer], w.mp_seq[tx], seller, w.mp_site[tx],
+                                            w.mp_dir[tx], w.mp_step[tx], lock)
+    unlock(w.tx_count)[buyer] = count + 1  # (the pool gets the list when it is next weighed or read)
     return False
+
+
+@njit
+def append_node(w, buyer, prev, seq, seller, site, direction, step, stake):
+    """The list node after ``prev`` (-1: a first one) of buyer's list recording reveal ``seq``: an
+    existing one with the same content, else a new one (``chn_lstop``; the host keeps room).  A list is
+    then one node whatever branch made it, and a settled list's cached weights serve every branch."""
+    x = w.ls_kid[prev] if prev >= 0 else w.chn_lroot[buyer]
+    first = x
+    while x >= 0:
+        if (w.ls_seq[x] == seq and w.ls_stake[x] == stake
+                and math.copysign(1.0, w.ls_stake[x]) == math.copysign(1.0, stake)):
+            return x
+        x = w.ls_sib[x]
+    top = w.chn_lstop[0]
+    unlock(w.ls_seller)[top] = seller
+    unlock(w.ls_site)[top] = site
+    unlock(w.ls_dir)[top] = direction
+    unlock(w.ls_step)[top] = step
+    unlock(w.ls_stake)[top] = stake
+    unlock(w.ls_prev)[top] = prev
+    unlock(w.ls_len)[top] = (w.ls_len[prev] if prev >= 0 else 0) + 1
+    unlock(w.ls_seq)[top] = seq
+    unlock(w.ls_buyer)[top] = buyer
+    unlock(w.ls_kid)[top] = -1
+    unlock(w.ls_sib)[top] = first
+    unlock(w.ls_wt)[top] = -1
+    if prev >= 0:
+        unlock(w.ls_kid)[prev] = top
+    else:
+        unlock(w.chn_lroot)[buyer] = top
+    unlock(w.chn_lstop)[0] = top + 1
+    return top
+
+
+@njit
+def cache_weights(w, v, weights):
+    """Keep the weights of list v (its ls_len[v] transactions) for the next settlement of the same list, if
+    the cache has room (the host packs it with the lists)."""
+    top = w.chn_wttop[0]
+    k = weights.shape[0]
+    if top + k > w.chn_wt.shape[0]:
+        return
+    wt = unlock(w.chn_wt)
+    for x in range(k):
+        wt[top + x] = weights[x]
+    unlock(w.ls_wt)[v] = top
+    unlock(w.chn_wttop)[0] = top + k
 
 
 @njit
@@ -566,6 +712,8 @@ def finish_deposit(w, b, tx):
     """After a deposit's settlement: the depositor pays the deposit's gas (never below a zero balance),
     and its delay from sending to this block is measured (first application only)."""
     buyer = w.mp_buyer[tx]
+    unlock(w.chn_bver)[buyer] = -1  # the settlement emptied its list
+    unlock(w.chn_ver)[buyer] = -1
     if w.chn_gas_price > 0.0:
         cost = min(w.chn_gas_price * deposit_gas(w, float(w.chn_nopen[0])), w.balance[buyer])
         unlock(w.balance)[buyer] -= cost
@@ -578,38 +726,27 @@ def finish_deposit(w, b, tx):
 
 @njit
 def save_checkpoint(w):
-    """The ledger arrays' state becomes the checkpoint's."""
-    _copy_ledger(w.balance, w.pot, w.burned, w.tx_off, w.tx_cap, w.tx_count, w.tx_seller, w.tx_site, w.tx_dir,
-                 w.tx_step, w.tx_stake, w.pool_top, w.money, w.rep_settled, w.rep_reduced, w.rep_earned,
-                 w.rep_stake_lost, w.rep_deposits, w.gas_paid,
+    """The ledger arrays' state becomes the checkpoint's (``ck_*``).  Its buyers' lists of open
+    transactions are not copied: the checkpoint is a live block, whose state keeps them (``bs_ver``)."""
+    _copy_ledger(w.balance, w.pot, w.burned, w.tx_off, w.tx_cap, w.tx_count, w.pool_top, w.money, w.rep_settled,
+                 w.rep_reduced, w.rep_earned, w.rep_stake_lost, w.rep_deposits, w.gas_paid,
                  unlock(w.ck_balance), unlock(w.ck_pot), unlock(w.ck_burned), unlock(w.ck_tx_off),
-                 unlock(w.ck_tx_cap), unlock(w.ck_tx_count), unlock(w.ck_tx_seller), unlock(w.ck_tx_site),
-                 unlock(w.ck_tx_dir), unlock(w.ck_tx_step), unlock(w.ck_tx_stake), unlock(w.ck_pool_top),
-                 unlock(w.ck_money), unlock(w.ck_rep_settled), unlock(w.ck_rep_reduced),
-                 unlock(w.ck_rep_earned), unlock(w.ck_rep_stake_lost), unlock(w.ck_rep_deposits),
-                 unlock(w.ck_gas_paid))
+                 unlock(w.ck_tx_cap), unlock(w.ck_tx_count), unlock(w.ck_pool_top), unlock(w.ck_money),
+                 unlock(w.ck_rep_settled), unlock(w.ck_rep_reduced), unlock(w.ck_rep_earned),
+                 unlock(w.ck_rep_stake_lost), unlock(w.ck_rep_deposits), unlock(w.ck_gas_paid))
 
 
 @njit
-def _copy_ledger(balance, pot, burned, tx_off, tx_cap, tx_count, tx_seller, tx_site, tx_dir, tx_step, tx_stake,
-                 pool_top, money, rep_settled, rep_reduced, rep_earned, rep_stake_lost, rep_deposits, gas_paid,
-                 o_balance, o_pot, o_burned, o_tx_off, o_tx_cap, o_tx_count, o_tx_seller, o_tx_site, o_tx_dir,
-                 o_tx_step, o_tx_stake, o_pool_top, o_money, o_rep_settled, o_rep_reduced, o_rep_earned,
-                 o_rep_stake_lost, o_rep_deposits, o_gas_paid):
+def _copy_ledger(balance, pot, burned, tx_off, tx_cap, tx_count, pool_top, money, rep_settled, rep_reduced,
+                 rep_earned, rep_stake_lost, rep_deposits, gas_paid, o_balance, o_pot, o_burned, o_tx_off, o_tx_cap,
+                 o_tx_count, o_pool_top, o_money, o_rep_settled, o_rep_reduced, o_rep_earned, o_rep_stake_lost,
+                 o_rep_deposits, o_gas_paid):
     o_balance[:] = balance
     o_pot[:] = pot
     o_burned[:] = burned
     o_tx_off[:] = tx_off
     o_tx_cap[:] = tx_cap
     o_tx_count[:] = tx_count
-    for i in range(tx_off.shape[0]):  # only each buyer's open transactions: the rest of the pool is free
-        a = tx_off[i]
-        for x in range(a, a + tx_count[i]):
-            o_tx_seller[x] = tx_seller[x]
-            o_tx_site[x] = tx_site[x]
-            o_tx_dir[x] = tx_dir[x]
-            o_tx_step[x] = tx_step[x]
-            o_tx_stake[x] = tx_stake[x]
     o_pool_top[0] = pool_top[0]
     o_money[0] = money[0]
     o_rep_settled[:] = rep_settled
@@ -629,13 +766,11 @@ def set_current(w, b):
 @njit
 def save_state(w, b, parent):
     """Block b's state (``blk_bal``, ``bs_*``): the ledger arrays' (they hold the state after b, made on
-    ``parent``).  A buyer's list of open transactions that the block changed is saved as a new version
-    (``ls_*``); the others keep their version in the parent."""
+    ``parent``), with each buyer's list as its node (``chn_bver``: nothing is copied)."""
     n = w.balance.shape[0]
     bal, pot, count, ver = unlock(w.blk_bal), unlock(w.bs_pot), unlock(w.bs_tx_count), unlock(w.bs_ver)
     settled, reduced, earned = unlock(w.bs_rep_settled), unlock(w.bs_rep_reduced), unlock(w.bs_rep_earned)
     lost, deposits, gas = unlock(w.bs_rep_stake_lost), unlock(w.bs_rep_deposits), unlock(w.bs_gas_paid)
-    cur = unlock(w.chn_ver)
     for i in range(n):
         bal[b, i] = w.balance[i]
         pot[b, i] = w.pot[i]
@@ -646,33 +781,9 @@ def save_state(w, b, parent):
         lost[b, i] = w.rep_stake_lost[i]
         deposits[b, i] = w.rep_deposits[i]
         gas[b, i] = w.gas_paid[i]
-        if cur[i] == -2:
-            cur[i] = _save_list(w, i)
-            ver[b, i] = cur[i]
-        else:
-            ver[b, i] = ver[parent, i]
+        ver[b, i] = w.chn_bver[i]
     unlock(w.bs_burned)[b] = w.burned[0]
     unlock(w.bs_money)[b] = w.money[0]
-
-
-@njit
-def _save_list(w, i):
-    """Buyer i's open transactions, as the ledger arrays hold them, as a new version; its number."""
-    k = w.tx_count[i]
-    if k == 0:
-        return -1
-    top = w.chn_lstop[0]
-    a = w.tx_off[i]
-    seller, site, dirs, step, stake = (unlock(w.ls_seller), unlock(w.ls_site), unlock(w.ls_dir),
-                                       unlock(w.ls_step), unlock(w.ls_stake))
-    for x in range(k):
-        seller[top + x] = w.tx_seller[a + x]
-        site[top + x] = w.tx_site[a + x]
-        dirs[top + x] = w.tx_dir[a + x]
-        step[top + x] = w.tx_step[a + x]
-        stake[top + x] = w.tx_stake[a + x]
-    unlock(w.chn_lstop)[0] = top + k
-    return top
 
 
 @njit
@@ -683,6 +794,7 @@ def load_state(w, b):
     balance, pot, count = unlock(w.balance), unlock(w.pot), unlock(w.tx_count)
     settled, reduced, earned = unlock(w.rep_settled), unlock(w.rep_reduced), unlock(w.rep_earned)
     lost, deposits, gas = unlock(w.rep_stake_lost), unlock(w.rep_deposits), unlock(w.gas_paid)
+    bver = unlock(w.chn_bver)
     for i in range(n):
         balance[i] = w.blk_bal[b, i]
         pot[i] = w.bs_pot[b, i]
@@ -693,6 +805,7 @@ def load_state(w, b):
         lost[i] = w.bs_rep_stake_lost[b, i]
         deposits[i] = w.bs_rep_deposits[b, i]
         gas[i] = w.bs_gas_paid[b, i]
+        bver[i] = w.bs_ver[b, i]
     unlock(w.burned)[0] = w.bs_burned[b]
     unlock(w.money)[0] = w.bs_money[b]
     unlock(w.chn_cur)[0] = b
@@ -700,26 +813,36 @@ def load_state(w, b):
 
 @njit
 def materialise(w, i):
-    """Buyer i's open transactions in the ledger arrays are those of the current block's state (a copy of
-    that version unless the arrays hold it already, or a block being applied has changed them)."""
-    v = w.bs_ver[w.chn_cur[0], i]
-    cur = unlock(w.chn_ver)
-    if cur[i] == -2 or cur[i] == v:
+    """Buyer i's open transactions in the ledger arrays' pool are its list in the current state
+    (``chn_bver``): nothing to do if the pool holds that list; only the nodes after it if the pool holds a
+    list it extends; else the whole list."""
+    v = w.chn_bver[i]
+    held = w.chn_ver[i]
+    if held == v:
         return
-    k = w.bs_tx_count[w.chn_cur[0], i]
-    unlock(w.tx_count)[i] = 0  # (nothing of the other version to move)
+    k = w.ls_len[v] if v >= 0 else 0
+    h = w.ls_len[held] if held >= 0 else 0
+    x = v  # is the held list a beginning of v's?  (a node is the list that ends with it)
+    while x >= 0 and w.ls_len[x] > h:
+        x = w.ls_prev[x]
+    if x != held:
+        h = 0
+    unlock(w.tx_count)[i] = h  # what reserve moves if the block must move
     reserve(w, i, k)  # the host keeps room (chain_needs)
     a = w.tx_off[i]
     seller, site, dirs = unlock(w.tx_seller), unlock(w.tx_site), unlock(w.tx_dir)
     step, stake = unlock(w.tx_step), unlock(w.tx_stake)
-    for x in range(k):
-        seller[a + x] = w.ls_seller[v + x]
-        site[a + x] = w.ls_site[v + x]
-        dirs[a + x] = w.ls_dir[v + x]
-        step[a + x] = w.ls_step[v + x]
-        stake[a + x] = w.ls_stake[v + x]
+    x = v
+    while x >= 0 and w.ls_len[x] > h:  # the nodes after the held beginning, last first
+        p = a + w.ls_len[x] - 1
+        seller[p] = w.ls_seller[x]
+        site[p] = w.ls_site[x]
+        dirs[p] = w.ls_dir[x]
+        step[p] = w.ls_step[x]
+        stake[p] = w.ls_stake[x]
+        x = w.ls_prev[x]
     unlock(w.tx_count)[i] = k
-    cur[i] = v
+    unlock(w.chn_ver)[i] = v
 
 
 @njit
@@ -808,9 +931,13 @@ def next_checkpoint(w):
     hc = w.blk_height[c]
     if w.blk_height[canon] - hc >= w.chn_final:
         return c  # final by depth, whoever has not heard of it
-    for i in range(w.view_head.shape[0]):
+    n = w.view_head.shape[0]
+    first = w.chn_behind[0]  # the robot that was behind last time is likely to be still
+    for a in range(n):
+        i = (first + a) % n
         h = w.view_head[i]
         if h < 0 or w.blk_height[h] < hc or ancestor_at(w, h, hc) != c:
+            unlock(w.chn_behind)[0] = i
             return -1
     return c
 
@@ -822,9 +949,10 @@ def move_checkpoint(w, c):
     head is dropped keeps its head's height, weight, hash and its own balance (``view_head`` -1) until
     it hears a heavier block."""
     save_checkpoint(w)
-    live, known = unlock(w.mp_live), unlock(w.mp_known)
+    live, known, mask = unlock(w.mp_live), unlock(w.mp_known), unlock(w.mp_mask)
     n = known.shape[0]
     pending = w.mp_count[0]
+    lo, hi = mask.shape[0], -1  # the words of c's transactions: mask their bits, word by word
     for k in range(w.blk_ntx[c]):
         tx = w.blk_tx[w.blk_txoff[c] + k]
         if not live[tx]:
@@ -835,10 +963,13 @@ def move_checkpoint(w, c):
             unlock(w.mp_for_buyer)[w.mp_buyer[tx]] -= 1
             unlock(w.mp_own)[w.mp_origin[tx]] -= 1
             drop_own(w, tx)
-        word = tx >> 6
-        bit = ~(np.uint64(1) << np.uint64(tx & 63))
-        for i in range(n):
-            known[i, word] &= bit
+        mask[tx >> 6] |= np.uint64(1) << np.uint64(tx & 63)
+        lo, hi = min(lo, tx >> 6), max(hi, tx >> 6)
+    for i in range(n):  # nobody knows them any more
+        for word in range(lo, hi + 1):
+            known[i, word] &= ~mask[word]
+    for word in range(lo, hi + 1):
+        mask[word] = 0
     order = unlock(w.mp_order)
     k = 0
     top = 0
@@ -849,18 +980,46 @@ def move_checkpoint(w, c):
             k += 1
     unlock(w.mp_words)[0] = (top >> 6) + 1 if k > 0 else 0
     unlock(w.mp_cursor)[0] = 0  # new transactions take the lowest free slots
+    lo, hi = mask.shape[0], -1
+    words = np.empty(w.blk_ntx[c], np.int64)  # the words with bits to clear
+    nw = 0
+    for k in range(w.blk_ntx[c]):
+        tx = w.blk_tx[w.blk_txoff[c] + k]
+        if mask[tx >> 6] == np.uint64(0):
+            words[nw] = tx >> 6
+            nw += 1
+        mask[tx >> 6] |= np.uint64(1) << np.uint64(tx & 63)
+        lo, hi = min(lo, tx >> 6), max(hi, tx >> 6)
     hc = w.blk_height[c]
-    blive, inc = unlock(w.blk_live), unlock(w.blk_inc)
-    for b in range(blive.shape[0]):
+    blive, inc, mark = unlock(w.blk_live), unlock(w.blk_inc), unlock(w.blk_mark)
+    for b in range(w.chn_slots[0]):  # 1: descends from c, 2: does not, 0: not known yet
+        mark[b] = 0
+    mark[c] = 1
+    for b in range(w.chn_slots[0]):
+        if not blive[b] or mark[b] != 0:
+            continue
+        x = b  # up to the first block whose answer is known (c, or any block at c's height or below)
+        while mark[x] == 0 and w.blk_height[x] > hc:
+            x = w.blk_parent[x]
+        keep = mark[x] == 1
+        end = x
+        x = b
+        while x != end:  # every block on the way has the same answer: each block is walked once
+            mark[x] = 1 if keep else 2
+            x = w.blk_parent[x]
+    for b in range(w.chn_slots[0]):
         if not blive[b]:
             continue
-        if b != c and ancestor_at(w, b, hc) != c:
+        if mark[b] != 1:
             blive[b] = False
             unlock(w.chn_nblk)[0] -= 1
+            unlock(w.chn_free)[0] = min(w.chn_free[0], b)
             continue
-        for k in range(w.blk_ntx[c]):  # final now: they leave every branch's pending set
-            tx = w.blk_tx[w.blk_txoff[c] + k]
-            inc[b, tx >> 6] &= ~(np.uint64(1) << np.uint64(tx & 63))
+        for a in range(nw):  # final now: they leave every branch's pending set
+            word = words[a]
+            inc[b, word] &= ~mask[word]
+    for word in range(lo, hi + 1):
+        mask[word] = 0
     unlock(w.blk_parent)[c] = -1
     unlock(w.chn_ckpt)[0] = c
     for i in range(n):
@@ -888,8 +1047,9 @@ def gossip(w):
     words = w.mp_words[0]  # (known-bits beyond are all 0)
     for i in range(n):
         old[i] = heads[i]
-        for k in range(words):
-            mold[i, k] = known[i, k]
+        if w.nbr_count[i] > 0:  # (neighbours are mutual: only a robot with one is heard)
+            for k in range(words):
+                mold[i, k] = known[i, k]
     loss = w.chn_loss
     cut = partitioned(w, t)
     for i in range(n):
