@@ -345,7 +345,7 @@ def chain_settle(weigh):
         v = w.chn_bver[buyer]
         k = w.tx_count[buyer]
         if w.chn_cache and v >= 0 and w.ls_wt[v] >= 0:
-            weights = unlock(w.chn_wt)[w.ls_wt[v]:w.ls_wt[v] + k]
+            weights = _blocks.cached_weights(w, v, k)
         else:
             weights = np.zeros(k)
             weigh(w, buyer, weights, rng)

@@ -687,6 +687,13 @@ def append_node(w, buyer, prev, seq, seller, site, direction, step, stake):
 
 
 @njit
+def cached_weights(w, v, k):
+    """The k weights cached for list node v (``cache_weights``), as the same array type a fresh weighing
+    gives (the settlement reads them; only ledger operations may unlock ledger arrays)."""
+    return unlock(w.chn_wt)[w.ls_wt[v]:w.ls_wt[v] + k]
+
+
+@njit
 def cache_weights(w, v, weights):
     """Keep the weights of list v (its ls_len[v] transactions) for the next settlement of the same list, if
     the cache has room (the host packs it with the lists)."""
