@@ -277,6 +277,18 @@ def _branch_deposits(w, b):
     return count
 
 
+def _run_conserving_money(sim, steps, robots=25):
+    """Step ``sim`` one step at a time; after each, every live block's balances add up to the initial
+    wealth plus one reward per deposit on its branch, and the canonical ledger to the initial wealth plus
+    its rewards."""
+    for _ in range(steps):
+        sim.step(1)
+        w = sim.world
+        for b in np.flatnonzero(w.blk_live):
+            assert w.blk_bal[b].sum() == pytest.approx(robots * W0 + R * _branch_deposits(w, int(b)), abs=1e-9)
+        assert w.balance.sum() + w.pot.sum() == pytest.approx(robots * W0 + R * int(w.rep_deposits.sum()), abs=1e-9)
+
+
 def test_money_is_conserved_on_every_branch_of_a_forking_swarm():
     """A paper-like swarm (25 naive robots, delayed payment, no backbone, range 50 in 1200 x 600: the
     communication graph is split most of the time), P = 5: forks and reorganisations happen on their
@@ -286,13 +298,7 @@ def test_money_is_conserved_on_every_branch_of_a_forking_swarm():
                        "swarm": {"robots": 25, "groups": [{"behaviour": "naive", "count": 25}]},
                        "chain": {"consensus": "poa", "period": 5, "out_of_turn_delay": 2}})
     sim = im.Simulation(cfg, 11)
-    w = sim.world
-    for _ in range(1500):
-        sim.step(1)
-        w = sim.world
-        for b in np.flatnonzero(w.blk_live):
-            assert w.blk_bal[b].sum() == pytest.approx(25 * W0 + R * _branch_deposits(w, int(b)), abs=1e-9)
-        assert w.balance.sum() + w.pot.sum() == pytest.approx(25 * W0 + R * int(w.rep_deposits.sum()), abs=1e-9)
+    _run_conserving_money(sim, 1500)
     m = sim.chain_measures()
     assert m["forks"] > 0 and m["view_reorgs"] > 0 and m["deposits_paid"] > 0
 

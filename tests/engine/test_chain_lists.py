@@ -10,12 +10,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from numba import njit
 
 import infomarket as im
 from infomarket.config.load import validate
-from infomarket.engine.geometry import angular_distance
 from infomarket.engine.step import chain_settle
 from infomarket.ledger import blocks
+from infomarket.payments.schemes import outlier_weights
 
 
 def _config(scheme: str = "outlier", robots: int = 3, **over):
@@ -104,16 +105,13 @@ def test_a_cached_settlement_is_reused_only_for_the_same_list(lists):
     assert int(w.ls_wt[a]) == start
 
 
+_outlier = njit(outlier_weights)
+
+
 def outlier_with_rng(buyer, sellers, sites, directions, weights, rng, theta=30.0):
-    """Outlier penalisation (eqs. 7-8, as ``payments.schemes``) that takes ``rng`` (and never draws): its
-    weights may not be cached."""
-    k = weights.shape[0]
-    for x in range(k):
-        c = 0
-        for y in range(k):
-            if sites[y] == sites[x] and angular_distance(directions[x], directions[y]) < theta:
-                c += 1
-        weights[x] = c
+    """The paper's outlier penalisation (``payments.schemes.outlier_weights``) behind a rule that takes
+    ``rng`` (and never draws): its weights may not be cached."""
+    _outlier(buyer, sellers, sites, directions, weights, theta)
 
 
 def test_a_forking_run_pays_the_same_with_and_without_the_cache():

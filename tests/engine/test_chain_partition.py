@@ -11,7 +11,7 @@ import pytest
 import infomarket as im
 from infomarket.errors import ConfigError
 
-from .test_chain import R, W0, _branch_deposits, _config, _deposit, _place
+from .test_chain import R, W0, _branch_deposits, _config, _deposit, _place, _run_conserving_money
 
 
 def _conserved(w):
@@ -124,11 +124,6 @@ def test_money_is_conserved_on_every_branch_of_a_partitioned_swarm():
                     "swarm": {"robots": 25, "groups": [{"behaviour": "naive", "count": 25}]},
                     "chain": {"consensus": "poa", "period": 5, "out_of_turn_delay": 2, "partition": [300, 1100]}})
     sim = im.Simulation(cfg, 11)
-    for _ in range(1500):
-        sim.step(1)
-        w = sim.world
-        for b in np.flatnonzero(w.blk_live):
-            assert w.blk_bal[b].sum() == pytest.approx(25 * W0 + R * _branch_deposits(w, int(b)), abs=1e-9)
-        assert w.balance.sum() + w.pot.sum() == pytest.approx(25 * W0 + R * int(w.rep_deposits.sum()), abs=1e-9)
+    _run_conserving_money(sim, 1500)
     m = sim.chain_measures()
     assert m["forks"] > 0 and m["deposits_paid"] > 0
