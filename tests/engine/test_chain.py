@@ -192,11 +192,11 @@ def test_a_partition_forks_and_its_payments_are_redone_when_it_reconnects():
     sim.step(2)
     b1 = int(w.view_head[2])
     assert (w.blk_height[b1], w.blk_weight[b1], w.blk_ntx[b1]) == (1, 2, 1)
-    assert w.blk_bal[b1].tolist() == [W0, W0, W0, W0 + R]
+    assert blocks.balances_after(w, b1).tolist() == [W0, W0, W0, W0 + R]
     sim.step(3)
     a1 = int(w.view_head[0])
     assert (w.blk_height[a1], w.blk_weight[a1], w.blk_step[a1], w.blk_ntx[a1]) == (1, 1, 5, 1)
-    assert w.blk_bal[a1].tolist() == [W0, W0 + R, W0, W0]
+    assert blocks.balances_after(w, a1).tolist() == [W0, W0 + R, W0, W0]
     assert int(w.chn_forks[0]) == 1 and int(w.chn_canon[0]) == b1
     assert w.balance.tolist() == [W0, W0, W0, W0 + R]  # the canonical ledger: B's chain
     assert int(w.view_head[1]) == 0 and int(w.view_head[3]) == b1  # robot 1 hears of A1 at step 6 only
@@ -238,7 +238,7 @@ def test_a_heavier_branch_takes_over_the_canonical_chain_and_its_transactions_ar
     assert int(w.chn_reorgs[0]) == 1 + x_wins
     assert int(w.chn_reorg_tx[0]) == 1 + x_wins
     assert w.balance.tolist() == ([W0, W0 + R] if x_wins else [W0 + R, W0])
-    assert w.blk_bal[z2].tolist() == [W0 + R, W0] and w.blk_bal[x2].tolist() == [W0, W0 + R]
+    assert blocks.balances_after(w, z2).tolist() == [W0 + R, W0] and blocks.balances_after(w, x2).tolist() == [W0, W0 + R]
 
 
 def test_a_robot_left_behind_past_the_finality_depth_keeps_its_view_until_it_hears_a_heavier_block():
@@ -277,16 +277,67 @@ def _branch_deposits(w, b):
     return count
 
 
+def test_blocks_without_transactions_share_a_state_that_outlives_the_block_that_made_it():
+    """Robot 1 the only signer, P = 1, finality depth 1, no links and no backbone: robot 0 never hears a
+    block, so a block is final once one block lies on it.  Step 1: robot 1 sells robot 0 a vector and
+    deposits an item: block 1 includes both (balances 1 and 1 + 1; robot 0's open list holds the sale).
+    Steps 2 and 3 bring no transaction: blocks 2 and 3 include none, and the state after each is block 1's
+    (one state for the three).  After step 3 block 1 is dropped (block 2 is the checkpoint) and its state
+    lives on for blocks 2 and 3.  Step 4: robot 1 deposits again: block 4 has a state of its own (1, 3)."""
+    sim = im.Simulation(_config(2, comm=0.0, period=1, signers=[1], finality=1), 1)
+    w = sim.world
+    assert bool(mempool.chain_reveal(sim._view, 0, 1, 0, 45.0))
+    _deposit(sim, 1)
+    sim.step(1)
+    b1 = int(w.view_head[1])
+    assert w.blk_ntx[b1] == 2 and w.balance.tolist() == [W0, W0 + R]
+    assert w.tx_seller[w.tx_off[0]:w.tx_off[0] + w.tx_count[0]].tolist() == [1]  # the pool holds the sale
+    sim.step(1)
+    b2 = int(w.view_head[1])
+    assert w.blk_ntx[b2] == 0 and w.blk_st[b2] == w.blk_st[b1] and int(w.chn_ckpt[0]) == b1
+    sim.step(1)
+    b3 = int(w.view_head[1])
+    assert int(w.chn_ckpt[0]) == b2 and not w.blk_live[b1] and w.blk_live[b3]
+    assert w.blk_st[b3] == w.blk_st[b1]
+    for b in (b2, b3):
+        assert blocks.balances_after(w, b).tolist() == [W0, W0 + R]
+    assert w.blk_live[w.chn_cur[0]]  # the ledger arrays hold the state of a live block
+    assert w.balance.tolist() == [W0, W0 + R] and w.tx_count.tolist() == [1, 0]
+    _deposit(sim, 1)
+    sim.step(1)
+    b4 = int(w.view_head[1])
+    assert w.blk_st[b4] != w.blk_st[b3] and int(w.chn_ckpt[0]) == b3
+    assert blocks.balances_after(w, b4).tolist() == [W0, W0 + 2 * R]
+    assert blocks.balances_after(w, b3).tolist() == [W0, W0 + R]
+    assert w.balance.tolist() == [W0, W0 + 2 * R]
+
+
+def _list_sellers(w, v):
+    """The sellers of the list that ends with node v, oldest first (walked through ``ls_prev``)."""
+    out = []
+    while v >= 0:
+        out.append(int(w.ls_seller[v]))
+        v = int(w.ls_prev[v])
+    return out[::-1]
+
+
 def _run_conserving_money(sim, steps, robots=25):
     """Step ``sim`` one step at a time; after each, every live block's balances add up to the initial
     wealth plus one reward per deposit on its branch, and the canonical ledger to the initial wealth plus
-    its rewards."""
+    its rewards.  And the ledger arrays are the canonical head's state: its balances, every buyer's list in
+    the pool (what a rule or the results read), held for a live block with the head's state."""
     for _ in range(steps):
         sim.step(1)
         w = sim.world
         for b in np.flatnonzero(w.blk_live):
-            assert w.blk_bal[b].sum() == pytest.approx(robots * W0 + R * _branch_deposits(w, int(b)), abs=1e-9)
+            assert blocks.balances_after(w, b).sum() == pytest.approx(robots * W0 + R * _branch_deposits(w, int(b)), abs=1e-9)
         assert w.balance.sum() + w.pot.sum() == pytest.approx(robots * W0 + R * int(w.rep_deposits.sum()), abs=1e-9)
+        canon, cur = int(w.chn_canon[0]), int(w.chn_cur[0])
+        assert w.blk_live[cur] and w.blk_st[cur] == w.blk_st[canon]
+        assert np.array_equal(w.balance, blocks.balances_after(w, canon))
+        for i in range(robots):
+            pool = w.tx_seller[w.tx_off[i]:w.tx_off[i] + w.tx_count[i]].tolist()
+            assert pool == _list_sellers(w, int(w.bs_ver[w.blk_st[canon], i]))
 
 
 def test_money_is_conserved_on_every_branch_of_a_forking_swarm():

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import infomarket as im
+from infomarket.ledger import blocks
 from infomarket.errors import ConfigError
 
 from .test_chain import R, W0, _branch_deposits, _config, _deposit, _place, _run_conserving_money
@@ -17,7 +18,7 @@ from .test_chain import R, W0, _branch_deposits, _config, _deposit, _place, _run
 def _conserved(w):
     """Every live block's balances add up to the initial wealth plus one reward per deposit on its branch."""
     for b in np.flatnonzero(w.blk_live):
-        assert w.blk_bal[b].sum() == pytest.approx(4 * W0 + R * _branch_deposits(w, int(b)), abs=1e-12)
+        assert blocks.balances_after(w, b).sum() == pytest.approx(4 * W0 + R * _branch_deposits(w, int(b)), abs=1e-12)
 
 
 def test_a_partitioned_swarm_forks_and_the_lighter_branch_is_undone_when_it_ends():
@@ -44,7 +45,7 @@ def test_a_partitioned_swarm_forks_and_the_lighter_branch_is_undone_when_it_ends
     assert (w.blk_height[a1], w.blk_signer[a1], w.blk_step[a1], w.blk_weight[a1], w.blk_ntx[a1]) == (1, 0, 5, 1, 1)
     assert int(w.view_head[1]) == 0 and int(w.view_head[3]) == b1  # nothing crossed x = 600
     assert int(w.chn_forks[0]) == 1 and int(w.chn_canon[0]) == b1
-    assert w.blk_bal[a1].tolist() == [W0, W0 + R, W0, W0] and w.blk_bal[b1].tolist() == [W0, W0, W0, W0 + R]
+    assert blocks.balances_after(w, a1).tolist() == [W0, W0 + R, W0, W0] and blocks.balances_after(w, b1).tolist() == [W0, W0, W0, W0 + R]
     assert w.balance.tolist() == [W0, W0, W0, W0 + R]
     sim.step(1)
     _conserved(w)

@@ -30,6 +30,7 @@ def build_world(cfg: Experiment, rng: np.random.Generator, *, record_events: boo
                     sites=len(params["sites_r"]))
     ledger = ledger_of(cfg)
     if cfg.chain.enabled:
+        ledger.update(blocks.chain_pool(ledger))
         world = ChainWorld(**params, **swarm, **ledger, **log, **chain_of(cfg, ledger, rng))
     else:
         world = World(**params, **swarm, **ledger, **log)

@@ -375,7 +375,7 @@ def chain_variant(weigh) -> ChainStep:
     def ledger_at(w, target):
         """Make the ledger arrays hold the state after block ``target``: a copy of the state it keeps
         (``ledger.blocks.save_state``); nothing is applied again."""
-        if w.chn_cur[0] != target:
+        if not _blocks.same_state(w, w.chn_cur[0], target):
             _blocks.load_state(w, target)
 
     @njit
@@ -391,10 +391,11 @@ def chain_variant(weigh) -> ChainStep:
                 continue
             parent = w.view_head[s]
             b = _blocks.new_block(w, s, t)
-            ledger_at(w, parent)
-            apply_block(w, b, rng)
-            _blocks.set_current(w, b)
-            _blocks.save_state(w, b, parent)
+            if w.blk_ntx[b] > 0:  # (a block with no transaction shares its parent's state: new_block)
+                ledger_at(w, parent)
+                apply_block(w, b, rng)
+                _blocks.set_current(w, b)
+                _blocks.save_state(w, b)
             _blocks.adopt(w, s, b)
             if w.chn_backbone and w.chn_latency == 0:
                 _blocks.deliver_block(w, b)

@@ -173,7 +173,7 @@ class BlockLog:
         else:
             parent = self._lost_parent(previous, height, signer, step, h)
         txs = tuple(self._tx(w, int(x)) for x in _block_txs(w, b))
-        block = Block(len(self.blocks), parent, height, h, signer, step, txs, w.blk_bal[b].copy())
+        block = Block(len(self.blocks), parent, height, h, signer, step, txs, w.blk_bal[w.blk_st[b]].copy())
         self.blocks.append(block)
         self._slot[b] = (block.id, h, step)
         self._hash[b], self._step[b] = h, step

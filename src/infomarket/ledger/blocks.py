@@ -6,11 +6,15 @@ State (``SPEC``, the ``chain`` domain; only ledger operations write it, like the
 * **Blocks**, a store of the blocks that are not final yet: parent, height, weight (total difficulty:
   2 per in-turn block, 1 per out-of-turn one, as Clique), hash, signer, step, the transactions it
   includes (mempool slots, in the order they were sent: ``blk_tx[blk_txoff[b]:][:blk_ntx[b]]``), a bit
-  per pending transaction on its branch (``blk_inc``), every robot's balance after it (``blk_bal``, the
-  snapshot a robot's view reads) and the rest of the ledger's state after it (``bs_*``; each buyer's open
-  transactions as a node of the list store ``ls_*``: its last transaction, ``ls_prev`` the rest; the same
-  reveal appended to the same list is the same node on every branch, so a node is a list's content and
-  a settled list's weights are cached by it, ``ls_wt``).  The **checkpoint** (``chn_ckpt``) is the newest
+  per pending transaction on its branch (``blk_inc``), and the ledger's state after it: a row
+  (``blk_st``) of every robot's balances (``blk_bal``, the snapshot a robot's view reads) and the rest of
+  the ledger (``bs_*``; each buyer's open transactions as a node of the list store ``ls_*``: its last
+  transaction, ``ls_prev`` the rest; the same reveal appended to the same list is the same node on every
+  branch, so a node is a list's content and a settled list's weights are cached by it, ``ls_wt``).  A
+  block that includes no transaction (most of them: two in three at the paper's size, all of them in a
+  large sparse swarm) has its parent's row: nothing is copied or applied, and the rows in use stay few
+  and warm, whatever the number of live blocks.  A row is kept while a live block uses it (``st_used``),
+  even once the block that made it is dropped.  The **checkpoint** (``chn_ckpt``) is the newest
   final block (every robot's head descends from it, or it lies ``chn_final`` blocks below the canonical
   head): nothing before it can change, so it is the root of the store.
 * **Mempool** (``ledger.mempool``): transactions not yet in a final block, with a bit per robot
@@ -25,10 +29,12 @@ State (``SPEC``, the ``chain`` domain; only ledger operations write it, like the
 * **Measures** (the log): blocks made, forks, reorganisations and the transactions they dropped, failed
   transactions, deposit-to-payment delays, every robot's summed view lag.
 
-Memory: the blocks since the checkpoint (each with an O(n) state and O(pending / 64) bits), the list
-nodes they use and their cached weights, the mempool with its known-bits (O(n x transactions in flight)),
-two ledgers (the checkpoint's without its lists: its block keeps them).  Every
-array is sized by what is live (the host packs the arenas); nothing grows with the run's history.
+Memory: the blocks since the checkpoint (each with O(pending / 64) bits, and an O(n) state row if it
+includes transactions), the list nodes they use and their cached weights, the mempool with its known-bits
+(O(n x transactions in flight)), two ledgers (the checkpoint's without its lists: its block keeps them).
+Every array is sized by what is live (the host packs the arenas); nothing grows with the run's history.
+First capacities scale with the swarm (``POOL_PER_ROBOT``, ``MEMPOOL_PER_ROBOT``, ``ENTRIES_PER_ROBOT``),
+zeroed, so a run seldom stops for the host to grow an array and untouched room takes no memory.
 """
 from __future__ import annotations
 
@@ -116,7 +122,12 @@ SPEC = Spec("chain", [
         ("blk_tx", "int64", "Bt", "block b's transactions (mempool slots, in the order they were sent) are "
                                   "blk_tx[blk_txoff[b] : blk_txoff[b] + blk_ntx[b]]"),
         ("chn_txtop", "int64", "1", "first unused entry of blk_tx (the host packs the live blocks' entries)"),
-        ("blk_bal", "float64", "Bc,n", "every robot's balance after it"),
+        ("blk_st", "int64", "Bc", "the ledger state after the block (a row of blk_bal and bs_*): a new one "
+                                  "for a block with transactions, its parent's for a block without"),
+        ("st_used", "bool", "Bc", "the state row is some live block's (blk_st)"),
+        ("chn_stfree", "int64", "1", "every state row below it is used (where new_block looks for a free one)"),
+        ("blk_bal", "float64", "Bc,n", "every robot's balance in each state (row blk_st[b]: after block b; "
+                                       "balances_after)"),
         ("blk_inc", "uint64", "Bc,T/64", "bit tx: pending transaction tx is included on its branch after the "
                                          "checkpoint"),
         *[(f"bs_{f}", _LEDGER_KINDS[f][0], "Bc" if _LEDGER_KINDS[f][1] == "1" else "Bc,n",
@@ -143,9 +154,11 @@ SPEC = Spec("chain", [
                                    "block being applied"),
         ("chn_ver", "int64", "n", "the list (a node) of each buyer whose transactions the ledger arrays' "
                                   "pool holds (materialise)"),
+        ("chn_unheld", "bool", "1", "some buyer's list in chn_bver may not be the one the pool holds "
+                                    "(chn_ver): set when a state is loaded or a list grows"),
         ("chn_ckpt", "int64", "1", "the checkpoint's slot"),
         ("chn_canon", "int64", "1", "the canonical head's slot"),
-        ("chn_cur", "int64", "1", "the block whose state the ledger arrays hold"),
+        ("chn_cur", "int64", "1", "a live block whose state the ledger arrays hold"),
         ("chn_mute", "int64", "1", "1 mutes the event and payment logs and the measures (blocks are applied "
                                    "once each and never replayed: stays 0)"),
         ("chn_seq", "int64", "1", "transactions sent so far (their order)"),
@@ -200,19 +213,39 @@ SPEC = Spec("chain", [
 #: state); they change no number.
 BLOCK_CAPACITY = (16, 1024)
 BLOCK_STATE_BYTES = 1 << 30
-MEMPOOL_CAPACITY = 1024
-#: First size of the blocks' transaction lists (``blk_tx``).
-TX_ENTRIES = 16384
-#: First number of nodes of the buyers' lists (``ls_*``).
-LIST_ENTRIES = 16384
+MEMPOOL_CAPACITY = 4096
+#: First size of the blocks' transaction lists (``blk_tx``), and more per robot: ``chain_needs`` keeps room
+#: for every signer due to include the whole mempool.
+TX_ENTRIES = 1 << 18
+#: First number of nodes of the buyers' lists (``ls_*``), and more per robot (room for every due signer to
+#: append a node per pending reveal, ``chain_needs``).
+LIST_ENTRIES = 1 << 17
+#: The part of both that grows with the swarm: entries a robot.
+ENTRIES_PER_ROBOT = 64
 #: First size of the settlement cache (``chn_wt``).
-WEIGHT_ENTRIES = 16384
+WEIGHT_ENTRIES = 1 << 17
+#: First size of the ledger's transaction pool in a chain world: ``POOL_ENTRIES`` and ``POOL_PER_ROBOT`` a
+#: robot (the instant ledger's is ``ledger.state.TX_CAPACITY`` a robot).  ``chain_needs`` bounds what any
+#: branch's lists may need: a paper-size run reaches 30 000-70 000 entries, 10 000 robots 850 000.
+POOL_ENTRIES = 1 << 16
+POOL_PER_ROBOT = 128
+#: Mempool slots a robot at first (at least ``MEMPOOL_CAPACITY``): ``chain_needs`` keeps a slot for every
+#: purchase a step could make, about 2 x the robots of a large swarm.
+MEMPOOL_PER_ROBOT = 3
 
 
 def first_block_slots(n: int) -> int:
     """Block slots a fresh chain of n robots starts with (``BLOCK_CAPACITY``, ``BLOCK_STATE_BYTES``)."""
     per_block = 8 * n * (len(BLOCK_STATE) + 2)  # blk_bal, bs_*, bs_ver
     return int(min(BLOCK_CAPACITY[1], max(BLOCK_CAPACITY[0], BLOCK_STATE_BYTES // per_block)))
+
+
+def chain_pool(ledger: dict) -> dict:
+    """The ledger's transaction pool enlarged to ``POOL_ENTRIES`` for a chain world (zeroed: untouched
+    entries take no memory), so a run grows it rarely; the same entries, so no number moves."""
+    n = ledger["balance"].shape[0]
+    size = max(ledger["tx_seller"].shape[0], POOL_ENTRIES + POOL_PER_ROBOT * n)
+    return {f: _grown(ledger[f], 0, size) for f in TX_POOL}
 
 
 def _words(t: int) -> int:
@@ -226,7 +259,7 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
     the checkpoint a copy of the ledger.  ``cache_weights``: the payment scheme's weights depend only on the
     list it weighs (it takes neither ``market`` nor ``rng``), so a settled list's weights may be reused."""
     n = ledger["balance"].shape[0]
-    bc, t = first_block_slots(n), MEMPOOL_CAPACITY
+    bc, t = first_block_slots(n), 64 * _words(max(MEMPOOL_CAPACITY, MEMPOOL_PER_ROBOT * n))
     z = np.zeros
     ns, gs = zip(*gas_table)
     chain = {
@@ -244,8 +277,9 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
         "blk_live": z(bc, np.bool_), "blk_parent": np.full(bc, -1, np.int64), "blk_height": z(bc, np.int64),
         "blk_weight": z(bc, np.int64), "blk_hash": z(bc, np.int64), "blk_signer": np.full(bc, -1, np.int64),
         "blk_step": z(bc, np.int64), "blk_kids": z(bc, np.int64), "blk_bb": z(bc, np.bool_),
-        "blk_mark": z(bc, np.int8),
-        "blk_ntx": z(bc, np.int64), "blk_txoff": z(bc, np.int64), "blk_tx": z(TX_ENTRIES, np.int64), "blk_bal": z((bc, n)), "blk_inc": z((bc, _words(t)), np.uint64),
+        "blk_mark": z(bc, np.int8), "blk_st": z(bc, np.int64), "st_used": z(bc, np.bool_),
+        "chn_stfree": np.ones(1, np.int64),
+        "blk_ntx": z(bc, np.int64), "blk_txoff": z(bc, np.int64), "blk_tx": z(TX_ENTRIES + ENTRIES_PER_ROBOT * n, np.int64), "blk_bal": z((bc, n)), "blk_inc": z((bc, _words(t)), np.uint64),
         "chn_ckpt": z(1, np.int64), "chn_canon": z(1, np.int64), "chn_cur": z(1, np.int64),
         "chn_mute": z(1, np.int64), "chn_seq": z(1, np.int64),
         "chn_nopen": z(1, np.int64), "chn_behind": z(1, np.int64), "chn_txtop": z(1, np.int64),
@@ -271,17 +305,19 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
         chain[f"bs_{f}"] = z(bc if dims == "1" else (bc, n), np.dtype(kind))
     chain["bs_ver"] = np.full((bc, n), -1, np.int64)
     for f in TX_POOL:
-        chain[f"ls_{f[3:]}"] = z(LIST_ENTRIES, ledger[f].dtype)
+        chain[f"ls_{f[3:]}"] = z(LIST_ENTRIES + ENTRIES_PER_ROBOT * n, ledger[f].dtype)
     for f in ("ls_prev", "ls_len", "ls_seq", "ls_buyer", "ls_kid", "ls_sib", "ls_wt"):
-        chain[f] = np.full(LIST_ENTRIES, -1, np.int64)
+        chain[f] = np.full(LIST_ENTRIES + ENTRIES_PER_ROBOT * n, -1, np.int64)
     chain["chn_lroot"] = np.full(n, -1, np.int64)
     chain["chn_lstop"] = z(1, np.int64)
     chain["chn_wt"] = z(WEIGHT_ENTRIES)
     chain["chn_wttop"] = z(1, np.int64)
     chain["chn_ver"] = np.full(n, -1, np.int64)
+    chain["chn_unheld"] = z(1, np.bool_)
     chain["chn_bver"] = np.full(n, -1, np.int64)
     # genesis: slot 0, height 0, every robot's head, the checkpoint and the canonical head
     chain["blk_live"][0] = True
+    chain["st_used"][0] = True  # genesis's state is row 0
     chain["blk_hash"][0] = np.int64(int(seed) % (2**62))
     chain["blk_bal"][0] = ledger["balance"]
     for f in BLOCK_STATE:  # genesis's state: the fresh ledger (no open transaction)
@@ -289,6 +325,16 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
         chain[f"bs_{f}"][0] = v[0] if v.shape == (1,) else v
     SPEC.check(chain)
     return chain
+
+
+def used_states(world) -> np.ndarray:
+    """The state rows live blocks use (of ``blk_bal`` and ``bs_*``)."""
+    return np.flatnonzero(world.st_used)
+
+
+def balances_after(world, b: int) -> np.ndarray:
+    """Every robot's balance after live block b (a view of its state's row)."""
+    return world.blk_bal[world.blk_st[b]]
 
 
 def _grown(old: np.ndarray, axis: int, size: int, fill=0) -> np.ndarray:
@@ -328,7 +374,7 @@ def _packed_lists(world, changes: dict, lists: int) -> dict:
     ``bs_ver``, ``chn_ver``, ``chn_bver`` renumbered; ``ls_kid``, ``ls_sib``, ``chn_lroot`` rebuilt; the kept
     nodes' cached weights packed too), grown when they and what the next step adds (``lists - chn_lstop``)
     do not fit twice."""
-    live = np.flatnonzero(world.blk_live)
+    live = used_states(world)
     top = int(world.chn_lstop[0])
     keep = np.zeros(top, np.bool_)
     _reachable(world.ls_prev, np.concatenate([world.bs_ver[live].ravel(), world.chn_ver, world.chn_bver]), keep)
@@ -417,16 +463,16 @@ def grow_chain(world, needs) -> dict:
     if blocks > bc:
         size = max(2 * bc, blocks)
         for f in ("blk_live", "blk_height", "blk_weight", "blk_hash", "blk_step", "blk_kids", "blk_bb", "blk_mark", "blk_ntx",
-                  "blk_txoff"):
+                  "blk_txoff", "blk_st", "st_used"):
             changes[f] = _grown(getattr(world, f), 0, size)
         for f in ("blk_parent", "blk_signer"):
             changes[f] = _grown(getattr(world, f), 0, size, -1)
         # a new slot's state and bits are written whole when a block is made in it (new_block, save_state),
         # and nothing reads a free slot's: the new rows are left untouched (no memory until used)
         # (and only the live slots' rows are copied: a free slot's are never read)
-        live = np.flatnonzero(world.blk_live)
+        live = used_states(world)
         changes["blk_bal"] = _grown_rows(world.blk_bal, live, size)
-        changes["blk_inc"] = _grown_rows(changes.get("blk_inc", world.blk_inc), live, size)
+        changes["blk_inc"] = _grown_rows(changes.get("blk_inc", world.blk_inc), np.flatnonzero(world.blk_live), size)
         for f in BLOCK_STATE:
             changes[f"bs_{f}"] = _grown_rows(getattr(world, f"bs_{f}"), live, size)
         changes["bs_ver"] = _grown_rows(world.bs_ver, live, size)
@@ -552,6 +598,33 @@ for _b in range(64):
     _LOWEST_BIT[((1 << _b) * 0x03F79D71B4CB0A89 % 2**64) >> 58] = _b
 
 
+#: Gaps of the Shell sort of a block's transactions (Ciura's sequence, extended by x2.25).
+_GAPS = np.array([1, 4, 10, 23, 57, 132, 301, 701, 1577, 3548, 7983, 17961, 40412, 90927, 204585, 460316,
+                  1035711], np.int64)
+
+
+@njit
+def sort_by_seq(w, txs, k):
+    """Put the first k mempool slots of ``txs`` in sending order (``mp_seq``, all distinct), in place:
+    an insertion sort (a block's transactions come mostly in slot order, which is mostly sending order),
+    as a Shell sort's last pass when there are many."""
+    seq = w.mp_seq
+    g = 0
+    while g + 1 < _GAPS.shape[0] and _GAPS[g + 1] * 3 < k:
+        g += 1
+    while g >= 0:
+        gap = _GAPS[g]
+        for a in range(gap, k):
+            v = txs[a]
+            key = seq[v]
+            c = a - gap
+            while c >= 0 and seq[txs[c]] > key:
+                txs[c + gap] = txs[c]
+                c -= gap
+            txs[c + gap] = v
+        g -= 1
+
+
 @njit
 def new_block(w, signer, t):
     """``signer`` makes a block on its head at step t, holding every pending transaction it knows that
@@ -596,23 +669,19 @@ def new_block(w, signer, t):
             txs[k] = word * 64 + _LOWEST_BIT[(low * _DE_BRUIJN) >> np.uint64(58)]
             k += 1
             m ^= low
-    if k * k > w.mp_count[0]:  # many: take them in sending order from the pending list
-        j = 0
-        for a in range(w.mp_count[0]):
-            tx = w.mp_order[a]
-            if (inc[b, tx >> 6] >> np.uint64(tx & 63)) & np.uint64(1) != np.uint64(0) and not on_branch(w, parent, tx):
-                txs[j] = tx
-                j += 1
-    else:
-        for a in range(1, k):  # few: insertion sort into sending order
-            v = txs[a]
-            c = a - 1
-            while c >= 0 and w.mp_seq[txs[c]] > w.mp_seq[v]:
-                txs[c + 1] = txs[c]
-                c -= 1
-            txs[c + 1] = v
+    sort_by_seq(w, txs, k)
     unlock(w.blk_txoff)[b] = top
     unlock(w.blk_ntx)[b] = k
+    if k == 0:  # no transaction: its parent's state
+        unlock(w.blk_st)[b] = w.blk_st[parent]
+    else:  # a state row of its own (there are never more states than blocks): the lowest free one
+        used = unlock(w.st_used)
+        s = w.chn_stfree[0]
+        while used[s]:
+            s += 1
+        used[s] = True
+        unlock(w.chn_stfree)[0] = s + 1
+        unlock(w.blk_st)[b] = s
     unlock(w.chn_txtop)[0] = top + k
     return b
 
@@ -647,6 +716,7 @@ def include_tx(w, b, tx):
         balance[seller] -= lock
         money[0] -= lock
         unlock(w.pot)[buyer] += lock
+    unlock(w.chn_unheld)[0] = True
     unlock(w.chn_bver)[buyer] = append_node(w, buyer, w.chn_bver[buyer], w.mp_seq[tx], seller, w.mp_site[tx],
                                             w.mp_dir[tx], w.mp_step[tx], lock)
     unlock(w.tx_count)[buyer] = count + 1  # (the pool gets the list when it is next weighed or read)
@@ -765,16 +835,24 @@ def _copy_ledger(balance, pot, burned, tx_off, tx_cap, tx_count, pool_top, money
 
 
 @njit
+def same_state(w, a, b):
+    """Do blocks a and b have the same state (the same row: one of them, or a block between, includes no
+    transaction)?"""
+    return w.blk_st[a] == w.blk_st[b]
+
+
+@njit
 def set_current(w, b):
     """The ledger arrays now hold the state after block b."""
     unlock(w.chn_cur)[0] = b
 
 
 @njit
-def save_state(w, b, parent):
-    """Block b's state (``blk_bal``, ``bs_*``): the ledger arrays' (they hold the state after b, made on
-    ``parent``), with each buyer's list as its node (``chn_bver``: nothing is copied)."""
+def save_state(w, b):
+    """Block b's state (its row of ``blk_bal`` and ``bs_*``, ``blk_st``): the ledger arrays' (they hold the
+    state after b), with each buyer's list as its node (``chn_bver``: nothing is copied)."""
     n = w.balance.shape[0]
+    b = w.blk_st[b]
     bal, pot, count, ver = unlock(w.blk_bal), unlock(w.bs_pot), unlock(w.bs_tx_count), unlock(w.bs_ver)
     settled, reduced, earned = unlock(w.bs_rep_settled), unlock(w.bs_rep_reduced), unlock(w.bs_rep_earned)
     lost, deposits, gas = unlock(w.bs_rep_stake_lost), unlock(w.bs_rep_deposits), unlock(w.bs_gas_paid)
@@ -798,23 +876,25 @@ def load_state(w, b):
     """The ledger arrays get block b's state (``save_state``), except the buyers' lists of open
     transactions, which ``materialise`` copies when they are needed.  ``chn_cur`` is then b."""
     n = w.balance.shape[0]
+    s = w.blk_st[b]
     balance, pot, count = unlock(w.balance), unlock(w.pot), unlock(w.tx_count)
     settled, reduced, earned = unlock(w.rep_settled), unlock(w.rep_reduced), unlock(w.rep_earned)
     lost, deposits, gas = unlock(w.rep_stake_lost), unlock(w.rep_deposits), unlock(w.gas_paid)
     bver = unlock(w.chn_bver)
     for i in range(n):
-        balance[i] = w.blk_bal[b, i]
-        pot[i] = w.bs_pot[b, i]
-        count[i] = w.bs_tx_count[b, i]
-        settled[i] = w.bs_rep_settled[b, i]
-        reduced[i] = w.bs_rep_reduced[b, i]
-        earned[i] = w.bs_rep_earned[b, i]
-        lost[i] = w.bs_rep_stake_lost[b, i]
-        deposits[i] = w.bs_rep_deposits[b, i]
-        gas[i] = w.bs_gas_paid[b, i]
-        bver[i] = w.bs_ver[b, i]
-    unlock(w.burned)[0] = w.bs_burned[b]
-    unlock(w.money)[0] = w.bs_money[b]
+        balance[i] = w.blk_bal[s, i]
+        pot[i] = w.bs_pot[s, i]
+        count[i] = w.bs_tx_count[s, i]
+        settled[i] = w.bs_rep_settled[s, i]
+        reduced[i] = w.bs_rep_reduced[s, i]
+        earned[i] = w.bs_rep_earned[s, i]
+        lost[i] = w.bs_rep_stake_lost[s, i]
+        deposits[i] = w.bs_rep_deposits[s, i]
+        gas[i] = w.bs_gas_paid[s, i]
+        bver[i] = w.bs_ver[s, i]
+    unlock(w.chn_unheld)[0] = True
+    unlock(w.burned)[0] = w.bs_burned[s]
+    unlock(w.money)[0] = w.bs_money[s]
     unlock(w.chn_cur)[0] = b
 
 
@@ -854,8 +934,13 @@ def materialise(w, i):
 
 @njit
 def materialise_all(w):
+    """Every buyer's list of the current state in the pool (nothing to do unless a list changed since the
+    last call: ``chn_unheld``)."""
+    if not w.chn_unheld[0]:
+        return
     for i in range(w.balance.shape[0]):
         materialise(w, i)
+    unlock(w.chn_unheld)[0] = False
 
 
 @njit(inline="always")
@@ -875,7 +960,7 @@ def set_head(w, i, b):
     unlock(w.view_height)[i] = w.blk_height[b]
     unlock(w.view_weight)[i] = w.blk_weight[b]
     unlock(w.view_hash)[i] = w.blk_hash[b]
-    unlock(w.view_bal)[i] = w.blk_bal[b, i]
+    unlock(w.view_bal)[i] = w.blk_bal[w.blk_st[b], i]
     unlock(w.view_stale)[i] = True
 
 
@@ -956,6 +1041,7 @@ def move_checkpoint(w, c):
     head is dropped keeps its head's height, weight, hash and its own balance (``view_head`` -1) until
     it hears a heavier block."""
     save_checkpoint(w)
+    set_current(w, c)
     live, known, mask = unlock(w.mp_live), unlock(w.mp_known), unlock(w.mp_mask)
     n = known.shape[0]
     pending = w.mp_count[0]
@@ -998,7 +1084,7 @@ def move_checkpoint(w, c):
         mask[tx >> 6] |= np.uint64(1) << np.uint64(tx & 63)
         lo, hi = min(lo, tx >> 6), max(hi, tx >> 6)
     hc = w.blk_height[c]
-    blive, inc, mark = unlock(w.blk_live), unlock(w.blk_inc), unlock(w.blk_mark)
+    blive, inc, mark, used = unlock(w.blk_live), unlock(w.blk_inc), unlock(w.blk_mark), unlock(w.st_used)
     for b in range(w.chn_slots[0]):  # 1: descends from c, 2: does not, 0: not known yet
         mark[b] = 0
     mark[c] = 1
@@ -1014,6 +1100,8 @@ def move_checkpoint(w, c):
         while x != end:  # every block on the way has the same answer: each block is walked once
             mark[x] = 1 if keep else 2
             x = w.blk_parent[x]
+    for b in range(w.chn_slots[0]):  # (a state row is used by blocks in slots below chn_slots)
+        used[b] = False
     for b in range(w.chn_slots[0]):
         if not blive[b]:
             continue
@@ -1025,8 +1113,13 @@ def move_checkpoint(w, c):
         for a in range(nw):  # final now: they leave every branch's pending set
             word = words[a]
             inc[b, word] &= ~mask[word]
+        used[w.blk_st[b]] = True
     for word in range(lo, hi + 1):
         mask[word] = 0
+    s = 0
+    while s < used.shape[0] and used[s]:
+        s += 1
+    unlock(w.chn_stfree)[0] = s
     unlock(w.blk_parent)[c] = -1
     unlock(w.chn_ckpt)[0] = c
     for i in range(n):
