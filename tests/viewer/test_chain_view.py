@@ -73,3 +73,30 @@ def test_the_chain_layout_is_aligned_and_a_recording_decodes():
     last = rec.frame(len(rec.frames) - 1)
     assert last.step == 60 and last.header["chain_height"] >= 1
     assert (last.columns["chain_lag"] == last.header["chain_height"] - last.columns["chain_height"]).all()
+
+
+def test_a_branch_keeps_its_number_from_frame_to_frame_while_it_lasts():
+    """A hand-made block tree: genesis 0; canonical 0 -> 1 -> 2; branch A leaves it at block 3 (on 0,
+    hash 900), branch B at block 4 (on 1, hash 100; block 5 on it).  Frame 1: robots on 2, 3, 5 and a
+    dropped head: new branches are numbered in hash order, B 1 and A 2.  Frame 2: robot 2 is back on the
+    canonical head, B is gone, and A keeps its 2 (numbered afresh, as a viewer without memory would, A
+    would become 1 and change colour).  Frame 3: branch C (block 6 on 0) takes the lowest free number, 1."""
+    from types import SimpleNamespace
+
+    from infomarket.ledger.blocklog import DROPPED, BranchNumbers, chain_views
+
+    w = SimpleNamespace(
+        chn_canon=np.array([2]), blk_live=np.ones(7, bool),
+        blk_parent=np.array([-1, 0, 1, 0, 1, 4, 0]), blk_height=np.array([0, 1, 2, 1, 2, 3, 1]),
+        blk_hash=np.array([7, 8, 9, 900, 100, 300, 50]),
+        view_head=np.array([2, 3, 5, -1]), view_height=np.array([2, 1, 3, 1]))
+    numbers = BranchNumbers()
+    height, lag, branch = chain_views(w, numbers)
+    assert branch.tolist() == [0, 2, 1, DROPPED]
+    assert height.tolist() == [2, 1, 3, 1] and lag.tolist() == [0, 1, -1, 1]
+    w.view_head = np.array([2, 3, 2, -1])
+    assert chain_views(w, numbers)[2].tolist() == [0, 2, 0, DROPPED]
+    assert chain_views(w)[2].tolist() == [0, 1, 0, DROPPED]  # afresh: what a frame without memory shows
+    w.view_head = np.array([2, 3, 2, 6])
+    assert chain_views(w, numbers)[2].tolist() == [0, 2, 0, 1]
+

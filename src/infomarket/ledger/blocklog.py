@@ -227,11 +227,36 @@ class BlockLog:
         return out
 
 
-def chain_views(w) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+class BranchNumbers:
+    """Numbers for the branches robots are on that hold from one frame to the next (a viewer colours a
+    branch by its number).  A branch is known by the hash of its first block off the canonical branch; it
+    keeps its number while some robot is on it; a new branch takes the lowest number free (new branches of
+    one frame in hash order).  Numbers run 1 .. ``DROPPED`` - 1 (the last is shared beyond that)."""
+
+    def __init__(self) -> None:
+        self._of: dict[int, int] = {}
+
+    def __call__(self, keys) -> dict[int, int]:
+        """Number of each branch key now present (keys no longer present free their numbers)."""
+        keys = {int(k) for k in keys}
+        self._of = {k: v for k, v in self._of.items() if k in keys}
+        used = set(self._of.values())
+        free = 1
+        for k in sorted(keys - self._of.keys()):
+            while free in used:
+                free += 1
+            self._of[k] = min(free, DROPPED - 1)
+            used.add(free)
+        return self._of
+
+
+def chain_views(w, numbers: BranchNumbers | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Each robot's head height, lag (canonical height minus its head's) and branch, from the world's
     arrays now: branch 0 when its head is on the canonical branch (however far behind), 1, 2, ... for each
-    other branch (numbered by the block where it leaves the canonical one, in slot order, so a number
-    may change from one step to the next), ``DROPPED`` when its head's branch was dropped."""
+    other branch (``numbers``: a ``BranchNumbers`` kept across calls keeps a branch's number while it
+    lasts; without one, the branches are numbered afresh), ``DROPPED`` when its head's branch was
+    dropped."""
+    numbers = BranchNumbers() if numbers is None else numbers
     heads = w.view_head.astype(np.int64)
     canon = int(w.chn_canon[0])
     on_canon = np.zeros(w.blk_live.shape[0], bool)
@@ -248,8 +273,9 @@ def chain_views(w) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         off &= cur >= 0
         off[off] = ~on_canon[cur[off]]
     branch = np.zeros(heads.shape, np.int64)
-    leaves = np.unique(leaf[leaf >= 0])
-    branch[leaf >= 0] = np.minimum(np.searchsorted(leaves, leaf[leaf >= 0]) + 1, DROPPED - 1)
+    keys = w.blk_hash[leaf[leaf >= 0]]
+    of = numbers(keys)
+    branch[leaf >= 0] = [of[int(k)] for k in keys]
     branch[heads < 0] = DROPPED
     height = w.view_height.astype(np.float64)
     return height, w.blk_height[canon] - height, branch

@@ -19,7 +19,7 @@ import numpy as np
 from ..engine import geometry as kernels  # to_world: the robot-frame rotation the engine uses
 from ..engine.world import EVENT_NAMES, FOOD, NEST, SITE_NAMES, STATE_NAMES, headings, open_transactions
 from ..errors import FormatError
-from ..ledger.blocklog import DROPPED, chain_views
+from ..ledger.blocklog import DROPPED, BranchNumbers, chain_views
 from ..registry import behaviours
 
 #: The engine's own robot-frame -> world rotation, as plain Python (it also takes arrays of robots).
@@ -40,8 +40,9 @@ COLUMNS = (
 #: With the chain model on (docs/chain-model.md) frames carry more: the canonical height and the forks
 #: and reorganisations so far in the header, and per robot its head's height, its lag (canonical height
 #: minus its head's) and its branch: 0 when its head is on the canonical branch (however far behind),
-#: 1, 2, ... for each other branch (numbered by the block where it leaves the canonical one, in slot
-#: order, so the number may change from frame to frame), ``DROPPED`` when its branch was dropped.
+#: 1, 2, ... for each other branch (a branch keeps its number from frame to frame while it lasts, when
+#: the caller keeps a ``BranchNumbers``, as a session and a recording do), ``DROPPED`` when its branch
+#: was dropped.
 CHAIN_HEADER = ("chain_height", "chain_forks", "chain_reorgs")
 CHAIN_FLOAT_COLUMNS = (("chain_height", "<f4"), ("chain_lag", "<f4"))
 CHAIN_BYTE_COLUMNS = (("branch", "u1"),)
@@ -123,8 +124,9 @@ def _believed(w, site: int) -> tuple[np.ndarray, np.ndarray]:
     return w.pos[:, 0] + dx, w.pos[:, 1] + dy
 
 
-def encode(sim, honest: np.ndarray | None = None) -> bytes:
-    """The current state of ``sim`` as one binary frame (see ``COLUMNS``)."""
+def encode(sim, honest: np.ndarray | None = None, branches: BranchNumbers | None = None) -> bytes:
+    """The current state of ``sim`` as one binary frame (see ``COLUMNS``); ``branches``: the chain
+    model's branch numbers kept from frame to frame (``ledger.blocklog.BranchNumbers``)."""
     w = sim.world  # re-read every time: the engine may replace arrays between steps
     honest = honest_mask(sim) if honest is None else honest
     items = w.items.astype(np.float64)
@@ -149,7 +151,7 @@ def encode(sim, honest: np.ndarray | None = None) -> bytes:
         "state": w.state, "flags": flags, "pending_food": pend[:, 0], "pending_nest": pend[:, 1],
     }
     if chain:
-        values["chain_height"], values["chain_lag"], values["branch"] = chain_views(w)
+        values["chain_height"], values["chain_lag"], values["branch"] = chain_views(w, branches)
     return header.tobytes() + b"".join(np.ascontiguousarray(values[c], dtype=t).tobytes()
                                        for c, t in layout(chain)[1])
 
@@ -208,7 +210,7 @@ def _last_events(w, i: int, last: int) -> list[dict]:
     return out
 
 
-def robot_detail(sim, i: int, last: int = LAST_EVENTS) -> dict:
+def robot_detail(sim, i: int, last: int = LAST_EVENTS, branches: BranchNumbers | None = None) -> dict:
     """What the side panel shows about robot ``i`` beyond the frame's columns: its pending (unconfirmed)
     purchases with the world position each points at, its open transactions as buyer since its last
     deposit, and its last events."""
@@ -228,7 +230,7 @@ def robot_detail(sim, i: int, last: int = LAST_EVENTS) -> dict:
            "state": STATE_NAMES[int(w.state[i])], "pot": round(float(w.pot[i]), 6),
            "pending": pending, "open_transactions": open_tx, "events": _last_events(w, i, last)}
     if chain_on(sim):
-        height, lag, branch = chain_views(w)
+        height, lag, branch = chain_views(w, branches)
         steps = max(sim.clock, 1)
         out["chain"] = {"height": int(height[i]), "canonical_height": int(w.blk_height[w.chn_canon[0]]),
                         "lag": int(lag[i]), "branch": int(branch[i]), "head_dropped": bool(w.view_head[i] < 0),

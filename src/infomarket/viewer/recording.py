@@ -24,6 +24,7 @@ from ..engine import Simulation
 from ..checks import explain
 from ..errors import InfomarketError, InternalError
 from . import STATIC
+from ..ledger.blocklog import BranchNumbers
 from .frames import Frame, decode, encode, event_columns, frame_size, honest_mask, scene
 
 #: Frames a replay holds by default: enough to watch smoothly, small enough to open fast (~2 MB for 25
@@ -63,13 +64,14 @@ def record(config: Experiment, seed: int | None = None, *, steps: int | None = N
     except Exception as exc:  # a rule that keeps the kernel from compiling: named (checks.explain)
         raise explain(config, seed, exc) from None
     honest = honest_mask(sim)
-    frames = [encode(sim, honest)]
+    branches = BranchNumbers()  # a branch keeps its number from frame to frame while it lasts
+    frames = [encode(sim, honest, branches)]
     while sim.clock < steps:
         try:
             sim.step(min(every, steps - sim.clock))
         except Exception as exc:  # a rule raised: named with its file, line and the step
             raise explain(config, sim.seed, exc, sim, record_events=True) from None
-        frames.append(encode(sim, honest))
+        frames.append(encode(sim, honest, branches))
         if on_progress:
             on_progress(sim.clock, steps)
     return Recording(scene(sim), frames, event_columns(sim), every)

@@ -29,6 +29,7 @@ from ..engine import Simulation
 from ..checks import explain
 from ..errors import InfomarketError
 from ..seeds import MAX_SEED
+from ..ledger.blocklog import BranchNumbers
 from .frames import encode, honest_mask, robot_detail, scene
 
 DEFAULT_SPEED = 10
@@ -107,6 +108,7 @@ class Session:
         except Exception as exc:  # a rule that keeps the kernel from compiling: named (checks.explain)
             raise explain(self.config, self.seed, exc) from None
         self._honest = honest_mask(self.sim)
+        self._branches = BranchNumbers()  # a branch keeps its number (its ring's colour) while it lasts
 
     def scene(self) -> dict:
         return {"type": "scene", **scene(self.sim)}
@@ -116,10 +118,10 @@ class Session:
                 "seed": self.seed, "selected": self.selected}
 
     def frame(self) -> bytes:
-        return encode(self.sim, self._honest)
+        return encode(self.sim, self._honest, self._branches)
 
     def detail(self) -> dict | None:
-        return None if self.selected is None else robot_detail(self.sim, self.selected)
+        return None if self.selected is None else robot_detail(self.sim, self.selected, branches=self._branches)
 
     def advance(self, k: int) -> tuple[bytes, dict | None]:
         """Step ``k`` times; the new frame and the selected robot's details (run in a worker thread)."""
