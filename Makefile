@@ -24,7 +24,7 @@ demo: venv
 # search and the chain model: a cold fresh clone's `.ci/run` took 7 min 35 s of pytest, 8 min 16 s in all;
 # later that day, 1 388 tests with the RL interface, the chain study and revm's cold gas: 8 min 32 s, 9 min 17 s;
 # at the end of the day, 1 412 tests with the chain's list nodes and gas table: 9 min 52 s, 10 min 52 s;
-# with blocks sharing states, 1 413 tests: 9 min 35 s, 10 min 24 s).
+# with blocks sharing states, 1 413 tests: 9 min 35 s, 10 min 24 s; with stable branch numbers, 1 414: 10 min 1 s, 10 min 54 s).
 # A kernel one process compiled, the other loads from the disk cache.  TEST_WORKERS=0 runs them inline.
 TEST_WORKERS ?= 2
 test: venv
