@@ -273,9 +273,9 @@ def chain_views(w, numbers: BranchNumbers | None = None) -> tuple[np.ndarray, np
         off &= cur >= 0
         off[off] = ~on_canon[cur[off]]
     branch = np.zeros(heads.shape, np.int64)
-    keys = w.blk_hash[leaf[leaf >= 0]]
+    keys, which = np.unique(w.blk_hash[leaf[leaf >= 0]], return_inverse=True)
     of = numbers(keys)
-    branch[leaf >= 0] = [of[int(k)] for k in keys]
+    branch[leaf >= 0] = np.array([of[int(k)] for k in keys], np.int64)[which]  # (a lookup per branch)
     branch[heads < 0] = DROPPED
     height = w.view_height.astype(np.float64)
     return height, w.blk_height[canon] - height, branch

@@ -374,10 +374,10 @@ def _packed_lists(world, changes: dict, lists: int) -> dict:
     ``bs_ver``, ``chn_ver``, ``chn_bver`` renumbered; ``ls_kid``, ``ls_sib``, ``chn_lroot`` rebuilt; the kept
     nodes' cached weights packed too), grown when they and what the next step adds (``lists - chn_lstop``)
     do not fit twice."""
-    live = used_states(world)
+    rows = used_states(world)
     top = int(world.chn_lstop[0])
     keep = np.zeros(top, np.bool_)
-    _reachable(world.ls_prev, np.concatenate([world.bs_ver[live].ravel(), world.chn_ver, world.chn_bver]), keep)
+    _reachable(world.ls_prev, np.concatenate([world.bs_ver[rows].ravel(), world.chn_ver, world.chn_bver]), keep)
     old = np.flatnonzero(keep)
     total = old.shape[0]
     new_of = np.full(top + 1, -1, np.int64)  # index top + 1 - 1 = -1 -> -1
@@ -413,7 +413,7 @@ def _packed_lists(world, changes: dict, lists: int) -> dict:
 
     bs_ver = changes.get("bs_ver", world.bs_ver)  # (grown already when the block slots grew; renumbered in
     # place: the world this packs is replaced by the one make_room returns)
-    bs_ver[live] = renumber(world.bs_ver[live])
+    bs_ver[rows] = renumber(world.bs_ver[rows])
     out.update(bs_ver=bs_ver, chn_ver=renumber(world.chn_ver), chn_bver=renumber(world.chn_bver),
                chn_lroot=roots, chn_lstop=np.array([total], np.int64), chn_wt=wt,
                chn_wttop=np.array([used], np.int64))
@@ -467,15 +467,15 @@ def grow_chain(world, needs) -> dict:
             changes[f] = _grown(getattr(world, f), 0, size)
         for f in ("blk_parent", "blk_signer"):
             changes[f] = _grown(getattr(world, f), 0, size, -1)
-        # a new slot's state and bits are written whole when a block is made in it (new_block, save_state),
-        # and nothing reads a free slot's: the new rows are left untouched (no memory until used)
-        # (and only the live slots' rows are copied: a free slot's are never read)
-        live = used_states(world)
-        changes["blk_bal"] = _grown_rows(world.blk_bal, live, size)
+        # a new slot's bits and a new state row are written whole when first used (new_block, save_state),
+        # and nothing reads a free one: the new rows are left untouched (no memory until used), and only
+        # the live blocks' bits and the used state rows are copied
+        rows = used_states(world)
+        changes["blk_bal"] = _grown_rows(world.blk_bal, rows, size)
         changes["blk_inc"] = _grown_rows(changes.get("blk_inc", world.blk_inc), np.flatnonzero(world.blk_live), size)
         for f in BLOCK_STATE:
-            changes[f"bs_{f}"] = _grown_rows(getattr(world, f"bs_{f}"), live, size)
-        changes["bs_ver"] = _grown_rows(world.bs_ver, live, size)
+            changes[f"bs_{f}"] = _grown_rows(getattr(world, f"bs_{f}"), rows, size)
+        changes["bs_ver"] = _grown_rows(world.bs_ver, rows, size)
     if lists > world.ls_seller.shape[0]:
         changes.update(_packed_lists(world, changes, lists))
     if entries > world.blk_tx.shape[0]:
@@ -1045,9 +1045,14 @@ def move_checkpoint(w, c):
     live, known, mask = unlock(w.mp_live), unlock(w.mp_known), unlock(w.mp_mask)
     n = known.shape[0]
     pending = w.mp_count[0]
-    lo, hi = mask.shape[0], -1  # the words of c's transactions: mask their bits, word by word
+    words = np.empty(w.blk_ntx[c], np.int64)  # the words holding c's transactions' bits, and their mask
+    nw = 0
     for k in range(w.blk_ntx[c]):
         tx = w.blk_tx[w.blk_txoff[c] + k]
+        if mask[tx >> 6] == np.uint64(0):
+            words[nw] = tx >> 6
+            nw += 1
+        mask[tx >> 6] |= np.uint64(1) << np.uint64(tx & 63)
         if not live[tx]:
             continue
         live[tx] = False
@@ -1056,13 +1061,9 @@ def move_checkpoint(w, c):
             unlock(w.mp_for_buyer)[w.mp_buyer[tx]] -= 1
             unlock(w.mp_own)[w.mp_origin[tx]] -= 1
             drop_own(w, tx)
-        mask[tx >> 6] |= np.uint64(1) << np.uint64(tx & 63)
-        lo, hi = min(lo, tx >> 6), max(hi, tx >> 6)
     for i in range(n):  # nobody knows them any more
-        for word in range(lo, hi + 1):
-            known[i, word] &= ~mask[word]
-    for word in range(lo, hi + 1):
-        mask[word] = 0
+        for a in range(nw):
+            known[i, words[a]] &= ~mask[words[a]]
     order = unlock(w.mp_order)
     k = 0
     top = 0
@@ -1073,20 +1074,11 @@ def move_checkpoint(w, c):
             k += 1
     unlock(w.mp_words)[0] = (top >> 6) + 1 if k > 0 else 0
     unlock(w.mp_cursor)[0] = 0  # new transactions take the lowest free slots
-    lo, hi = mask.shape[0], -1
-    words = np.empty(w.blk_ntx[c], np.int64)  # the words with bits to clear
-    nw = 0
-    for k in range(w.blk_ntx[c]):
-        tx = w.blk_tx[w.blk_txoff[c] + k]
-        if mask[tx >> 6] == np.uint64(0):
-            words[nw] = tx >> 6
-            nw += 1
-        mask[tx >> 6] |= np.uint64(1) << np.uint64(tx & 63)
-        lo, hi = min(lo, tx >> 6), max(hi, tx >> 6)
     hc = w.blk_height[c]
     blive, inc, mark, used = unlock(w.blk_live), unlock(w.blk_inc), unlock(w.blk_mark), unlock(w.st_used)
-    for b in range(w.chn_slots[0]):  # 1: descends from c, 2: does not, 0: not known yet
-        mark[b] = 0
+    for b in range(w.chn_slots[0]):  # marks: 1 descends from c, 2 does not, 0 not known yet; and every
+        mark[b] = 0  # state row is free until a kept block is found using it (rows used are below chn_slots)
+        used[b] = False
     mark[c] = 1
     for b in range(w.chn_slots[0]):
         if not blive[b] or mark[b] != 0:
@@ -1100,8 +1092,6 @@ def move_checkpoint(w, c):
         while x != end:  # every block on the way has the same answer: each block is walked once
             mark[x] = 1 if keep else 2
             x = w.blk_parent[x]
-    for b in range(w.chn_slots[0]):  # (a state row is used by blocks in slots below chn_slots)
-        used[b] = False
     for b in range(w.chn_slots[0]):
         if not blive[b]:
             continue
@@ -1114,8 +1104,8 @@ def move_checkpoint(w, c):
             word = words[a]
             inc[b, word] &= ~mask[word]
         used[w.blk_st[b]] = True
-    for word in range(lo, hi + 1):
-        mask[word] = 0
+    for a in range(nw):
+        mask[words[a]] = 0
     s = 0
     while s < used.shape[0] and used[s]:
         s += 1
