@@ -45,11 +45,13 @@ def empty_store(tmp_path):
     return Store(tmp_path / "st").create()
 
 
-@pytest.mark.parametrize("query", ["", "   ", ";", "-- c", " ; ; "])
-def test_store_sql_of_no_statement_is_one_error(query, empty_store, capsys):
+@pytest.mark.parametrize("query, words", [("", "the query is empty"), ("   ", "the query is empty"),
+                                          (";", "holds no SQL statement"), ("-- c", "holds no SQL statement"),
+                                          (" ; ; ", "holds no SQL statement")])
+def test_store_sql_of_no_statement_is_one_error(query, words, empty_store, capsys):
     pytest.importorskip("duckdb")
     before = sorted(p.name for p in empty_store.root.rglob("*"))
-    refused(capsys, ["store", "sql", str(empty_store.root), query], "query")
+    refused(capsys, ["store", "sql", str(empty_store.root), query], words)
     assert sorted(p.name for p in empty_store.root.rglob("*")) == before
 
 
