@@ -170,6 +170,7 @@ TINY_SEARCH = ("--defence staking --byzantines 3 --budget 2 --popsize 2 --runs 1
                "--steps 60 --transitory 20 --workers 1")
 SMALL = {
     "infomarket check attack_search": "infomarket check attack_search",
+    "infomarket check chain_partition": "infomarket check chain_partition",
     "infomarket attack-search attack_search --out results/attack_search":
         f"infomarket attack-search attack_search {TINY_SEARCH} --out as",
     "infomarket attack-search attack_search --workers 2 --out results/attack_search":
@@ -260,6 +261,8 @@ def test_documented_command_runs_at_a_small_size(documented, tmp_path, monkeypat
     if words[1] == "attack-search":
         report = json.loads((tmp_path / "as" / "report.json").read_text())
         assert report["steps"] == 60 and report["transitory"] == 20 and report["reduced"]
+    if words[1] == "check":
+        assert "\nchain: " in out
     if words[1:3] == ["store", "sql"]:
         assert "chain_id" in out or "blocks" in out
     if words[1:3] == ["store", "verify"]:
