@@ -256,6 +256,16 @@ def test_a_chain_value_that_cannot_act_in_the_run_is_one_warning_line(lines, wor
     assert "chain: poa" in captured.out
 
 
+def test_quiet_silences_the_chain_warning_but_not_the_run(tmp_path, capsys):
+    path = chain_file(tmp_path, 'consensus = "poa"', "partition = [400, 500]")
+    assert main(["run", path, "--out", str(tmp_path / "o"), "--quiet"]) == 0
+    assert capsys.readouterr().err == ""
+    assert main(["run", path, "--out", str(tmp_path / "o2")]) == 0
+    warned = [ln for ln in capsys.readouterr().err.splitlines() if "warning" in ln]
+    assert warned == ["infomarket: warning: chain.partition = [400, 500] starts at or after the run's end (steps "
+                      "= 300): the network is never partitioned"]
+
+
 def test_a_chain_that_acts_gives_no_warning_and_check_describes_it(tmp_path, capsys):
     path = chain_file(tmp_path, 'consensus = "poa"', "period = 5", "backbone = true", "latency = 3",
                       "partition = [100, 200]")

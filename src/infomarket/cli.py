@@ -16,7 +16,7 @@ from pathlib import Path
 from . import __version__
 from .bench import cli as bench_cli
 from .cliargs import Parser, at_least, seed_value
-from .errors import EXIT_FAILED, EXIT_USAGE, InfomarketError, report, show_warning
+from .errors import EXIT_FAILED, EXIT_USAGE, ConfigWarning, InfomarketError, report, show_warning
 
 SUBCOMMAND_MODULES = ("infomarket.runner.cli", "infomarket.analysis.cli", "infomarket.viewer.cli",
                       "infomarket.chain.cli", "infomarket.analysis.sensitivity_cli")
@@ -216,6 +216,8 @@ def main(argv: list[str] | None = None) -> int:
     try:
         with warnings.catch_warnings():  # a configuration's warning as one `infomarket: warning:` line
             warnings.showwarning = show_warning
+            if quiet:  # --quiet prints nothing but errors
+                warnings.simplefilter("ignore", ConfigWarning)
             return int(args.func(args) or 0)
     except InfomarketError as exc:
         # bad input (configuration, options, store) is a ValueError: exit 2; anything else: 1

@@ -9,8 +9,6 @@ from __future__ import annotations
 import sys
 import warnings
 
-_python_showwarning = warnings.showwarning
-
 EXIT_USAGE = 2
 EXIT_FAILED = 1
 
@@ -87,10 +85,11 @@ def report(error: str | BaseException, code: int | None = None) -> int:
 def show_warning(message, category, filename, lineno, file=None, line=None) -> None:
     """``warnings.showwarning`` for the command line: a ``ConfigWarning`` as ``infomarket: warning: ...``
     (one line, no source location); any other warning as Python prints it."""
+    out = sys.stderr if file is None else file
     if issubclass(category, ConfigWarning):
-        print(f"infomarket: warning: {printable(str(message))}", file=sys.stderr if file is None else file, flush=True)
+        print(f"infomarket: warning: {printable(str(message))}", file=out, flush=True)
     else:
-        _python_showwarning(message, category, filename, lineno, file, line)
+        out.write(warnings.formatwarning(message, category, filename, lineno, line))
 
 
 def printable(text: str, limit: int = 20000) -> str:
