@@ -44,9 +44,8 @@ def add_subcommand(sub) -> None:
 
 
 def run(args) -> int:
-    from . import run_bench, run_scaling, run_swarm_sizes
-
     from ..errors import UsageError
+    from . import run_bench, run_scaling, run_swarm_sizes
 
     if args.chain and not args.robots:  # the default bench times fig4C+chain already; --chain alone did nothing
         raise UsageError("--chain goes with --robots (every robot a blockchain node at each swarm size); the "

@@ -9,14 +9,14 @@ terminal state), so ``terminated`` is always False.
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 import gymnasium as gym
 from gymnasium import spaces
 from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode
 from gymnasium.vector.utils import batch_space
-
-from collections.abc import Mapping
 
 from ..config import sizes
 from ..errors import ArgumentError, ConfigError, InputTypeError, UsageError
