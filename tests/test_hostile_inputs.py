@@ -132,12 +132,13 @@ def test_rl_train_refuses_a_population_beyond_memory_before_building_it(monkeypa
     assert not out.exists()
 
 
-def test_rl_train_refuses_a_blank_defence(monkeypatch, capsys):
+def test_rl_train_refuses_a_blank_defence_or_out(monkeypatch, capsys):
     pytest.importorskip("gymnasium")
     import infomarket.rl.envs
 
     monkeypatch.setattr(infomarket.rl.envs, "AttackVectorEnv", never)
     refused(capsys, ["rl-train", "--defence", ""], "--defence ''")
+    refused(capsys, ["rl-train", "--out", " "], "--out ' '")
 
 
 def test_rl_train_takes_every_defence_the_search_takes():

@@ -64,6 +64,8 @@ def cmd_rl_train(args) -> int:
 
     if args.transitory >= args.steps:
         raise UsageError(f"--transitory {args.transitory}: must be below --steps {args.steps}")
+    if args.out is not None and not args.out.strip():  # a blank variable: not "no file", and not this folder
+        raise UsageError(f"--out {args.out!r}: give a file for the result (or leave the option out)")
     out = Path(args.out) if args.out else None
     if out is not None and (out.is_dir() or not out.parent.is_dir()):
         raise UsageError(f"--out {out}: must be a file in an existing folder")
