@@ -3,6 +3,7 @@
 listed below, as run or as not run with the reason, so a new or edited command needs a decision."""
 from __future__ import annotations
 
+import json
 import re
 import shlex
 from pathlib import Path
@@ -153,3 +154,135 @@ def test_cheap_documented_command_runs(cmd, tmp_path, monkeypatch, capsys):
     monkeypatch.chdir(tmp_path)
     assert main(shlex.split(cmd)[1:]) == 0
     assert capsys.readouterr().out.strip()
+
+
+
+# ------------------------------------------------------------------ docs run at a small size
+#: These pages' commands are all run, each at a small size: every command they show (console blocks, plain
+#: blocks, and `infomarket ...` in the text) maps here to the same command with only SIZE_OPTIONS changed
+#: (and placeholders filled), run in a scratch folder.  A new or edited command there needs an entry.
+SMALL_DOCS = ("attack-search.md", "rl.md", "chain-model.md")
+#: Options that change how much is run, not what: a small run may set these, and nothing else.
+SIZE_OPTIONS = frozenset({"steps", "transitory", "budget", "popsize", "runs", "heldout_runs", "best", "iterations",
+                          "pairs", "eval_runs", "repeats", "batch", "robots", "out", "workers", "defence",
+                          "byzantines", "store", "chain_period"})
+TINY_SEARCH = ("--defence staking --byzantines 3 --budget 2 --popsize 2 --runs 1 --heldout-runs 2 --best 1 "
+               "--steps 60 --transitory 20 --workers 1")
+SMALL = {
+    "infomarket check attack_search": "infomarket check attack_search",
+    "infomarket check chain_partition": "infomarket check chain_partition",
+    "infomarket attack-search attack_search --out results/attack_search":
+        f"infomarket attack-search attack_search {TINY_SEARCH} --out as",
+    "infomarket attack-search attack_search --workers 2 --out results/attack_search":
+        f"infomarket attack-search attack_search {TINY_SEARCH} --out as",
+    "infomarket attack-search attack_search --defence staking --byzantines 3 --budget 48 --runs 4 --heldout-runs 16 "
+    "--best 2 --out /tmp/attack-reduced": f"infomarket attack-search attack_search {TINY_SEARCH} --out as",
+    "infomarket bench --env --json": "infomarket bench --env --json --steps 60 --repeats 1 --batch 2",
+    "infomarket rl-train --steps 4000 --transitory 1000 --iterations 60 --pairs 32 --eval-runs 32 --seed 0 "
+    "--out rl-train.json": "infomarket rl-train --steps 60 --transitory 20 --iterations 1 --pairs 1 --eval-runs 2 "
+                           "--seed 0 --out rl-train.json",
+    "infomarket rl-train --steps 10000 --transitory 5000 --iterations 60 --pairs 16 --eval-runs 32 --seed 0":
+        "infomarket rl-train --steps 60 --transitory 20 --iterations 1 --pairs 1 --eval-runs 2 --seed 0",
+    "infomarket bench": "infomarket bench --steps 40 --repeats 1",
+    "infomarket bench --steps 15000": "infomarket bench --steps 40 --repeats 1",
+    "infomarket bench --robots 25,250,2500,10000 --steps 1000 --chain":
+        "infomarket bench --robots 25,30 --steps 40 --chain",
+    "infomarket store sql STORE 'SELECT * FROM chain'": "infomarket store sql chainstore 'SELECT * FROM chain'",
+    "infomarket store verify DIR/store": "infomarket store verify chainstore",
+    "infomarket bench --env": "infomarket bench --env --steps 60 --repeats 1 --batch 2",
+    "infomarket rl-train": "infomarket rl-train --steps 60 --transitory 20 --iterations 1 --pairs 1 --eval-runs 2",
+}
+#: Shown in these pages but not run here, with the reason.
+SMALL_NOT_RUN = {
+    "infomarket attack-search attack_search --defence staking,theta20 --byzantines 3 --dask tcp://head:8786 "
+    "--out results/as-dask": "needs a Dask scheduler at that address; tests/search runs one on a LocalCluster",
+    "infomarket view": "a web server that runs until stopped; tests/viewer",
+    "infomarket attack-search": "the command's name in the text; its commands are the ones above",
+    "infomarket sweep attack_search": "sweep has no --steps: 24 runs of 30 000 steps at the least; `check "
+                                      "attack_search` (run above) builds and validates each of its conditions",
+    "infomarket chain demo --chain-period P":
+        "an EVM replay of a 3 000-step run; tests/chain/test_block_replay.py runs `chain demo --chain-period 5`",
+}
+
+
+def small_doc_commands() -> list[str]:
+    out = []
+    for name in SMALL_DOCS:
+        text = (ROOT / "docs" / name).read_text()
+        lines, fence = [], None  # fence: the open block's language ("" for a plain block), None outside one
+        for ln in text.splitlines():
+            if ln.startswith("```"):
+                fence = ln[3:].strip() if fence is None else None
+            elif fence in ("", "console"):
+                lines.append(ln)
+        lines += re.findall(r"`(infomarket [^`]+)`", text)
+        for line in lines:
+            cmd = line.split(" #")[0].strip().removeprefix("$ ").removeprefix(".venv/bin/")
+            if cmd.startswith("infomarket"):
+                out.append(shlex.join(shlex.split(cmd)))
+    return sorted(set(out))
+
+
+def test_every_command_of_the_small_run_pages_has_a_small_form():
+    found = set(small_doc_commands())
+    assert {"infomarket rl-train --steps 10000 --transitory 5000 --iterations 60 --pairs 16 --eval-runs 32 --seed 0",
+            "infomarket check attack_search"} <= found  # the collector sees plain blocks and console blocks
+    missing = found - set(SMALL) - set(SMALL_NOT_RUN)
+    assert not missing, f"give these a small form in SMALL (or a reason in SMALL_NOT_RUN): {sorted(missing)}"
+    stale = (set(SMALL) | set(SMALL_NOT_RUN)) - found
+    assert not stale, f"no longer in {SMALL_DOCS}: {sorted(stale)}"
+
+
+@pytest.mark.parametrize("documented", sorted(SMALL))
+def test_a_small_form_changes_only_the_size(documented):
+    parser = build_parser()
+    big = vars(parser.parse_args(shlex.split(documented)[1:]))
+    small = vars(parser.parse_args(shlex.split(SMALL[documented])[1:]))
+    changed = {k for k in big.keys() | small.keys() if big.get(k) != small.get(k)}
+    assert changed <= SIZE_OPTIONS, f"the small form changes more than the size: {sorted(changed - SIZE_OPTIONS)}"
+
+
+def _chain_store(folder: Path) -> None:
+    """A results store holding a chain table: one short run of the chain study's partition setup."""
+    assert main(["run", "chain_partition", "--steps", "200", "--runs", "1", "--out", str(folder), "--quiet"]) == 0
+
+
+@pytest.mark.parametrize("documented", sorted(SMALL))
+def test_documented_command_runs_at_a_small_size(documented, tmp_path, monkeypatch, capsys):
+    pytest.importorskip("gymnasium") if " rl-train" in documented or "--env" in documented else None
+    monkeypatch.chdir(tmp_path)
+    words = shlex.split(SMALL[documented])
+    if "chainstore" in words:  # the store the page's `STORE` stands for
+        _chain_store(tmp_path / "chainstore")
+        capsys.readouterr()
+    assert main(words[1:]) == 0, capsys.readouterr().err
+    out = capsys.readouterr().out
+    assert out.strip()
+    if words[1] == "attack-search":
+        report = json.loads((tmp_path / "as" / "report.json").read_text())
+        assert report["steps"] == 60 and report["transitory"] == 20 and report["reduced"]
+    if words[1] == "check":
+        assert "\nchain: " in out
+    if words[1:3] == ["store", "sql"]:
+        assert "chain_id" in out or "blocks" in out
+    if words[1:3] == ["store", "verify"]:
+        assert "1 committed part(s), 0 damaged" in out
+
+
+#: The Python examples of these pages, run with their sizes made small (each pattern must match).
+PY_SMALL = {"num_envs=64": "num_envs=2", "steps=10000": "steps=60", "transitory=5000": "transitory=20"}
+
+
+def test_the_python_examples_of_the_small_run_pages_run_at_a_small_size(tmp_path, monkeypatch):
+    pytest.importorskip("gymnasium")
+    monkeypatch.chdir(tmp_path)
+    blocks = [b for name in SMALL_DOCS
+              for b in re.findall(r"```python\n(.*?)```", (ROOT / "docs" / name).read_text(), re.S)]
+    assert blocks
+    for code in blocks:
+        for big, small in PY_SMALL.items():
+            code = code.replace(big, small)
+        names: dict = {}
+        exec(compile(code, "<docs example>", "exec"), names)  # noqa: S102 - the docs' own example
+        if "env" in names:
+            assert names["env"].num_envs == 2 and names["env"].runs.steps == 60

@@ -10,12 +10,13 @@ import importlib.util
 import json
 import os
 import sys
+import warnings
 from pathlib import Path
 
 from . import __version__
 from .bench import cli as bench_cli
 from .cliargs import Parser, at_least, seed_value
-from .errors import EXIT_FAILED, EXIT_USAGE, InfomarketError, report
+from .errors import EXIT_FAILED, EXIT_USAGE, ConfigWarning, InfomarketError, report, show_warning
 
 SUBCOMMAND_MODULES = ("infomarket.runner.cli", "infomarket.analysis.cli", "infomarket.viewer.cli",
                       "infomarket.chain.cli", "infomarket.analysis.sensitivity_cli")
@@ -125,7 +126,7 @@ def cmd_list(args) -> int:
 
 
 def cmd_check(args) -> int:
-    from .config import load_experiment
+    from .config import chain as chain_rules, load_experiment
 
     cfg = load_experiment(args.experiment)
     if cfg.plugins:  # validating needs the rules they register: say that their code ran
@@ -137,6 +138,9 @@ def cmd_check(args) -> int:
     print(f"{cfg.name}: valid. {groups}; scheme {cfg.payment.scheme} (stake {cfg.payment.stake}); "
           f"{cfg.steps} steps, transitory {cfg.transitory}, {runs} runs{per}, seed {cfg.seed}; "
           f"config hash {cfg.config_hash()}")
+    swept = cfg.sweep is not None and any(k.startswith("chain.") for k in cfg.sweep.grid) or cfg.sweep is not None \
+        and any(k.startswith("chain.") for values in cfg.sweep.axes.values() for v in values for k in v.set)
+    print(chain_rules.describe(cfg.chain) + (" (the base: the sweep sets [chain] keys per condition)" if swept else ""))
     if cfg.sweep is not None and cfg.sweep.sample is not None:  # the design is checked at every corner
         from .runner.design import make_design
 
@@ -210,7 +214,11 @@ def main(argv: list[str] | None = None) -> int:
     if quiet:  # the engine's "compiling the step kernel..." line too (workers inherit the variable)
         os.environ["INFOMARKET_COMPILE_NOTICE"] = "0"
     try:
-        return int(args.func(args) or 0)
+        with warnings.catch_warnings():  # a configuration's warning as one `infomarket: warning:` line
+            warnings.showwarning = show_warning
+            if quiet:  # --quiet prints nothing but errors
+                warnings.simplefilter("ignore", ConfigWarning)
+            return int(args.func(args) or 0)
     except InfomarketError as exc:
         # bad input (configuration, options, store) is a ValueError: exit 2; anything else: 1
         return report(exc)

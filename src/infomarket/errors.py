@@ -7,6 +7,7 @@ prints them with ``report`` (one line ``infomarket: error: ...`` on stderr, no t
 from __future__ import annotations
 
 import sys
+import warnings
 
 EXIT_USAGE = 2
 EXIT_FAILED = 1
@@ -58,6 +59,11 @@ class FormatError(InfomarketError, ValueError):
     """Bytes do not have the layout infomarket writes (e.g. a viewer frame of the wrong size)."""
 
 
+class ConfigWarning(InfomarketError, UserWarning):
+    """A configuration value that is valid but cannot act in this run (e.g. a chain partition after the
+    run's end); issued with ``warnings.warn``, and printed by the command line as one line."""
+
+
 class InternalError(InfomarketError, RuntimeError):
     """A defect of infomarket itself (a damaged package, an impossible state), never the user's to fix."""
 
@@ -74,6 +80,16 @@ def report(error: str | BaseException, code: int | None = None) -> int:
         code = exit_code(error) if isinstance(error, BaseException) else EXIT_USAGE
     print(f"infomarket: error: {printable(str(error))}", file=sys.stderr, flush=True)
     return code
+
+
+def show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """``warnings.showwarning`` for the command line: a ``ConfigWarning`` as ``infomarket: warning: ...``
+    (one line, no source location); any other warning as Python prints it."""
+    out = sys.stderr if file is None else file
+    if issubclass(category, ConfigWarning):
+        print(f"infomarket: warning: {printable(str(message))}", file=out, flush=True)
+    else:
+        out.write(warnings.formatwarning(message, category, filename, lineno, line))
 
 
 def printable(text: str, limit: int = 20000) -> str:

@@ -117,17 +117,25 @@ def test_bad_cells_are_refused_before_anything_is_written(tmp_path, capsys, opti
 
 
 def test_a_pending_defence_waits_for_its_scheme(tmp_path, capsys, monkeypatch):
-    """The study's `distinct` cell joins only once `outlier_distinct` is registered: with the scheme
-    hidden it is refused, saying which scheme it waits for (registered, it is a cell: see the next test)."""
+    """A defence declared in `[pending_defences]` joins the cells only once its scheme is registered:
+    unregistered it is refused, saying which scheme it waits for; registered, it is a cell.  (`distinct`
+    waited so for `outlier_distinct`; now registered, it is on the experiment's own axis.)"""
+    import infomarket as im
     from infomarket.search import study
 
+    declared = study.load_declarations()
+    pending = {"later": {"requires": "outlier_distinct", "set": {"payment.scheme": "outlier_distinct"}}}
+    monkeypatch.setattr(study, "load_declarations", lambda: {**declared, "pending_defences": pending})
     registered = study.payments()
     monkeypatch.setattr(study, "payments", lambda: {k: v for k, v in registered.items() if k != "outlier_distinct"})
     out = tmp_path / "never"
-    assert main(["attack-search", "attack_search", "--defence", "distinct", "--out", str(out)]) == 2
+    assert main(["attack-search", "attack_search", "--defence", "later", "--out", str(out)]) == 2
     err = capsys.readouterr().err
-    assert "--defence distinct" in err and "outlier_distinct" in err and "Traceback" not in err
+    assert "--defence later" in err and "outlier_distinct" in err and "Traceback" not in err
     assert not out.exists()
+    monkeypatch.setattr(study, "payments", lambda: registered)
+    s = study.load(im.load_experiment("attack_search"))
+    assert {(c.defence, c.byzantines) for c in study.cells(s, ["later"], [3])} == {("later", 3)}
 
 
 def test_with_outlier_distinct_registered_the_distinct_cell_is_searched():

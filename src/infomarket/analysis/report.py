@@ -47,6 +47,7 @@ class Report:
     sections: list[tuple[str, str]] = field(default_factory=list)  # (markdown, html), e.g. sensitivity
     lock: str = ""  # were the rows' rules declared before the store's first run (analysis.declared)
     gaps: list[str] = field(default_factory=list)  # incomplete experiments (analysis.completeness)
+    lengths: list[str] = field(default_factory=list)  # experiments run at another length than the paper's
 
     def counts(self) -> dict[str, int]:
         return {v: int((self.table["verdict"] == v).sum()) for v in (PASS, FAIL, INCONCLUSIVE, NO_DATA)}
@@ -80,6 +81,9 @@ def build_report(source, out: str | Path, *, vector: str = "svg", label: str | N
     table = headline_table(frames)
     report = Report(label, results, table, collect_provenance(frames, label))
     report.gaps = [g.describe() for g in incomplete.values()]
+    report.lengths = length_notes(frames.runs)
+    for note in report.lengths:
+        echo(f"WARNING: {note}")
     report.lock = summary(check(frames.meta.get("declarations") if frames.meta else None), "tolerances.toml", "rows.")
     report.future = future.section(frames, out, vector, echo)
     store = store if store is not None else (Store(source) if isinstance(source, (str, Path)) else
@@ -94,6 +98,26 @@ def build_report(source, out: str | Path, *, vector: str = "svg", label: str | N
         report.files.append(out / name)
     echo(f"wrote {', '.join(str(p) for p in report.files)}")
     return report
+
+
+def length_notes(runs: pd.DataFrame) -> list[str]:
+    """One line per shipped experiment whose runs in the store are not as long as the experiment declares
+    (the paper's length): its rows compare numbers of runs of two lengths, which the page must say."""
+    if runs.empty or "steps" not in runs.columns or "experiment" not in runs.columns:
+        return []
+    from ..config.load import load_experiment, shipped_experiments  # with the report: the loader is not needed otherwise
+
+    shipped, out = shipped_experiments(), []
+    for name, group in runs.groupby("experiment", sort=True):
+        if name not in shipped:
+            continue
+        declared = load_experiment(name).steps
+        have = sorted({int(s) for s in group["steps"].dropna()})
+        if have and have != [declared]:
+            out.append(f"{name}: runs of {' and '.join(f'{s:,}' for s in have)} steps, judged against numbers for runs "
+                       f"of {declared:,} steps (the paper's, the experiment's declared length); counts that grow with the run's length (items, "
+                       f"wealth) are not comparable, so read its rows and figures as a look, not a check")
+    return out
 
 
 def _label(source) -> str:
@@ -142,6 +166,9 @@ def to_markdown(report: Report) -> str:
           "Figures and headline numbers of *An Information Market for Social Navigation in Robots*, "
           "recomputed from this results store. Tolerances: `src/infomarket/analysis/tolerances.toml` "
           "(declared before any result was seen; rows marked REVISED there were changed for issue 24 after the full paper sweep).", ""]
+    if report.lengths:
+        md += ["## Run lengths", "", "These experiments were run at another length than the paper's:", ""] + \
+            [f"- **{n}**" for n in report.lengths] + [""]
     if report.gaps:
         md += ["## Incomplete designs", "", "The figures and rows that use these experiments are drawn from part of "
                "their design; their rows are inconclusive.", ""] + [f"- {g}" for g in report.gaps] + [""]
@@ -201,6 +228,9 @@ def to_html(report: Report) -> str:
              "<p>Figures and headline numbers of <i>An Information Market for Social Navigation in Robots</i>, "
              "recomputed from this results store. Tolerances: <code>src/infomarket/analysis/tolerances.toml"
              "</code> (declared before any result was seen; rows marked REVISED there were changed for issue 24 after the full paper sweep).</p>", "<h2>Figures</h2>"]
+    if report.lengths:
+        parts += ["<h2>Run lengths</h2><p>These experiments were run at another length than the paper's:</p><ul>"] \
+            + [f"<li><b>{e(n)}</b></li>" for n in report.lengths] + ["</ul>"]
     if report.gaps:
         parts += ["<h2>Incomplete designs</h2><ul>"] + [f"<li>{e(g)}</li>" for g in report.gaps] + ["</ul>"]
     for r in report.figures:

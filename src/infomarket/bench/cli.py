@@ -44,15 +44,19 @@ def add_subcommand(sub) -> None:
 
 
 def run(args) -> int:
+    from ..errors import UsageError
     from . import run_bench, run_scaling, run_swarm_sizes
 
+    if args.chain and not args.robots:  # the default bench times fig4C+chain already; --chain alone did nothing
+        raise UsageError("--chain goes with --robots (every robot a blockchain node at each swarm size); the "
+                         "default bench already times fig4C+chain")
     if args.env:
         return _env(args)
     if args.batch is not None or args.interval is not None:
-        from ..errors import UsageError
-
         raise UsageError("--batch and --interval go with --env (the RL vector environment's benchmark)")
     args.steps = 15000 if args.steps is None else args.steps
+    if args.robots:
+        _check_sizes(args)
     args.repeats = 7 if args.repeats is None else args.repeats
     if args.scaling:
         report = run_scaling(steps=args.steps)
@@ -105,6 +109,20 @@ def run(args) -> int:
     return 0
 
 
+def _check_sizes(args) -> None:
+    """Every swarm size of --robots fits in memory, checked here before any process starts."""
+    from ..errors import ConfigError, UsageError
+    from .setups import chain_at  # with the command: `infomarket --help` stays light
+    from .swarm import scaled_config
+
+    for n in args.robots:
+        try:
+            scaled_config(n, args.steps, chain=chain_at(n) if args.chain else None)
+        except ConfigError as exc:
+            why = str(exc).split("\n", 1)[-1].strip()
+            raise UsageError(f"--robots {n:,}: {why}") from None
+
+
 def _env(args) -> int:
     from ..errors import UsageError
 
@@ -113,7 +131,16 @@ def _env(args) -> int:
         import gymnasium  # noqa: F401
     except ModuleNotFoundError as exc:
         raise UsageError(f"bench --env needs {exc.name}: pip install 'infomarket[rl]'") from exc
-    r = run_env_bench(steps=3000 if args.steps is None else args.steps, batch=args.batch or 64,
+    from ..config import sizes  # with the command: `infomarket --help` stays light
+    from ..rl.envs import configured
+    from .env import ENV_SETUP
+
+    steps, batch = 3000 if args.steps is None else args.steps, args.batch or 64
+    too_big = sizes.batch_too_big(configured(ENV_SETUP, None, steps, min(1000, steps // 3)), batch,
+                                  f"--batch {batch}")
+    if too_big:
+        raise UsageError(too_big)
+    r = run_env_bench(steps=steps, batch=batch,
                       interval=args.interval or 10, repeats=5 if args.repeats is None else args.repeats)
     if args.json:
         print(json.dumps(r, indent=2))

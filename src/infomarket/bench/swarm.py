@@ -13,6 +13,7 @@ import subprocess
 import sys
 
 from ..config import load_experiment
+from ..config.load import validate
 from ..config.schema import Experiment
 from ..errors import SimulationError
 
@@ -37,7 +38,7 @@ def scaled_config(robots: int, steps: int, base: str = "fig2A", chain: dict | No
     data["swarm"]["robots"] = robots
     if chain is not None:
         data["chain"] = chain
-    return Experiment.model_validate(data)
+    return validate(data, f"{base} at {robots:,} robots")  # a ConfigError (too big for memory...), one message
 
 
 def measure(robots: int, steps: int, seed: int = 1, chain: dict | None = None) -> dict:

@@ -154,6 +154,9 @@ def load_experiment(what: str | Path) -> Experiment:
     that ``infomarket sweep fig2A --out fig2A`` can be run again; write ``./fig2A`` (or give a path with a
     folder or an extension) to name the file instead."""
     shipped = shipped_experiments()
+    if isinstance(what, str) and not what.strip():  # Path("") is the current folder: name what is missing
+        raise ConfigError(f"experiment {what!r}: empty; name a shipped experiment (e.g. fig2A) or a .toml / .json "
+                          f"file")
     if isinstance(what, str) and what in shipped and not looks_like_path(what):
         path = shipped[what]
     else:

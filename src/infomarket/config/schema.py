@@ -18,7 +18,7 @@ from pydantic import BaseModel, StrictBool, ConfigDict, Field, ValidationInfo, f
 from .. import plugins
 from ..errors import ConfigError
 from ..registry import behaviours, payments
-from . import sizes, terrain
+from . import chain as chain_rules, sizes, terrain
 from .sample import Sample
 
 #: Seeds are 63-bit everywhere (files, the command line, the Python API, the store's int64 columns).
@@ -333,6 +333,7 @@ class Experiment(_Strict):
         missing = [p for p in spec.params if p not in self.payment.params and p not in spec.defaults]
         if missing:
             raise ConfigError(f"payment.params: scheme {spec.name!r} needs {', '.join(missing)}")
+        chain_rules.check(self.chain, self.steps)  # contradictions refused; what cannot act, warned about
         if self.chain.enabled:
             for s in self.chain.signers:
                 if s >= self.swarm.robots:

@@ -123,3 +123,14 @@ def runs_too_big(cfg, runs: int, *, history_every: int | None = None) -> str | N
     if need <= limit()[0]:
         return None
     return _refusal(f"the results of {runs:,} runs", need, None, "ask for fewer runs")
+
+
+def batch_too_big(cfg, runs: int, what: str, *, extra: dict[str, int] | None = None) -> str | None:
+    """Why ``runs`` runs of ``cfg`` held at once (the RL vector env's worlds: ``what`` names the option
+    that asked for them), plus ``extra`` bytes by part, would not fit in memory, or None."""
+    parts = {k: v * runs for k, v in run_bytes(cfg).items()}
+    parts.update(extra or {})
+    need = sum(parts.values())
+    if need <= limit()[0]:
+        return None
+    return _refusal(f"{what}: {runs:,} runs at once", need, parts, "ask for fewer runs at once")

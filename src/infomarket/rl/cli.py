@@ -4,6 +4,7 @@ seeds (docs/rl.md)."""
 from __future__ import annotations
 
 import json
+import math
 import time
 from pathlib import Path
 
@@ -15,11 +16,15 @@ def _positive(text: str) -> float:
         v = float(text)
     except ValueError:
         v = float("nan")
-    if not v > 0:
+    if not (v > 0 and math.isfinite(v)):  # inf would turn every policy weight into NaN
         import argparse
 
-        raise argparse.ArgumentTypeError(f"must be a number above 0, got {text!r}")
+        raise argparse.ArgumentTypeError(f"must be a finite number above 0, got {text!r}")
     return v
+
+
+#: Bytes per ES iteration of the learning curve kept in memory (a Python float and its list slot).
+CURVE_BYTES = 32
 
 
 def add_subcommand(sub) -> None:
@@ -59,10 +64,23 @@ def cmd_rl_train(args) -> int:
 
     if args.transitory >= args.steps:
         raise UsageError(f"--transitory {args.transitory}: must be below --steps {args.steps}")
+    if args.out is not None and not args.out.strip():  # a blank variable: not "no file", and not this folder
+        raise UsageError(f"--out {args.out!r}: give a file for the result (or leave the option out)")
     out = Path(args.out) if args.out else None
     if out is not None and (out.is_dir() or not out.parent.is_dir()):
         raise UsageError(f"--out {out}: must be a file in an existing folder")
+    if args.defence is not None and not args.defence.strip():
+        raise UsageError(f"--defence {args.defence!r}: name one defence of the experiment's sweep, e.g. staking")
     cell = {k: v for k, v in (("defence", args.defence), ("byzantines", args.byzantines)) if v is not None}
+    from ..config import sizes  # with the command, like every import here: `infomarket --help` stays light
+    from .envs import configured
+
+    cfg = configured(args.experiment, cell or None, args.steps, args.transitory)
+    # the 2 x pairs worlds held at once, and the learning curve (a float per iteration, in a list)
+    too_big = sizes.batch_too_big(cfg, 2 * args.pairs, f"--pairs {args.pairs}",
+                                  extra={"learning curve": CURVE_BYTES * args.iterations})
+    if too_big:
+        raise UsageError(too_big)
     t0 = time.perf_counter()
     env = AttackVectorEnv(args.experiment, 2 * args.pairs, cell=cell or None, steps=args.steps,
                           transitory=args.transitory, interval=args.interval)

@@ -9,6 +9,8 @@ terminal state), so ``terminated`` is always False.
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 import gymnasium as gym
 from gymnasium import spaces
@@ -16,7 +18,8 @@ from gymnasium.utils import seeding
 from gymnasium.vector import AutoresetMode
 from gymnasium.vector.utils import batch_space
 
-from ..errors import ConfigError, UsageError
+from ..config import sizes
+from ..errors import ArgumentError, ConfigError, InputTypeError, UsageError
 from ..seeds import MAX_SEED
 from .observe import OBSERVATION
 from .runs import ACTIONS, Runs, select_cell
@@ -31,9 +34,45 @@ REWARDS = {"items": "minus the honest robots' items deposited in the interval, p
 
 def configured(experiment, cell, steps, transitory):
     """The experiment an environment runs: ``select_cell`` with ``steps`` / ``transitory`` overridden."""
+    if isinstance(experiment, str) and not experiment.strip():  # Path("") would read as the current folder
+        raise ArgumentError(f"experiment {experiment!r}: name a shipped experiment (e.g. attack_search), a file "
+                            f"or give an Experiment")
+    if cell is not None and not isinstance(cell, Mapping):
+        raise InputTypeError(f"cell={cell!r}: a dict of the sweep's keys, e.g. "
+                             f"cell={{'defence': 'staking', 'byzantines': 3}}")
     cfg = select_cell(experiment, cell)
     changes = {k: v for k, v in (("steps", steps), ("transitory", transitory)) if v is not None}
     return cfg.with_overrides(**changes) if changes else cfg
+
+
+def checked_actions(actions):
+    """``actions`` as a tuple of names; a bare string is refused rather than split into its letters."""
+    if isinstance(actions, str):
+        raise InputTypeError(f"actions={actions!r}: a sequence of the attacker's parameter names, e.g. "
+                             f"actions=({actions!r},)")
+    try:
+        return tuple(actions)
+    except TypeError:
+        raise InputTypeError(f"actions={actions!r}: a sequence of the attacker's parameter names, e.g. "
+                             f"{ACTIONS}") from None
+
+
+def action_array(action, shape: tuple[int, ...], what: str) -> np.ndarray:
+    """``action`` as a float array of exactly ``shape``; None, text, a wrong shape or NaN are refused here
+    (naming ``what``) rather than failing inside numpy or writing NaN into the run.  +-inf is clipped to
+    the parameter's range like any value outside it."""
+    if action is None:
+        raise InputTypeError(f"{what} is None: an array of shape {shape} is needed")
+    try:
+        a = np.asarray(action, np.float64)
+    except (TypeError, ValueError):
+        raise InputTypeError(f"{what}: not an array of numbers of shape {shape} ({type(action).__name__})") from None
+    if a.shape != shape:
+        raise ArgumentError(f"{what} has shape {a.shape}; this environment takes shape {shape}")
+    if np.isnan(a).any():
+        raise ArgumentError(f"{what} holds NaN at {tuple(int(i) for i in np.argwhere(np.isnan(a))[0])}: every "
+                            f"entry must be a number (values outside a parameter's range are clipped to it)")
+    return a
 
 
 def checked(interval, reward):
@@ -97,7 +136,7 @@ class AttackEnv(gym.Env):
     def __init__(self, experiment="attack_search", *, cell: dict | None = None, steps: int | None = None,
                  transitory: int | None = None, interval: int = 10, actions=ACTIONS, reward: str = "items"):
         self.interval, self.reward_name = checked(interval, reward)
-        self.runs = Runs(configured(experiment, cell, steps, transitory), 1, actions=actions)
+        self.runs = Runs(configured(experiment, cell, steps, transitory), 1, actions=checked_actions(actions))
         self.observation_space, self.action_space = _spaces(self.runs)
         self.agents = self.runs.agents
         self._rewards = _Rewarder(self.runs, reward)
@@ -114,7 +153,7 @@ class AttackEnv(gym.Env):
     def step(self, action):
         if self._over:
             raise UsageError("the episode is over (or was never started): call reset() first")
-        self.runs.act(np.asarray(action)[None])
+        self.runs.act(action_array(action, self.action_space.shape, "action")[None])
         self.runs.advance(self.runs.clocks + self.interval)
         reward = float(self._rewards.team()[0])
         self._rewards_last = self._rewards.per_agent()[0]  # what the parallel env hands each agent
@@ -137,7 +176,12 @@ class AttackVectorEnv(gym.vector.VectorEnv):
                  steps: int | None = None, transitory: int | None = None, interval: int = 10, actions=ACTIONS,
                  reward: str = "items"):
         self.interval, self.reward_name = checked(interval, reward)
-        self.runs = Runs(configured(experiment, cell, steps, transitory), num_envs, actions=actions)
+        cfg = configured(experiment, cell, steps, transitory)
+        if isinstance(num_envs, (int, np.integer)) and not isinstance(num_envs, bool) and num_envs > 0:
+            too_big = sizes.batch_too_big(cfg, int(num_envs), f"num_envs={num_envs}")
+            if too_big:  # checked before any world is built, as a single run's size is
+                raise ArgumentError(too_big)
+        self.runs = Runs(cfg, num_envs, actions=checked_actions(actions))
         self.num_envs = self.runs.size
         self.single_observation_space, self.single_action_space = _spaces(self.runs)
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
@@ -145,6 +189,7 @@ class AttackVectorEnv(gym.vector.VectorEnv):
         self._rewards = _Rewarder(self.runs, reward)
         self._env_rngs = [seeding.np_random(None)[0] for _ in range(self.num_envs)]
         self._autoreset = np.ones(self.num_envs, bool)
+        self._started = False
 
     def reset(self, *, seed: int | list[int] | None = None, options: dict | None = None):
         super().reset(seed=seed if isinstance(seed, (int, np.integer)) or seed is None else None)
@@ -160,15 +205,19 @@ class AttackVectorEnv(gym.vector.VectorEnv):
         self.runs.reset(np.arange(self.num_envs), [episode_seed(r) for r in self._env_rngs])
         self._rewards.mark()
         self._autoreset[:] = False
+        self._started = True
         return self.runs.obs.copy(), self._info()
 
     def step(self, actions):
+        if not self._started:
+            raise UsageError("the vector env was never reset: call reset() first")
+        actions = action_array(actions, self.action_space.shape, "actions")
         again = np.flatnonzero(self._autoreset)
         if len(again):
             self.runs.reset(again, [episode_seed(self._env_rngs[b]) for b in again], observe=False)
         go = ~self._autoreset
         if len(again):
-            self.runs.act(np.asarray(actions)[go], np.flatnonzero(go))
+            self.runs.act(actions[go], np.flatnonzero(go))
         else:
             self.runs.act(actions)
         clocks = self.runs.clocks

@@ -3,13 +3,14 @@
 from __future__ import annotations
 
 import functools
+from collections.abc import Mapping
 
 import numpy as np
 from gymnasium import spaces
 from pettingzoo import ParallelEnv
 
-from ..errors import UsageError
-from .envs import AttackEnv
+from ..errors import InputTypeError, UsageError
+from .envs import AttackEnv, action_array
 from .observe import OBSERVATION
 from .runs import ACTIONS
 
@@ -53,13 +54,18 @@ class AttackParallelEnv(ParallelEnv):
     def step(self, actions: dict):
         if not self.agents:
             raise UsageError("every agent is done (or the env was never reset): call reset() first")
+        if not isinstance(actions, Mapping):
+            raise InputTypeError(f"actions: a dict of each acting agent's action, got {type(actions).__name__}")
         unknown = set(actions) - set(self.agents)
         if unknown:
-            raise UsageError(f"actions for agents that are not acting: {sorted(unknown)}")
-        act = self.runs.default_action.copy()
-        current = self.runs.bparams[0][self.runs.agents][:, self.runs.columns]
-        for k, a in enumerate(self.possible_agents):
-            act[k] = actions[a] if a in actions else current[k]  # an agent given no action keeps its last
+            raise UsageError(f"actions for agents that are not acting: {sorted(unknown, key=str)}")
+        missing = [a for a in self.agents if a not in actions]
+        if missing:  # every agent acts each step (PettingZoo's parallel API); {} is a mistake, not a no-op
+            raise UsageError(f"actions: no action for {', '.join(missing[:5])}"
+                             + (f" and {len(missing) - 5} more" if len(missing) > 5 else "")
+                             + f"; give one for every agent in env.agents")
+        shape = (len(self.runs.actions),)
+        act = np.stack([action_array(actions[a], shape, f"actions[{a!r}]") for a in self.possible_agents])
         obs, _, _, truncated, info = self._env.step(act)
         rewards = self._env._rewards_last
         out = (self._split(obs), self._split(rewards.astype(float).tolist()),

@@ -196,7 +196,7 @@ def add_subcommand(sub) -> None:
         a.add_argument("store", metavar="STORE")
         a.set_defaults(func=func)
     text = ("run a DuckDB SQL query over the store's verified parts (tables robots, history, events, payments, "
-            "sites, configs, runs: docs/data.md); needs pip install 'infomarket[sql]'")
+            "sites, configs, chain, runs: docs/data.md); needs pip install 'infomarket[sql]'")
     a = ss.add_parser("sql", help=text, description=text)
     a.add_argument("store", metavar="STORE")
     a.add_argument("query", metavar="QUERY", help="e.g. \"SELECT condition, avg(items_collected) FROM robots GROUP BY ALL\"")

@@ -12,8 +12,33 @@ def _ints(text: str) -> list[int]:
         out = [int(t) for t in text.split(",") if t.strip()]
     except ValueError:
         raise UsageError(f"--byzantines {text!r}: expected whole numbers separated by commas, e.g. 1,3,8") from None
+    if not out:  # a blank shell variable must not widen the search to every cell
+        raise UsageError(f"--byzantines {text!r}: give at least one count, e.g. 3 (leave the option out for "
+                         f"every count of the study)")
+    return out
+
+
+def _names(text: str) -> list[str]:
+    out = [t.strip() for t in text.split(",") if t.strip()]
     if not out:
-        raise UsageError("--byzantines: give at least one count")
+        raise UsageError(f"--defence {text!r}: give at least one defence, e.g. staking (leave the option out for "
+                         f"every defence of the study)")
+    return out
+
+
+def _reductions(st, declared, exp, chosen, all_cells, args) -> list[str]:
+    """What makes this search smaller than the declared study (the report is marked reduced by it)."""
+    out = []
+    if len(chosen) < len(all_cells):
+        out.append(f"{len(chosen)} of {len(all_cells)} cells")
+    if args.steps is not None and args.steps != exp.steps:
+        out.append(f"--steps {args.steps} (declared {exp.steps})")
+    if args.transitory is not None and args.transitory != exp.transitory:
+        out.append(f"--transitory {args.transitory} (declared {exp.transitory})")
+    for key in ("budget", "popsize", "runs", "heldout_runs", "best"):
+        have, want = getattr(st.settings, key), getattr(declared.settings, key)
+        if have < want:
+            out.append(f"--{key.replace('_', '-')} {have} (declared {want})")
     return out
 
 
@@ -26,21 +51,31 @@ def cmd_attack_search(args) -> int:
     from .driver import search_cell, store_runner
     from .study import cells
 
+    if not args.out.strip():  # Path("") is the current folder: a blank variable must not write there
+        raise UsageError(f"--out {args.out!r}: give a folder for the store and the report")
     exp = load_experiment(args.experiment)
     st = study_mod.load(exp, budget=args.budget, popsize=args.popsize, runs=args.runs,
                         heldout_runs=args.heldout_runs, best=args.best, objective=args.objective, seed=args.seed)
-    defences = [d for d in args.defence.split(",") if d] if args.defence else None
-    chosen = cells(st, defences, _ints(args.byzantines) if args.byzantines else None)
+    defences = _names(args.defence) if args.defence is not None else None
+    chosen = cells(st, defences, _ints(args.byzantines) if args.byzantines is not None else None)
+    s = st.settings
+    evaluated = s.generations * s.popsize
+    if args.best is not None and s.best > evaluated:
+        raise UsageError(f"--best {s.best}: more than the {evaluated} candidates a cell evaluates "
+                         f"(--budget {s.budget}, population {s.popsize}); give --best {evaluated} or less, "
+                         f"or a larger --budget")
     if args.steps is not None and args.transitory is not None and args.transitory >= args.steps:
         raise UsageError(f"--transitory {args.transitory}: must be below --steps {args.steps}")
     for c in chosen:  # every configuration is checked before anything runs
         c.with_attack({}, steps=args.steps, transitory=args.transitory)
+    first = chosen[0].with_attack({}, steps=args.steps, transitory=args.transitory)
+    reduced = "; ".join(([args.reduced] if args.reduced else [])
+                        + _reductions(st, study_mod.load(exp), exp, chosen, cells(st), args))
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {out}: exists and is not a directory")
     store = Store(out / "store", cache=True)  # read after every generation: each part read once
     store.refuse_foreign()
-    s = st.settings
     per_cell = (s.generations * s.popsize + len(st.baselines) - bool(st.reference)) * s.runs + (
         min(s.best, s.generations * s.popsize)
                                                      + len(st.baselines)) * s.heldout_runs
@@ -72,9 +107,10 @@ def cmd_attack_search(args) -> int:
             client.close()
     wall = time.perf_counter() - t0
     analysis = report.analyse(st, results)
-    written = report.write(out, analysis, reduced=args.reduced or "", wall_seconds=wall)
+    length = {"steps": first.steps, "transitory": first.transitory}
+    written = report.write(out, analysis, reduced=reduced, wall_seconds=wall, **length)
     if not args.quiet:
-        print(report.markdown(analysis, reduced=args.reduced or "", wall_seconds=wall))
+        print(report.markdown(analysis, reduced=reduced, wall_seconds=wall, **length))
         made = sum(r.done for r in results)
         kept = sum(r.skipped for r in results)
         print(f"attack-search: {made} runs made now, {kept} found in the store; {wall:.1f} s wall; "

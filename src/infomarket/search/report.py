@@ -104,13 +104,16 @@ def analyse(study: Study, results: list[CellSearch]) -> dict:
     return {"objective": obj, "settings": asdict(s), "cells": out_cells, "bounded_defence": bounded}
 
 
-def write(out: Path, analysis: dict, *, reduced: str = "", wall_seconds: float | None = None) -> list[Path]:
-    """``report.json``, ``report.md`` and ``loss.png`` (worst-case loss vs Byzantine share) into ``out``."""
+def write(out: Path, analysis: dict, *, reduced: str = "", wall_seconds: float | None = None,
+          steps: int | None = None, transitory: int | None = None) -> list[Path]:
+    """``report.json``, ``report.md`` and ``loss.png`` (worst-case loss vs Byzantine share) into ``out``;
+    ``steps`` and ``transitory``: the runs' length, recorded so a shortened search reads as one."""
     out = Path(out)
     paths = [out / "report.json", out / "report.md"]
-    meta = {"reduced": reduced, "wall_seconds": wall_seconds}
+    meta = {"reduced": reduced, "wall_seconds": wall_seconds, "steps": steps, "transitory": transitory}
     paths[0].write_text(json.dumps({**meta, **analysis}, indent=2, default=_json) + "\n")
-    paths[1].write_text(markdown(analysis, reduced=reduced, wall_seconds=wall_seconds))
+    paths[1].write_text(markdown(analysis, reduced=reduced, wall_seconds=wall_seconds, steps=steps,
+                                 transitory=transitory))
     fig = _figure(analysis, out / "loss.png")
     return paths + ([fig] if fig else [])
 
@@ -125,12 +128,15 @@ def _json(v):
     raise InputTypeError(f"not JSON: {type(v).__name__}")
 
 
-def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None) -> str:
+def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, steps: int | None = None,
+             transitory: int | None = None) -> str:
     s = a["settings"]
     lines = ["# Attack search", ""]
     if reduced:
         lines += [f"**REDUCED RUN ({reduced}): not the declared study; no answer here is the study's.**", ""]
-    lines += [f"Objective: {a['objective']}; CMA-ES popsize {s['popsize']}, {s['budget']} evaluations per cell, "
+    length = "" if steps is None else (f"Runs of {steps} steps, items counted after step {transitory}. "
+                                       if transitory is not None else f"Runs of {steps} steps. ")
+    lines += [f"{length}Objective: {a['objective']}; CMA-ES popsize {s['popsize']}, {s['budget']} evaluations per cell, "
               f"{s['runs']} runs per candidate (common random numbers per generation), {s['heldout_runs']} held-out "
               f"runs per attack, best {s['best']} re-evaluated."
               + (f" Wall time {wall_seconds:.0f} s." if wall_seconds else ""), "",

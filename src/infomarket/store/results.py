@@ -490,8 +490,15 @@ class Store:
         return found, moved
 
     # ------------------------------------------------------------------ reading
+    def _require(self) -> None:
+        """StoreError unless the folder holds a store: a mistyped path must not read as an empty store."""
+        if not self.exists():
+            raise StoreError(f"{self.root}: not an infomarket results store (no store.json)")
+
     def _records(self) -> dict[str, pd.DataFrame]:
-        """Every commit record by part id; StoreDamaged if one cannot be read."""
+        """Every commit record by part id; StoreError for a missing store, StoreDamaged if a record cannot
+        be read."""
+        self._require()
         out = {}
         for pid, path in sorted(self._parts("runs").items()):
             try:
@@ -543,12 +550,15 @@ class Store:
         every read (``skip_damaged=True``: leave the damaged parts out and read the others).  The query can
         read those parts' files only and write no file (DuckDB's external access is switched off).  A table
         with no rows in the store has no view.  Needs DuckDB: ``pip install 'infomarket[sql]'``."""
+        if not isinstance(query, str):
+            raise SqlError(f"Store.sql: the query must be a string of SQL, not {type(query).__name__}")
+        if not query.strip():
+            raise SqlError("the query is empty; e.g. \"SELECT count(*) FROM robots\"")
         try:
             import duckdb
         except ImportError:
             raise StoreError("Store.sql needs DuckDB: pip install 'infomarket[sql]'") from None
-        if not self.exists():
-            raise StoreError(f"{self.root}: not an infomarket results store (no store.json)")
+        self._require()
         self.meta()  # readable, or a StoreError
         found = self.verify()
         if found.damaged and not skip_damaged:
@@ -570,7 +580,11 @@ class Store:
             con.execute("SET enable_external_access = false")
             con.execute("SET lock_configuration = true")
             try:
-                return con.execute(query).df()
+                result = con.execute(query)
+                if result is None or result.description is None:  # only ';' or comments: no statement
+                    raise SqlError(f"the query {query.strip()[:60]!r} holds no SQL statement that returns rows; "
+                                   f"e.g. \"SELECT count(*) FROM robots\"")
+                return result.df()
             except duckdb.Error as exc:
                 raise SqlError(f"{self.root}: the query failed: {exc} (tables: "
                                f"{', '.join(r[0] for r in con.execute('SHOW TABLES').fetchall())})") from None

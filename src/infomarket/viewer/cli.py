@@ -33,8 +33,10 @@ def _say(text: str) -> None:
 
 
 def _announce(text: str) -> None:
-    """The line a user acts on (the viewer's address): on stdout, so ``infomarket view X | head -1`` gets it."""
-    print(text, flush=True)
+    """The line a user acts on (the viewer's address): on stdout, so ``infomarket view X | head -1`` gets it.
+    With --quiet only the address itself, the line's last word (``server.serve`` ends the line with it),
+    so a script can read it as is (docs/viewer.md)."""
+    print(text.rsplit(None, 1)[-1] if QUIET else text, flush=True)
 
 
 def _load(experiment: str, steps: int | None = None):

@@ -264,7 +264,7 @@ async def serve(config: Experiment, seed: int | None = None, *, port: int = DEFA
                 fps: float = DEFAULT_FPS, say: Callable[[str], None] = print,
                 announce: Callable[[str], None] | None = None) -> None:
     """Serve until Ctrl-C, SIGTERM, or (unless ``keep_running``) the last page closes.  ``say`` tells what
-    happens; ``announce`` (default: ``say``) gets the one line with the address to open."""
+    happens; ``announce`` (default: ``say``) gets the one line with the address to open, as its last word."""
     announce = announce or say
     app = create_app(config, seed, fps=fps, idle_grace=None if keep_running else idle_grace, host=host)
     st = app[STATE]
