@@ -1,4 +1,4 @@
-"""The paper's open questions (issue 10): the ``future`` sweep's figures and its declared questions.
+"""The paper's open questions: the ``future`` sweep's figures and its declared questions.
 
 The sweep (``infomarket sweep future``) runs three attacks (``future_liar``, ``future_farmer``,
 ``future_surfer``) against four defences, plus every defence without Byzantines (``future_honest``).
@@ -10,6 +10,7 @@ power, non-inferiority tests for "no cost" and "kept"): yes, no or inconclusive,
 """
 from __future__ import annotations
 
+import html
 import math
 import tomllib
 from collections.abc import Callable
@@ -25,8 +26,9 @@ from scipy import stats as sps
 from . import stats as st
 from .boxplots import draw_boxes, legend_handles
 from .declared import check, size_note, status_of, summary
-from .figures import _runs_text
+from .figures import _runs_text, save
 from .frames import Frames, MissingDataError
+from .study import html_table, md_table
 from ..errors import ConfigError
 
 TOLERANCES = Path(__file__).with_name("tolerances.toml")
@@ -368,8 +370,6 @@ class Section:
 def section(frames: Frames, out: Path, vector: str, echo: Callable[[str], None]) -> Section | None:
     """Draw each attack's figure and answer the declared questions; None when the store has no
     future-sweep runs (a paper-only store's report is unchanged)."""
-    from .figures import save
-
     if not has_data(frames):
         return None
     figs = []
@@ -392,7 +392,7 @@ def section(frames: Frames, out: Path, vector: str, echo: Callable[[str], None])
 
 INTRO = ("The paper's future work, run: reputation-aware scepticism and adaptive Theta against attacks aimed at "
          "them (docs/research.md). Questions and decision rules: `src/infomarket/analysis/tolerances.toml` "
-         "([statistics], [questions]); the rules were revised for issue 24 after the first full sweep (see the file). "
+         "([statistics], [questions]); the rules were revised after the first full sweep (the amendments are listed at the end of this report). "
          "The sample is the run (swarm items in the last 10 000 steps). Each comparison gives the Hodges-Lehmann "
          "shift and Cliff's delta with 95 % bootstrap intervals, a one-sided Mann-Whitney U test (Holm-adjusted "
          "over the angles or defences the question spans), and its simulated power for the declared margin; "
@@ -400,7 +400,7 @@ INTRO = ("The paper's future work, run: reputation-aware scepticism and adaptive
 COLUMNS = ["question", "answer", "declared", "statistics", "rule"]
 
 
-def to_markdown(s: Section, md_table: Callable[[pd.DataFrame], str]) -> list[str]:
+def to_markdown(s: Section) -> list[str]:
     md = ["## The paper's open questions: reputation-aware defences", "", INTRO, ""]
     for name, caption, files, note in s.figures:
         md += [f"### {name}", "", caption, ""]
@@ -411,9 +411,7 @@ def to_markdown(s: Section, md_table: Callable[[pd.DataFrame], str]) -> list[str
     return md
 
 
-def to_html(s: Section, html_table: Callable[[pd.DataFrame], str]) -> list[str]:
-    import html
-
+def to_html(s: Section) -> list[str]:
     e = html.escape
     parts = ["<h2>The paper's open questions: reputation-aware defences</h2>", f"<p>{e(INTRO)}</p>"]
     for name, caption, files, note in s.figures:

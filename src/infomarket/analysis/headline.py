@@ -18,7 +18,8 @@ import numpy as np
 import pandas as pd
 
 from . import metrics, stats
-from .figures import THETA_DEG
+from .metrics import THETA_DEG
+from .completeness import affected, gaps
 from .frames import Frames, MissingDataError, require
 from ..errors import ConfigError
 
@@ -167,7 +168,7 @@ def _fig3_shrinks(f: Frames) -> Measurement:
 
 
 def _mann_whitney(name: str) -> Callable[[Frames], Measurement]:
-    """Run-level (issue 24): each run's honest minus Byzantine mean wealth share (percentage points),
+    """Run-level: each run's honest minus Byzantine mean wealth share (percentage points),
     one-sided Wilcoxon signed-rank test; the paper's robot-level Mann-Whitney, which pools robots over
     runs (pseudo-replicates), is shown beside it.  ``floor``: 1 / 2^runs, the smallest p the runs allow."""
     def measure(f: Frames) -> Measurement:
@@ -297,8 +298,6 @@ def headline_table(source, rules: dict[str, Rule] | None = None) -> pd.DataFrame
     decided it, or ``no data`` when the store lacks what the row needs).
 
     ``source`` is anything ``Frames.of`` reads: a Store, a store path, Frames or a dict of tables."""
-    from .completeness import affected, gaps
-
     frames = Frames.of(source)
     rules = load_rules() if rules is None else rules
     incomplete = gaps(frames.runs)

@@ -22,7 +22,11 @@ from .frames import Frames, MissingDataError
 from .headline import FAIL, INCOMPLETE, INCONCLUSIVE, NO_DATA, PASS, headline_table
 from .stats import N_TOO_SMALL, shown
 from .provenance import Provenance, collect_provenance
+from .sensitivity import report_section
+from .study import html_table, md_table, packaged
 
+#: the declarations of the headline rows and the open questions, with their record of amendments
+TOLERANCES = packaged("tolerances.toml")
 TABLE_COLUMNS = {"figure": "figure", "claim": "claim", "paper": "paper", "store": "this store",
                  "tolerance": "tolerance", "verdict": "verdict"}
 
@@ -85,8 +89,6 @@ def build_report(source, out: str | Path, *, vector: str = "svg", label: str | N
     store = store if store is not None else (Store(source) if isinstance(source, (str, Path)) else
                                              source if isinstance(source, Store) else None)
     if store is not None:
-        from .sensitivity import report_section
-
         report.sections = report_section(store, out, vector, echo)
     echo(f"paper vs this store: {_counts_text(report)}")
     for name, text in (("report.md", to_markdown(report)), ("report.html", to_html(report))):
@@ -104,17 +106,6 @@ def _label(source) -> str:
 
 
 # ------------------------------------------------------------------------------------------ markdown
-def _md_cell(text) -> str:
-    return str(text).replace("|", "\\|").replace("\n", " ")
-
-
-def _md_table(df: pd.DataFrame) -> str:
-    lines = ["| " + " | ".join(_md_cell(c) for c in df.columns) + " |",
-             "|" + "---|" * len(df.columns)]
-    lines += ["| " + " | ".join(_md_cell(v) for v in row) + " |" for row in df.itertuples(index=False)]
-    return "\n".join(lines)
-
-
 def _counts_text(report: Report) -> str:
     c = report.counts()
     notes = report.table["note"] if "note" in report.table else pd.Series(dtype=str)
@@ -141,7 +132,7 @@ def to_markdown(report: Report) -> str:
     md = [f"# Paper figures from {report.source}", "",
           "Figures and headline numbers of *An Information Market for Social Navigation in Robots*, "
           "recomputed from this results store. Tolerances: `src/infomarket/analysis/tolerances.toml` "
-          "(declared before any result was seen; rows marked REVISED there were changed for issue 24 after the full paper sweep).", ""]
+          "(declared before any result was seen; rows marked REVISED there were changed after the full paper sweep: see the amendments at the end).", ""]
     if report.gaps:
         md += ["## Incomplete designs", "", "The figures and rows that use these experiments are drawn from part of "
                "their design; their rows are inconclusive.", ""] + [f"- {g}" for g in report.gaps] + [""]
@@ -161,15 +152,16 @@ def to_markdown(report: Report) -> str:
             md.append(f"*Skipped: {r.note}.*")
         md.append("")
     md += ["## Paper vs this store", "", _summary(report), "",
-           _md_table(_shown_table(report)), ""]
+           md_table(_shown_table(report)), ""]
     if report.future is not None:
-        md += future.to_markdown(report.future, _md_table)
+        md += future.to_markdown(report.future)
     md += ["## Provenance", ""]
     md += [f"- {k}: {v}" for k, v in report.provenance.facts.items()]
     if not report.provenance.experiments.empty:
-        md += ["", _md_table(report.provenance.experiments)]
+        md += ["", md_table(report.provenance.experiments)]
     for section, _ in report.sections:
         md += ["", section]
+    md += ["", *TOLERANCES.record_markdown()]
     return "\n".join(md) + "\n"
 
 
@@ -182,17 +174,6 @@ td,th{border:1px solid #ccc;padding:4px 8px;text-align:left;vertical-align:top}t
 .note{color:#666;font-style:italic}"""
 
 
-def _html_table(df: pd.DataFrame, verdicts: bool = False) -> str:
-    head = "".join(f"<th>{html.escape(str(c))}</th>" for c in df.columns)
-    body = []
-    for row in df.itertuples(index=False):
-        cls = ""
-        if verdicts:
-            cls = f' class="{str(row[-1]).split(" (")[0].replace(" ", "")}"'
-        body.append(f"<tr{cls}>" + "".join(f"<td>{html.escape(str(v))}</td>" for v in row) + "</tr>")
-    return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
-
-
 def to_html(report: Report) -> str:
     e = html.escape
     parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>Paper figures from {e(report.source)}"
@@ -200,7 +181,7 @@ def to_html(report: Report) -> str:
              f"<h1>Paper figures from {e(report.source)}</h1>",
              "<p>Figures and headline numbers of <i>An Information Market for Social Navigation in Robots</i>, "
              "recomputed from this results store. Tolerances: <code>src/infomarket/analysis/tolerances.toml"
-             "</code> (declared before any result was seen; rows marked REVISED there were changed for issue 24 after the full paper sweep).</p>", "<h2>Figures</h2>"]
+             "</code> (declared before any result was seen; rows marked REVISED there were changed after the full paper sweep: see the amendments at the end).</p>", "<h2>Figures</h2>"]
     if report.gaps:
         parts += ["<h2>Incomplete designs</h2><ul>"] + [f"<li>{e(g)}</li>" for g in report.gaps] + ["</ul>"]
     for r in report.figures:
@@ -213,14 +194,15 @@ def to_html(report: Report) -> str:
         else:
             parts.append(f"<p class='note'>Skipped: {e(r.note)}.</p>")
     parts += ["<h2>Paper vs this store</h2>", f"<p>{e(_summary(report))}</p>",
-              _html_table(_shown_table(report), verdicts=True)]
+              html_table(_shown_table(report), verdicts=True)]
     if report.future is not None:
-        parts += future.to_html(report.future, _html_table)
+        parts += future.to_html(report.future)
     parts.append("<h2>Provenance</h2><ul>")
     parts += [f"<li>{e(k)}: {e(v)}</li>" for k, v in report.provenance.facts.items()]
     parts.append("</ul>")
     if not report.provenance.experiments.empty:
-        parts.append(_html_table(report.provenance.experiments))
+        parts.append(html_table(report.provenance.experiments))
     parts += [section for _, section in report.sections]
+    parts.append(TOLERANCES.record_html())
     parts.append("</body></html>")
     return "\n".join(parts) + "\n"

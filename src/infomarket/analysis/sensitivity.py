@@ -23,8 +23,14 @@ import numpy as np
 import pandas as pd
 
 from ..config.sample import BUILTIN_OUTPUTS
+from ..runner import design as designs
 from ..runner.design import Design
+from ..store import Store, StoreError
+from .declared import check, status_of
+from .figures import save
 from .frames import MissingDataError
+from .stats import INCONCLUSIVE, NO, YES, answer
+from .study import Declaration as study_declaration, html_table, md_table, packaged
 
 RUN = ["condition", "run"]
 CONF_LEVEL = 0.95
@@ -35,7 +41,8 @@ COLUMNS = ["experiment", "output", "method", "index", "parameter", "parameter2",
 TITLES = {"S1": "first order S1", "ST": "total ST", "S2": "second order S2", "mu_star": "Morris μ*",
           "mu": "Morris μ", "sigma": "Morris σ", "PAWN": "PAWN (median KS)",
           "PAWN_null": "PAWN without effect (95th pct.)"}
-QUESTIONS = Path(__file__).with_name("sensitivity_questions.toml")
+DECLARATION = packaged("sensitivity_questions.toml")
+QUESTIONS = DECLARATION.path
 
 
 @dataclass
@@ -305,8 +312,6 @@ def sensitivity(robots: pd.DataFrame, design: Design, *, seed: int | None = None
 
 def from_store(store, experiment: str | None = None) -> Sensitivity:
     """The indices of the design kept in ``store`` (the only one, or ``experiment``'s)."""
-    from ..runner import design as designs
-    from ..store import Store, StoreError
 
     store = Store(store) if not isinstance(store, Store) else store
     if not store.exists():
@@ -389,7 +394,6 @@ def local_robustness(local: Sensitivity, reference: pd.DataFrame | None = None, 
     step); ``moves``: μ*'s lower bound above it."""
     from scipy import stats as sps
 
-    from .stats import answer
 
     d = local.design
     if local.runs is None or local.runs_per_point[0] < 2:
@@ -427,9 +431,7 @@ def local_robustness(local: Sensitivity, reference: pd.DataFrame | None = None, 
 
 # ------------------------------------------------------------------------------------- questions
 def load_questions(path: Path = QUESTIONS) -> dict:
-    import tomllib
-
-    return tomllib.loads(Path(path).read_text())
+    return DECLARATION.data if Path(path) == QUESTIONS else study_declaration.read(path).data
 
 
 def answers(s: Sensitivity, questions: dict | None = None, local: tuple[pd.DataFrame, pd.DataFrame] | None = None,
@@ -438,8 +440,6 @@ def answers(s: Sensitivity, questions: dict | None = None, local: tuple[pd.DataF
     for robustness, a local one: one row per question and output with the answer and its numbers.
     A design of another size than the declared one says so; the precision question is answered only
     at the declared size."""
-    from .declared import status_of
-    from .stats import INCONCLUSIVE, NO, YES
 
     q = (questions or load_questions())["questions"]
     d, t = s.design, s.table
@@ -640,34 +640,31 @@ def _intro(s: Sensitivity) -> str:
 
 
 def markdown(s: Sensitivity, files: list[str], answers_table: pd.DataFrame | None = None) -> str:
-    from .report import _md_table
-
     d = s.design
     lines = [f"## Global sensitivity: {d.experiment}", "", _intro(s), ""]
-    lines += [_md_table(pd.DataFrame({"parameter": d.names, "key": d.keys,
+    lines += [md_table(pd.DataFrame({"parameter": d.names, "key": d.keys,
                                       "range": [f"[{lo:g}, {hi:g}]" for lo, hi in zip(d.low, d.high)]})), ""]
     ft = floor_table(s)
     if len(ft):
-        lines += ["Seed noise (from the replicates of every point):", "", _md_table(ft), ""]
-    lines += [_md_table(summary_table(s)), ""]
+        lines += ["Seed noise (from the replicates of every point):", "", md_table(ft), ""]
+    lines += [md_table(summary_table(s)), ""]
     if answers_table is not None and len(answers_table):
         lines += ["Declared questions (`src/infomarket/analysis/sensitivity_questions.toml`):", "",
-                  _md_table(answers_table), ""]
+                  md_table(answers_table), ""]
+        lines += [line.replace("## ", "### ", 1) for line in DECLARATION.record_markdown()]
     lines += [f"![{f}]({f})" for f in files if f.endswith(".png")]
     return "\n".join(lines) + "\n"
 
 
 def html_section(s: Sensitivity, files: list[str], answers_table: pd.DataFrame | None = None) -> str:
-    from .report import _html_table
-
     d = s.design
     parts = [f"<h2>Global sensitivity: {html.escape(d.experiment)}</h2>", f"<p>{html.escape(_intro(s))}</p>"]
     ft = floor_table(s)
     if len(ft):
-        parts.append(_html_table(ft))
-    parts.append(_html_table(summary_table(s)))
+        parts.append(html_table(ft))
+    parts.append(html_table(summary_table(s)))
     if answers_table is not None and len(answers_table):
-        parts.append(_html_table(answers_table))
+        parts += [html_table(answers_table), DECLARATION.record_html().replace("h2>", "h3>")]
     parts += [f"<p><img src='{html.escape(f)}' alt='{html.escape(f)}'></p>" for f in files if f.endswith(".png")]
     return "\n".join(parts)
 
@@ -676,7 +673,6 @@ def declared_answers(s: Sensitivity, store=None, local: tuple[pd.DataFrame, pd.D
                      ) -> pd.DataFrame | None:
     """``answers`` for the design the questions file declares (None for another experiment), with each
     question's lock status against ``store``'s record (``analysis.declared``)."""
-    from .declared import check
 
     questions = load_questions()
     if s.design.experiment != questions["questions"]["design"]["experiment"]:
@@ -696,7 +692,6 @@ def write(s: Sensitivity, out: str | Path, *, vector: str = "svg",
     """``STEM.csv`` / ``.parquet`` (the long table, the noise floor and PAWN included), the bar chart
     (and the S2 heat map of a second-order Sobol' design) as PNG and ``vector``, and ``STEM.md``
     (``stem``: ``sensitivity-NAME``, or NAME when it starts with "sensitivity"); returns the files."""
-    from .figures import save
 
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
@@ -716,7 +711,6 @@ def write(s: Sensitivity, out: str | Path, *, vector: str = "svg",
 def report_section(store, out: Path, vector: str = "svg", echo=lambda line: None) -> list[tuple[str, str]]:
     """(markdown, html) of every design in ``store``, figures written into ``out``; [] when it has none
     or when a design is not complete yet (with a note through ``echo``)."""
-    from ..runner import design as designs
 
     sections = []
     for name in designs.designs(store.root):

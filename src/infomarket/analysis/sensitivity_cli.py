@@ -27,6 +27,7 @@ def add_subcommand(subparsers) -> None:
 
 
 def cmd_sensitivity(args: argparse.Namespace) -> int:
+    # the analysis (SALib, matplotlib) loads when the command runs, not when the CLI starts
     from ..errors import report
     from ..store import Store
     from .frames import MissingDataError
