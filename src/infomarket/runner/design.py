@@ -32,6 +32,9 @@ from ..config.sample import BUILTIN_OUTPUTS, Sample
 from ..config.schema import Experiment
 from ..errors import ConfigError
 from ..registry import behaviours
+from ..store import StoreError
+from ..store.files import write_atomic, write_text_atomic
+from ..store.results import write_table
 from .keypaths import KEY_PART, label, set_path
 
 #: Corners checked exhaustively up to this many keys (2^D validations); beyond, the two extreme corners
@@ -306,10 +309,6 @@ def _paths(root: Path, experiment: str) -> tuple[Path, Path]:
 def save(store, design: Design) -> None:
     """Keep the design in the store (matrix first, settings last); refuse a store whose design of the
     same experiment differs.  Call with the store's lock held."""
-    from ..store import StoreError
-    from ..store.files import write_atomic, write_text_atomic
-    from ..store.results import write_table
-
     def write_parquet_atomic(frame, path):  # with each column's unit and description (store.dictionary)
         write_atomic(path, lambda tmp: write_table("designs", frame, tmp))
 
@@ -341,7 +340,6 @@ def designs(root) -> list[str]:
 
 def load(root, experiment: str) -> Design:
     """The design of ``experiment`` kept in the store at ``root``."""
-    from ..store import StoreError
 
     spec_path, matrix_path = _paths(root, experiment)
     try:
