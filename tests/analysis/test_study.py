@@ -8,7 +8,7 @@ import copy
 import pandas as pd
 import pytest
 
-from infomarket.analysis import chain_study, sensitivity, study, terrain
+from infomarket.analysis import chain_study, sensitivity_report, study, terrain
 from infomarket.analysis.declared import ADDED, DECLARED, EDITED
 from infomarket.analysis.report import TOLERANCES
 from infomarket.errors import ConfigError
@@ -79,7 +79,7 @@ def test_the_record_is_no_declaration_for_the_lock_check(tmp_path):
     assert {lk.status for lk in d.locks({"q.toml": before})} == {ADDED}
 
 
-SHIPPED = {"chain": chain_study.DECLARATION, "terrain": terrain.DECLARATION, "sensitivity": sensitivity.DECLARATION,
+SHIPPED = {"chain": chain_study.DECLARATION, "terrain": terrain.DECLARATION, "sensitivity": sensitivity_report.DECLARATION,
            "tolerances": TOLERANCES, "search": SEARCH}
 
 

@@ -2,9 +2,8 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
-from ..cliargs import UsageError, writable_dir
+from ..cliargs import writable_dir
 
 
 def add_subcommand(subparsers) -> None:
@@ -28,10 +27,9 @@ def cmd_figures(args: argparse.Namespace) -> int:
     from ..store import Store
     from .frames import Frames
     from .report import build_report
+    from .study import out_dir
 
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise UsageError(f"--out {out}: exists and is not a directory")
+    out = out_dir(args.out)
     # raises StoreError for a missing or foreign folder, StoreDamaged (naming the repair) for a damaged one
     store = Store(args.store)
     frames = Frames.of(store)

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import html
 import math
-import tomllib
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -25,13 +24,14 @@ from scipy import stats as sps
 
 from . import stats as st
 from .boxplots import draw_boxes, legend_handles
-from .declared import check, size_note, status_of, summary
+from .declared import size_note, status_of
 from .figures import _runs_text, save
 from .frames import Frames, MissingDataError
-from .study import html_table, md_table
+from .headline import DECLARATION
+from .study import Declaration, html_table, md_table
 from ..errors import ConfigError
 
-TOLERANCES = Path(__file__).with_name("tolerances.toml")
+TOLERANCES = DECLARATION.path
 ATTACKS = {"future_liar": "constant liar (scaboteur)", "future_farmer": "reputation farmer",
            "future_surfer": "Theta-surfer"}
 HONEST = "future_honest"
@@ -103,15 +103,19 @@ STATISTICS = {"alpha": st.ALPHA, "power": st.POWER, "margin_fraction": 0.10, "co
               "runs": None}
 
 
+def _declaration(path: str | Path) -> Declaration:
+    return DECLARATION if Path(path) == TOLERANCES else Declaration.read(path)
+
+
 def load_statistics(path: str | Path = TOLERANCES) -> dict:
     """The shared statistical declarations ([statistics]) of the questions, with defaults."""
-    return {**STATISTICS, **tomllib.loads(Path(path).read_text()).get("statistics", {})}
+    return {**STATISTICS, **_declaration(path).data.get("statistics", {})}
 
 
 def load_questions(path: str | Path = TOLERANCES) -> dict[str, Question]:
     """The declared questions; each one's params include the shared [statistics] (its own win)."""
     shared = load_statistics(path)
-    data = tomllib.loads(Path(path).read_text()).get("questions", {})
+    data = _declaration(path).questions
     out = {}
     for qid, spec in data.items():
         params = {**shared, **{k: v for k, v in spec.items() if k not in ("question", "rule")}}
@@ -269,7 +273,7 @@ def question_table(source, questions: dict[str, Question] | None = None) -> pd.D
     predates the store's first run (``declared``: see ``analysis.declared``)."""
     frames = Frames.of(source)
     questions = load_questions() if questions is None else questions
-    locks = check(frames.meta.get("declarations") if frames.meta else None)
+    locks = DECLARATION.locks(frames.meta.get("declarations") if frames.meta else None)
     try:
         runs = swarm_items(frames.robots)
     except MissingDataError as exc:
@@ -386,7 +390,7 @@ def section(frames: Frames, out: Path, vector: str, echo: Callable[[str], None])
     small = int((table["note"] == st.N_TOO_SMALL).sum())
     echo(f"open questions: {counts.get(YES, 0)} yes, {counts.get(NO, 0)} no, {counts.get(INCONCLUSIVE, 0)} "
          f"inconclusive{f' ({small} with n too small to reach alpha)' if small else ''}, {counts.get(NO_DATA, 0)} no data")
-    lock = summary(check(frames.meta.get("declarations") if frames.meta else None), "tolerances.toml", "questions.")
+    lock = DECLARATION.lock_summary(frames.meta.get("declarations") if frames.meta else None, "questions.")
     return Section(figs, table, lock)
 
 

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import inspect
 import math
-import tomllib
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -19,11 +18,14 @@ import pandas as pd
 
 from . import metrics, stats
 from .metrics import THETA_DEG
+from .study import Declaration, packaged
 from .completeness import affected, gaps
 from .frames import Frames, MissingDataError, require
 from ..errors import ConfigError
 
-TOLERANCES = Path(__file__).with_name("tolerances.toml")
+#: the rows (and the open questions, analysis.future) with their record of amendments
+DECLARATION = packaged("tolerances.toml")
+TOLERANCES = DECLARATION.path
 PASS, FAIL, NO_DATA, INCONCLUSIVE = "pass", "fail", "no data", "inconclusive"
 COLUMNS = ["id", "figure", "claim", "paper", "store", "value", "tolerance", "verdict", "note"]
 INCOMPLETE = "incomplete design"  # a row whose experiment lacks conditions of its shipped plan
@@ -59,7 +61,7 @@ class Rule:
 
 def load_rules(path: str | Path = TOLERANCES) -> dict[str, Rule]:
     """The rules of ``path`` by id, in file order."""
-    data = tomllib.loads(Path(path).read_text())
+    data = (DECLARATION if Path(path) == TOLERANCES else Declaration.read(path)).data
     rules = {}
     for rid, spec in data["rows"].items():
         bounds = {k: float(spec[k]) for k in ("min", "max", "above", "below") if k in spec}

@@ -15,18 +15,15 @@ import pandas as pd
 
 from ..store import Store
 from . import future
-from .declared import check, summary
 from .completeness import gaps
 from .figures import FIGURES, save
 from .frames import Frames, MissingDataError
-from .headline import FAIL, INCOMPLETE, INCONCLUSIVE, NO_DATA, PASS, headline_table
+from .headline import DECLARATION as TOLERANCES, FAIL, INCOMPLETE, INCONCLUSIVE, NO_DATA, PASS, headline_table
 from .stats import N_TOO_SMALL, shown
 from .provenance import Provenance, collect_provenance
-from .sensitivity import report_section
-from .study import html_table, md_table, packaged
+from .sensitivity_report import report_section
+from .study import html_table, md_table
 
-#: the declarations of the headline rows and the open questions, with their record of amendments
-TOLERANCES = packaged("tolerances.toml")
 TABLE_COLUMNS = {"figure": "figure", "claim": "claim", "paper": "paper", "store": "this store",
                  "tolerance": "tolerance", "verdict": "verdict"}
 
@@ -84,7 +81,7 @@ def build_report(source, out: str | Path, *, vector: str = "svg", label: str | N
     table = headline_table(frames)
     report = Report(label, results, table, collect_provenance(frames, label))
     report.gaps = [g.describe() for g in incomplete.values()]
-    report.lock = summary(check(frames.meta.get("declarations") if frames.meta else None), "tolerances.toml", "rows.")
+    report.lock = TOLERANCES.lock_summary(frames.meta.get("declarations") if frames.meta else None, "rows.")
     report.future = future.section(frames, out, vector, echo)
     store = store if store is not None else (Store(source) if isinstance(source, (str, Path)) else
                                              source if isinstance(source, Store) else None)

@@ -29,6 +29,7 @@ import pandas as pd
 
 from ..cliargs import UsageError, writable_dir
 from ..errors import ConfigError
+from . import declared
 from .declared import NOTES, Lock, check, status_of, summary
 
 HERE = Path(__file__).parent
@@ -109,7 +110,9 @@ class Declaration:
 
     # ------------------------------------------------------------------ against a store's record
     def locks(self, recorded: dict | None) -> list[Lock]:
-        return check(recorded, {self.name: self.path})
+        """Each declaration against the store's record, read from the file the store records under this
+        name (``declared.FILES``; this file for one no store records)."""
+        return check(recorded, {self.name: declared.FILES.get(self.name, self.path)})
 
     def lock_summary(self, recorded: dict | None, prefix: str = "") -> str:
         return summary(self.locks(recorded), self.name, prefix)
