@@ -1,5 +1,6 @@
-"""The structure, drawn again from the code: which package imports which (no circle), each step piece
-defined once, and the ledger's arrays written only by ledger operations."""
+"""The structure, drawn again from the code: which module imports which (no circle between files, nor
+between packages), function-local imports that say why, each step piece defined once, and the ledger's
+arrays written only by ledger operations."""
 from __future__ import annotations
 
 import ast
@@ -10,6 +11,8 @@ import infomarket
 from infomarket.engine.world import LEDGER
 
 PACKAGE = Path(infomarket.__file__).parent
+ROOT = "infomarket"  # the package's facade: Python imports it before any of its modules, so its imports
+#                      of everything say nothing about layering (its edges are left out)
 
 
 def _module_name(path: Path) -> str:
@@ -20,25 +23,233 @@ def _module_name(path: Path) -> str:
     return ".".join(parts)
 
 
-def _imports(path: Path) -> set[str]:
-    """Every infomarket module this file imports, at the top or inside a function."""
-    tree = ast.parse(path.read_text())
-    here = _module_name(path).split(".")
-    package = here if path.name == "__init__.py" else here[:-1]
-    out = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Import):
-            out |= {a.name for a in node.names if a.name.startswith("infomarket")}
-        elif isinstance(node, ast.ImportFrom):
-            if node.level:
-                base = package[:len(package) - node.level + 1]
-                mod = ".".join(base + ([node.module] if node.module else []))
-            else:
-                mod = node.module or ""
-            if mod.startswith("infomarket"):
-                out.add(mod)
-                out |= {f"{mod}.{a.name}" for a in node.names}
-    return out
+MODULES = {_module_name(p): p for p in PACKAGE.rglob("*.py")}
+
+
+def _targets(module: str, is_package: bool, node: ast.Import | ast.ImportFrom) -> list[str]:
+    """The project modules an import statement loads: ``from pkg import name`` is ``pkg.name`` when that
+    is a module, else ``pkg`` (its ``__init__``)."""
+    if isinstance(node, ast.Import):
+        return [a.name for a in node.names if a.name.split(".")[0] == "infomarket"]
+    if node.level:
+        here = module.split(".")
+        package = here if is_package else here[:-1]
+        base = ".".join(package[:len(package) - node.level + 1] + ([node.module] if node.module else []))
+    else:
+        base = node.module or ""
+    if base.split(".")[0] != "infomarket":
+        return []
+    return [f"{base}.{a.name}" if f"{base}.{a.name}" in MODULES else base for a in node.names]
+
+
+def _imports(tree: ast.AST):
+    """(import statement, inside a function?) for every import of ``tree``, ``if TYPE_CHECKING:`` aside."""
+    def walk(node, local):
+        for child in ast.iter_child_nodes(node):
+            if isinstance(child, ast.If) and "TYPE_CHECKING" in ast.unparse(child.test):
+                continue
+            if isinstance(child, (ast.Import, ast.ImportFrom)):
+                yield child, local
+            yield from walk(child, local or isinstance(child, (ast.FunctionDef, ast.AsyncFunctionDef, ast.Lambda)))
+    yield from walk(tree, False)
+
+
+def file_graph(sources: dict[str, tuple[str, bool]] | None = None) -> dict[str, set[str]]:
+    """module -> the project modules it imports (at the top or inside a function), per file."""
+    sources = sources or {m: (p.read_text(), p.name == "__init__.py") for m, p in MODULES.items()}
+    graph: dict[str, set[str]] = defaultdict(set)
+    for module, (text, is_package) in sources.items():
+        if module == ROOT:
+            continue
+        for node, _ in _imports(ast.parse(text)):
+            graph[module] |= {t for t in _targets(module, is_package, node) if t != module}
+    return graph
+
+
+def _explained(lines: list[str], node: ast.stmt) -> bool:
+    """A comment on the import's own lines, or on the line above it (or above the block of imports and
+    blank lines it belongs to)."""
+    if any("#" in lines[i - 1] for i in range(node.lineno, node.end_lineno + 1)):
+        return True
+    j = node.lineno - 2
+    while j >= 0 and "#" not in lines[j] and (not lines[j].strip()
+                                              or lines[j].lstrip().startswith(("from ", "import "))):
+        j -= 1
+    return j >= 0 and (lines[j].lstrip().startswith("#") or (j == node.lineno - 2 and "#" in lines[j]))
+
+
+def unexplained_local_imports(text: str, module: str = "infomarket.x", is_package: bool = False) -> list[str]:
+    """Function-local imports of a project module with no comment saying why (as their source text)."""
+    lines = text.splitlines()
+    return [ast.unparse(node) for node, local in _imports(ast.parse(text))
+            if local and _targets(module, is_package, node) and not _explained(lines, node)]
+
+
+def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components of more than one node (each a set of modules in a circle), sorted."""
+    index, low, stack, on, found = {}, {}, [], set(), []
+
+    def visit(v):
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in sorted(graph.get(v, ())):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                found.append(sorted(comp))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return sorted(found)
+
+
+#: circles other branches remove (the lead empties this after merging them): modules -> the branch
+KNOWN_CIRCLES = {
+    ("infomarket.engine.params", "infomarket.engine.paths", "infomarket.engine.step"):
+        "ledger (fill_turn_tables moves out of engine.step)",
+    ("infomarket.chain.backends", "infomarket.chain.market"): "contract (revert_data moves to the module both use)",
+}
+
+#: function-local imports of project modules without a comment saying why, in files the pipeline branch does
+#: not own: file -> statements.  Each needs its why-comment or a move to the top; the lead empties this.
+UNEXPLAINED = {
+    "bench/cli.py": {
+        "from . import run_bench, run_scaling, run_swarm_sizes", "from ..errors import UsageError",
+        "from .env import run_env_bench",
+    },
+    "bench/env.py": {"from ..rl.envs import AttackVectorEnv, configured"},
+    "bench/scaling.py": {
+        "from ..runner.execute import warm", "from ..runner.sweep import plan, run_sweep",
+        "from ..store import Store",
+    },
+    "bench/swarm.py": {"from ..engine.simulation import Simulation", "from .setups import chain_at"},
+    "chain/backends.py": {"from .market import revert_data"},
+    "chain/block_replay.py": {
+        "from ..ledger.gas import GAS_DEPOSIT_N, gas_schedule, table_gas",
+        "from ..ledger.mempool import STAKE_TOLERANCE",
+    },
+    "chain/cli.py": {
+        "from .. import load_experiment, simulate", "from ..engine.simulation import Simulation",
+        "from ..errors import ConfigError", "from ..ledger.blocklog import BlockLog",
+        "from .block_replay import match_purchases, replay_blocks", "from .errors import ChainError",
+        "from .evm_replay import replay_result", "from .market import connect",
+    },
+    "checks.py": {
+        "from .engine.build import build_world", "from .engine.params import behaviour_kinds",
+        "from .engine.simulation import Simulation", "from .engine.world import kernel_view",
+        "from .errors import SimulationError", "from .state.flags import ErrorFlags",
+    },
+    "cli.py": {
+        "from .analysis import summarise", "from .config import load_experiment",
+        "from .config import shipped_experiments", "from .demo import run_demo",
+        "from .registry import behaviours, payments", "from .runner.execute import default_workers",
+        "from .runner.progress import progress",
+        "from .runner.run import RunInterrupted, prepare, run_experiment",
+    },
+    "cliargs.py": {"from .seeds import MAX_SEED"},
+    "config/sizes.py": {"from ..space.grid import grid_shape"},
+    "config/terrain.py": {"from ..space.obstacles import encode, distance"},
+    "engine/params.py": {"from .step import fill_turn_tables"},
+    "engine/simulation.py": {"from ..config.load import validate", "from ..ledger.blocklog import chain_views"},
+    "engine/specialise.py": {"from .build import behaviour_kinds"},
+    "payments/__init__.py": {"from ..registry import get_payment"},
+    "rl/cli.py": {
+        "from ..runner.progress import progress", "from .envs import AttackVectorEnv",
+        "from .run import compare, describe", "from .train import train",
+    },
+    "rl/runs.py": {"from ..behaviours.attacks import POLICY", "from ..runner.plan import conditions"},
+    "runner/cli.py": {
+        "from ..config import load_experiment", "from ..config import sizes",
+        "from ..config.load import looks_like_path", "from ..config.load import validate",
+        "from ..errors import ConfigError", "from ..runner.execute import default_workers",
+        "from ..runner.progress import progress", "from ..runner.sweep import plan, run_sweep",
+        "from ..store import Store", "from ..store import Store, StoreError",
+    },
+    "runner/execute.py": {
+        "from ..checks import explain_compile_failure", "from ..engine.specialise import kernel_id",
+    },
+    "runner/run.py": {"from .execute import preflight"},
+    "runner/sweep.py": {"from .design import save"},
+    "search/cli.py": {
+        "from . import report, study as study_mod", "from ..config import load_experiment",
+        "from ..runner.execute import default_workers, local_executor, warm",
+        "from ..runner.progress import progress", "from ..store import Store",
+        "from .driver import search_cell, store_runner", "from .study import cells",
+    },
+    "search/driver.py": {"from ..errors import SimulationError"},
+    "state/view.py": {"from ..generated import generated_digest, load_generated"},
+    "store/results.py": {"from ..config.load import validate", "from .declarations import fingerprint"},
+    "viewer/cli.py": {
+        "from ..config import load_experiment", "from ..engine import Simulation",
+        "from .movie import check_movie_path", "from .movie import write_movie",
+        "from .recording import record, write_html", "from .server import serve",
+    },
+}
+
+
+def test_the_cycle_finder_finds_a_cycle():
+    assert _cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == [["a", "b", "c"]]
+    assert _cycles({"a": {"b"}, "b": set()}) == []
+    assert _cycles({"a": {"b"}, "b": {"a"}, "c": {"d"}, "d": {"c", "a"}}) == [["a", "b"], ["c", "d"]]
+
+
+def test_the_graph_sees_function_local_and_relative_imports():
+    sources = {"infomarket.p.a": ("from . import b\n", False),
+               "infomarket.p.b": ("def f():\n    from .a import g\n", False),
+               "infomarket.p": ("from .a import x\n", True)}
+    global MODULES
+    saved, MODULES = MODULES, {m: None for m in sources}
+    try:
+        graph = file_graph(sources)
+    finally:
+        MODULES = saved
+    assert graph == {"infomarket.p.a": {"infomarket.p.b"}, "infomarket.p.b": {"infomarket.p.a"},
+                     "infomarket.p": {"infomarket.p.a"}}
+    assert _cycles(graph) == [["infomarket.p.a", "infomarket.p.b"]]
+
+
+def test_no_import_circle_between_files():
+    graph = file_graph()
+    assert "infomarket.ledger.kernels" in graph["infomarket.engine.step"]  # the graph is really drawn
+    assert [c for c in _cycles(graph) if tuple(c) not in KNOWN_CIRCLES] == []
+
+
+def test_the_known_circles_are_still_there():
+    """Once a branch removes its circle, take it out of KNOWN_CIRCLES (so it cannot come back unseen)."""
+    found = {tuple(c) for c in _cycles(file_graph())}
+    assert [c for c in KNOWN_CIRCLES if c not in found] == []
+
+
+def test_the_why_comment_finder():
+    text = ("def f():\n    from .a import b  # a imports this module\n"
+            "def g():\n    # a imports this module\n    from .a import b\n\n    from .c import d\n"
+            "def h():\n    from .a import b\n    import numpy\n"
+            "def k():\n    x = 1\n    from .c import d\n")
+    assert unexplained_local_imports(text) == ["from .a import b", "from .c import d"]
+
+
+def test_function_local_imports_of_project_modules_say_why():
+    found = {}
+    for module, path in sorted(MODULES.items()):
+        rel = str(path.relative_to(PACKAGE))
+        bad = [s for s in unexplained_local_imports(path.read_text(), module, path.name == "__init__.py")
+               if s not in UNEXPLAINED.get(rel, set())]
+        if bad:
+            found[rel] = bad
+    assert found == {}
 
 
 def _unit(module: str) -> str | None:
@@ -54,40 +265,10 @@ def _unit(module: str) -> str | None:
 
 def package_graph() -> dict[str, set[str]]:
     graph: dict[str, set[str]] = defaultdict(set)
-    for path in PACKAGE.rglob("*.py"):
-        src = _unit(_module_name(path))
-        if src is None:  # the package's own __init__: the public facade, imports everything
-            continue
-        for mod in _imports(path):
-            dst = _unit(mod)
-            if dst and dst != src:
-                graph[src].add(dst)
+    for module, targets in file_graph().items():
+        src = _unit(module)
+        graph[src] |= {dst for dst in map(_unit, targets) if dst and dst != src}
     return graph
-
-
-def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
-    found, state, stack = [], {}, []
-
-    def visit(node):
-        state[node] = 1
-        stack.append(node)
-        for nxt in sorted(graph.get(node, ())):
-            if state.get(nxt) == 1:
-                found.append(stack[stack.index(nxt):] + [nxt])
-            elif nxt not in state:
-                visit(nxt)
-        stack.pop()
-        state[node] = 2
-
-    for node in sorted(graph):
-        if node not in state:
-            visit(node)
-    return found
-
-
-def test_the_cycle_finder_finds_a_cycle():
-    assert _cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == [["a", "b", "c", "a"]]
-    assert _cycles({"a": {"b"}, "b": set()}) == []
 
 
 def test_no_import_circle_between_packages():

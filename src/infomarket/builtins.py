@@ -33,7 +33,7 @@ register_payment("outlier", schemes.outlier_weights,
                  description="sellers share information_share * reward + stakes by similarity weight",
                  limits={"theta": ("in (0, 180]", lambda v: 0 < v <= 180)})
 
-# The paper's open questions (issue 10, docs/research.md): rules that read the ledger's reputation record.
+# The paper's open questions (docs/research.md): rules that read the ledger's reputation record.
 from .behaviours import reputation  # noqa: E402
 from .payments import adaptive  # noqa: E402
 from .payments import distinct  # noqa: E402
@@ -69,7 +69,7 @@ register_payment("adaptive_outlier", adaptive.adaptive_outlier_weights,
                  limits={"theta": ("in (0, 180]", lambda v: 0 < v <= 180),
                          "theta_min": ("in (0, 180]", lambda v: 0 < v <= 180)})
 
-# Issue 23: the parameterised attack family, the threats the hand-written set lacked, and continuous trust.
+# The parameterised attack family, the threats the hand-written set lacked, and continuous trust.
 from .behaviours import attacks, weighted  # noqa: E402
 
 _UNIT = ("in [0, 1]", lambda v: 0 <= v <= 1)

@@ -18,6 +18,7 @@ from typing import Callable
 
 import numba
 
+from ._numba_internals import CPUDispatcher
 from .errors import ConfigError, RegistrationError, RuleError
 
 #: Fixed leading arguments of each kind of rule (everything after them is a parameter).
@@ -92,7 +93,7 @@ _PAYMENTS: dict[str, PaymentSpec] = {}
 
 
 def _jit(func: Callable) -> Callable:
-    if isinstance(func, numba.core.registry.CPUDispatcher):
+    if isinstance(func, CPUDispatcher):
         return func
     if not inspect.isfunction(func):  # a builtin, a class, a number...: numba compiles only Python functions
         raise RuleError(f"a rule must be a Python function (def ...), got {_shown(func)}")

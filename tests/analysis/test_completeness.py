@@ -64,7 +64,7 @@ def test_a_reduced_future_sweep_prints_inconclusive_n_too_small():
     every answer is inconclusive, and the printed answer says why."""
     table = future.question_table(Frames(robots=sweep(hopeless, runs=2)))
     assert set(table.answer) == {"inconclusive"} and set(table.note) == {"n too small"}
-    md = "\n".join(future.to_markdown(future.Section([], table, ""), lambda df: df.to_csv(sep="|")))
+    md = "\n".join(future.to_markdown(future.Section([], table, "")))
     assert md.count("inconclusive (n too small)") == len(table)
     # with the declared 32 runs nothing is "n too small"
     assert set(future.question_table(Frames(robots=sweep(hopeless)))["note"]) == {""}

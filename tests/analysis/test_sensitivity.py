@@ -222,7 +222,7 @@ def test_a_noisy_output_sits_on_a_floor_of_one_and_a_noiseless_one_on_zero(repli
     assert drift.floor_low < 1.0 < drift.floor_high and drift.floor_low > 0.6
     assert drift.run_share_low > 0.7
     # the floor is drawn on the figure, with its value in the legend, and every panel names its run count
-    from infomarket.analysis.sensitivity import _bars
+    from infomarket.analysis.sensitivity_report import _bars
 
     fig = _bars(s)
     labels = [t.get_text() for ax in fig.axes for t in (ax.get_legend().get_texts() if ax.get_legend() else [])]

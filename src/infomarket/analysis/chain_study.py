@@ -3,7 +3,7 @@ paper's result (Figs. 3-4: the Byzantines' wealth share stays low; Fig. 7: staki
 against 3 Byzantines above Theta) hold when the robots run the ledger themselves (docs/chain-model.md),
 at toychain's and geth-argos's settings, and at what block period, loss rate or gas price does it break?
 
-``infomarket chain-study STORE [STORE ...] --out DIR`` reads the stores of the shipped experiments
+``infomarket chain-study STORE [STORE ...] --out DIR`` (``analysis.chain_cli``; figure: ``analysis.chain_figure``) reads the stores of the shipped experiments
 ``chain_paper``, ``chain_fig7``, ``chain_sweep``, ``chain_fig7_sweep`` (and ``chain_partition`` once
 ``chain.partition`` exists), made with ``infomarket sweep NAME --out STORE``, and writes DIR/chain-study.md,
 DIR/chain-study.csv (question, rule, n, effect with its 95 % interval, answer) and DIR/chain-study.png.
@@ -13,20 +13,17 @@ Cliff's delta with bootstrap intervals, simulated power); a rule its runs cannot
 """
 from __future__ import annotations
 
-import argparse
 import math
-import textwrap
-import tomllib
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from . import stats as st
-from .declared import check, status_of
+from .study import packaged
 
-QUESTIONS = Path(__file__).with_name("chain_questions.toml")
+DECLARATION = packaged("chain_questions.toml")
+QUESTIONS = DECLARATION.path
 YES, NO, INCONCLUSIVE = st.YES, st.NO, st.INCONCLUSIVE
 NOT_RUN, PENDING = "not run", "pending"
 PAPER, FIG7, SWEEP, FIG7_SWEEP, PARTITION = ("chain_paper", "chain_fig7", "chain_sweep", "chain_fig7_sweep",
@@ -36,7 +33,7 @@ AXES = {"period": ("period_{}", 150), "loss": ("loss_{}", 0.0), "gas": ("gas_{}"
 
 
 def declaration() -> dict:
-    return tomllib.loads(QUESTIONS.read_text())
+    return DECLARATION.data
 
 
 # ------------------------------------------------------------------------------------------ per run
@@ -358,7 +355,8 @@ def answer(runs: pd.DataFrame, chain: pd.DataFrame | None = None, decl: dict | N
 
 def markdown(a: Answers, wall: str = "") -> str:
     lines = ["# Chain study: answers", "",
-             "Questions and rules: `src/infomarket/analysis/chain_questions.toml` (declared before the runs).", ""]
+             "Questions and rules: `src/infomarket/analysis/chain_questions.toml` (declared before the runs; "
+             "its amendments and deviations are listed at the end).", ""]
     if a.locks:
         lines += [a.locks, ""]
     if wall:
@@ -370,174 +368,7 @@ def markdown(a: Answers, wall: str = "") -> str:
     for qid, verdict in a.verdicts.items():
         lines += [f"## {qid}: {st.shown(verdict.answer, verdict.note)}", ""]
         lines += [f"- {d}" for d in verdict.details] + [""]
+    lines += DECLARATION.record_markdown()
     return "\n".join(lines)
 
 
-# ------------------------------------------------------------------------------------------ figure
-def figure(a: Answers, path: Path, decl: dict | None = None) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    decl = decl or declaration()
-    runs = a.runs
-    fig, axes = plt.subplots(3, 3, figsize=(15, 12.5), constrained_layout=True)
-    xlabels = {"period": "block period (steps)", "loss": "message loss probability",
-               "gas": "gas price (a reveal's gas / the stake)"}
-    for j, axis in enumerate(("period", "loss", "gas")):
-        pts = axis_values(decl, axis)
-        xs = np.arange(len(pts))
-        ax = axes[0, j]
-        for payment, colour, mk in (("outlier", "tab:orange", "o"), ("staking", "tab:blue", "s")):
-            med, lo, hi, ns = [], [], [], []
-            for _, label in pts:
-                x = (_sel(runs, PAPER, chain=label, payment=payment, byzantines=5) if label == "toychain"
-                     else _sel(runs, SWEEP, chain=label, payment=payment))
-                ns.append(len(x))
-                med.append(np.median(x) if len(x) else np.nan)
-                lo.append(np.percentile(x, 25) if len(x) else np.nan)
-                hi.append(np.percentile(x, 75) if len(x) else np.nan)
-            med, lo, hi = map(np.asarray, (med, lo, hi))
-            name = "Fig. 3C (no stake)" if payment == "outlier" else "Fig. 4C (staking)"
-            ax.errorbar(xs, med, yerr=[med - lo, hi - med], color=colour, marker=mk, capsize=3, label=f"{name}: chain")
-            ref = _sel(runs, PAPER, chain="instant", payment=payment, byzantines=5)
-            if len(ref):
-                ax.axhline(np.median(ref), color=colour, ls="--", lw=1, label=f"{name}: instant ledger (n={len(ref)})")
-        ax.axhline(20.0, color="grey", ls=":", lw=1, label="equal share (5 of 25)")
-        ax.set_xticks(xs, [f"{v:g}" for v, _ in pts])
-        ax.set_xlabel(xlabels[axis])
-        ax.set_ylabel("Byzantines' wealth share, % (median, IQR)")
-        shown = a.table.set_index("question").loc[f"breaks_{axis}", "answer"].split(" (")[0]
-        ax.set_title(f"Figs. 3C/4C vs {axis}; the result breaks: {shown}", fontsize=10)
-        ax.text(0.01, 0.99, f"runs per point: {min(ns)}-{max(ns)}", transform=ax.transAxes, va="top", fontsize=8)
-        ax.legend(fontsize=7, loc="best")
-        ax = axes[1, j]
-        for market, colour, mk in (("staking", "tab:blue", "s"), ("no_staking", "tab:red", "^")):
-            med, lo, hi, ns = [], [], [], []
-            for _, label in pts:
-                x = (_sel(runs, FIG7, "items", chain=label, market=market, rotation_angle=90.0) if label == "toychain"
-                     else _sel(runs, FIG7_SWEEP, "items", chain=label, market=market))
-                ns.append(len(x))
-                med.append(np.median(x) if len(x) else np.nan)
-                lo.append(np.percentile(x, 25) if len(x) else np.nan)
-                hi.append(np.percentile(x, 75) if len(x) else np.nan)
-            med, lo, hi = map(np.asarray, (med, lo, hi))
-            ax.errorbar(xs, med, yerr=[med - lo, hi - med], color=colour, marker=mk, capsize=3,
-                        label=f"{market.replace('_', ' ')}: chain")
-            ref = _sel(runs, FIG7, "items", chain="instant", market=market, rotation_angle=90.0)
-            if len(ref):
-                ax.axhline(np.median(ref), color=colour, ls="--", lw=1, label=f"{market.replace('_', ' ')}: instant (n={len(ref)})")
-        ax.set_xticks(xs, [f"{v:g}" for v, _ in pts])
-        ax.set_xlabel(xlabels[axis])
-        ax.set_ylabel("swarm items, last 10 000 steps (median, IQR)")
-        ax.set_title(f"Fig. 7, 3 Byzantines at 90 deg vs {axis}", fontsize=10)
-        ax.text(0.01, 0.02, f"runs per point: {min(ns)}-{max(ns)}" + ("" if max(ns or [0]) else " (not run)"),
-                transform=ax.transAxes, fontsize=8)
-        ax.legend(fontsize=7, loc="best")
-    # the named settings
-    ax = axes[2, 0]
-    settings = ("instant", "toychain", "geth_argos")
-    conds = [(p, k) for p in ("outlier", "staking") for k in (1, 3, 5)]
-    width = 0.26
-    for i, s in enumerate(settings):
-        data = [_sel(runs, PAPER, chain=s, payment=p, byzantines=k) for p, k in conds]
-        pos = np.arange(len(conds)) + (i - 1) * width
-        ok = [d if len(d) else np.array([np.nan]) for d in data]
-        bp = ax.boxplot(ok, positions=pos, widths=width * 0.9, patch_artist=True, showfliers=False)
-        for b in bp["boxes"]:
-            b.set_facecolor(("lightgrey", "tab:green", "tab:purple")[i])
-        ax.plot([], [], "s", color=("lightgrey", "tab:green", "tab:purple")[i],
-                label=f"{s} (n={max(len(d) for d in data)})")
-    ax.set_xticks(np.arange(len(conds)), [f"{'3' if p == 'outlier' else '4'}{'ABC'[(k - 1) // 2]}" for p, k in conds])
-    ax.set_xlabel("paper condition (Fig. 3: no stake, Fig. 4: staking; A/B/C: 1/3/5 Byzantines)")
-    ax.set_ylabel("Byzantines' wealth share, %")
-    ax.set_title(f"Figs. 3-4: toychain {a.verdicts['wealth_toychain'].answer}, geth-argos "
-                 f"{a.verdicts['wealth_geth_argos'].answer}", fontsize=10)
-    ax.legend(fontsize=7)
-    ax = axes[2, 1]
-    conds7 = [(m, ang) for ang in (45.0, 90.0) for m in ("staking", "no_staking")]
-    for i, s in enumerate(settings):
-        data = [_sel(runs, FIG7, "items", chain=s, market=m, rotation_angle=ang) for m, ang in conds7]
-        pos = np.arange(len(conds7)) + (i - 1) * width
-        ok = [d if len(d) else np.array([np.nan]) for d in data]
-        bp = ax.boxplot(ok, positions=pos, widths=width * 0.9, patch_artist=True, showfliers=False)
-        for b in bp["boxes"]:
-            b.set_facecolor(("lightgrey", "tab:green", "tab:purple")[i])
-        ax.plot([], [], "s", color=("lightgrey", "tab:green", "tab:purple")[i],
-                label=f"{s} (n={max(len(d) for d in data)})")
-    ax.set_xticks(np.arange(len(conds7)), [f"{m.replace('_', ' ')}\n{ang:g} deg" for m, ang in conds7])
-    ax.set_ylabel("swarm items, last 10 000 steps")
-    ax.set_title(f"Fig. 7: toychain {a.verdicts['fig7_toychain'].answer}, geth-argos "
-                 f"{a.verdicts['fig7_geth_argos'].answer}", fontsize=10)
-    ax.legend(fontsize=7)
-    ax = axes[2, 2]
-    pf, pr = a.verdicts["partition_forks"], a.verdicts["partition_rich"]
-    ax.set_axis_off()
-    ax.text(0.02, 0.95, "Partition (food side | nest side)", fontsize=11, va="top", transform=ax.transAxes)
-    ax.text(0.02, 0.80, f"forks that undo payments: {pf.answer}\n{textwrap.fill(pf.note, 50)}\n\n"
-                        f"changes who gets rich: {pr.answer}\n{textwrap.fill(pr.note, 50)}",
-            fontsize=9, va="top", transform=ax.transAxes)
-    fig.suptitle("The paper's result on the robots' own chain (chain_questions.toml)", fontsize=12)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-
-
-# ------------------------------------------------------------------------------------------ CLI
-def load(stores: list[str]) -> tuple[pd.DataFrame, pd.DataFrame | None, str]:
-    """Per-run values of every store given, their chain measures (when a store keeps them) and a line on
-    whether the questions were declared before each store's first run."""
-    from ..store import Store
-    from .frames import Frames
-
-    frames, chains, locks = [], [], []
-    for path in stores:
-        store = Store(path)
-        f = Frames.from_store(store)  # StoreError (exit 2) for a missing or foreign folder
-        if not f.robots.empty:
-            frames.append(f.robots)
-        if callable(getattr(store, "chain", None)):  # a store that keeps the chain measures per run
-            c = store.chain()
-            if len(c):
-                chains.append(c)
-        status = {status_of(check(store.declarations(), {"chain_questions.toml": QUESTIONS}),
-                            "chain_questions.toml", f"questions.{q}") for q in declaration()["questions"]}
-        locks.append(f"{path}: {', '.join(sorted(status))}")
-    robots = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame()
-    chain = pd.concat(chains, ignore_index=True) if chains else None
-    note = ("Declaration record (store.json) for chain_questions.toml: " + "; ".join(locks) +
-            " ('not recorded': the store's record does not list this file; its commit precedes the runs)")
-    return per_run(robots), chain, note
-
-
-def add_subcommand(subparsers) -> None:
-    p = subparsers.add_parser(
-        "chain-study", help="answer the chain study's questions (does the paper's result survive the robots' "
-                            "own chain?) from its stores, with a figure",
-        description="Read the stores of chain_paper, chain_fig7, chain_sweep, chain_fig7_sweep (and "
-                    "chain_partition) and write chain-study.md, chain-study.csv and chain-study.png in DIR: "
-                    "each declared question (chain_questions.toml), its rule, run counts, effect with a 95 % "
-                    "interval, and the answer (yes / no / inconclusive / not run / pending).")
-    p.add_argument("stores", nargs="+", metavar="STORE", help="results stores (infomarket sweep NAME --out STORE)")
-    p.add_argument("--out", required=True, metavar="DIR", help="folder for the answers and the figure")
-    p.add_argument("--wall", default="", help="a line on how long the runs took, copied into chain-study.md")
-    p.set_defaults(func=cmd_chain_study)
-
-
-def cmd_chain_study(args: argparse.Namespace) -> int:
-    from ..cliargs import UsageError, writable_dir
-
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise UsageError(f"--out {out}: exists and is not a directory")
-    runs, chain, locks = load(args.stores)
-    if runs.empty:
-        raise UsageError(f"{', '.join(args.stores)}: no completed runs of the chain study")
-    a = answer(runs, chain)
-    a.locks = locks
-    out = writable_dir(out)
-    (out / "chain-study.md").write_text(markdown(a, args.wall))
-    a.table.to_csv(out / "chain-study.csv", index=False)
-    figure(a, out / "chain-study.png")
-    print(a.table[["question", "n", "answer"]].to_string(index=False))
-    print(f"wrote {out / 'chain-study.md'}, {out / 'chain-study.csv'}, {out / 'chain-study.png'}")
-    return 0

@@ -2,9 +2,8 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
-from ..cliargs import UsageError, writable_dir
+from ..cliargs import writable_dir
 
 
 def add_subcommand(subparsers) -> None:
@@ -17,20 +16,20 @@ def add_subcommand(subparsers) -> None:
     p.add_argument("--vector", choices=("svg", "pdf"), default="svg", help="vector format besides PNG")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.set_defaults(func=cmd_figures)
-    from .chain_study import add_subcommand as add_chain_study  # `infomarket chain-study` (docs/research.md)
+    from .chain_cli import add_subcommand as add_chain_study  # `infomarket chain-study` (docs/research.md)
 
     add_chain_study(subparsers)
 
 
 def cmd_figures(args: argparse.Namespace) -> int:
     """Exit 0 when the report is written, whatever the verdicts: a failed row is a finding, not an error."""
+    # the analysis and matplotlib load when the command runs, not when the CLI starts
     from ..store import Store
     from .frames import Frames
     from .report import build_report
+    from .study import out_dir
 
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise UsageError(f"--out {out}: exists and is not a directory")
+    out = out_dir(args.out)
     # raises StoreError for a missing or foreign folder, StoreDamaged (naming the repair) for a damaged one
     store = Store(args.store)
     frames = Frames.of(store)

@@ -1,6 +1,5 @@
 """Is a store's design complete?  Conditions missing from a shipped experiment, and conditions with fewer
-runs than the others, so that no figure or answer is drawn silently from part of its design (issue 21:
-after ``store repair`` a damaged part is set aside, and a figure would otherwise lose a condition).
+runs than the others, so that no figure or answer is drawn silently from part of its design (after ``store repair`` a damaged part is set aside, and a figure would otherwise lose a condition).
 
 A store does not record the grid it was swept from, but a shipped experiment's grid is known: the
 conditions of an experiment in the store are compared with those the shipped file plans (by their keys,
@@ -14,6 +13,9 @@ import re
 from dataclasses import dataclass
 
 import pandas as pd
+
+from ..config.load import load_experiment, shipped_experiments
+from ..runner.plan import conditions
 
 
 @dataclass(frozen=True)
@@ -53,9 +55,6 @@ def _key(cid: str) -> str:
 
 def gaps(runs: pd.DataFrame) -> dict[str, Gap]:
     """The incomplete shipped experiments of a runs table (the store's ``runs``), by name."""
-    from ..config.load import load_experiment, shipped_experiments
-    from ..runner.plan import conditions
-
     if runs is None or runs.empty or not {"experiment", "condition", "run"} <= set(runs.columns):
         return {}
     ok = runs[runs["status"] == "ok"] if "status" in runs.columns else runs

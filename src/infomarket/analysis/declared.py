@@ -10,7 +10,10 @@ or rule text does).  A report compares that record with the files it answers fro
   first run and has not been edited since;
 - ``edited``: in the record with another hash: the rule was edited after the store's first run;
 - ``added``: not in the record: declared after the store's first run;
-- ``not recorded``: the store predates the record (made before issue 24): nothing can be said.
+- ``not recorded``: the store predates the record (made before stores kept one): nothing can be said.
+
+A file's record of amendments and deviations (``[[amendments]]``, ``[[deviations]]``, read by
+``analysis.study``) is a note about its declarations, not one: it is left out.
 
 A question that declares ``runs`` (its planned run count) is also checked against the runs it is
 answered with (``size_note``).
@@ -23,6 +26,7 @@ from pathlib import Path
 from ..store.declarations import FILES, SECTIONS, fingerprint, fingerprint_file  # noqa: F401  (the record's format)
 
 DECLARED, EDITED, ADDED, NOT_RECORDED = "declared", "edited", "added", "not recorded"
+NOTES = ("amendments", "deviations")  # a file's record of its history, not declarations
 
 
 @dataclass(frozen=True)
@@ -41,6 +45,8 @@ def check(recorded: dict | None, files: dict[str, Path] | None = None) -> list[L
     for name, fp in current.items():
         old = (recorded or {}).get(name)
         for section, h in fp["sections"].items():
+            if section in NOTES:
+                continue
             if old is None:
                 status = NOT_RECORDED
             elif section not in old.get("sections", {}):
@@ -63,8 +69,8 @@ def summary(locks: list[Lock], file: str, prefix: str = "") -> str:
     before the store's first run, and which were edited or added after it."""
     mine = [lk for lk in locks if lk.file == file and lk.section.startswith(prefix)]
     if not mine or all(lk.status == NOT_RECORDED for lk in mine):
-        return (f"{file}: the store holds no record of its declarations (made before issue 24), so whether "
-                "they were declared before its first run cannot be checked here")
+        return (f"{file}: the store holds no record of its declarations (made before stores kept one), "
+                "so whether they were declared before its first run cannot be checked here")
     by = {s: [lk.section for lk in mine if lk.status == s] for s in (DECLARED, EDITED, ADDED)}
     text = f"{file}: {len(by[DECLARED])} of {len(mine)} declarations unchanged since before the store's first run"
     if by[EDITED]:

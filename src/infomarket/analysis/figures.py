@@ -18,13 +18,13 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from ..registry import get_payment
 from . import metrics, stats
+from .headline import load_rules
+from .metrics import THETA_DEG
 from .boxplots import BYZANTINE, HONEST, draw_boxes, honest_vs_byzantine, legend_handles
 from .frames import Frames, MissingDataError, composition, experiment
 
 EQUAL_SHARE_PCT = 100.0 / 25  # every robot's wealth share when wealth is equal (docs/model.md §7)
-THETA_DEG = get_payment("outlier").defaults["theta"]  # outlier threshold (paper, Fig. 7): the scheme's default
 STAKING, NO_STAKING = "#2ca02c", "#ff7f0e"
 
 
@@ -111,7 +111,7 @@ def fig2(robots: pd.DataFrame) -> Figure:
 # ---------------------------------------------------------------------------------------- Figs. 3-4
 def _annotate_mann_whitney(ax: Axes, rows: pd.DataFrame) -> str:
     """The equal-share line, and the tests as text for under the panel: the run-level test the report
-    judges (issue 24) and the paper's robot-level one."""
+    judges and the paper's robot-level one."""
     ax.axhline(EQUAL_SHARE_PCT, **EQUAL_SHARE_LINE, zorder=0)
     honest = rows["honest"].to_numpy(bool)
     if honest.all() or not honest.any():
@@ -256,8 +256,6 @@ def fig7_tests(runs: pd.DataFrame, byzantines: int, *, alpha: float = stats.ALPH
 
 def _fig7_rules() -> tuple[float, float, float]:
     """(alpha, 7B's margin fraction, 7A's margin fraction) as the tolerance rows declare them."""
-    from .headline import load_rules  # headline imports this module: import when drawing
-
     rules = load_rules()
     b, a = rules["fig7B_staking_helps"], rules["fig7A_no_difference"]
     return (float(b.params.get("alpha", stats.ALPHA)), float(b.params.get("margin_fraction", 0.10)),

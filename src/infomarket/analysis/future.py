@@ -1,4 +1,4 @@
-"""The paper's open questions (issue 10): the ``future`` sweep's figures and its declared questions.
+"""The paper's open questions: the ``future`` sweep's figures and its declared questions.
 
 The sweep (``infomarket sweep future``) runs three attacks (``future_liar``, ``future_farmer``,
 ``future_surfer``) against four defences, plus every defence without Byzantines (``future_honest``).
@@ -10,8 +10,8 @@ power, non-inferiority tests for "no cost" and "kept"): yes, no or inconclusive,
 """
 from __future__ import annotations
 
+import html
 import math
-import tomllib
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,12 +24,14 @@ from scipy import stats as sps
 
 from . import stats as st
 from .boxplots import draw_boxes, legend_handles
-from .declared import check, size_note, status_of, summary
-from .figures import _runs_text
+from .declared import size_note, status_of
+from .figures import _runs_text, save
 from .frames import Frames, MissingDataError
+from .headline import DECLARATION
+from .study import Declaration, html_table, md_table
 from ..errors import ConfigError
 
-TOLERANCES = Path(__file__).with_name("tolerances.toml")
+TOLERANCES = DECLARATION.path
 ATTACKS = {"future_liar": "constant liar (scaboteur)", "future_farmer": "reputation farmer",
            "future_surfer": "Theta-surfer"}
 HONEST = "future_honest"
@@ -101,15 +103,19 @@ STATISTICS = {"alpha": st.ALPHA, "power": st.POWER, "margin_fraction": 0.10, "co
               "runs": None}
 
 
+def _declaration(path: str | Path) -> Declaration:
+    return DECLARATION if Path(path) == TOLERANCES else Declaration.read(path)
+
+
 def load_statistics(path: str | Path = TOLERANCES) -> dict:
     """The shared statistical declarations ([statistics]) of the questions, with defaults."""
-    return {**STATISTICS, **tomllib.loads(Path(path).read_text()).get("statistics", {})}
+    return {**STATISTICS, **_declaration(path).data.get("statistics", {})}
 
 
 def load_questions(path: str | Path = TOLERANCES) -> dict[str, Question]:
     """The declared questions; each one's params include the shared [statistics] (its own win)."""
     shared = load_statistics(path)
-    data = tomllib.loads(Path(path).read_text()).get("questions", {})
+    data = _declaration(path).questions
     out = {}
     for qid, spec in data.items():
         params = {**shared, **{k: v for k, v in spec.items() if k not in ("question", "rule")}}
@@ -267,7 +273,7 @@ def question_table(source, questions: dict[str, Question] | None = None) -> pd.D
     predates the store's first run (``declared``: see ``analysis.declared``)."""
     frames = Frames.of(source)
     questions = load_questions() if questions is None else questions
-    locks = check(frames.meta.get("declarations") if frames.meta else None)
+    locks = DECLARATION.locks(frames.meta.get("declarations") if frames.meta else None)
     try:
         runs = swarm_items(frames.robots)
     except MissingDataError as exc:
@@ -368,8 +374,6 @@ class Section:
 def section(frames: Frames, out: Path, vector: str, echo: Callable[[str], None]) -> Section | None:
     """Draw each attack's figure and answer the declared questions; None when the store has no
     future-sweep runs (a paper-only store's report is unchanged)."""
-    from .figures import save
-
     if not has_data(frames):
         return None
     figs = []
@@ -386,13 +390,13 @@ def section(frames: Frames, out: Path, vector: str, echo: Callable[[str], None])
     small = int((table["note"] == st.N_TOO_SMALL).sum())
     echo(f"open questions: {counts.get(YES, 0)} yes, {counts.get(NO, 0)} no, {counts.get(INCONCLUSIVE, 0)} "
          f"inconclusive{f' ({small} with n too small to reach alpha)' if small else ''}, {counts.get(NO_DATA, 0)} no data")
-    lock = summary(check(frames.meta.get("declarations") if frames.meta else None), "tolerances.toml", "questions.")
+    lock = DECLARATION.lock_summary(frames.meta.get("declarations") if frames.meta else None, "questions.")
     return Section(figs, table, lock)
 
 
 INTRO = ("The paper's future work, run: reputation-aware scepticism and adaptive Theta against attacks aimed at "
          "them (docs/research.md). Questions and decision rules: `src/infomarket/analysis/tolerances.toml` "
-         "([statistics], [questions]); the rules were revised for issue 24 after the first full sweep (see the file). "
+         "([statistics], [questions]); the rules were revised after the first full sweep (the amendments are listed at the end of this report). "
          "The sample is the run (swarm items in the last 10 000 steps). Each comparison gives the Hodges-Lehmann "
          "shift and Cliff's delta with 95 % bootstrap intervals, a one-sided Mann-Whitney U test (Holm-adjusted "
          "over the angles or defences the question spans), and its simulated power for the declared margin; "
@@ -400,7 +404,7 @@ INTRO = ("The paper's future work, run: reputation-aware scepticism and adaptive
 COLUMNS = ["question", "answer", "declared", "statistics", "rule"]
 
 
-def to_markdown(s: Section, md_table: Callable[[pd.DataFrame], str]) -> list[str]:
+def to_markdown(s: Section) -> list[str]:
     md = ["## The paper's open questions: reputation-aware defences", "", INTRO, ""]
     for name, caption, files, note in s.figures:
         md += [f"### {name}", "", caption, ""]
@@ -411,9 +415,7 @@ def to_markdown(s: Section, md_table: Callable[[pd.DataFrame], str]) -> list[str
     return md
 
 
-def to_html(s: Section, html_table: Callable[[pd.DataFrame], str]) -> list[str]:
-    import html
-
+def to_html(s: Section) -> list[str]:
     e = html.escape
     parts = ["<h2>The paper's open questions: reputation-aware defences</h2>", f"<p>{e(INTRO)}</p>"]
     for name, caption, files, note in s.figures:

@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import inspect
 import math
-import tomllib
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -18,11 +17,15 @@ import numpy as np
 import pandas as pd
 
 from . import metrics, stats
-from .figures import THETA_DEG
+from .metrics import THETA_DEG
+from .study import Declaration, packaged
+from .completeness import affected, gaps
 from .frames import Frames, MissingDataError, require
 from ..errors import ConfigError
 
-TOLERANCES = Path(__file__).with_name("tolerances.toml")
+#: the rows (and the open questions, analysis.future) with their record of amendments
+DECLARATION = packaged("tolerances.toml")
+TOLERANCES = DECLARATION.path
 PASS, FAIL, NO_DATA, INCONCLUSIVE = "pass", "fail", "no data", "inconclusive"
 COLUMNS = ["id", "figure", "claim", "paper", "store", "value", "tolerance", "verdict", "note"]
 INCOMPLETE = "incomplete design"  # a row whose experiment lacks conditions of its shipped plan
@@ -58,7 +61,7 @@ class Rule:
 
 def load_rules(path: str | Path = TOLERANCES) -> dict[str, Rule]:
     """The rules of ``path`` by id, in file order."""
-    data = tomllib.loads(Path(path).read_text())
+    data = (DECLARATION if Path(path) == TOLERANCES else Declaration.read(path)).data
     rules = {}
     for rid, spec in data["rows"].items():
         bounds = {k: float(spec[k]) for k in ("min", "max", "above", "below") if k in spec}
@@ -167,7 +170,7 @@ def _fig3_shrinks(f: Frames) -> Measurement:
 
 
 def _mann_whitney(name: str) -> Callable[[Frames], Measurement]:
-    """Run-level (issue 24): each run's honest minus Byzantine mean wealth share (percentage points),
+    """Run-level: each run's honest minus Byzantine mean wealth share (percentage points),
     one-sided Wilcoxon signed-rank test; the paper's robot-level Mann-Whitney, which pools robots over
     runs (pseudo-replicates), is shown beside it.  ``floor``: 1 / 2^runs, the smallest p the runs allow."""
     def measure(f: Frames) -> Measurement:
@@ -297,8 +300,6 @@ def headline_table(source, rules: dict[str, Rule] | None = None) -> pd.DataFrame
     decided it, or ``no data`` when the store lacks what the row needs).
 
     ``source`` is anything ``Frames.of`` reads: a Store, a store path, Frames or a dict of tables."""
-    from .completeness import affected, gaps
-
     frames = Frames.of(source)
     rules = load_rules() if rules is None else rules
     incomplete = gaps(frames.runs)

@@ -5,8 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from ..registry import get_payment
 from .frames import MissingDataError, require
 
+THETA_DEG = get_payment("outlier").defaults["theta"]  # outlier threshold (paper, Fig. 7): the scheme's default
 RUN = ["condition", "run"]  # a run is unique within one experiment by (condition, run)
 
 

@@ -15,13 +15,14 @@ import pandas as pd
 
 from ..store import Store
 from . import future
-from .declared import check, summary
 from .completeness import gaps
 from .figures import FIGURES, save
 from .frames import Frames, MissingDataError
-from .headline import FAIL, INCOMPLETE, INCONCLUSIVE, NO_DATA, PASS, headline_table
+from .headline import DECLARATION as TOLERANCES, FAIL, INCOMPLETE, INCONCLUSIVE, NO_DATA, PASS, headline_table
 from .stats import N_TOO_SMALL, shown
 from .provenance import Provenance, collect_provenance
+from .sensitivity_report import report_section
+from .study import html_table, md_table
 
 TABLE_COLUMNS = {"figure": "figure", "claim": "claim", "paper": "paper", "store": "this store",
                  "tolerance": "tolerance", "verdict": "verdict"}
@@ -84,13 +85,11 @@ def build_report(source, out: str | Path, *, vector: str = "svg", label: str | N
     report.lengths = length_notes(frames.runs)
     for note in report.lengths:
         echo(f"WARNING: {note}")
-    report.lock = summary(check(frames.meta.get("declarations") if frames.meta else None), "tolerances.toml", "rows.")
+    report.lock = TOLERANCES.lock_summary(frames.meta.get("declarations") if frames.meta else None, "rows.")
     report.future = future.section(frames, out, vector, echo)
     store = store if store is not None else (Store(source) if isinstance(source, (str, Path)) else
                                              source if isinstance(source, Store) else None)
     if store is not None:
-        from .sensitivity import report_section
-
         report.sections = report_section(store, out, vector, echo)
     echo(f"paper vs this store: {_counts_text(report)}")
     for name, text in (("report.md", to_markdown(report)), ("report.html", to_html(report))):
@@ -128,17 +127,6 @@ def _label(source) -> str:
 
 
 # ------------------------------------------------------------------------------------------ markdown
-def _md_cell(text) -> str:
-    return str(text).replace("|", "\\|").replace("\n", " ")
-
-
-def _md_table(df: pd.DataFrame) -> str:
-    lines = ["| " + " | ".join(_md_cell(c) for c in df.columns) + " |",
-             "|" + "---|" * len(df.columns)]
-    lines += ["| " + " | ".join(_md_cell(v) for v in row) + " |" for row in df.itertuples(index=False)]
-    return "\n".join(lines)
-
-
 def _counts_text(report: Report) -> str:
     c = report.counts()
     notes = report.table["note"] if "note" in report.table else pd.Series(dtype=str)
@@ -165,7 +153,7 @@ def to_markdown(report: Report) -> str:
     md = [f"# Paper figures from {report.source}", "",
           "Figures and headline numbers of *An Information Market for Social Navigation in Robots*, "
           "recomputed from this results store. Tolerances: `src/infomarket/analysis/tolerances.toml` "
-          "(declared before any result was seen; rows marked REVISED there were changed for issue 24 after the full paper sweep).", ""]
+          "(declared before any result was seen; rows marked REVISED there were changed after the full paper sweep: see the amendments at the end).", ""]
     if report.lengths:
         md += ["## Run lengths", "", "These experiments were run at another length than the paper's:", ""] + \
             [f"- **{n}**" for n in report.lengths] + [""]
@@ -188,15 +176,16 @@ def to_markdown(report: Report) -> str:
             md.append(f"*Skipped: {r.note}.*")
         md.append("")
     md += ["## Paper vs this store", "", _summary(report), "",
-           _md_table(_shown_table(report)), ""]
+           md_table(_shown_table(report)), ""]
     if report.future is not None:
-        md += future.to_markdown(report.future, _md_table)
+        md += future.to_markdown(report.future)
     md += ["## Provenance", ""]
     md += [f"- {k}: {v}" for k, v in report.provenance.facts.items()]
     if not report.provenance.experiments.empty:
-        md += ["", _md_table(report.provenance.experiments)]
+        md += ["", md_table(report.provenance.experiments)]
     for section, _ in report.sections:
         md += ["", section]
+    md += ["", *TOLERANCES.record_markdown()]
     return "\n".join(md) + "\n"
 
 
@@ -209,17 +198,6 @@ td,th{border:1px solid #ccc;padding:4px 8px;text-align:left;vertical-align:top}t
 .note{color:#666;font-style:italic}"""
 
 
-def _html_table(df: pd.DataFrame, verdicts: bool = False) -> str:
-    head = "".join(f"<th>{html.escape(str(c))}</th>" for c in df.columns)
-    body = []
-    for row in df.itertuples(index=False):
-        cls = ""
-        if verdicts:
-            cls = f' class="{str(row[-1]).split(" (")[0].replace(" ", "")}"'
-        body.append(f"<tr{cls}>" + "".join(f"<td>{html.escape(str(v))}</td>" for v in row) + "</tr>")
-    return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
-
-
 def to_html(report: Report) -> str:
     e = html.escape
     parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>Paper figures from {e(report.source)}"
@@ -227,7 +205,7 @@ def to_html(report: Report) -> str:
              f"<h1>Paper figures from {e(report.source)}</h1>",
              "<p>Figures and headline numbers of <i>An Information Market for Social Navigation in Robots</i>, "
              "recomputed from this results store. Tolerances: <code>src/infomarket/analysis/tolerances.toml"
-             "</code> (declared before any result was seen; rows marked REVISED there were changed for issue 24 after the full paper sweep).</p>", "<h2>Figures</h2>"]
+             "</code> (declared before any result was seen; rows marked REVISED there were changed after the full paper sweep: see the amendments at the end).</p>", "<h2>Figures</h2>"]
     if report.lengths:
         parts += ["<h2>Run lengths</h2><p>These experiments were run at another length than the paper's:</p><ul>"] \
             + [f"<li><b>{e(n)}</b></li>" for n in report.lengths] + ["</ul>"]
@@ -243,14 +221,15 @@ def to_html(report: Report) -> str:
         else:
             parts.append(f"<p class='note'>Skipped: {e(r.note)}.</p>")
     parts += ["<h2>Paper vs this store</h2>", f"<p>{e(_summary(report))}</p>",
-              _html_table(_shown_table(report), verdicts=True)]
+              html_table(_shown_table(report), verdicts=True)]
     if report.future is not None:
-        parts += future.to_html(report.future, _html_table)
+        parts += future.to_html(report.future)
     parts.append("<h2>Provenance</h2><ul>")
     parts += [f"<li>{e(k)}: {e(v)}</li>" for k, v in report.provenance.facts.items()]
     parts.append("</ul>")
     if not report.provenance.experiments.empty:
-        parts.append(_html_table(report.provenance.experiments))
+        parts.append(html_table(report.provenance.experiments))
     parts += [section for _, section in report.sections]
+    parts.append(TOLERANCES.record_html())
     parts.append("</body></html>")
     return "\n".join(parts) + "\n"

@@ -2,9 +2,8 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 
-from ..cliargs import UsageError, writable_dir
+from ..cliargs import writable_dir
 
 
 def add_subcommand(subparsers) -> None:
@@ -27,14 +26,15 @@ def add_subcommand(subparsers) -> None:
 
 
 def cmd_sensitivity(args: argparse.Namespace) -> int:
+    # the analysis (SALib, matplotlib) loads when the command runs, not when the CLI starts
     from ..errors import report
     from ..store import Store
     from .frames import MissingDataError
-    from .sensitivity import declared_answers, from_store, local_robustness, stem, summary_table, write
+    from . import study
+    from .sensitivity import from_store, local_robustness
+    from .sensitivity_report import declared_answers, stem, summary_table, write
 
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise UsageError(f"--out {out}: exists and is not a directory")
+    out = study.out_dir(args.out)
     try:
         s = from_store(args.store, args.experiment)
     except MissingDataError as exc:

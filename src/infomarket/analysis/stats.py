@@ -9,7 +9,7 @@ hand calculations.
   (at step 0 every robot holds the same wealth, where BCa would return NaN).  Resampling is seeded, so
   a report is reproducible byte for byte.
 
-Run-level comparisons (issue 24, "statistics you can trust"): every research answer and report verdict
+Run-level comparisons: every research answer and report verdict
 that compares two conditions goes through ``compare`` / ``answer_*`` here, so each states
 
 - the effect with an interval: the Hodges-Lehmann shift (median of all pairwise differences x_i - y_j,

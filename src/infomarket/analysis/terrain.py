@@ -7,7 +7,7 @@ the items per site stored with the two_food sweep (or a two_food_sites store), a
 DIR/terrain.json and DIR/terrain.png.  Every test is on per-run values or on robots pooled over runs,
 as the questions say; the answers are whatever the rules give, "no" included.
 
-Issue 24: each comparison also reports its run-level effect with a bootstrap interval and the power its
+Each comparison also reports its run-level effect with a bootstrap interval and the power its
 run count gives (``analysis.stats``); a rule its run count cannot decide answers "inconclusive".  Two-food
 is tested at the run level (Wilcoxon signed-rank on per-run honest - Byzantine gaps), the robot-level
 p-value reported beside it; the crowd's ratio is read from its bootstrap interval.
@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -24,22 +23,23 @@ import pandas as pd
 from scipy import stats as sps
 
 from ..cliargs import UsageError
+from ..store.results import Store
 from . import stats as st
-from .declared import check, size_note, summary
+from . import study
+from .declared import size_note
 from .stats import mann_whitney
 
-QUESTIONS = Path(__file__).with_name("terrain_questions.toml")
+DECLARATION = study.packaged("terrain_questions.toml")
+QUESTIONS = DECLARATION.path
 
 
 def questions() -> dict:
-    return tomllib.loads(QUESTIONS.read_text())["questions"]
+    return DECLARATION.questions
 
 
 def _two_food_sites(root: Path) -> pd.DataFrame | None:
     """Items per site of the runs with two food sites: from the ``two_food`` sweep's store (sweeps store
     the sites table), else from a ``two_food_sites`` store (``infomarket run``); None without either."""
-    from ..store.results import Store
-
     for name in ("two_food", "two_food_sites"):
         store = Store(root / name)
         if not store.exists():
@@ -55,8 +55,6 @@ def _two_food_sites(root: Path) -> pd.DataFrame | None:
 
 
 def _robots(root: Path, name: str) -> pd.DataFrame:
-    from ..store.results import Store
-
     path = root / name
     store = Store(path)
     if not store.exists():
@@ -160,7 +158,7 @@ def _separation(sub: pd.DataFrame, alpha: float) -> dict:
 
 def outlier_two_food(robots: pd.DataFrame, rule: dict, sites: pd.DataFrame | None) -> dict:
     """Q3: honest vs Byzantine wealth share with two food sites (and with one, descriptive).  The test is
-    run-level (issue 24): each run's honest-minus-Byzantine mean share, Wilcoxon signed-rank; the
+    run-level: each run's honest-minus-Byzantine mean share, Wilcoxon signed-rank; the
     robot-level Mann-Whitney of the original rule pools robots over runs and is reported beside it."""
     two = _separation(robots[robots.food_sites == 2], rule["p_below"])
     one = _separation(robots[robots.food_sites == 1], rule["p_below"])
@@ -183,7 +181,7 @@ def outlier_two_food(robots: pd.DataFrame, rule: dict, sites: pd.DataFrame | Non
 
 def crowd_collisions(robots: pd.DataFrame, rule: dict) -> dict:
     """Q4: per-robot items per run with collisions on vs off, 100 robots (25, descriptive).  The answer
-    reads the bootstrap interval of the ratio of medians (issue 24): yes when it lies at or above
+    reads the bootstrap interval of the ratio of medians: yes when it lies at or above
     min_ratio, no when below, inconclusive when it straddles."""
     per_run = robots.groupby(["robots", "collisions", "run"], observed=True).items_collected.mean()
     out = {}
@@ -203,7 +201,7 @@ def crowd_collisions(robots: pd.DataFrame, rule: dict) -> dict:
 
 def _boxes(ax, data: list, labels: list[str], positions=None) -> None:
     """Box plots in the report's convention (``boxplots.draw_boxes``), each tick naming its run count."""
-    from .boxplots import HONEST, draw_boxes
+    from .boxplots import HONEST, draw_boxes  # matplotlib loads when drawing, not when the CLI starts
 
     pos = list(range(1, len(data) + 1)) if positions is None else list(positions)
     draw_boxes(ax, [np.asarray(d, float) for d in data], pos, HONEST, width=0.55)
@@ -269,13 +267,10 @@ def figure(a: dict, path: Path) -> Path:
 
 def _declarations(root: Path, names) -> list[str]:
     """Per store: were the terrain questions declared before its first run (analysis.declared)?"""
-    from ..store.results import Store
-
     out = []
     for name in names:
         if (root / name).exists():
-            out.append(f"store {name}: " + summary(check(Store(root / name).declarations()),
-                                                   "terrain_questions.toml", "questions."))
+            out.append(f"store {name}: " + DECLARATION.lock_summary(Store(root / name).declarations(), "questions."))
     return out
 
 
@@ -383,6 +378,7 @@ def markdown(a: dict) -> str:
     if "declarations" in a:
         lines.append("")
         lines += [f"- {line}" for line in a["declarations"]]
+    lines += ["", *DECLARATION.record_markdown()]
     return "\n".join(lines) + "\n"
 
 
@@ -405,14 +401,11 @@ def add_subcommand(subparsers) -> None:
 
 
 def cmd_terrain_report(args: argparse.Namespace) -> int:
-    from ..cliargs import writable_dir
-
-    root = Path(args.results)
-    a = answer(root)
-    out = writable_dir(Path(args.out))
-    (out / "terrain.md").write_text(markdown(a))
-    (out / "terrain.json").write_text(json.dumps(_jsonable(a), indent=1))
-    figure(a, out / "terrain.png")
-    print(markdown(a))
-    print(f"wrote {out / 'terrain.md'}, {out / 'terrain.json'}, {out / 'terrain.png'}")
+    out = study.out_dir(args.out)
+    a = answer(Path(args.results))
+    text = markdown(a)
+    files = study.write(out, "terrain", text, extra=[("terrain.json", json.dumps(_jsonable(a), indent=1))],
+                        figure=lambda p: figure(a, p))
+    print(text)
+    print(f"wrote {', '.join(str(f) for f in files)}")
     return 0

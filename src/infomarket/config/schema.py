@@ -11,14 +11,15 @@ from __future__ import annotations
 import hashlib
 import json
 import re
+from pathlib import Path
 from typing import Annotated, Any, Literal, Union
 
-from pydantic import BaseModel, StrictBool, ConfigDict, Field, ValidationInfo, field_validator, model_validator
+from pydantic import BaseModel, StrictBool, ConfigDict, Field, ValidationError, ValidationInfo, field_validator, model_validator
 
 from .. import plugins
 from ..errors import ConfigError
 from ..registry import behaviours, payments
-from . import chain as chain_rules, sizes, terrain
+from . import chain as chain_rules, messages, sizes, terrain
 from .sample import Sample
 
 #: Seeds are 63-bit everywhere (files, the command line, the Python API, the store's int64 columns).
@@ -377,8 +378,6 @@ class Experiment(_Strict):
 
     def with_overrides(self, **changes) -> "Experiment":
         """A re-validated copy with top-level fields replaced (e.g. steps, runs, seed)."""
-        from .load import validate  # (load imports this module)
-
         data = self.model_dump()
         data.update(changes)
         return validate(data)  # one ConfigError naming the key; plugins are absolute paths or module names by now
@@ -392,3 +391,21 @@ class Experiment(_Strict):
         elif data.get("chain", {}).get("partition", 0) is None:
             data["chain"].pop("partition")  # and chain setups without a partition
         return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:16]
+
+
+#: Union branches that pydantic names inside error locations (``food`` is one site or a list of sites;
+#: an obstacle's ``shape`` picks its model): left out of the key paths users see.
+_BRANCHES = {"Site": None, "list[Site]": None, "rect": Rect, "circle": CircleObstacle, "segment": Segment}
+
+
+def validate(data: dict[str, Any], source: str = "configuration", base: Path | None = None) -> Experiment:
+    """Validate a dictionary in our schema; raise ConfigError listing every problem.  ``base`` is the
+    folder relative plugin paths are resolved against (the experiment file's)."""
+    if not isinstance(data, dict):
+        raise ConfigError(f"{source}: an experiment is a table of keys (a dict), got {type(data).__name__}")
+    try:
+        return Experiment.model_validate(data, context={"base": base})
+    except RecursionError:
+        raise ConfigError(f"{source}: nested too deeply to be an experiment") from None
+    except ValidationError as exc:
+        raise ConfigError(messages.invalid(source, exc, Experiment, _BRANCHES)) from None

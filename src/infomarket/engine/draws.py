@@ -12,8 +12,8 @@ from __future__ import annotations
 import numpy as np
 from numba import types
 from numba.extending import overload
-from numba.np.random.distributions import random_normal
-from numba.np.random.generator_core import next_double
+
+from .._numba_internals import next_double, random_normal
 
 
 def uniform(source):

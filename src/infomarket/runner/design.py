@@ -32,6 +32,10 @@ from ..config.sample import BUILTIN_OUTPUTS, Sample
 from ..config.schema import Experiment
 from ..errors import ConfigError
 from ..registry import behaviours
+from ..store import StoreError
+from ..store.files import write_atomic, write_text_atomic
+from ..store.results import write_table
+from .keypaths import KEY_PART, label, set_path
 
 #: Corners checked exhaustively up to this many keys (2^D validations); beyond, the two extreme corners
 #: and each key at each end with the others at the opposite end and at their low end.
@@ -131,12 +135,10 @@ class Design:
 # -------------------------------------------------------------------------------------- key paths
 def _get(data: dict, path: str, where: str) -> tuple[bool, Any]:
     """(found, value) at a dotted path; a missing entry of a ``params`` table is (False, None)."""
-    from .plan import _PART
-
     node: Any = data
     parts = path.split(".")
     for k, part in enumerate(parts):
-        m = _PART.match(part)
+        m = KEY_PART.match(part)
         if not m:
             raise ConfigError(f"{where}: {path!r} is not a key path (like payment.stake or swarm.groups[1].count)")
         name, index = m.group(1), m.group(2)
@@ -167,16 +169,12 @@ def _kind(data: dict, path: str, where: str) -> bool:
 def apply(base: dict, design_keys: list[str], also: list[list[str]], remainder: str | None,
           values, where: str) -> dict:
     """A copy of ``base`` with each key (and the keys that follow it) set; then the remainder count."""
-    from .plan import _set_path
-
     data = copy.deepcopy(base)
     for key, follow, v in zip(design_keys, also, values):
         for path in (key, *follow):
-            _set_path(data, path, v, where)
+            set_path(data, path, v, where)
     if remainder is not None:
-        from .plan import _PART
-
-        k = int(_PART.match(remainder.split(".")[1]).group(2))
+        k = int(KEY_PART.match(remainder.split(".")[1]).group(2))
         others = sum(g["count"] for j, g in enumerate(data["swarm"]["groups"]) if j != k)
         data["swarm"]["groups"][k]["count"] = data["swarm"]["robots"] - others
     return data
@@ -211,15 +209,13 @@ def _check_both_kinds(cfg: Experiment, outputs: list[str], where: str) -> None:
 
 def make_design(exp: Experiment, seed: int | None = None) -> Design:
     """The design of ``exp``'s ``[sweep.sample]``, checked at every corner, drawn by SALib."""
-    from .plan import _label
-
     sample: Sample = exp.sweep.sample
     master = exp.seed if seed is None else seed
     where = f"{exp.name}: sweep.sample"
     base = exp.model_dump(exclude={"sweep"})
     keys = list(sample.bounds)
     bounds = [sample.bound(k) for k in keys]
-    names = [b.name or _label(k) for k, b in zip(keys, bounds)]
+    names = [b.name or label(k) for k, b in zip(keys, bounds)]
     for n in names:
         if n in ("point", "experiment", "condition", "run", "seed") or n in BUILTIN_OUTPUTS:
             raise ConfigError(f"{where}.bounds: the column name {n!r} is taken; give the key a `name`")
@@ -241,10 +237,8 @@ def make_design(exp: Experiment, seed: int | None = None) -> Design:
         integer.append(is_int)
     rem = sample.remainder
     if rem is not None:
-        from .plan import _PART
-
         parts = rem.split(".")
-        m = _PART.match(parts[1]) if len(parts) == 3 else None
+        m = KEY_PART.match(parts[1]) if len(parts) == 3 else None
         if not (parts[0] == "swarm" and m and m.group(1) == "groups" and m.group(2) is not None
                 and parts[2] == "count"):
             raise ConfigError(f"{where}.remainder: {rem!r} must be a group's count, like swarm.groups[0].count")
@@ -258,8 +252,8 @@ def make_design(exp: Experiment, seed: int | None = None) -> Design:
     for corner in _corners(len(keys)):
         vals = [int(high[j] if c else low[j]) if integer[j] else (high[j] if c else low[j])
                 for j, c in enumerate(corner)]
-        label = ", ".join(f"{n} = {v}" for n, v in zip(names, vals))
-        at = f"{where}: at the corner {label}"
+        shown = ", ".join(f"{n} = {v}" for n, v in zip(names, vals))
+        at = f"{where}: at the corner {shown}"
         data = apply(base, keys, also, rem, vals, at)
         try:
             cfg = validate(data, at)
@@ -315,10 +309,6 @@ def _paths(root: Path, experiment: str) -> tuple[Path, Path]:
 def save(store, design: Design) -> None:
     """Keep the design in the store (matrix first, settings last); refuse a store whose design of the
     same experiment differs.  Call with the store's lock held."""
-    from ..store import StoreError
-    from ..store.files import write_atomic, write_text_atomic
-    from ..store.results import write_table
-
     def write_parquet_atomic(frame, path):  # with each column's unit and description (store.dictionary)
         write_atomic(path, lambda tmp: write_table("designs", frame, tmp))
 
@@ -350,7 +340,6 @@ def designs(root) -> list[str]:
 
 def load(root, experiment: str) -> Design:
     """The design of ``experiment`` kept in the store at ``root``."""
-    from ..store import StoreError
 
     spec_path, matrix_path = _paths(root, experiment)
     try:

@@ -11,7 +11,6 @@ import copy
 import hashlib
 import itertools
 import json
-import re
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -19,9 +18,10 @@ from ..config.load import validate
 from ..config.schema import Experiment
 from ..seeds import run_seed
 from ..errors import ConfigError
+from .design import design_data, make_design
+from .keypaths import label, set_path
 
 BASE = "base"
-_PART = re.compile(r"^([A-Za-z_][A-Za-z0-9_]*)(?:\[(\d+)\])?$")
 
 
 @dataclass(frozen=True)
@@ -48,38 +48,6 @@ def condition_number(cid: str) -> int:
     return int(hashlib.sha256(cid.encode()).hexdigest()[:15], 16)
 
 
-def _set_path(data: dict, path: str, value: Any, where: str) -> None:
-    """Assign ``value`` at a dotted path like ``swarm.groups[1].params.rotation_angle``."""
-    parts = path.split(".")
-    node: Any = data
-    for k, part in enumerate(parts):
-        m = _PART.match(part)
-        if not m:
-            raise ConfigError(f"{where}: {path!r} is not a key path (like payment.stake or swarm.groups[1].count)")
-        name, index = m.group(1), m.group(2)
-        last = k == len(parts) - 1
-        if not isinstance(node, dict) or (name not in node and not (last and parts[k - 1] == "params")):
-            allowed = ", ".join(sorted(node)) if isinstance(node, dict) else "none"
-            raise ConfigError(f"{where}: unknown condition key {path!r}: no {name!r} here; allowed: {allowed}")
-        if index is not None:
-            seq = node[name]
-            if not isinstance(seq, list) or int(index) >= len(seq):
-                raise ConfigError(f"{where}: {path!r}: index {index} out of range")
-            if last:
-                seq[int(index)] = value
-            else:
-                node = seq[int(index)]
-            continue
-        if last:
-            node[name] = value
-        else:
-            node = node[name]
-
-
-def _label(path: str) -> str:
-    return _PART.match(path.split(".")[-1]).group(1)
-
-
 def conditions(exp: Experiment, *, runs: int | None = None, seed: int | None = None,
                scale: float = 1.0) -> list[Condition]:
     """Expand an experiment into its conditions (one, ``base``, when it has no sweep)."""
@@ -94,7 +62,7 @@ def conditions(exp: Experiment, *, runs: int | None = None, seed: int | None = N
     sw = exp.sweep
     if sw.sample is not None:
         return _sampled(exp, master, n_runs(sw.runs or exp.runs))
-    labels = [_label(p) for p in sw.grid] + list(sw.axes)
+    labels = [label(p) for p in sw.grid] + list(sw.axes)
     dupes = {x for x in labels if labels.count(x) > 1}
     if dupes:
         raise ConfigError(f"{exp.name}: sweep keys {sorted(dupes)} would name two columns the same")
@@ -106,11 +74,11 @@ def conditions(exp: Experiment, *, runs: int | None = None, seed: int | None = N
         data = copy.deepcopy(base)
         keys: dict[str, Any] = {}
         for (path, _), value in zip(grid_items, combo[:len(grid_items)]):
-            _set_path(data, path, value, f"{exp.name}: sweep.grid")
-            keys[_label(path)] = value
+            set_path(data, path, value, f"{exp.name}: sweep.grid")
+            keys[label(path)] = value
         for (name, _), av in zip(axis_items, combo[len(grid_items):]):
             for path, value in av.set.items():
-                _set_path(data, path, value, f"{exp.name}: sweep.axes.{name}")
+                set_path(data, path, value, f"{exp.name}: sweep.axes.{name}")
             keys[name] = av.value
         cid = ",".join(f"{k}={json.dumps(keys[k]) if isinstance(keys[k], str) else keys[k]}"
                        for k in sorted(keys)).replace('"', "")
@@ -125,8 +93,6 @@ def conditions(exp: Experiment, *, runs: int | None = None, seed: int | None = N
 
 def _sampled(exp: Experiment, master: int, runs: int) -> list[Condition]:
     """One condition ``point=i`` per row of the experiment's sampled design (``runner.design``)."""
-    from .design import design_data, make_design
-
     design = make_design(exp, master)
     out = []
     for keys, data in design_data(exp, design):

@@ -1,4 +1,4 @@
-"""Adversary search (issue 23): CMA-ES over the parameterised `attacker` to find the worst attack each
+"""Adversary search: CMA-ES over the parameterised `attacker` to find the worst attack each
 defence faces, each candidate evaluated as conditions of a results store on the sweep machinery.
 
 Modules: ``space`` (the parameter vector and its ranges), ``objective`` (what a run is worth to the

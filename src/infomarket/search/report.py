@@ -19,7 +19,7 @@ from ..analysis import stats
 from ..errors import InputTypeError
 from .driver import CellSearch
 from .objective import loss
-from .study import Study
+from .study import DECLARATION, Study
 
 
 def _pick(held, labels, objective):
@@ -158,6 +158,7 @@ def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, s
     for c in a["cells"]:
         p = ", ".join(f"{k}={v:g}" for k, v in c["params"].items())
         lines.append(f"- {c['defence']}, {c['byzantines']} (started at {c.get('start_from') or 'the centre'}): {p}")
+    lines += ["", *DECLARATION.record_markdown()]
     return "\n".join(lines) + "\n"
 
 

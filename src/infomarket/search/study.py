@@ -16,6 +16,7 @@ from pathlib import Path
 
 from ..config.load import validate
 from ..config.schema import Experiment
+from ..analysis.study import Declaration
 from ..errors import ConfigError, UsageError
 from ..registry import payments
 from ..runner.plan import conditions
@@ -23,6 +24,8 @@ from .objective import OBJECTIVES
 from .space import NAMES
 
 QUESTIONS = Path(__file__).with_name("questions.toml")
+#: the declared settings, baselines and questions, with their record of amendments (printed in the report)
+DECLARATION = Declaration.read(QUESTIONS, "search/questions.toml")
 ATTACKER = "attacker"
 
 

@@ -33,9 +33,10 @@ import numpy as np
 from numba import config, types
 from numba.core.datamodel.models import StructModel
 from numba.experimental import structref
-from numba.core import cgutils, ir_utils
+from numba.core import cgutils
 from numba.extending import NativeValue, box, intrinsic, register_model, unbox
 
+from .._numba_internals import BOX, MEMINFO, add_alias, alias_func_extensions
 from .spec import Spec
 
 
@@ -103,10 +104,10 @@ def _unlock_aliases(lhs, args, alias_map, arg_aliases):
     ``@overload(inline="always")`` (the engine's draws) runs numba's dead-code elimination, which sees a
     write into a fresh, unused call result and deletes it: ``unlock(w.site_items)[k] += 1`` next to a
     draw was silently lost (tests/terrain/test_sites_and_collisions.py keeps that case)."""
-    ir_utils._add_alias(lhs, args[0].name, alias_map, arg_aliases)
+    add_alias(lhs, args[0].name, alias_map, arg_aliases)
 
 
-ir_utils.alias_func_extensions[("_unlock", __name__)] = _unlock_aliases
+alias_func_extensions[("_unlock", __name__)] = _unlock_aliases
 
 
 def _identity(array):
@@ -146,7 +147,7 @@ def _box_world(typ, val, c):
     """The new struct's one reference goes to the MemInfo object (which steals it), as numba's boxing."""
     meminfo = cgutils.create_struct_proxy(typ)(c.context, c.builder, value=val).meminfo
     boxed = c.box(types.MemInfoPointer(types.voidptr), meminfo)
-    ctor = c.pyapi.unserialize(c.pyapi.serialize_object(WorldRef._numba_box_))
+    ctor = c.pyapi.unserialize(c.pyapi.serialize_object(getattr(WorldRef, BOX)))
     ty = c.pyapi.unserialize(c.pyapi.serialize_object(typ))
     out = c.pyapi.call_function_objargs(ctor, [ty, boxed])
     for obj in (ctor, ty, boxed):
@@ -159,7 +160,7 @@ def _unbox_world(typ, obj, c):
     """Borrow the handle for the call: the reference unboxing takes is given back when the call ends
     (the ``cleanup``), since compiled code never counts it."""
     mip = types.MemInfoPointer(types.voidptr)
-    mi_obj = c.pyapi.object_getattr_string(obj, "_meminfo")
+    mi_obj = c.pyapi.object_getattr_string(obj, MEMINFO)
     mi = c.unbox(mip, mi_obj).value
     c.pyapi.decref(mi_obj)
     st = cgutils.create_struct_proxy(typ)(c.context, c.builder)

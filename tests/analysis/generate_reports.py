@@ -1,0 +1,89 @@
+"""Every declared study's report, generated from the tests' synthetic stores, to compare before and after a
+change to the analysis (the verdicts, numbers, CSV and JSON must not move):
+
+    PYTHONPATH=src python tests/analysis/generate_reports.py OUT [STORES] [headline future chain terrain sens]
+
+STORES (default /tmp/infomarket-report-stores) keeps the stores between calls: the terrain and sensitivity
+ones run short sweeps, the others are written directly.  Run it on both trees and ``diff -r`` the OUTs.
+"""
+import shutil
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+from infomarket.cli import main  # noqa: E402  (after the repository is on the path)
+from tests.analysis.synthetic import _runs, paper_like, write_store  # noqa: E402
+
+OUT = Path(sys.argv[1]) if __name__ == "__main__" else None
+STORES = Path(sys.argv[2]) if len(sys.argv) > 2 and "/" in sys.argv[2] else Path("/tmp/infomarket-report-stores")
+what = [w for w in sys.argv[2:] if "/" not in w] or ["headline", "future", "chain", "terrain", "sens"]
+
+def fresh(p):
+    if p.exists():
+        shutil.rmtree(p)
+    return p
+
+def run():
+    if "headline" in what:
+        for name, kw in (("paper", {}), ("equal", {"honest_richer": False})):
+            st = STORES / name
+            if not st.exists(): write_store(st, paper_like(**kw))
+            assert main(["figures", str(st), "--out", str(fresh(OUT / f"figures-{name}")), "--quiet"]) == 0
+    if "future" in what:
+        from tests.analysis import test_future as tf
+        for fn in (tf.hopeless, tf.rescued, tf.costly):
+            st = STORES / f"future-{fn.__name__}"
+            if not st.exists():
+                robots = tf.sweep(fn)
+                write_store(st, {"future": (robots, _runs(robots, 30000, 20000, ("byzantines", "defence")), None)})
+            assert main(["figures", str(st), "--out", str(fresh(OUT / f"future-{fn.__name__}")), "--quiet"]) == 0
+    if "chain" in what:
+        from tests.analysis import test_chain_study as tc
+        from infomarket.analysis import chain_study as cs
+        for shift in (0.0, 15.0):
+            d = STORES / f"chain-{shift:g}"
+            if not d.exists(): d.mkdir(parents=True); tc._write(d, shift)
+            assert main(["chain-study", str(d / "store"), "--out", str(fresh(OUT / f"chain-cli-{shift:g}"))]) == 0
+        # in-memory: every question with data
+        rng = np.random.default_rng(8)
+        f7 = []
+        for _, label in cs.axis_values(tc.DECL, "period"):
+            if label != "toychain":
+                f7.append(tc.fig7_runs(rng, n=12, gain=0.0 if label == "period_5" else 60.0, experiment=cs.FIG7_SWEEP,
+                                       settings=(label,), angles=(90.0,)))
+        runs = pd.concat([tc.paper_runs(rng, settings=("toychain", "geth_argos")), tc.sweep_runs(rng, {"period_50"}),
+                          tc.fig7_runs(rng, settings=("instant", "toychain", "geth_argos")), *f7,
+                          tc.partition_runs(rng, 0.0)])
+        a = cs.answer(runs, None)
+        (OUT / "chain-mem").mkdir(parents=True, exist_ok=True)
+        (OUT / "chain-mem" / "chain-study.md").write_text(cs.markdown(a))
+        a.table.to_csv(OUT / "chain-mem" / "chain-study.csv", index=False)
+    if "terrain" in what:
+        from tests.terrain.test_report import _small
+        root = STORES / "terrain"
+        if not root.exists():
+            tmp = STORES / "terrain-toml"; tmp.mkdir(parents=True, exist_ok=True)
+            for name in ("corridor", "two_food", "crowd"):
+                assert main(["sweep", str(_small(name, tmp)), "--runs", "2", "--out", str(root / name), "--workers", "1", "--quiet"]) == 0
+        assert main(["terrain-report", str(root), "--out", str(fresh(OUT / "terrain"))]) == 0
+    if "sens" in what:
+        from tests.analysis import test_sensitivity as ts
+        from infomarket.analysis import sensitivity as sm
+        sm.PAWN_PERMUTATIONS = 20
+        st = STORES / "sens"
+        if not st.exists():
+            st.mkdir(parents=True); ts.sweep(st, "sobol", 128)
+        assert main(["sensitivity", str(st / "store-sobol"), "--out", str(fresh(OUT / "sens"))]) == 0
+        assert main(["figures", str(st / "store-sobol"), "--out", str(fresh(OUT / "sens-figures")), "--quiet"]) == 0
+        st2 = STORES / "shipped-sens"
+        if not st2.exists():
+            assert main(["sweep", "sensitivity", "--samples", "2", "--out", str(st2), "--quiet"]) == 0
+        assert main(["sensitivity", str(st2), "--out", str(fresh(OUT / "sens-shipped"))]) == 0
+    print("done", what)
+
+
+if __name__ == "__main__":
+    run()

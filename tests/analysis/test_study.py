@@ -1,0 +1,120 @@
+"""The declared-study pipeline (analysis.study): a declaration file's record of amendments and deviations
+is read, checked and printed in every report of its study, and it is no declaration (a store's lock check
+leaves it out)."""
+from __future__ import annotations
+
+import copy
+
+import pandas as pd
+import pytest
+
+from infomarket.analysis import chain_study, sensitivity_report, study, terrain
+from infomarket.analysis.declared import ADDED, DECLARED, EDITED
+from infomarket.analysis.report import TOLERANCES
+from infomarket.errors import ConfigError
+from infomarket.search.study import DECLARATION as SEARCH
+from infomarket.store.declarations import fingerprint_file
+
+FILE = """[questions.q1]
+question = "Does it?"
+rule = "p < 0.05"
+
+[[amendments]]
+date = "2026-01-02 10:00 UTC"
+seen = "before any result"
+questions = ["q1"]
+what = "alpha 0.05 instead of 0.1."
+why = "The field's convention."
+
+[[deviations]]
+date = "2026-01-03"
+seen = "after the first runs"
+what = "12 runs per condition, not 24."
+why = "The machine was slower than planned."
+"""
+
+
+def test_the_record_is_printed_whole_and_in_order(tmp_path):
+    (tmp_path / "q.toml").write_text(FILE)
+    d = study.Declaration.read(tmp_path / "q.toml")
+    assert [r.kind for r in d.records()] == ["amendment", "deviation"]
+    assert d.record_markdown() == [
+        "## Amendments and deviations (q.toml)", "",
+        "- **Amendment, 2026-01-02 10:00 UTC** (q1), before any result: alpha 0.05 instead of 0.1. *Why:* The "
+        "field's convention.",
+        "- **Deviation, 2026-01-03**, after the first runs: 12 runs per condition, not 24. *Why:* The machine was "
+        "slower than planned.", ""]
+    assert "<li>Deviation, 2026-01-03, after the first runs: 12 runs per condition" in d.record_html()
+
+
+def test_a_file_without_a_record_says_so(tmp_path):
+    (tmp_path / "q.toml").write_text(FILE.split("[[amendments]]")[0])
+    assert study.Declaration.read(tmp_path / "q.toml").record_markdown()[2] == "q.toml records none: the study ran as declared."
+
+
+@pytest.mark.parametrize("old, new, words", [
+    ('why = "The field\'s convention."', "", "q.toml: amendments[0] lacks why"),
+    ('seen = "after the first runs"', "", "q.toml: deviations[0] lacks seen"),
+    ('what = "alpha', 'when = "x"\nwhat = "alpha', "q.toml: amendments[0]: unknown key 'when'; allowed: date, seen")])
+def test_a_malformed_record_is_refused_naming_it(tmp_path, old, new, words):
+    (tmp_path / "q.toml").write_text(FILE.replace(old, new))
+    with pytest.raises(ConfigError) as e:
+        study.Declaration.read(tmp_path / "q.toml")
+    assert words in str(e.value)
+
+
+def test_the_record_is_no_declaration_for_the_lock_check(tmp_path):
+    """A store recorded before the file had a record: every declaration still reads as declared; an
+    edited rule still reads as edited."""
+    (tmp_path / "q.toml").write_text(FILE)
+    d = study.Declaration.read(tmp_path / "q.toml")
+    now = fingerprint_file(d.path)
+    before = copy.deepcopy(now)
+    for key in ("amendments", "deviations"):
+        before["sections"].pop(key)
+    assert {(lk.section, lk.status) for lk in d.locks({"q.toml": before})} == {("questions.q1", DECLARED)}
+    before["sections"]["questions.q1"] = "0" * 64
+    assert {lk.status for lk in d.locks({"q.toml": before})} == {EDITED}
+    before["sections"].pop("questions.q1")
+    assert {lk.status for lk in d.locks({"q.toml": before})} == {ADDED}
+
+
+SHIPPED = {"chain": chain_study.DECLARATION, "terrain": terrain.DECLARATION, "sensitivity": sensitivity_report.DECLARATION,
+           "tolerances": TOLERANCES, "search": SEARCH}
+
+
+@pytest.mark.parametrize("name", SHIPPED)
+def test_every_shipped_study_records_its_history_in_fields(name):
+    records = SHIPPED[name].records()
+    assert records and all(r.date[:4] == "2026" and r.what and r.why for r in records)
+
+
+def test_the_chain_report_prints_every_amendment_and_deviation():
+    md = chain_study.markdown(chain_study.answer(pd.DataFrame(columns=["experiment"])))
+    for r in chain_study.DECLARATION.records():
+        assert r.markdown() in md
+    assert md.count("- **Amendment, ") == 2 and md.count("- **Deviation, ") == 2
+
+
+def test_the_shipped_records_are_printed_by_their_reports(paper_store, tmp_path):
+    from infomarket.analysis.report import build_report
+
+    build_report(paper_store, tmp_path)
+    md = (tmp_path / "report.md").read_text()
+    assert all(r.markdown() in md for r in TOLERANCES.records()) and md.count("- **Amendment, ") == 3
+    assert "Amendments and deviations (tolerances.toml)" in (tmp_path / "report.html").read_text()
+    assert "issue" not in md.lower()
+
+
+def test_md_and_html_tables():
+    df = pd.DataFrame({"a": ["x|y"], "verdict": ["inconclusive (n too small)"]})
+    assert study.md_table(df) == "| a | verdict |\n|---|---|\n| x\\|y | inconclusive (n too small) |"
+    assert '<tr class="inconclusive"><td>x|y</td>' in study.html_table(df, verdicts=True)
+
+
+def test_out_must_be_a_folder(tmp_path):
+    (tmp_path / "f").write_text("")
+    with pytest.raises(study.UsageError, match="exists and is not a directory"):
+        study.out_dir(tmp_path / "f")
+    files = study.write(tmp_path / "o", "s", "# md\n", table=pd.DataFrame({"a": [1]}), extra=[("s.json", "{}")])
+    assert [f.name for f in files] == ["s.md", "s.csv", "s.json"] and (tmp_path / "o" / "s.csv").read_text() == "a\n1\n"
