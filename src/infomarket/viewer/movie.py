@@ -157,8 +157,9 @@ class ArenaPicture:
         self.bar_text = bar_ax.text(0.5, 0.5, "", ha="center", va="center", fontsize=9, color="#000")
         self.groups = ", ".join(f"{s['kind'].count(k)} {b['name']}" for k, b in enumerate(s["behaviours"]))
 
-    def draw(self, f: Frame) -> None:
-        """Move every artist to frame ``f``."""
+    def draw(self, f: Frame, seed: int | None = None) -> None:
+        """Move every artist to frame ``f``; ``seed``: the run's, when it is not the scene's (an RL
+        environment draws each episode, a new seed, on one picture)."""
         s, r, honest, c = self.scene, self.r, self.honest, f.columns
         xy = np.c_[c["x"], c["y"]]
         a = np.radians(c["heading"].astype(np.float64))
@@ -172,7 +173,8 @@ class ArenaPicture:
             _place(self.rings, xy[in_contact(xy, r)], 2 * r + 3)
         h = f.header
         items = h["items_honest"] + h["items_byzantine"]
-        self.caption.set_text(f"{s['name']} ({self.groups}), seed {s['seed']}: {items:.0f} items collected "
+        seed = s["seed"] if seed is None else seed
+        self.caption.set_text(f"{s['name']} ({self.groups}), seed {seed}: {items:.0f} items collected "
                               f"(honest {h['items_honest']:.0f}, Byzantine {h['items_byzantine']:.0f})")
         if self.chain:
             branch = c["branch"]
