@@ -2,8 +2,8 @@
 
 Needs the ``sb3`` extra (``pip install 'infomarket[sb3]'``: stable-baselines3 and torch).  The env comes
 from Gymnasium's registry (``import infomarket.rl`` registers it); PPO's Gaussian policy acts in
-[-1, 1], so ``RescaleAction`` maps that onto each parameter's own range.  Then the learned policy and the
-experiment's constant 20-degree liar play the same held-out seeds, and the script prints the honest
+[-1, 1], so ``RescaleAction`` maps that onto each parameter's own range; ``FlattenObservation`` gives
+its network one row of every agent's observation.  Then the learned policy and the experiment's constant 20-degree liar play the same held-out seeds, and the script prints the honest
 robots' items per honest robot under each (lower: the stronger attack).
 
     python examples/sb3_attack.py --timesteps 20000
@@ -15,7 +15,7 @@ import json
 
 import gymnasium as gym
 import numpy as np
-from gymnasium.wrappers import RescaleAction
+from gymnasium.wrappers import FlattenObservation, RescaleAction
 from stable_baselines3 import PPO
 
 import infomarket.rl  # registers infomarket/Attack-v0 with Gymnasium
@@ -27,7 +27,7 @@ HELD_OUT = 10_000
 def make_env(args) -> gym.Env:
     env = gym.make(infomarket.rl.ENV_ID, steps=args.steps, transitory=args.transitory, interval=args.interval)
     ones = np.ones(env.action_space.shape, np.float32)
-    return RescaleAction(env, min_action=-ones, max_action=ones)
+    return FlattenObservation(RescaleAction(env, min_action=-ones, max_action=ones))
 
 
 def play(env: gym.Env, policy, seed: int) -> tuple[float, int]:

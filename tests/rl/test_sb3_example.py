@@ -37,3 +37,15 @@ def test_ppo_trains_and_the_liars_score_is_the_engines_run(example):
 def test_the_same_seed_learns_the_same_policy(example):
     a, b = (example.main(ARGS + ["--seed", "1"]) for _ in range(2))
     assert a["learned_items_per_honest"] == b["learned_items_per_honest"] and a["run_seeds"] == b["run_seeds"]
+
+
+def test_stable_baselines3s_own_checker_passes_on_the_examples_env(example):
+    import argparse
+    import warnings
+
+    from stable_baselines3.common.env_checker import check_env
+
+    env = example.make_env(argparse.Namespace(steps=300, transitory=100, interval=10))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        check_env(env)
