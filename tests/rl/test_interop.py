@@ -56,8 +56,8 @@ def test_render_draws_the_arena_as_the_movie_does_with_the_robots_where_they_are
     for _ in range(5):
         env.step(env.runs.default_action)
     img = env.render()
-    width = 600  # rl.interop.RENDER_WIDTH_PX; attack_search's arena is 1200 x 600
-    assert img.dtype == np.uint8 and img.shape == (40 + 26 + 300 + 28, width, 3)
+    width = 720  # rl.interop.RENDER_WIDTH_PX; attack_search's arena is 1200 x 600
+    assert img.dtype == np.uint8 and img.shape == (40 + 26 + 360 + 28, width, 3)
     scale, top = width / 1200, 40 + 26  # caption and legend above the arena
     w = env.runs.worlds[0]
     for i in range(25):
@@ -80,7 +80,7 @@ def test_the_vector_env_renders_each_sub_environment():
     venv = AttackVectorEnv(num_envs=2, **SMALL, render_mode="rgb_array")
     venv.reset(seed=3)
     a, b = venv.render()
-    assert a.shape == b.shape == (394, 600, 3) and not np.array_equal(a, b)  # two runs, two seeds
+    assert a.shape == b.shape == (454, 720, 3) and not np.array_equal(a, b)  # two runs, two seeds
 
 
 def test_pettingzoo_parallel_api_test_passes_with_a_render_mode():
@@ -88,7 +88,7 @@ def test_pettingzoo_parallel_api_test_passes_with_a_render_mode():
     assert env.render_mode == "rgb_array"
     parallel_api_test(env, num_cycles=40)
     env.reset(seed=0)
-    assert env.render().shape == (394, 600, 3)
+    assert env.render().shape == (454, 720, 3)
 
 
 def test_supersuit_wraps_the_parallel_env_as_a_vector_env():

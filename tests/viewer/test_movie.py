@@ -156,3 +156,14 @@ def test_a_chain_movies_caption_says_the_chain_line():
     assert movie.chain_status(header, np.array([0, 1, 1, 2, DROPPED], np.uint8)) == (
         "chain: height 12, 3 forks, 1 reorganisations; 4 robots off the canonical branch, on 2 others")
     assert movie.chain_status(header, np.array([0, DROPPED], np.uint8)).endswith("; 1 robot off the canonical branch")
+
+
+def test_a_caption_too_long_for_the_picture_is_set_smaller_to_fit(recording):
+    picture = movie.ArenaPicture(recording.scene, 720, 120)
+    last = recording.frame(len(recording.frames) - 1)
+    picture.draw(last)
+    normal = picture.caption.get_fontsize()
+    picture.draw(last, seed=2**63 - 1)  # 19 digits: the caption would run past the right edge at 11 pt
+    box = picture.caption.get_window_extent(picture.fig.canvas.get_renderer())
+    assert "seed 9223372036854775807:" in picture.caption.get_text()
+    assert picture.caption.get_fontsize() < normal and box.x1 <= 720

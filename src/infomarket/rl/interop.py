@@ -20,8 +20,8 @@ from ..errors import ConfigError
 from ..viewer.frames import decode, encode, scene
 from ..viewer.movie import ArenaPicture
 
-#: Width of a rendered picture in pixels (its height follows the arena's aspect and the caption).
-RENDER_WIDTH_PX = 600
+#: Width of a rendered picture in pixels, the GIF movie's (its height follows the arena's aspect).
+RENDER_WIDTH_PX = 720
 #: The one render mode: an RGB array [height, width, 3] of uint8.
 RENDER_MODES = ("rgb_array",)
 

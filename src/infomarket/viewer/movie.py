@@ -174,15 +174,15 @@ class ArenaPicture:
         h = f.header
         items = h["items_honest"] + h["items_byzantine"]
         seed = s["seed"] if seed is None else seed
-        self.caption.set_text(f"{s['name']} ({self.groups}), seed {seed}: {items:.0f} items collected "
-                              f"(honest {h['items_honest']:.0f}, Byzantine {h['items_byzantine']:.0f})")
+        _fit(self.caption, f"{s['name']} ({self.groups}), seed {seed}: {items:.0f} items collected "
+                           f"(honest {h['items_honest']:.0f}, Byzantine {h['items_byzantine']:.0f})", 11)
         if self.chain:
             branch = c["branch"]
             forked = (branch != 0) & (branch != DROPPED)
             _place(self.branch_rings, xy[forked], self.ring_d)
             self.branch_rings.set_edgecolors([branch_colour(b) for b in branch[forked]])
             _place(self.dropped_rings, xy[branch == DROPPED], self.ring_d)
-            self.chain_text.set_text(chain_status(h, branch))
+            _fit(self.chain_text, chain_status(h, branch), 9)
         self.bar.set_width(min(f.step / self.total_steps, 1.0))
         self.bar_text.set_text(f"step {f.step} / {self.total_steps}")
 
@@ -206,6 +206,18 @@ def chain_status(header: dict, branch: np.ndarray) -> str:
             f"{header['chain_reorgs']:.0f} reorganisations; {off} robot{'' if off == 1 else 's'} off the canonical "
             "branch")
     return text + (f", on {others} other{'' if others == 1 else 's'}" if others else "")
+
+
+def _fit(text, value: str, fontsize: float) -> None:
+    """Set ``text`` at ``fontsize``, smaller where it would run past the figure's right edge (a long
+    seed, a long name)."""
+    text.set_text(value)
+    text.set_fontsize(fontsize)
+    fig = text.get_figure()
+    box = text.get_window_extent(fig.canvas.get_renderer())
+    room = fig.bbox.width * 0.985 - box.x0
+    if box.width > room:
+        text.set_fontsize(fontsize * room / box.width)
 
 
 def _place(rings, xy: np.ndarray, diameter: float) -> None:
