@@ -3,8 +3,9 @@
 Needs the ``sb3`` extra (``pip install 'infomarket[sb3]'``: stable-baselines3 and torch).  The env comes
 from Gymnasium's registry (``import infomarket.rl`` registers it); PPO's Gaussian policy acts in
 [-1, 1], so ``RescaleAction`` maps that onto each parameter's own range; ``FlattenObservation`` gives
-its network one row of every agent's observation.  Then the learned policy and the experiment's constant 20-degree liar play the same held-out seeds, and the script prints the honest
-robots' items per honest robot under each (lower: the stronger attack).
+its network one row of every agent's observation.  Then the learned policy and the experiment's constant
+20-degree liar play the same held-out seeds, and the script prints the honest robots' items per honest
+robot under each (lower: the stronger attack).
 
     python examples/sb3_attack.py --timesteps 20000
 """
