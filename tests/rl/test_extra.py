@@ -28,3 +28,12 @@ def test_the_commands_exit_2_naming_the_extra(no_gymnasium, argv, capsys):
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert "infomarket[rl]" in err and "Traceback" not in err
+
+
+def test_importing_rl_without_gymnasium_registers_nothing_and_does_not_fail(no_gymnasium):
+    import importlib
+
+    import infomarket.rl as rl
+
+    rl = importlib.reload(rl)  # the import-time registration runs again, with `import gymnasium` failing
+    assert rl.ENV_ID == "infomarket/Attack-v0"

@@ -67,7 +67,20 @@ def test_the_chain_layout_is_aligned_and_a_recording_decodes():
         size = np.dtype(t).itemsize
         assert offset % size == 0
         offset += 7 * size
-    assert fr.frame_size(7, chain=True) == offset
+    assert offset == 64 + 7 * 57 == 463  # 8 header numbers; 13 float32 and 5 uint8 columns
+    assert fr.frame_size(7, chain=True) == 464  # padded to a multiple of 8
+
+
+def test_a_chain_frame_is_padded_so_frames_laid_end_to_end_stay_aligned():
+    """A replay lays its frames end to end and the page reads frame k's float64 header at k times the
+    frame size, so the size must be a multiple of 8: 64 + 57 n bytes is not when n is not (25 robots:
+    1 489 bytes, padded to 1 496)."""
+    assert fr.frame_size(25, chain=True) == 1496 and fr.frame_size(24, chain=True) == 64 + 24 * 57
+    assert all(fr.frame_size(n, chain) % 8 == 0 for n in range(1, 65) for chain in (False, True))
+    sim = _partitioned()
+    cfg = sim.config.with_overrides(swarm={"robots": 5, "groups": [{"behaviour": "naive", "count": 5}]})
+    data = fr.encode(im.Simulation(cfg, 1))
+    assert len(data) == fr.frame_size(5, chain=True) == 64 + 5 * 57 + 3 and data[-3:] == bytes(3)
     cfg = im.load_experiment("fig4C").with_overrides(steps=60, chain={"consensus": "poa", "period": 5})
     rec = record(cfg, 2, every=20)
     last = rec.frame(len(rec.frames) - 1)

@@ -98,3 +98,72 @@ def test_mp4_without_ffmpeg_suggests_a_gif(monkeypatch, tmp_path):
 def test_other_formats_are_refused(tmp_path, name):
     with pytest.raises(ConfigError, match=r"\.mp4 or \.gif"):
         movie.check_movie_path(tmp_path / name)
+
+
+def _chain_recording():
+    """The partition story of test_chain_view at step 5 (robot 0 on a fork, branch 1; robots 1-3 on the
+    canonical branch), with robot 3's branch marked dropped by hand: one frame."""
+    from infomarket.ledger.blocklog import DROPPED
+    from infomarket.viewer import frames as fr
+    from infomarket.viewer.recording import Recording
+
+    from .test_chain_view import _partitioned
+
+    sim = _partitioned()
+    data = bytearray(fr.encode(sim))
+    header, columns = fr.layout(chain=True)
+    offset = 8 * len(header) + sum(4 * np.dtype(t).itemsize for c, t in columns if c != "branch")  # 4 robots
+    assert [c for c, _ in columns][-1] == "branch" and data[offset:offset + 4] == bytes([1, 0, 0, 0])
+    data[offset + 3] = DROPPED
+    return Recording(fr.scene(sim), [bytes(data)], fr.event_columns(sim), 1)
+
+
+def test_a_chain_movie_rings_each_robot_off_the_canonical_branch(tmp_path):
+    """Robot 0 (on branch 1) gets a ring in the first branch colour, robot 3 (dropped) a grey one; robots
+    1 and 2, on the canonical branch, none; the legend names both rings."""
+    rec = _chain_recording()
+    path = movie.write_movie(rec, tmp_path / "chain.gif")
+    with Image.open(path) as im:
+        rgb = np.asarray(im.convert("RGB")).astype(int)
+    height, width, _ = rgb.shape
+    arena_px = 2 * round(width * 600 / 1200 / 2)
+    top = height - 28 - arena_px
+    scale = width / 1200
+    ys, xs = np.mgrid[0:height, 0:width]
+    xy = rec.frame(0).columns
+
+    def near(colour, i, lo, hi, tol=30) -> int:
+        """Pixels of ``colour`` between ``lo`` and ``hi`` pixels from robot i's centre."""
+        d = np.hypot(xs - xy["x"][i] * scale, ys - (top + xy["y"][i] * scale))
+        return int((np.all(np.abs(rgb - colour) < tol, axis=-1) & (d >= lo) & (d <= hi)).sum())
+
+    purple, grey = (0x94, 0x67, 0xBD), (0x66, 0x66, 0x66)
+    ring = (8 * scale + 1.5, 8 * scale + 4.5)  # 3 pixels out from the disc (radius 8), 2 points wide
+    assert near(purple, 0, *ring) > 15
+    assert near(grey, 3, *ring, tol=12) > 8  # dashed: about half a ring
+    for i in (1, 2):
+        assert near(purple, i, *ring) == 0 and near(grey, i, *ring, tol=12) == 0
+    legend = rgb[40:top]
+    assert np.all(np.abs(legend - purple) < 30, axis=-1).sum() > 15  # the ring's legend marker
+
+
+def test_a_chain_movies_caption_says_the_chain_line():
+    """As the page's chain status line: height, forks and reorganisations from the header; the robots off
+    the canonical branch and how many other branches they are on (a dropped branch is not one)."""
+    from infomarket.ledger.blocklog import DROPPED
+
+    header = {"chain_height": 12.0, "chain_forks": 3.0, "chain_reorgs": 1.0}
+    assert movie.chain_status(header, np.array([0, 1, 1, 2, DROPPED], np.uint8)) == (
+        "chain: height 12, 3 forks, 1 reorganisations; 4 robots off the canonical branch, on 2 others")
+    assert movie.chain_status(header, np.array([0, DROPPED], np.uint8)).endswith("; 1 robot off the canonical branch")
+
+
+def test_a_caption_too_long_for_the_picture_is_set_smaller_to_fit(recording):
+    picture = movie.ArenaPicture(recording.scene, 720, 120)
+    last = recording.frame(len(recording.frames) - 1)
+    picture.draw(last)
+    normal = picture.caption.get_fontsize()
+    picture.draw(last, seed=2**63 - 1)  # 19 digits: the caption would run past the right edge at 11 pt
+    box = picture.caption.get_window_extent(picture.fig.canvas.get_renderer())
+    assert "seed 9223372036854775807:" in picture.caption.get_text()
+    assert picture.caption.get_fontsize() < normal and box.x1 <= 720

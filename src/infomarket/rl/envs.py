@@ -21,6 +21,7 @@ from gymnasium.vector.utils import batch_space
 from ..config import sizes
 from ..errors import ArgumentError, ConfigError, InputTypeError, UsageError
 from ..seeds import MAX_SEED
+from .interop import RENDER_MODES, ArenaRenderer, Rebuilt, checked_render_mode
 from .observe import OBSERVATION
 from .runs import ACTIONS, Runs, select_cell
 
@@ -123,20 +124,24 @@ def _spaces(runs: Runs):
     return obs, act
 
 
-class AttackEnv(gym.Env):
+class AttackEnv(Rebuilt, gym.Env):
     """One run of ``experiment`` with its ``attacker`` robots controlled together.
 
     Observation [agents, len(OBSERVATION)] in [0, 1]; action [agents, len(actions)], each column one of
     the attacker's parameters in its own range (default ``rot_base`` in [0, 180] degrees and ``collude``,
     >= 0.5 to share one rotation and buy each other's offers); reward ``REWARDS[reward]``; ``info["seed"]`` is the
-    episode's run seed."""
+    episode's run seed.  ``render_mode="rgb_array"``: ``render()`` draws the arena as the replay movie does.
+    Pickled and copied as its arguments (``rl.interop.Rebuilt``): a copy starts before its first reset."""
 
-    metadata = {"render_modes": []}
+    metadata = {"render_modes": list(RENDER_MODES), "render_fps": 15}
 
     def __init__(self, experiment="attack_search", *, cell: dict | None = None, steps: int | None = None,
-                 transitory: int | None = None, interval: int = 10, actions=ACTIONS, reward: str = "items"):
+                 transitory: int | None = None, interval: int = 10, actions=ACTIONS, reward: str = "items",
+                 render_mode: str | None = None):
         self.interval, self.reward_name = checked(interval, reward)
+        self.render_mode = checked_render_mode(render_mode)
         self.runs = Runs(configured(experiment, cell, steps, transitory), 1, actions=checked_actions(actions))
+        self._renderer = ArenaRenderer(self.runs)
         self.observation_space, self.action_space = _spaces(self.runs)
         self.agents = self.runs.agents
         self._rewards = _Rewarder(self.runs, reward)
@@ -162,26 +167,34 @@ class AttackEnv(gym.Env):
         self._over = truncated
         return self.runs.obs[0].copy(), reward, False, truncated, {"seed": int(self.runs.seeds[0])}
 
+    def render(self) -> np.ndarray | None:
+        """The arena now, [height, width, 3] uint8 (``render_mode="rgb_array"``; otherwise None)."""
+        return self._renderer.rgb(0) if self.render_mode == "rgb_array" else None
 
-class AttackVectorEnv(gym.vector.VectorEnv):
+
+class AttackVectorEnv(Rebuilt, gym.vector.VectorEnv):
     """``num_envs`` independent runs of ``AttackEnv``'s task, stepped in one compiled call.
 
     Sub-environment i seeded with ``seed + i`` (``reset(seed=seed)``) is ``AttackEnv`` reset with that seed,
     episode after episode.  Autoreset is Gymnasium's default, next-step: the ``step`` after a run's episode
-    ends starts its next episode (that run's action is ignored, its reward is 0)."""
+    ends starts its next episode (that run's action is ignored, its reward is 0).  ``render()`` (with
+    ``render_mode="rgb_array"``) draws every sub-environment's arena, a tuple of arrays."""
 
-    metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": []}
+    metadata = {"autoreset_mode": AutoresetMode.NEXT_STEP, "render_modes": list(RENDER_MODES), "render_fps": 15}
+    _CARRIED = Rebuilt._CARRIED + ("_env_rngs",)
 
     def __init__(self, experiment="attack_search", num_envs: int = 64, *, cell: dict | None = None,
                  steps: int | None = None, transitory: int | None = None, interval: int = 10, actions=ACTIONS,
-                 reward: str = "items"):
+                 reward: str = "items", render_mode: str | None = None):
         self.interval, self.reward_name = checked(interval, reward)
+        self.render_mode = checked_render_mode(render_mode)
         cfg = configured(experiment, cell, steps, transitory)
         if isinstance(num_envs, (int, np.integer)) and not isinstance(num_envs, bool) and num_envs > 0:
             too_big = sizes.batch_too_big(cfg, int(num_envs), f"num_envs={num_envs}")
             if too_big:  # checked before any world is built, as a single run's size is
                 raise ArgumentError(too_big)
         self.runs = Runs(cfg, num_envs, actions=checked_actions(actions))
+        self._renderer = ArenaRenderer(self.runs)
         self.num_envs = self.runs.size
         self.single_observation_space, self.single_action_space = _spaces(self.runs)
         self.observation_space = batch_space(self.single_observation_space, self.num_envs)
@@ -229,6 +242,12 @@ class AttackVectorEnv(gym.vector.VectorEnv):
         self._autoreset = truncated.copy()
         terminated = np.zeros(self.num_envs, bool)
         return self.runs.obs.copy(), rewards, terminated, truncated, self._info()
+
+    def render(self) -> tuple[np.ndarray, ...] | None:
+        """Each sub-environment's arena now (``render_mode="rgb_array"``; otherwise None)."""
+        if self.render_mode != "rgb_array":
+            return None
+        return tuple(self._renderer.rgb(b) for b in range(self.num_envs))
 
     def _info(self) -> dict:
         """Each sub-environment's episode seed, with Gymnasium's vector-info mask (every entry set)."""

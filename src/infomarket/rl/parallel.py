@@ -11,24 +11,29 @@ from pettingzoo import ParallelEnv
 
 from ..errors import InputTypeError, UsageError
 from .envs import AttackEnv, action_array
+from .interop import RENDER_MODES, Rebuilt
 from .observe import OBSERVATION
 from .runs import ACTIONS
 
 
-class AttackParallelEnv(ParallelEnv):
+class AttackParallelEnv(Rebuilt, ParallelEnv):
     """One run of ``experiment``; every ``step`` is a decision interval of ``interval`` engine steps.
 
     ``observation_space(agent)``: Box [len(OBSERVATION)] in [0, 1]; ``action_space(agent)``: Box
     [len(actions)] of the attacker's parameters; rewards per agent: ``items`` (shared by all) or
     ``liar_wealth`` (each agent's own gain in wealth share).  All agents are truncated together at the
-    end of the run, and then leave ``agents``."""
+    end of the run, and then leave ``agents``.  ``render_mode="rgb_array"``: ``render()`` draws the arena
+    (as ``AttackEnv``); pickled and copied as its arguments (``rl.interop.Rebuilt``)."""
 
-    metadata = {"name": "infomarket_attack_v0", "render_modes": [], "is_parallelizable": True}
+    metadata = {"name": "infomarket_attack_v0", "render_modes": list(RENDER_MODES), "render_fps": 15,
+                "is_parallelizable": True}
 
     def __init__(self, experiment="attack_search", *, cell: dict | None = None, steps: int | None = None,
-                 transitory: int | None = None, interval: int = 10, actions=ACTIONS, reward: str = "items"):
+                 transitory: int | None = None, interval: int = 10, actions=ACTIONS, reward: str = "items",
+                 render_mode: str | None = None):
         self._env = AttackEnv(experiment, cell=cell, steps=steps, transitory=transitory, interval=interval,
-                              actions=actions, reward=reward)
+                              actions=actions, reward=reward, render_mode=render_mode)
+        self.render_mode = self._env.render_mode
         self.runs = self._env.runs
         self.possible_agents = [f"robot_{i}" for i in self.runs.agents]
         self.agents: list[str] = []
@@ -74,6 +79,16 @@ class AttackParallelEnv(ParallelEnv):
         if truncated:
             self.agents = []
         return out
+
+    def render(self) -> np.ndarray | None:
+        """The arena now, [height, width, 3] uint8 (``render_mode="rgb_array"``; otherwise None)."""
+        return self._env.render()
+
+    def _carried(self) -> dict:
+        return self._env._carried()  # the random streams live in the single env it wraps
+
+    def _carry(self, values: dict) -> None:
+        self._env._carry(values)
 
     def state(self) -> np.ndarray:
         """Every agent's observation row, stacked (the global state a centralised critic may use)."""

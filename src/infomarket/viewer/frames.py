@@ -1,8 +1,9 @@
 """Frames: one snapshot of the swarm, encoded so the browser reads it without parsing.
 
 A frame is a header of float64 numbers followed by one contiguous little-endian array per robot
-attribute (``COLUMNS``), float32 columns first, then uint8 ones, so every column starts on an aligned
-offset and the page wraps each in a typed-array view (no copy, no JSON): 1 000 robots cost 50 kB.
+attribute (``COLUMNS``), float32 columns first, then uint8 ones, then zero bytes up to a multiple of 8
+(``ALIGN``), so every column starts on an aligned offset, in one frame and in a replay's frames laid end
+to end, and the page wraps each in a typed-array view (no copy, no JSON): 1 000 robots cost 50 kB.
 The live server, the self-contained replay and the movie all draw from these same bytes, so the three
 show exactly the same thing.
 
@@ -50,6 +51,10 @@ CHAIN_BYTE_COLUMNS = (("branch", "u1"),)
 #: Bits of the ``flags`` column.
 CARRYING, FOOD_VALID, NEST_VALID, LAST_FOOD, LAST_NEST = 1, 2, 4, 8, 16
 
+#: A frame's size is a multiple of this (the widest column type, the float64 header), so that frame k of
+#: a replay, at k times the frame size, starts where a Float64Array may begin (viewer.js, ``makeLayout``).
+ALIGN = 8
+
 #: How many of a robot's most recent events the side panel lists.
 LAST_EVENTS = 8
 
@@ -68,7 +73,11 @@ def chain_on(sim) -> bool:
 
 
 def frame_size(n: int, chain: bool = False) -> int:
-    """Bytes in one frame of ``n`` robots."""
+    """Bytes in one frame of ``n`` robots, padding included."""
+    return -(-_payload_size(n, chain) // ALIGN) * ALIGN
+
+
+def _payload_size(n: int, chain: bool) -> int:
     header, columns = layout(chain)
     return 8 * len(header) + n * sum(np.dtype(t).itemsize for _, t in columns)
 
@@ -152,8 +161,10 @@ def encode(sim, honest: np.ndarray | None = None, branches: BranchNumbers | None
     }
     if chain:
         values["chain_height"], values["chain_lag"], values["branch"] = chain_views(w, branches)
+    n = len(w.pos)
+    padding = bytes(frame_size(n, chain) - _payload_size(n, chain))
     return header.tobytes() + b"".join(np.ascontiguousarray(values[c], dtype=t).tobytes()
-                                       for c, t in layout(chain)[1])
+                                       for c, t in layout(chain)[1]) + padding
 
 
 @dataclass(frozen=True)

@@ -23,7 +23,7 @@
   const V = {
     mode: "live", scene: null, layout: null, frame: null, selected: null, detail: null,
     showComm: false, playing: false, dirty: true, panelDirty: true, chartsDirty: true, ready: false,
-    history: null, robotsDrawn: 0, view: null,
+    history: null, robotsDrawn: 0, view: null, lastError: null,
     fps: 0, rafFps: 0, drawn: 0, totalDrawn: 0, rafs: 0, fpsSince: performance.now(),
     source: null,
   };
@@ -38,7 +38,9 @@
       offset += n * Typed.BYTES_PER_ELEMENT;
       return col;
     });
-    return { n, columns, size: offset, header: scene.header };
+    // frames.py pads a frame to a multiple of 8 bytes (ALIGN), so that in a replay, where the frames lie
+    // end to end in one buffer, frame k's float64 header starts on an 8-byte boundary
+    return { n, columns, size: Math.ceil(offset / 8) * 8, header: scene.header };
   }
 
   function decodeFrame(buffer, base, L) {
@@ -456,11 +458,13 @@
     requestAnimationFrame(tick);
   }
 
-  function error(message) {
+  /** Show ``message``; a passing one hides after 6 s, a ``lasting`` one (the page cannot go on) stays. */
+  function error(message, lasting = false) {
     const el = $("error");
+    V.lastError = message;
     el.textContent = message; el.hidden = false;
     clearTimeout(error.timer);
-    error.timer = setTimeout(() => { el.hidden = true; }, 6000);
+    if (!lasting) error.timer = setTimeout(() => { el.hidden = true; }, 6000);
   }
 
   function setPlaying(on) {
@@ -608,6 +612,10 @@
     get playing() { return V.playing; },
     get robots() { return V.scene ? V.scene.n : 0; },
     get robotsDrawn() { return V.robotsDrawn; },
+    /** With the chain model: robots drawn with a branch ring (off the canonical branch) in the current frame. */
+    get offCanonical() { return V.offCanonical || 0; },
+    /** The last error the page showed (null when none). */
+    get lastError() { return V.lastError; },
     /** With collisions on: robots drawn in contact with another in the current frame. */
     get contacts() { return V.contacts || 0; },
     get selected() { return V.selected; },
@@ -624,7 +632,7 @@
   const embedded = document.getElementById("infomarket-replay");
   if (embedded) {
     V.mode = "replay";
-    replaySource(JSON.parse(embedded.textContent)).catch((exc) => error(`cannot read the replay: ${exc}`));
+    replaySource(JSON.parse(embedded.textContent)).catch((exc) => error(`cannot read the replay: ${exc}`, true));
   } else {
     V.source = liveSource();
   }
