@@ -88,7 +88,7 @@ NOT_RUN = {
     "infomarket sweep chain_fig7_sweep --out results/chain/chain_fig7_sweep --workers 2 --runs 12":
         "336 chain runs of 30 000 steps",
     "infomarket sweep chain_partition --out results/chain/chain_partition --workers 2":
-        "96 chain runs (45 s); tests/engine/test_chain_partition.py runs partitioned swarms",
+        "96 chain runs (45 s); tests/ledger/test_chain_partition.py runs partitioned swarms",
     "infomarket chain-study results/chain/chain_paper results/chain/chain_fig7 results/chain/chain_sweep "
     "results/chain/chain_fig7_sweep results/chain/chain_partition --out results/chain/report":
         "needs the study's stores; tests/analysis/test_chain_study.py runs it on a synthetic one",

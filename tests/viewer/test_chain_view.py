@@ -1,13 +1,13 @@
 """The viewer with the chain model on (docs/chain-model.md): each robot's chain height, lag and branch in
 the frames, the panel's details and ``Simulation.snapshot``; nothing of it without the chain.  The
-expected views come from the partition story of tests/engine/test_chain.py, worked by hand."""
+expected views come from the partition story of tests/ledger/test_chain.py, worked by hand."""
 from __future__ import annotations
 
 import numpy as np
 
 import infomarket as im
 from infomarket.config.load import validate
-from infomarket.ledger import mempool
+from infomarket.ledger.poa import mempool
 from infomarket.viewer import frames as fr
 from infomarket.viewer.recording import record
 
@@ -22,8 +22,8 @@ def _partitioned():
                     "chain": {"consensus": "poa", "period": 2, "out_of_turn_delay": 3, "signers": [0, 2]}})
     sim = im.Simulation(cfg, 1, record_events=True)
     sim.world.pos[:] = np.array([(100.0, 100.0), (130.0, 100.0), (1000.0, 500.0), (1030.0, 500.0)])
-    mempool.chain_deposit(sim._view, 1)
-    mempool.chain_deposit(sim._view, 3)
+    mempool.send_deposit(sim._view, 1)
+    mempool.send_deposit(sim._view, 3)
     sim.step(5)
     return sim
 

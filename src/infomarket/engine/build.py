@@ -8,7 +8,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..config.schema import Experiment
-from ..ledger import blocks, gas
+from ..ledger import gas
+from ..ledger.poa import arena
 from ..ledger.state import grow_ledger, ledger_of
 from ..registry import get_payment
 from ..state.log import build_log, grow_log
@@ -30,7 +31,7 @@ def build_world(cfg: Experiment, rng: np.random.Generator, *, record_events: boo
                     sites=len(params["sites_r"]))
     ledger = ledger_of(cfg)
     if cfg.chain.enabled:
-        ledger.update(blocks.chain_pool(ledger))
+        ledger.update(arena.chain_pool(ledger))
         world = ChainWorld(**params, **swarm, **ledger, **log, **chain_of(cfg, ledger, rng))
     else:
         world = World(**params, **swarm, **ledger, **log)
@@ -48,11 +49,11 @@ def chain_seed(rng: np.random.Generator) -> int:
 
 
 def chain_of(cfg: Experiment, ledger: dict, rng: np.random.Generator) -> dict:
-    """The chain model's state for a run of ``cfg`` (``ledger.blocks``)."""
+    """The chain model's state for a run of ``cfg`` (``ledger.poa``)."""
     c = cfg.chain
     reveal, deposit = gas.gas_schedule(cfg.payment.scheme, cfg.payment.stake)
     rule = get_payment(cfg.payment.scheme).weights  # weights of a list, nothing else: cached per list
-    return blocks.build_chain(ledger, period=c.period, delay=c.out_of_turn_delay,
+    return arena.build_chain(ledger, period=c.period, delay=c.out_of_turn_delay,
                               signers=c.signers or list(range(cfg.swarm.robots)), backbone=c.backbone,
                               latency=c.latency, loss=c.loss, gas_price=c.gas_price, gas_reveal=reveal,
                               gas_table=list(zip(gas.GAS_DEPOSIT_N, deposit)), seed=chain_seed(rng),
@@ -66,9 +67,9 @@ def make_room(world: World, tx_need: np.ndarray | None = None) -> World:
     overrides each buyer's transaction need (default: open ones + 2 per neighbour)."""
     nbr = world.nbr_count
     changes = grow_swarm(world)
-    if isinstance(world, ChainWorld):  # blocks open transactions: the chain's own bound (ledger.blocks)
-        needs = blocks.chain_needs(kernel_view(world))
-        changes.update(blocks.grow_chain(world, needs))
+    if isinstance(world, ChainWorld):  # blocks open transactions: the chain's own bound (ledger.poa.arena)
+        needs = arena.chain_needs(kernel_view(world))
+        changes.update(arena.grow_chain(world, needs))
         if world.record:
             changes.update(grow_log(world, int(needs[3]), int(needs[4])))
         return world._replace(**changes)

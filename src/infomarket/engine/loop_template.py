@@ -1,5 +1,5 @@
 """Template of the compiled step loop.  Never imported as is: ``engine.specialise`` writes a module made of
-the step options (``TERRAIN``, ``PATHS``, ``CHAIN``), this source, and the three dispatch functions for the
+the step options (``TERRAIN``, ``PATHS``, ``LEDGER``), this source, and the three dispatch functions for the
 configured rules (below, declared and left to the generator), so each rule call is a direct, inlinable
 call and the whole kernel is cached on disk.  Every step piece it calls is in ``engine.step``, written
 once; ``engine.step.variant(TERRAIN, PATHS)`` gives them compiled for this kernel's options, so the code of
@@ -9,9 +9,11 @@ Order of operations per step (docs/model.md §3): neighbours; communication (off
 tables, then every robot buys in id order); move (foraging and payment, install the new table,
 behaviour step, noisy motion), robots in id order.
 
-With ``CHAIN`` (docs/chain-model.md) a step also opens with a gossip round after the neighbours,
-purchases and deposits become pending transactions, and it closes with the signers' blocks; without it
-none of that code is compiled (``CHAIN`` is a constant: numba prunes the branches it turns off).
+``LEDGER`` names the ledger (``ledger.backends``): ``"instant"``, the paper's, or ``"poa"``, the chain
+model (docs/chain-model.md), where a step also opens with a gossip round after the neighbours, purchases
+and deposits become pending transactions, and it closes with the signers' blocks.  The loop calls the
+same operations on either (``ledger.backends.operations``), chosen before anything compiles, so a
+kernel compiles none of the other ledger's code.
 
 Before a step changes anything, ``has_room`` checks that the step cannot outgrow a capacity (neighbour
 lists, pending lists, the transaction pool, the event log); if it could, the loop returns NEED_ROOM
@@ -20,16 +22,18 @@ with the step not begun, the host grows the arrays (``build.make_room``) and cal
 import numpy as np
 from numba import njit
 
-from infomarket.engine.step import chain_variant, record_history, variant
-from infomarket.ledger.kernels import burn_fuel, distribute, expire_stakes, reserve, settlement
-from infomarket.ledger.blocks import room_fits
+from infomarket.engine.step import record_history, variant
+from infomarket.ledger.backends import operations
+from infomarket.ledger.kernels import burn_fuel, distribute, expire_stakes, settlement
+from infomarket.ledger.poa.lists import keep_weights, weighed_before, weights_of
 from infomarket.state.view import unlock
 
 DONE = 0
 NEED_ROOM = 1
 
 # ---- provided by the generator (engine.specialise) --------------------------------------------------
-#: TERRAIN, PATHS, CHAIN: the step options (bools), written above this template
+#: TERRAIN, PATHS (bools), LEDGER (a name of ledger.backends.LEDGERS): the step options, written above this
+#: template
 #: sell_dispatch(kind, w, i, site, rng) -> (valid, x, y, age): robot i's offer for ``site``
 #: buy_dispatch(kind, w, i, nbrs, rng): robot i buys from its neighbours
 #: pay_dispatch(w, buyer, sellers, sites, directions, weights, rng): the scheme's weights
@@ -37,37 +41,24 @@ sell_dispatch = buy_dispatch = pay_dispatch = None
 
 #: This kernel's step pieces (engine.step.variant), chosen by its options before anything compiles.
 find_neighbours, begin_communication, install_table, forage, sense_sites, behaviour_step, move = variant(TERRAIN, PATHS)
+#: The chain model's ledger (a constant: numba prunes the branches it turns off).
+POA = LEDGER == "poa"
 
 
 @njit(cache=True)
 def has_room(w):
     """Can this step fit?  Per robot and site a buy rule may make one purchase per neighbour, and add
-    one pending entry per neighbour; the log gets at most one event per purchase plus a deposit, and
-    the payments log one row per transaction a deposit settles.
-    Transaction blocks that could overflow are moved to bigger ones while the pool has space."""
+    one pending entry per neighbour; the ledger's operations say whether its transactions fit."""
     nbr_count = w.nbr_count
-    n = nbr_count.shape[0]
     kn = w.nbr.shape[1]
     kp = w.pend_seller.shape[2]
-    events = n
-    payments = 0
-    for i in range(n):
+    for i in range(nbr_count.shape[0]):
         c = nbr_count[i]
         if c > kn:
             return False
         if w.pend_count[i, 0] + c > kp or w.pend_count[i, 1] + c > kp:
             return False
-        need = w.tx_count[i] + 2 * c
-        if not CHAIN and need > w.tx_cap[i] and not reserve(w, i, need):
-            return False
-        events += 2 * c
-        payments += need
-    if CHAIN:  # blocks open the transactions (ledger.blocks.chain_needs)
-        return room_fits(w)
-    if w.record and (w.ev_count[0] + events > w.ev_step.shape[0]
-                     or w.pay_count[0] + payments > w.pay_step.shape[0]):
-        return False
-    return True
+    return ledger_has_room(w)
 
 
 @njit(cache=True)
@@ -79,14 +70,22 @@ def weigh(w, i, weights, rng):
 
 @njit(cache=True)
 def settle(w, i, rng):
-    """Robot i deposited: weigh its open transactions with the scheme, then pay (ledger.kernels)."""
+    """Robot i's deposit is settled: the scheme weighs its open transactions, then
+    ``ledger.kernels.distribute`` pays.  In the chain model a list that any branch settled before keeps
+    its weights (``ledger.poa.lists``) when the scheme reads nothing but the list."""
+    if POA:
+        if weighed_before(w, i):
+            distribute(w, i, weights_of(w, i))
+            return
     weights = np.zeros(w.tx_count[i])
     weigh(w, i, weights, rng)
+    if POA:
+        keep_weights(w, i, weights)
     distribute(w, i, weights)
 
 
-#: The chain model's pieces around this kernel's weighing (engine.step.chain_variant), when it has one.
-chain_gossip, chain_deposit, make_blocks = chain_variant(weigh) if CHAIN else (None, None, None)
+#: This kernel's ledger operations (ledger.backends), around its settlement.
+ledger_has_room, begin_step, deposit, end_of_step = operations(LEDGER, settle)
 
 
 @njit(cache=True)
@@ -104,8 +103,7 @@ def run_steps(w, rng, t_end):
         if not has_room(w):
             return NEED_ROOM
         clock[0] += 1
-        if CHAIN:
-            chain_gossip(w)
+        begin_step(w)
         if w.stake_expiry > 0:
             for i in range(n):
                 expire_stakes(w, i)
@@ -125,10 +123,7 @@ def run_steps(w, rng, t_end):
                 buy_dispatch(kind[i], w, i, nbr[i, :nbr_count[i]], rng)
         for i in range(n):
             if forage(w, i, bits):
-                if CHAIN:
-                    chain_deposit(w, i)
-                else:
-                    settle(w, i, rng)
+                deposit(w, i, rng)
             install_table(w, i)
             if stop[i] > 0:
                 stop[i] -= 1
@@ -141,7 +136,6 @@ def run_steps(w, rng, t_end):
                 move(w, i, dx, dy, bits)
             if cool[i] > 0:
                 cool[i] -= 1
-        if CHAIN:
-            make_blocks(w, rng)
+        end_of_step(w, rng)
         record_history(w)
     return DONE

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
 
 from ..config.schema import Experiment
 from ..registry import behaviours
@@ -82,14 +83,21 @@ def guide_table(cdf: np.ndarray) -> np.ndarray:
 
 
 def turn_tables() -> tuple[np.ndarray, np.ndarray]:
-    """cos and sin of every whole-degree turn, computed by compiled code (the same libm calls the
-    kernel made before it looked them up), so a turn costs a table read instead of two calls."""
-    from .step import fill_turn_tables
-
+    """cos and sin of every whole-degree turn, computed by compiled code (the libm calls compiled code
+    makes), so a turn costs the kernel a table read instead of two calls."""
     c = np.empty(360)
     s = np.empty(360)
     fill_turn_tables(c, s, DEG)
     return c, s
+
+
+@njit
+def fill_turn_tables(cos_out, sin_out, deg):
+    """cos and sin of every whole-degree turn (``turn_tables``), with compiled code's libm."""
+    for k in range(cos_out.shape[0]):
+        a = float(k) * deg
+        cos_out[k] = math.cos(a)
+        sin_out[k] = math.sin(a)
 
 
 def site_arrays(cfg: Experiment) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

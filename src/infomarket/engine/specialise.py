@@ -13,8 +13,11 @@ import inspect
 from pathlib import Path
 from types import ModuleType
 
+from ..errors import InternalError
 from ..generated import COMPILED_PARTS, cache_dir, generated_digest, load_generated  # noqa: F401
+from ..ledger.backends import LEDGERS
 from ..registry import BehaviourSpec, PaymentSpec, Rule, get_behaviour, get_payment
+from .params import behaviour_kinds
 
 _TEMPLATE = Path(__file__).with_name("loop_template.py")
 _PACKAGE = Path(__file__).resolve().parents[1]
@@ -57,17 +60,27 @@ def _header(behaviours: list[BehaviourSpec], payment: PaymentSpec) -> str:
     return "\n".join(lines) + "\n"
 
 
+def ledger_name(ledger: str | bool) -> str:
+    """The ``LEDGER`` option: a name of ``ledger.backends.LEDGERS``, or a bool (the chain model or not)."""
+    if isinstance(ledger, bool):
+        return "poa" if ledger else "instant"
+    if ledger not in LEDGERS:
+        raise InternalError(f"unknown ledger {ledger!r}: one of {', '.join(LEDGERS)}")
+    return ledger
+
+
 def generate_source(behaviours: list[BehaviourSpec], payment: PaymentSpec, terrain: bool = False,
-                    paths: bool = False, chain: bool = False) -> str:
+                    paths: bool = False, ledger: str | bool = "instant") -> str:
     """Source of the specialised module (step options + template + dispatch) for these behaviours, in
     kind order; ``terrain`` selects the terrain variant of the step (engine.terrain), ``paths`` adds
-    waypoint paths to it (engine.paths; implies terrain), ``chain`` the chain model (docs/chain-model.md)."""
+    waypoint paths to it (engine.paths; implies terrain), ``ledger`` the ledger (``ledger.backends``:
+    ``"poa"`` is the chain model, docs/chain-model.md)."""
     lines = [_header(behaviours, payment),
              "# ---- step options: compile-time constants (numba freezes them; the branches they guard in",
              "# ---- engine.step are folded away when off)",
              f"TERRAIN = {bool(terrain or paths)}  # obstacles, several sites, line of sight, collisions",
              f"PATHS = {bool(paths)}  # waypoint paths",
-             f"CHAIN = {bool(chain)}  # robots as blockchain nodes (docs/chain-model.md)", "",
+             f"LEDGER = {ledger_name(ledger)!r}  # the ledger (ledger.backends.LEDGERS)", "",
              _TEMPLATE.read_text(),
              "", "# ---- generated dispatch " + "-" * 60,
              "from infomarket.registry import rule_function as _rule_function", ""]
@@ -98,12 +111,12 @@ def uses_paths(behaviour_names: tuple[str, ...]) -> bool:
 
 
 def _kernel_parts(behaviour_names: tuple[str, ...], payment_name: str, terrain: bool,
-                  chain: bool = False) -> tuple[str, str, bool]:
+                  ledger: str | bool = "instant") -> tuple[str, str, bool]:
     """(source, key, cacheable) of the kernel for these rules: the key hashes everything its machine code
     depends on (template, engine source, every rule's source, versions)."""
     behaviours = [get_behaviour(b) for b in behaviour_names]
     payment = get_payment(payment_name)
-    source = generate_source(behaviours, payment, terrain, any(b.paths for b in behaviours), chain)
+    source = generate_source(behaviours, payment, terrain, any(b.paths for b in behaviours), ledger)
     digest = generated_digest(source)
     cacheable = True
     for rule in [r for b in behaviours for r in (b.buy, b.sell)] + [payment.weights]:
@@ -116,11 +129,12 @@ def _kernel_parts(behaviour_names: tuple[str, ...], payment_name: str, terrain: 
 
 
 def kernel_module(behaviour_names: tuple[str, ...], payment_name: str, terrain: bool = False,
-                  chain: bool = False) -> ModuleType:
+                  ledger: str | bool = "instant") -> ModuleType:
     """The specialised kernel module (``run_steps``) for these behaviours (kind order) and scheme, on
     the paper's plane or (``terrain``) with obstacles, several sites, line of sight and collisions;
-    behaviours registered with ``paths=True`` add the paths variant (waypoint paths, engine.paths) to the terrain one."""
-    source, key, cacheable = _kernel_parts(behaviour_names, payment_name, terrain, chain)
+    behaviours registered with ``paths=True`` add the paths variant (waypoint paths, engine.paths) to the
+    terrain one; ``ledger`` as ``generate_source``."""
+    source, key, cacheable = _kernel_parts(behaviour_names, payment_name, terrain, ledger)
     return load_generated("kernel", key, source, cacheable)
 
 
@@ -128,8 +142,6 @@ def kernel_id(cfg) -> str:
     """The digest that names the compiled kernel an experiment runs on (``kernel_<id>.py`` in
     ``cache_dir()``): two experiments with the same id share one kernel, so a warm-up before forking
     workers is needed once per id.  Computes no code."""
-    from .build import behaviour_kinds
-
-    return _kernel_parts(behaviour_kinds(cfg), cfg.payment.scheme, cfg.terrain, cfg.chain.enabled)[1]
+    return _kernel_parts(behaviour_kinds(cfg), cfg.payment.scheme, cfg.terrain, ledger_name(cfg.chain.enabled))[1]
 
 

@@ -11,8 +11,8 @@ turn off before it types them (a kernel neither compiles nor runs a variant it d
 ``paths``    waypoint paths (``engine.paths``): a seeking robot follows the legs of a bought path, its
              waypoints are dead-reckoned, a bump marks the site.  Implies ``terrain``.
 
-The chain model (docs/chain-model.md) adds three pieces, ``chain_variant(settle)``: gossip, the deposit
-transaction, and block making (each block applied once, on a copy of its parent's ledger state).  A kernel without the chain never builds them.
+The ledger's operations (an instant ledger or the chain model) are the ledger's own
+(``ledger.backends``), chosen by the kernel's ``LEDGER`` option.
 
 Nothing here depends on the configured rules; the loop's generated dispatch calls the rules.
 """
@@ -20,12 +20,8 @@ import functools
 import math
 from typing import Callable, NamedTuple
 
-import numpy as np
 from numba import njit
 
-from ..ledger import blocks as _blocks
-from ..ledger.kernels import distribute
-from ..ledger.mempool import chain_deposit
 from ..state.view import unlock
 from .draws import normal, uniform
 from .geometry import norm, outside, rotate, to_frame, to_world, within
@@ -149,7 +145,7 @@ def variant(terrain: bool, paths: bool) -> Step:
     """The step's pieces for these options, chosen before anything compiles.  ``terrain`` and ``paths``
     are constants of the closures below, so numba prunes the branches they turn off before it types
     them: a kernel neither compiles nor runs the code of a variant it does not use (passed as
-    arguments instead, every kernel typed and lowered all of it, and compiled 50-70 % slower)."""
+    arguments instead, every kernel would type and lower all of it)."""
     return _variant(bool(terrain), bool(paths))
 
 
@@ -322,104 +318,6 @@ def _variant(terrain: bool, paths: bool) -> Step:
     return Step(find_neighbours, begin_communication, install_table, forage, sense_sites, behaviour_step, move)
 
 
-# ---- the chain model (docs/chain-model.md) -----------------------------------------------------------
-
-class ChainStep(NamedTuple):
-    """The chain model's pieces of a step, compiled around the kernel's settlement (``chain_variant``)."""
-
-    gossip: Callable
-    deposit: Callable
-    make_blocks: Callable
-
-
-@functools.cache
-def chain_settle(weigh):
-    """A deposit's settlement on the branch being applied, around ``weigh(w, buyer, weights, rng)``:
-    the weights of the buyer's list (``chn_bver``; the ledger arrays' pool holds it, ``materialise``) are
-    those cached when any branch settled the same list (the same node), if the scheme reads nothing but
-    the list (``chn_cache``); else the scheme weighs it (and the weights are cached).  Then
-    ``ledger.kernels.distribute`` pays."""
-
-    @njit
-    def settle(w, buyer, rng):
-        v = w.chn_bver[buyer]
-        k = w.tx_count[buyer]
-        if w.chn_cache and v >= 0 and w.ls_wt[v] >= 0:
-            weights = _blocks.cached_weights(w, v, k)
-        else:
-            weights = np.zeros(k)
-            weigh(w, buyer, weights, rng)
-            if w.chn_cache and v >= 0:
-                _blocks.cache_weights(w, v, weights)
-        distribute(w, buyer, weights)
-
-    return settle
-
-
-@functools.cache
-def chain_variant(weigh) -> ChainStep:
-    """The chain's step pieces around ``weigh(w, buyer, weights, rng)``, the kernel's payment rule (a
-    settlement: it weighs, ``ledger.kernels.distribute`` pays).  Every write goes through ``ledger.blocks``."""
-    settle = chain_settle(weigh)
-
-    @njit
-    def apply_block(w, b, rng):
-        """Apply block b's transactions, in order, to the ledger arrays (which hold its parent's state)."""
-        for k in range(w.blk_ntx[b]):
-            tx = w.blk_tx[w.blk_txoff[b] + k]
-            if _blocks.include_tx(w, b, tx):
-                settle(w, w.mp_buyer[tx], rng)
-                _blocks.finish_deposit(w, b, tx)
-
-    @njit
-    def ledger_at(w, target):
-        """Make the ledger arrays hold the state after block ``target``: a copy of the state it keeps
-        (``ledger.blocks.save_state``); nothing is applied again."""
-        if not _blocks.same_state(w, w.chn_cur[0], target):
-            _blocks.load_state(w, target)
-
-    @njit
-    def make_blocks(w, rng):
-        """End of a step: every signer whose turn has come (in signer-set order) makes a block on its head
-        and applies it (logged, measured); the heaviest block is the canonical head, whose state the
-        ledger arrays hold when this returns; the checkpoint moves up as far as every head agrees."""
-        t = w.clock[0]
-        signers = w.chn_signers
-        for k in range(signers.shape[0]):
-            s = signers[k]
-            if not _blocks.due(w, s, t) or not _blocks.can_make(w):
-                continue
-            parent = w.view_head[s]
-            b = _blocks.new_block(w, s, t)
-            if w.blk_ntx[b] > 0:  # (a block with no transaction shares its parent's state: new_block)
-                ledger_at(w, parent)
-                apply_block(w, b, rng)
-                _blocks.set_current(w, b)
-                _blocks.save_state(w, b)
-            _blocks.adopt(w, s, b)
-            if w.chn_backbone and w.chn_latency == 0:
-                _blocks.deliver_block(w, b)
-            _blocks.new_canonical(w, b)
-        while True:
-            c = _blocks.next_checkpoint(w)
-            if c < 0:
-                break
-            ledger_at(w, c)  # (the lists stay where they are: the checkpoint's block keeps its own)
-            _blocks.move_checkpoint(w, c)
-        ledger_at(w, w.chn_canon[0])
-        _blocks.materialise_all(w)
-
-    @njit
-    def gossip(w):
-        _blocks.gossip(w)
-
-    @njit
-    def deposit(w, i):
-        chain_deposit(w, i)
-
-    return ChainStep(gossip, deposit, make_blocks)
-
-
 # ---- the log -----------------------------------------------------------------------------------------
 
 @njit
@@ -431,12 +329,3 @@ def record_history(w):
         if 0 <= k < hist.shape[0]:
             for i in range(w.pos.shape[0]):
                 hist[k, i] = w.balance[i]
-
-
-@njit
-def fill_turn_tables(cos_out, sin_out, deg):
-    """cos and sin of every whole-degree turn (``params.turn_tables``), with the kernel's libm."""
-    for k in range(cos_out.shape[0]):
-        a = float(k) * deg
-        cos_out[k] = math.cos(a)
-        sin_out[k] = math.sin(a)

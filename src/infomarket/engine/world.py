@@ -22,7 +22,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from ..ledger import blocks as chain_state
+from ..ledger.poa import spec as chain_state
 from ..ledger import state as ledger_state
 from ..state import log as log_state
 from ..state.view import make_view, register_layout
@@ -36,7 +36,7 @@ from ..state.log import EV_DEPOSIT, EV_PURCHASE, EV_REFUSED, EVENT_NAMES  # noqa
 DOMAINS = (params.SPEC, swarm.SPEC, ledger_state.SPEC, log_state.SPEC)
 World = namedtuple("World", tuple(name for spec in DOMAINS for name in spec.names))
 register_layout("world", DOMAINS)
-#: A chain model's world (docs/chain-model.md): the same domains and the chain's (``ledger.blocks``).
+#: A chain model's world (docs/chain-model.md): the same domains and the chain's (``ledger.poa``).
 #: A separate layout, so the paper's world type (and every kernel compiled for it) has none of its fields.
 CHAIN_DOMAINS = DOMAINS + (chain_state.SPEC,)
 ChainWorld = namedtuple("ChainWorld", tuple(name for spec in CHAIN_DOMAINS for name in spec.names))

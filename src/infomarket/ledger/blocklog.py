@@ -6,19 +6,19 @@ block the model made with a stable id (slots of the block store are reused), its
 transactions and every robot's balance after it.  ``canonical()`` then gives the canonical chain, genesis
 first: what ``infomarket chain demo`` replays on the EVM.  It never writes to the world.
 
-What it reads, and the meaning it assumes (``ledger.blocks.SPEC`` and ``ledger.mempool``; written once
+What it reads, and the meaning it assumes (``ledger.poa.spec.SPEC`` and ``ledger.poa.mempool``; written once
 here, so a change of a field is a change of this module only):
 
 * ``blk_live[b]``: slot b holds a block (the checkpoint or one made after it).  A block in a slot is
   known by its ``blk_hash``, ``blk_step`` and ``blk_signer``: a slot whose hash or step changed since
   the last look holds a new block.  ``blk_height``, ``blk_signer``, ``blk_step``, ``blk_ntx``,
-  ``blk_tx[blk_txoff[b]:][:ntx]`` (mempool slots, in the block's order) and ``blk_bal[b]`` (every robot's balance
+  ``blk_tx[blk_txoff[b]:][:ntx]`` (mempool slots, in the block's order) and ``blk_bal[blk_state[b]]`` (every robot's balance
   after the block) are written once, when the block is made, and read here at the end of that step.
 * ``blk_parent[b]``: the parent's slot; the parent of a live block is live, except the checkpoint's
-  (``chn_ckpt``), which is -1.  A block that was made and became the checkpoint in the same step (a
+  (``checkpoint``), which is -1.  A block that was made and became the checkpoint in the same step (a
   zero-latency backbone) has lost its parent slot by the time we look: its parent is the block seen at
   the previous look at height h - 1; when there are several, the one whose hash the block's hash was
-  made from (``_child_hash``, the formula of ``blocks.new_block``).  A block that was made and dropped
+  made from (``_child_hash``, the formula of ``ledger.poa.blocks.new_block``).  A block that was made and dropped
   within one step is never seen (it cannot be on the canonical chain: a block has no child in the step
   it is made, and the canonical head at the end of a step is live).
 * Blocks made in one step are ordered by their signer's place in ``chn_signers`` (signers make blocks
@@ -27,7 +27,7 @@ here, so a change of a field is a change of this module only):
   seller, site, direction, stake and gas its sender's view set aside, step sent and sending order
   (``mp_seq``, unique over the run: the transaction's id).  A slot is freed only when its block becomes
   final and reused only by a transaction sent in a later step, so a block's transactions are read
-  intact at the end of the step it was made; every transaction sent (``chn_seq`` of them) is seen live
+  intact at the end of the step it was made; every transaction sent (``mp_sent`` of them) is seen live
   in the mempool or in a new block at the end of the step it was sent.
 * ``chn_canon``: the canonical head's slot; ``view_head[i]``: robot i's head slot (-1: dropped).
 
@@ -41,7 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import SimulationError
-from .mempool import DEPOSIT, REVEAL, mix
+from .poa.mempool import DEPOSIT, REVEAL, mix
 
 KINDS = {REVEAL: "reveal", DEPOSIT: "deposit"}
 #: ``chain_views``' branch of a robot whose head was dropped (``view_head`` -1).
@@ -87,7 +87,7 @@ class Block:
 
 
 def _child_hash(parent_hash: int, height: int, signer: int, step: int) -> int:
-    """The hash ``blocks.new_block`` gives a block of this height, signer and step on that parent."""
+    """The hash ``ledger.poa.blocks.new_block`` gives a block of this height, signer and step on that parent."""
     h = mix(np.uint64(parent_hash) ^ (np.uint64(height) * np.uint64(0x9E3779B97F4A7C15)))
     h = mix(h ^ (np.uint64(signer) + np.uint64(step) * np.uint64(0xD6E8FEB86659FD93)))
     return int(np.int64(h >> np.uint64(2)))
@@ -135,7 +135,7 @@ class BlockLog:
         self.canon_by_step.append(self.id_of(int(w.chn_canon[0])))
 
     def _record_txs(self, w) -> None:
-        top = int(w.chn_seq[0])
+        top = int(w.mp_sent[0])
         if top == self._seen_seq:
             return
         slots = np.flatnonzero(w.mp_live & (w.mp_seq >= self._seen_seq))
@@ -173,7 +173,7 @@ class BlockLog:
         else:
             parent = self._lost_parent(previous, height, signer, step, h)
         txs = tuple(self._tx(w, int(x)) for x in _block_txs(w, b))
-        block = Block(len(self.blocks), parent, height, h, signer, step, txs, w.blk_bal[w.blk_st[b]].copy())
+        block = Block(len(self.blocks), parent, height, h, signer, step, txs, w.blk_bal[w.blk_state[b]].copy())
         self.blocks.append(block)
         self._slot[b] = (block.id, h, step)
         self._hash[b], self._step[b] = h, step

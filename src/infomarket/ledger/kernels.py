@@ -11,12 +11,15 @@ import math
 
 from numba import njit
 
+from numba.extending import overload
+
 from ..state import flags
 from ..state.log import EV_DEPOSIT, EV_PURCHASE, EV_REFUSED
 from ..state.view import unlock
-#: A seller whose balance falls short of the stake by less than this (float rounding of sums of
-#: stakes, e.g. 1 - 24 x 0.04) can still lock it: the exact on-chain ledger would accept it.
-from .mempool import STAKE_TOLERANCE, chain_on, chain_reveal, muted
+from .instant import open_transaction as instant_open
+from .poa.mempool import reveal as poa_reveal
+from .poa.spec import runs_poa
+from .pool import move_transaction
 #: A settled sale counts as an outlier in its seller's reputation record when the scheme weighed it
 #: below this fraction of the best weight given to the same site in that settlement (or 0).  Half, not
 #: "below the best": with outlier penalisation honest sales weigh anywhere near the best (drift spreads
@@ -26,9 +29,8 @@ OUTLIER_FRACTION = 0.5
 
 @njit
 def log_event(w, kind, buyer, seller, site, direction, x, y, age, stake, sx=0.0, sy=0.0):
-    """Append one event to the log when recording; the host keeps enough room for a whole step.
-    (A chain world replaying blocks it has logged already is ``muted``.)"""
-    if not w.record or muted(w):
+    """Append one event to the log when recording; the host keeps enough room for a whole step."""
+    if not w.record:
         return
     k = w.ev_count[0]
     if k >= w.ev_step.shape[0]:
@@ -52,8 +54,6 @@ def log_event(w, kind, buyer, seller, site, direction, x, y, age, stake, sx=0.0,
 @njit
 def log_payment(w, buyer, tx, weight, amount):
     """Append one row to the payments log: what the seller of pool transaction ``tx`` received."""
-    if muted(w):
-        return
     k = w.pay_count[0]
     if k >= w.pay_step.shape[0]:
         unlock(w.flags)[0] |= flags.EVENT_OVERFLOW
@@ -67,64 +67,22 @@ def log_payment(w, buyer, tx, weight, amount):
     unlock(w.pay_count)[0] = k + 1
 
 
-@njit(inline="always")
-def _move_transaction(w, src, dst):
-    """Copy pool entry ``src`` (every field of a transaction) to ``dst``."""
-    unlock(w.tx_seller)[dst] = w.tx_seller[src]
-    unlock(w.tx_site)[dst] = w.tx_site[src]
-    unlock(w.tx_dir)[dst] = w.tx_dir[src]
-    unlock(w.tx_step)[dst] = w.tx_step[src]
-    unlock(w.tx_stake)[dst] = w.tx_stake[src]
-
-
-@njit
-def reserve(w, buyer, need):
-    """Make the buyer's block of the transaction pool hold at least ``need`` transactions, moving it to
-    a bigger block at the top of the pool if needed; False when the pool is full (the host grows it)."""
-    cap = w.tx_cap[buyer]
-    if need <= cap:
-        return True
-    cap = max(2 * cap, need + 8)
-    top = w.pool_top[0]
-    if top + cap > w.tx_seller.shape[0]:
-        return False
-    a = w.tx_off[buyer]
-    for x in range(w.tx_count[buyer]):
-        _move_transaction(w, a + x, top + x)
-    unlock(w.tx_off)[buyer] = top
-    unlock(w.tx_cap)[buyer] = cap
-    unlock(w.pool_top)[0] = top + cap
-    return True
-
-
-@njit(inline="always")
 def open_transaction(w, buyer, seller, site, direction):
-    """Lock the seller's stake and record the transaction; False (nothing recorded) when refused.
-    In a chain world (``ledger.mempool``) the seller's own view decides, and the purchase becomes a
-    pending reveal that a block applies later; elsewhere that branch compiles to a constant."""
-    if chain_on(w):
-        return chain_reveal(w, buyer, seller, site, direction)
-    k = w.tx_count[buyer]
-    if k >= w.tx_cap[buyer]:
-        unlock(w.flags)[0] |= flags.TX_OVERFLOW
-        return False
-    lock = 0.0
-    if w.stake > 0.0:
-        balance = unlock(w.balance)
-        if balance[seller] < w.stake - STAKE_TOLERANCE:
-            return False
-        lock = min(w.stake, balance[seller])  # never below zero, even within the tolerance
-        balance[seller] -= lock
-        unlock(w.money)[0] -= lock
-        unlock(w.pot)[buyer] += lock
-    x = w.tx_off[buyer] + k
-    unlock(w.tx_seller)[x] = seller
-    unlock(w.tx_site)[x] = site
-    unlock(w.tx_dir)[x] = direction
-    unlock(w.tx_step)[x] = w.clock[0]
-    unlock(w.tx_stake)[x] = lock
-    unlock(w.tx_count)[buyer] = k + 1
-    return True
+    """Open a transaction (a purchase) with the world's ledger: True when the seller can pay the stake.
+    The instant ledger (``ledger.instant``) locks the stake and records it at once; the chain model
+    (``ledger.poa.mempool``) lets the seller's own view decide and sends a reveal that a block applies
+    later.  Compiled code is resolved by the world's type (``ledger.backends.runs_poa``), so a kernel of
+    one ledger compiles nothing of the other."""
+    if runs_poa(w):
+        return poa_reveal(w, buyer, seller, site, direction)
+    return instant_open(w, buyer, seller, site, direction)
+
+
+@overload(open_transaction, inline="always")
+def _open_transaction(w, buyer, seller, site, direction):
+    if runs_poa(w):
+        return lambda w, buyer, seller, site, direction: poa_reveal(w, buyer, seller, site, direction)
+    return lambda w, buyer, seller, site, direction: instant_open(w, buyer, seller, site, direction)
 
 
 @njit
@@ -146,7 +104,7 @@ def expire_stakes(w, buyer):
         money[0] += w.tx_stake[a + x]
         pot[buyer] -= w.tx_stake[a + x]
     for x in range(k - m):
-        _move_transaction(w, a + m + x, a + x)
+        move_transaction(w, a + m + x, a + x)
     unlock(w.tx_count)[buyer] = k - m
 
 

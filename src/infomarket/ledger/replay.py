@@ -15,7 +15,8 @@ from ..errors import ConfigError, SimulationError
 from ..registry import get_payment
 from ..state.flags import ErrorFlags
 from ..state.view import make_view
-from .kernels import distribute, expire_stakes, open_transaction, reserve
+from .kernels import distribute, expire_stakes, open_transaction
+from .pool import reserve
 from .state import REPUTATION, grow_book, new_book
 
 

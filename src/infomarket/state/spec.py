@@ -7,14 +7,16 @@ the spec's ``writer`` decides how each field is typed there, and so who can writ
 
 ``host``    set when the run is built, never changed: read-only in compiled code, for everyone.
 ``engine``  the swarm's state: written by the engine's step, and by buy rules through ``behaviours.api``.
-``ledger``  the market's books: read-only in compiled code except inside ledger operations
-            (``ledger.kernels``), which alone may ``unlock`` them.  A rule that writes ``balance`` does
-            not compile.
+``ledger``  the market's books (and the chain model's state, ``ledger.poa.spec``): read-only in
+            compiled code except inside ledger operations (``ledger/``: the shared ``ledger.kernels`` and
+            each ledger's own), which alone may ``unlock`` them.  A rule that writes ``balance`` does not
+            compile.
 ``log``     outputs (events, payments, history, error bits, the clock): read-only except inside the
             engine's and the ledger's log operations.
 
 Shapes are written with symbols: ``n`` robots, ``kn`` neighbour slots, ``kp`` pending slots, ``P`` the
-transaction pool, ``E`` the event log, ``S`` sites, ``K`` obstacles, ``m`` history rows; ``""`` is a scalar.
+transaction pool, ``E`` the event log, ``S`` sites, ``K`` obstacles, ``m`` history rows; ``""`` is a scalar
+(the chain model's own symbols are listed in ``ledger.poa.spec``).
 """
 from __future__ import annotations
 

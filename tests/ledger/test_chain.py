@@ -15,7 +15,7 @@ from hypothesis import HealthCheck, given, settings, strategies as st
 import infomarket as im
 from infomarket.config.load import validate
 from infomarket.errors import ConfigError
-from infomarket.ledger import blocks, mempool
+from infomarket.ledger.poa import arena, blocks, mempool
 
 W0 = 1.0  # initial wealth
 R = 1.0  # reward
@@ -39,7 +39,7 @@ def _place(sim, points):
 
 def _deposit(sim, robot):
     """Robot ``robot`` sends a deposit transaction now (as if it had just dropped an item)."""
-    mempool.chain_deposit(sim._view, robot)
+    mempool.send_deposit(sim._view, robot)
 
 
 def _canonical(sim):
@@ -192,11 +192,11 @@ def test_a_partition_forks_and_its_payments_are_redone_when_it_reconnects():
     sim.step(2)
     b1 = int(w.view_head[2])
     assert (w.blk_height[b1], w.blk_weight[b1], w.blk_ntx[b1]) == (1, 2, 1)
-    assert blocks.balances_after(w, b1).tolist() == [W0, W0, W0, W0 + R]
+    assert arena.balances_after(w, b1).tolist() == [W0, W0, W0, W0 + R]
     sim.step(3)
     a1 = int(w.view_head[0])
     assert (w.blk_height[a1], w.blk_weight[a1], w.blk_step[a1], w.blk_ntx[a1]) == (1, 1, 5, 1)
-    assert blocks.balances_after(w, a1).tolist() == [W0, W0 + R, W0, W0]
+    assert arena.balances_after(w, a1).tolist() == [W0, W0 + R, W0, W0]
     assert int(w.chn_forks[0]) == 1 and int(w.chn_canon[0]) == b1
     assert w.balance.tolist() == [W0, W0, W0, W0 + R]  # the canonical ledger: B's chain
     assert int(w.view_head[1]) == 0 and int(w.view_head[3]) == b1  # robot 1 hears of A1 at step 6 only
@@ -210,7 +210,7 @@ def test_a_partition_forks_and_its_payments_are_redone_when_it_reconnects():
     assert int(w.chn_view_reorgs[0]) == 1 and int(w.chn_reorgs[0]) == 0
     assert w.balance.tolist() == [W0, W0 + R, W0, W0 + R]  # robot 1's reward, redone on B's chain
     sim.step(1)
-    assert set(w.view_head.tolist()) == {b2} and int(w.chn_ckpt[0]) == b2 and int(w.mp_count[0]) == 0
+    assert set(w.view_head.tolist()) == {b2} and int(w.checkpoint[0]) == b2 and int(w.mp_count[0]) == 0
     # deposit-to-payment delays of each paying block: B1 2 - 0, A1 5 - 0, B2 6 - 0
     assert (int(w.chn_delay_sum[0]), int(w.chn_delay_count[0])) == (13, 3)
 
@@ -238,7 +238,7 @@ def test_a_heavier_branch_takes_over_the_canonical_chain_and_its_transactions_ar
     assert int(w.chn_reorgs[0]) == 1 + x_wins
     assert int(w.chn_reorg_tx[0]) == 1 + x_wins
     assert w.balance.tolist() == ([W0, W0 + R] if x_wins else [W0 + R, W0])
-    assert blocks.balances_after(w, z2).tolist() == [W0 + R, W0] and blocks.balances_after(w, x2).tolist() == [W0, W0 + R]
+    assert arena.balances_after(w, z2).tolist() == [W0 + R, W0] and arena.balances_after(w, x2).tolist() == [W0, W0 + R]
 
 
 def test_a_robot_left_behind_past_the_finality_depth_keeps_its_view_until_it_hears_a_heavier_block():
@@ -252,9 +252,9 @@ def test_a_robot_left_behind_past_the_finality_depth_keeps_its_view_until_it_hea
     w = sim.world
     _deposit(sim, 0)
     sim.step(2)
-    assert int(w.blk_height[w.chn_ckpt[0]]) == 0 and int(w.view_head[0]) == 0
+    assert int(w.blk_height[w.checkpoint[0]]) == 0 and int(w.view_head[0]) == 0
     sim.step(1)
-    assert int(w.blk_height[w.chn_ckpt[0]]) == 1 and int(w.view_head[0]) == -1
+    assert int(w.blk_height[w.checkpoint[0]]) == 1 and int(w.view_head[0]) == -1
     assert (int(w.view_height[0]), w.view_bal[0]) == (0, W0)
     assert int(w.mp_count[0]) == 1  # robot 0's deposit: nobody else knows it
     sim.step(2)
@@ -270,7 +270,7 @@ def _branch_deposits(w, b):
     """Deposits on block b's branch: those settled by the checkpoint, plus the deposit transactions in
     the blocks from the checkpoint to b."""
     count = int(w.ck_rep_deposits.sum())
-    ck = int(w.chn_ckpt[0])
+    ck = int(w.checkpoint[0])
     while b != ck:
         count += sum(int(w.mp_kind[w.blk_tx[w.blk_txoff[b] + k]]) == mempool.DEPOSIT for k in range(int(w.blk_ntx[b])))
         b = int(w.blk_parent[b])
@@ -286,7 +286,7 @@ def test_blocks_without_transactions_share_a_state_that_outlives_the_block_that_
     lives on for blocks 2 and 3.  Step 4: robot 1 deposits again: block 4 has a state of its own (1, 3)."""
     sim = im.Simulation(_config(2, comm=0.0, period=1, signers=[1], finality=1), 1)
     w = sim.world
-    assert bool(mempool.chain_reveal(sim._view, 0, 1, 0, 45.0))
+    assert bool(mempool.reveal(sim._view, 0, 1, 0, 45.0))
     _deposit(sim, 1)
     sim.step(1)
     b1 = int(w.view_head[1])
@@ -294,21 +294,21 @@ def test_blocks_without_transactions_share_a_state_that_outlives_the_block_that_
     assert w.tx_seller[w.tx_off[0]:w.tx_off[0] + w.tx_count[0]].tolist() == [1]  # the pool holds the sale
     sim.step(1)
     b2 = int(w.view_head[1])
-    assert w.blk_ntx[b2] == 0 and w.blk_st[b2] == w.blk_st[b1] and int(w.chn_ckpt[0]) == b1
+    assert w.blk_ntx[b2] == 0 and w.blk_state[b2] == w.blk_state[b1] and int(w.checkpoint[0]) == b1
     sim.step(1)
     b3 = int(w.view_head[1])
-    assert int(w.chn_ckpt[0]) == b2 and not w.blk_live[b1] and w.blk_live[b3]
-    assert w.blk_st[b3] == w.blk_st[b1]
+    assert int(w.checkpoint[0]) == b2 and not w.blk_live[b1] and w.blk_live[b3]
+    assert w.blk_state[b3] == w.blk_state[b1]
     for b in (b2, b3):
-        assert blocks.balances_after(w, b).tolist() == [W0, W0 + R]
-    assert w.blk_live[w.chn_cur[0]]  # the ledger arrays hold the state of a live block
+        assert arena.balances_after(w, b).tolist() == [W0, W0 + R]
+    assert w.blk_live[w.state_block[0]]  # the ledger arrays hold the state of a live block
     assert w.balance.tolist() == [W0, W0 + R] and w.tx_count.tolist() == [1, 0]
     _deposit(sim, 1)
     sim.step(1)
     b4 = int(w.view_head[1])
-    assert w.blk_st[b4] != w.blk_st[b3] and int(w.chn_ckpt[0]) == b3
-    assert blocks.balances_after(w, b4).tolist() == [W0, W0 + 2 * R]
-    assert blocks.balances_after(w, b3).tolist() == [W0, W0 + R]
+    assert w.blk_state[b4] != w.blk_state[b3] and int(w.checkpoint[0]) == b3
+    assert arena.balances_after(w, b4).tolist() == [W0, W0 + 2 * R]
+    assert arena.balances_after(w, b3).tolist() == [W0, W0 + R]
     assert w.balance.tolist() == [W0, W0 + 2 * R]
 
 
@@ -330,14 +330,14 @@ def _run_conserving_money(sim, steps, robots=25):
         sim.step(1)
         w = sim.world
         for b in np.flatnonzero(w.blk_live):
-            assert blocks.balances_after(w, b).sum() == pytest.approx(robots * W0 + R * _branch_deposits(w, int(b)), abs=1e-9)
+            assert arena.balances_after(w, b).sum() == pytest.approx(robots * W0 + R * _branch_deposits(w, int(b)), abs=1e-9)
         assert w.balance.sum() + w.pot.sum() == pytest.approx(robots * W0 + R * int(w.rep_deposits.sum()), abs=1e-9)
-        canon, cur = int(w.chn_canon[0]), int(w.chn_cur[0])
-        assert w.blk_live[cur] and w.blk_st[cur] == w.blk_st[canon]
-        assert np.array_equal(w.balance, blocks.balances_after(w, canon))
+        canon, cur = int(w.chn_canon[0]), int(w.state_block[0])
+        assert w.blk_live[cur] and w.blk_state[cur] == w.blk_state[canon]
+        assert np.array_equal(w.balance, arena.balances_after(w, canon))
         for i in range(robots):
             pool = w.tx_seller[w.tx_off[i]:w.tx_off[i] + w.tx_count[i]].tolist()
-            assert pool == _list_sellers(w, int(w.bs_ver[w.blk_st[canon], i]))
+            assert pool == _list_sellers(w, int(w.bs_list[w.blk_state[canon], i]))
 
 
 def test_money_is_conserved_on_every_branch_of_a_forking_swarm():
@@ -363,7 +363,7 @@ def test_gas_is_charged_exactly():
     sim = im.Simulation(_config(2, period=1, backbone=True, gas_price=1e-7), 1)
     _place(sim, [(100.0, 100.0), (130.0, 100.0)])
     w = sim.world
-    assert bool(mempool.chain_reveal(sim._view, 1, 0, 0, 45.0))
+    assert bool(mempool.reveal(sim._view, 1, 0, 0, 45.0))
     assert w.view_avail[0] == pytest.approx(1.0 - 0.0112918, abs=1e-15)
     sim.step(1)
     assert w.balance.tolist() == pytest.approx([1.0 - 0.0112918, 1.0], abs=1e-15)
@@ -377,8 +377,8 @@ def test_a_seller_whose_view_cannot_pay_the_gas_is_refused():
     """Gas price 5e-6: a reveal costs 0.56459 (112 918 gas), so a seller holding 1 can sign one light
     contract but not a second before a block confirms anything."""
     sim = im.Simulation(_config(2, period=1000, gas_price=5e-6), 1)
-    assert bool(mempool.chain_reveal(sim._view, 1, 0, 0, 45.0))
-    assert not bool(mempool.chain_reveal(sim._view, 1, 0, 0, 45.0))
+    assert bool(mempool.reveal(sim._view, 1, 0, 0, 45.0))
+    assert not bool(mempool.reveal(sim._view, 1, 0, 0, 45.0))
 
 
 def test_the_deposit_gas_table_interpolates_the_measured_points():

@@ -2,64 +2,25 @@
 
 With ``[chain] consensus = "poa"`` the ledger does not apply a purchase or a deposit at once: it becomes a
 pending transaction in a bounded pool (the *mempool*), known at first only to the robot that sent it, and
-it moves money only when a block includes it (``ledger.blocks``).  This module holds what acts on a
-robot's own view and nothing else: the view check of a reveal, the recording of a deposit, and a robot's
-spendable balance at its head.
-
-The world a chain run compiles for has the chain's fields (``ledger.blocks.SPEC``); the paper's world has
-none.  ``chain_on(w)`` and ``chain_reveal`` are resolved by the *type* of ``w`` when numba compiles, so a
-kernel of the paper's world calls a stub that returns a constant and compiles none of the chain's code
-(``ledger.kernels.open_transaction`` branches on it).
+it moves money only when a block includes it (``ledger.poa.blocks``).  This module holds what acts on a
+robot's own view and nothing else: the view check of a reveal (``reveal``, the chain's way to open a
+transaction), the sending of a deposit, and a robot's spendable balance at its head.
 
 Random draws (message loss) come from a counter-based hash of the run's chain seed, the step and the two
 robots (``chance``): the engine's random streams are never touched, so turning the chain on does not move
 a single draw of the swarm's.
 """
 import numpy as np
-from numba import njit, types
-from numba.extending import overload
+from numba import njit
 
-from ..state.view import unlock
-
-#: A seller whose spendable money falls short of the stake by less than this (float rounding of sums of
-#: stakes, e.g. 1 - 24 x 0.04) can still lock it: the exact on-chain ledger would accept it.
-#: (``ledger.kernels.STAKE_TOLERANCE`` is this constant.)
-STAKE_TOLERANCE = 1e-9
+from ...state.view import unlock
+from ..lock import lock_stake_and_gas
 
 # Transaction kinds in the mempool.
 REVEAL = 0   #: revealInformation: a purchase (the seller sends it; stake and gas come from the seller)
 DEPOSIT = 1  #: buyItem + settle: a deposit (the depositing robot's; its reward pays the deposit's gas)
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
-
-
-def _is_chain_type(w) -> bool:
-    fields = getattr(w, "field_dict", None)
-    return fields is not None and "chn_period" in fields
-
-
-def chain_on(w) -> bool:
-    """Is ``w`` a chain model's world?  (A compile-time constant in compiled code.)"""
-    return hasattr(w, "chn_period")
-
-
-@overload(chain_on)
-def _chain_on(w):
-    if _is_chain_type(w):
-        return lambda w: True
-    return lambda w: False
-
-
-def muted(w) -> bool:
-    """Are the event and payment logs muted (a chain world replaying blocks it has logged already)?"""
-    return hasattr(w, "chn_mute") and w.chn_mute[0] != 0
-
-
-@overload(muted)
-def _muted(w):
-    if _is_chain_type(w):
-        return lambda w: w.chn_mute[0] != 0
-    return lambda w: False
 
 
 @njit(inline="always")
@@ -93,9 +54,9 @@ def learn(w, i, tx):
 
 @njit(inline="always")
 def on_branch(w, b, tx):
-    """Is pending transaction ``tx`` included on block b's branch after the checkpoint (``blk_inc``)?
+    """Is pending transaction ``tx`` included on block b's branch after the checkpoint (``blk_included``)?
     Nothing is for b = -1 (a dropped head)."""
-    return b >= 0 and (w.blk_inc[b, tx >> 6] >> np.uint64(tx & 63)) & np.uint64(1) != np.uint64(0)
+    return b >= 0 and (w.blk_included[b, tx >> 6] >> np.uint64(tx & 63)) & np.uint64(1) != np.uint64(0)
 
 
 @njit
@@ -116,7 +77,7 @@ def refresh_view(w, i):
         if not on_branch(w, h, tx):
             a -= w.mp_gas[tx]
             a -= w.mp_stake[tx]
-        tx = w.mp_onext[tx]
+        tx = w.mp_own_next[tx]
     unlock(w.view_avail)[i] = a
 
 
@@ -155,8 +116,8 @@ def new_tx(w, kind, origin, buyer, seller, site, direction, stake, gas):
         x = (x + 1) % cap
     live[x] = True
     unlock(w.mp_cursor)[0] = (x + 1) % cap
-    if x >> 6 >= w.mp_words[0]:
-        unlock(w.mp_words)[0] = (x >> 6) + 1
+    if x >> 6 >= w.mp_words_used[0]:
+        unlock(w.mp_words_used)[0] = (x >> 6) + 1
     unlock(w.mp_kind)[x] = kind
     unlock(w.mp_origin)[x] = origin
     unlock(w.mp_buyer)[x] = buyer
@@ -166,31 +127,31 @@ def new_tx(w, kind, origin, buyer, seller, site, direction, stake, gas):
     unlock(w.mp_stake)[x] = stake
     unlock(w.mp_gas)[x] = gas
     unlock(w.mp_step)[x] = w.clock[0]
-    unlock(w.mp_seq)[x] = w.chn_seq[0]
-    unlock(w.chn_seq)[0] += 1
+    unlock(w.mp_seq)[x] = w.mp_sent[0]
+    unlock(w.mp_sent)[0] += 1
     unlock(w.mp_order)[w.mp_count[0]] = x
     unlock(w.mp_count)[0] += 1
     if w.chn_backbone and w.chn_latency == 0 and not partitioned(w, w.clock[0]):
         for i in range(w.view_head.shape[0]):
             learn(w, i, x)
-        unlock(w.mp_bb)[x] = True
+        unlock(w.mp_by_backbone)[x] = True
     elif w.chn_backbone and w.chn_latency == 0:  # partitioned: its side at once, the rest when it ends
         side = nest_side(w, origin)
         for i in range(w.view_head.shape[0]):
             if nest_side(w, i) == side:
                 learn(w, i, x)
-        unlock(w.mp_bb)[x] = False
+        unlock(w.mp_by_backbone)[x] = False
     else:
         learn(w, origin, x)
-        unlock(w.mp_bb)[x] = False
+        unlock(w.mp_by_backbone)[x] = False
     if kind == REVEAL:
         unlock(w.mp_for_buyer)[buyer] += 1
         unlock(w.mp_own)[origin] += 1
         last = w.own_last[origin]
-        unlock(w.mp_oprev)[x] = last
-        unlock(w.mp_onext)[x] = -1
+        unlock(w.mp_own_prev)[x] = last
+        unlock(w.mp_own_next)[x] = -1
         if last >= 0:
-            unlock(w.mp_onext)[last] = x
+            unlock(w.mp_own_next)[last] = x
         else:
             unlock(w.own_first)[origin] = x
         unlock(w.own_last)[origin] = x
@@ -201,53 +162,35 @@ def new_tx(w, kind, origin, buyer, seller, site, direction, stake, gas):
 def drop_own(w, tx):
     """Take reveal ``tx`` out of its sender's list of own pending reveals."""
     i = w.mp_origin[tx]
-    p, q = w.mp_oprev[tx], w.mp_onext[tx]
+    p, q = w.mp_own_prev[tx], w.mp_own_next[tx]
     if p >= 0:
-        unlock(w.mp_onext)[p] = q
+        unlock(w.mp_own_next)[p] = q
     else:
         unlock(w.own_first)[i] = q
     if q >= 0:
-        unlock(w.mp_oprev)[q] = p
+        unlock(w.mp_own_prev)[q] = p
     else:
         unlock(w.own_last)[i] = p
 
 
 @njit
-def _reveal(w, buyer, seller, site, direction):
-    """The seller signs the light contract only if its own view can pay: its spendable money at its head
-    must cover the stake and the reveal's gas (the instant ledger's check, on the view).  The buyer gets
-    the vector at once (off-chain light contract); the reveal goes to the mempool."""
+def reveal(w, buyer, seller, site, direction):
+    """A purchase in a chain world (``ledger.kernels.open_transaction``).  The seller signs the light
+    contract only if its own view can pay: ``lock_stake_and_gas`` on its spendable money at its head
+    (the instant ledger's check, on the view).  The buyer gets the vector at once (off-chain light
+    contract); the reveal goes to the mempool.  True when the seller's view accepts it."""
     gas = w.chn_gas_price * w.chn_gas_reveal
     if w.view_stale[seller]:
         refresh_view(w, seller)
-    avail = unlock(w.view_avail)
-    lock = 0.0
-    if w.stake > 0.0 or gas > 0.0:
-        if avail[seller] < w.stake + gas - STAKE_TOLERANCE:
-            return False
-        if w.stake > 0.0:
-            lock = min(w.stake, avail[seller] - gas)
-        avail[seller] -= gas
-        avail[seller] -= lock
+    ok, lock = lock_stake_and_gas(unlock(w.view_avail), seller, w.stake, gas)
+    if not ok:
+        return False
     new_tx(w, REVEAL, seller, buyer, seller, site, direction, lock, gas)
     return True
 
 
-def chain_reveal(w, buyer, seller, site, direction):
-    """A purchase in a chain world (``ledger.kernels.open_transaction``): True when the seller's view
-    accepts it; the reveal is then pending."""
-    return _reveal(w, buyer, seller, site, direction)
-
-
-@overload(chain_reveal)
-def _chain_reveal(w, buyer, seller, site, direction):
-    if _is_chain_type(w):
-        return lambda w, buyer, seller, site, direction: _reveal(w, buyer, seller, site, direction)
-    return lambda w, buyer, seller, site, direction: False
-
-
 @njit
-def chain_deposit(w, i):
+def send_deposit(w, i):
     """Robot i deposited an item: a deposit transaction (buyItem, then settle) goes to the mempool; the
     reward and the payments move when a block includes it."""
     new_tx(w, DEPOSIT, i, i, -1, -1, 0.0, 0.0, 0.0)

@@ -1,13 +1,11 @@
-"""Digests of chain-model runs (docs/chain-model.md), recorded before the chain's speed work.
+"""Digests of chain-model runs (docs/chain-model.md).
 
 The chain's own numbers are guarded like the paper's (``tests/engine/golden.py``): each case hashes the
 robots table, the event and payment logs, the wealth history and the chain's measures of one run bit for
-bit.  The expected digests were recorded by the chain model as it stood when item 1 of issue 25 landed
-(commit 8b915b6), before its data structures were changed for speed; work that is only about speed must
-leave them alone.  A change that is meant to move the chain's numbers regenerates them (say why in the
+bit.  Work that only restructures the code or makes it faster must leave them alone.  A change that is meant to move the chain's numbers regenerates them (say why in the
 commit and in docs/chain-model.md)::
 
-    python -m tests.engine.test_chain_digest
+    python -m tests.ledger.test_chain_digest
 """
 from __future__ import annotations
 
@@ -19,7 +17,7 @@ import pytest
 import infomarket as im
 from infomarket.seeds import run_seed
 
-from .golden import _hash_frame
+from ..engine.golden import _hash_frame
 
 #: name -> (experiment, [chain] section, steps, run)
 CASES = {

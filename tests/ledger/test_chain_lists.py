@@ -1,6 +1,6 @@
 """The chain model's buyers' lists as shared nodes, and the settlement cache (docs/chain-model.md, "Speed").
 
-A buyer's list of open transactions on a branch is a node (``ledger.blocks.append_node``): the node of its
+A buyer's list of open transactions on a branch is a node (``ledger.poa.lists.append_node``): the node of its
 last transaction, whose predecessors are the rest.  The same reveal appended to the same list on two
 branches is one node, so a node *is* a list's content; a settled list's weights are cached by its node
 and reused by any branch that settles the same list.  Expected values are worked by hand from eqs. 7-8
@@ -14,8 +14,7 @@ from numba import njit
 
 import infomarket as im
 from infomarket.config.load import validate
-from infomarket.engine.step import chain_settle
-from infomarket.ledger import blocks
+from infomarket.ledger.poa.lists import append_node, materialise
 from infomarket.payments.schemes import outlier_weights
 
 
@@ -37,10 +36,10 @@ def lists():
     r1 (1, 0), r2 (2, 10), r3 (1, 100), r4 (1, 20)."""
     sim = im.Simulation(_config(), 1)
     v = sim._view
-    n1 = blocks.append_node(v, 0, -1, 1, 1, 0, 0.0, 5, 0.04)
-    n2 = blocks.append_node(v, 0, n1, 2, 2, 0, 10.0, 6, 0.04)
-    a = blocks.append_node(v, 0, n2, 3, 1, 0, 100.0, 7, 0.04)
-    b = blocks.append_node(v, 0, n2, 4, 1, 0, 20.0, 8, 0.04)
+    n1 = append_node(v, 0, -1, 1, 1, 0, 0.0, 5, 0.04)
+    n2 = append_node(v, 0, n1, 2, 2, 0, 10.0, 6, 0.04)
+    a = append_node(v, 0, n2, 3, 1, 0, 100.0, 7, 0.04)
+    b = append_node(v, 0, n2, 4, 1, 0, 20.0, 8, 0.04)
     return sim, (n1, n2, a, b)
 
 
@@ -50,12 +49,12 @@ def test_the_same_reveal_on_the_same_list_is_the_same_node(lists):
     assert len({n1, n2, a, b}) == 4
     assert [int(w.ls_len[x]) for x in (n1, n2, a, b)] == [1, 2, 3, 3]
     assert [int(w.ls_prev[x]) for x in (n1, n2, a, b)] == [-1, n1, n2, n2]
-    assert blocks.append_node(v, 0, n1, 2, 2, 0, 10.0, 6, 0.04) == n2  # another branch includes r2 on [r1]
-    assert blocks.append_node(v, 0, -1, 1, 1, 0, 0.0, 5, 0.04) == n1
-    top = int(w.chn_lstop[0])
+    assert append_node(v, 0, n1, 2, 2, 0, 10.0, 6, 0.04) == n2  # another branch includes r2 on [r1]
+    assert append_node(v, 0, -1, 1, 1, 0, 0.0, 5, 0.04) == n1
+    top = int(w.ls_top[0])
     # a branch whose seller could lock less, or another buyer's list, is another list
-    assert blocks.append_node(v, 0, n1, 2, 2, 0, 10.0, 6, 0.03) == top
-    assert blocks.append_node(v, 1, -1, 1, 1, 0, 0.0, 5, 0.04) == top + 1
+    assert append_node(v, 0, n1, 2, 2, 0, 10.0, 6, 0.03) == top
+    assert append_node(v, 1, -1, 1, 1, 0, 0.0, 5, 0.04) == top + 1
 
 
 def _pool(w, i):
@@ -71,10 +70,10 @@ def test_materialise_writes_the_list_of_the_state_into_the_pool(lists):
     A = [(1, 0.0), (2, 10.0), (1, 100.0)]
     B = [(1, 0.0), (2, 10.0), (1, 20.0)]
     for node, expected in [(a, A), (b, B), (a, A), (n1, A[:1]), (b, B), (-1, []), (n2, A[:2]), (a, A)]:
-        w.chn_bver[0] = node
-        blocks.materialise(v, 0)
+        w.state_list[0] = node
+        materialise(v, 0)
         assert _pool(w, 0) == expected
-        assert int(w.chn_ver[0]) == node
+        assert int(w.pool_list[0]) == node
 
 
 def test_a_cached_settlement_is_reused_only_for_the_same_list(lists):
@@ -84,25 +83,25 @@ def test_a_cached_settlement_is_reused_only_for_the_same_list(lists):
     robot 1 gets 0.5 x 6/9 = 1/3 and robot 2 1/6.  A's weights reused for B (a stale entry) would pay 0.3."""
     sim, (n1, n2, a, b) = lists
     v, w = sim._view, sim.world
-    settle = chain_settle(sim._kernel.weigh)
+    settle = sim._kernel.settle  # the kernel's settlement, with the chain's cache
     assert w.chn_cache  # outlier penalisation reads only the list
 
     def pay(node):
-        w.chn_bver[0] = node
-        blocks.materialise(v, 0)
+        w.state_list[0] = node
+        materialise(v, 0)
         w.pot[0] = 0.0
         before = w.balance.copy()
         settle(v, 0, sim.rng)
-        w.chn_bver[0] = w.chn_ver[0] = -1  # (what finish_deposit does after a settlement)
+        w.state_list[0] = w.pool_list[0] = -1  # (what finish_deposit does after a settlement)
         return (w.balance - before).tolist()
 
-    assert int(w.ls_wt[a]) == -1 and int(w.ls_wt[b]) == -1
+    assert int(w.ls_weights_at[a]) == -1 and int(w.ls_weights_at[b]) == -1
     assert pay(a) == pytest.approx([0.5, 0.3, 0.2], abs=1e-12)
-    start = int(w.ls_wt[a])
-    assert start >= 0 and w.chn_wt[start:start + 3].tolist() == [2.0, 2.0, 1.0]
+    start = int(w.ls_weights_at[a])
+    assert start >= 0 and w.weight_store[start:start + 3].tolist() == [2.0, 2.0, 1.0]
     assert pay(b) == pytest.approx([0.5, 1 / 3, 1 / 6], abs=1e-12)
     assert pay(a) == pytest.approx([0.5, 0.3, 0.2], abs=1e-12)  # from the cache
-    assert int(w.ls_wt[a]) == start
+    assert int(w.ls_weights_at[a]) == start
 
 
 _outlier = njit(outlier_weights)
@@ -129,7 +128,7 @@ def test_a_forking_run_pays_the_same_with_and_without_the_cache():
         runs[scheme] = sim
     cached, plain = runs["outlier"], runs["tmp_outlier_rng"]
     assert cached.world.chn_cache and not plain.world.chn_cache
-    assert int(cached.world.chn_wttop[0]) > 0 and int(plain.world.chn_wttop[0]) == 0
+    assert int(cached.world.weight_top[0]) > 0 and int(plain.world.weight_top[0]) == 0
     m = cached.chain_measures()
     assert m["deposits_paid"] > 0 and m["forks"] > 0
     assert m == plain.chain_measures()

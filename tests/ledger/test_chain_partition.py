@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import infomarket as im
-from infomarket.ledger import blocks
+from infomarket.ledger.poa import arena
 from infomarket.errors import ConfigError
 
 from .test_chain import R, W0, _branch_deposits, _config, _deposit, _place, _run_conserving_money
@@ -18,7 +18,7 @@ from .test_chain import R, W0, _branch_deposits, _config, _deposit, _place, _run
 def _conserved(w):
     """Every live block's balances add up to the initial wealth plus one reward per deposit on its branch."""
     for b in np.flatnonzero(w.blk_live):
-        assert blocks.balances_after(w, b).sum() == pytest.approx(4 * W0 + R * _branch_deposits(w, int(b)), abs=1e-12)
+        assert arena.balances_after(w, b).sum() == pytest.approx(4 * W0 + R * _branch_deposits(w, int(b)), abs=1e-12)
 
 
 def test_a_partitioned_swarm_forks_and_the_lighter_branch_is_undone_when_it_ends():
@@ -45,17 +45,17 @@ def test_a_partitioned_swarm_forks_and_the_lighter_branch_is_undone_when_it_ends
     assert (w.blk_height[a1], w.blk_signer[a1], w.blk_step[a1], w.blk_weight[a1], w.blk_ntx[a1]) == (1, 0, 5, 1, 1)
     assert int(w.view_head[1]) == 0 and int(w.view_head[3]) == b1  # nothing crossed x = 600
     assert int(w.chn_forks[0]) == 1 and int(w.chn_canon[0]) == b1
-    assert blocks.balances_after(w, a1).tolist() == [W0, W0 + R, W0, W0] and blocks.balances_after(w, b1).tolist() == [W0, W0, W0, W0 + R]
+    assert arena.balances_after(w, a1).tolist() == [W0, W0 + R, W0, W0] and arena.balances_after(w, b1).tolist() == [W0, W0, W0, W0 + R]
     assert w.balance.tolist() == [W0, W0, W0, W0 + R]
     sim.step(1)
     _conserved(w)
     b2 = int(w.chn_canon[0])
     assert (w.blk_height[b2], w.blk_signer[b2], w.blk_step[b2], w.blk_weight[b2]) == (2, 0, 6, 4)
-    assert int(w.blk_parent[b2]) == b1 and not w.blk_live[a1] and int(w.chn_ckpt[0]) == b1
+    assert int(w.blk_parent[b2]) == b1 and not w.blk_live[a1] and int(w.checkpoint[0]) == b1
     assert int(w.chn_view_reorgs[0]) == 1 and int(w.chn_reorgs[0]) == 0
     assert w.balance.tolist() == [W0, W0 + R, W0, W0 + R]  # robot 1's reward, redone on the nest side's chain
     sim.step(1)
-    assert set(w.view_head.tolist()) == {b2} and int(w.chn_ckpt[0]) == b2 and int(w.mp_count[0]) == 0
+    assert set(w.view_head.tolist()) == {b2} and int(w.checkpoint[0]) == b2 and int(w.mp_count[0]) == 0
     assert (int(w.chn_delay_sum[0]), int(w.chn_delay_count[0])) == (2 + 5 + 6, 3)
 
 
@@ -81,7 +81,7 @@ def test_the_backbone_carries_nothing_across_the_partition():
     sim.step(1)
     b2 = int(w.chn_canon[0])
     assert (w.blk_height[b2], w.blk_signer[b2], w.blk_step[b2], w.blk_weight[b2]) == (2, 0, 6, 4)
-    assert w.view_head.tolist() == [b2] * 4 and int(w.chn_ckpt[0]) == b2 and not w.blk_live[a1]
+    assert w.view_head.tolist() == [b2] * 4 and int(w.checkpoint[0]) == b2 and not w.blk_live[a1]
     assert int(w.chn_view_reorgs[0]) == 2 and int(w.mp_count[0]) == 0
     assert w.balance.tolist() == [W0, W0 + R, W0, W0 + R]
 
