@@ -118,8 +118,6 @@ def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
 
 #: circles other branches remove (the lead empties this after merging them): modules -> the branch
 KNOWN_CIRCLES = {
-    ("infomarket.engine.params", "infomarket.engine.paths", "infomarket.engine.step"):
-        "ledger (fill_turn_tables moves out of engine.step)",
     ("infomarket.chain.backends", "infomarket.chain.market"): "contract (revert_data moves to the module both use)",
 }
 
@@ -139,7 +137,7 @@ UNEXPLAINED = {
     "chain/backends.py": {"from .market import revert_data"},
     "chain/block_replay.py": {
         "from ..ledger.gas import GAS_DEPOSIT_N, gas_schedule, table_gas",
-        "from ..ledger.mempool import STAKE_TOLERANCE",
+        "from ..ledger.lock import STAKE_TOLERANCE",
     },
     "chain/cli.py": {
         "from .. import load_experiment, simulate", "from ..engine.simulation import Simulation",

@@ -113,7 +113,7 @@ def replay_blocks(blocks, purchase_of: dict, config, *, seed: int = 0, backend: 
     import numpy as np
 
     from ..ledger.gas import GAS_DEPOSIT_N, gas_schedule, table_gas
-    from ..ledger.mempool import STAKE_TOLERANCE
+    from ..ledger.lock import STAKE_TOLERANCE
 
     robots = config.swarm.robots
     params = market_params(config)
