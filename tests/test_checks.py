@@ -4,12 +4,40 @@ import pytest
 
 import infomarket as im
 from infomarket import checks
+from infomarket.engine.simulation import Simulation
 from infomarket.registry import behaviours, payments
 
 
-@pytest.mark.parametrize("name", sorted(behaviours()))
+#: Every behaviour registered when the tests are collected: each check compiles them all into its kernel,
+#: so the checks share one kernel per scheme (two more for waypoint paths) instead of two each.
+REGISTERED = sorted(behaviours())
+
+
+@pytest.mark.parametrize("name", REGISTERED)
 def test_every_registered_behaviour_passes(name):
-    checks.check_behaviour(name, steps=1500)
+    checks.check_behaviour(name, steps=1500, alongside=REGISTERED)
+
+
+def test_a_run_on_a_shared_kernel_is_the_run_on_its_own():
+    # saboteur is not first among the shared kinds: a robot's kind must index the kernel's kinds
+    cfg = checks._swarm("saboteur", 10, "delayed", 0.0, 600)
+    own = Simulation(cfg, 3, record_events=True)
+    shared = Simulation(cfg, 3, record_events=True, kernel_kinds=checks._kernel_kinds("saboteur", REGISTERED))
+    assert shared.kinds.index("saboteur") != own.kinds.index("saboteur")
+    assert shared.kernel_source != own.kernel_source
+    a, b = own.run(), shared.run()
+    assert len(a.events) > 50 and (a.events.kind == "purchase").any()
+    assert a.robots.equals(b.robots) and a.events.equals(b.events) and a.payments.equals(b.payments)
+
+
+def test_kernel_kinds_must_hold_the_experiments_behaviours_and_its_step():
+    cfg = checks._swarm("saboteur", 10, "delayed", 0.0, 600)
+    with pytest.raises(im.errors.ArgumentError, match="missing \\['saboteur'\\]"):
+        Simulation(cfg, 3, kernel_kinds=("naive", "greedy"))
+    with pytest.raises(im.errors.ArgumentError, match="waypoint paths"):
+        Simulation(cfg, 3, kernel_kinds=("naive", "saboteur", "waypoint"))
+    assert checks._kernel_kinds("saboteur", ["waypoint", "greedy", "naive"]) == ("naive", "greedy", "saboteur")
+    assert checks._kernel_kinds("waypoint", ["waypoint", "greedy", "naive"]) == ("naive", "waypoint")
 
 
 @pytest.mark.parametrize("name", sorted(payments()))
