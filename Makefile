@@ -18,14 +18,9 @@ demo: venv
 	$(BIN)/infomarket demo
 
 # Two processes (CI has 2 cores), tests handed out one by one as a process frees up (worksteal): on a
-# fresh clone most of the time is compiling kernels, and a module that compiles many (the rule checks)
-# must not keep one process busy while the other idles (worksteal: cold 4 min 47 s against 5 min 23 s by module,
-# measured before issues 20-24; on 2026-11-24, 1 270 tests with the contract's node suite, the attack
-# search and the chain model: a cold fresh clone's `.ci/run` took 7 min 35 s of pytest, 8 min 16 s in all;
-# later that day, 1 388 tests with the RL interface, the chain study and revm's cold gas: 8 min 32 s, 9 min 17 s;
-# at the end of the day, 1 412 tests with the chain's list nodes and gas table: 9 min 52 s, 10 min 52 s;
-# with blocks sharing states, 1 413 tests: 9 min 35 s, 10 min 24 s; with stable branch numbers, 1 414: 10 min 1 s, 10 min 54 s).
-# A kernel one process compiled, the other loads from the disk cache.  TEST_WORKERS=0 runs them inline.
+# fresh clone most of the time is compiling step kernels, and a module that compiles many must not keep one
+# process busy while the other idles.  A kernel one process compiled, the other loads from the disk cache;
+# tests share kernels where they can (docs/testing.md).  TEST_WORKERS=0 runs them inline.
 TEST_WORKERS ?= 2
 test: venv
 	$(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist worksteal

@@ -7,22 +7,22 @@ from infomarket import checks
 from infomarket.engine.simulation import Simulation
 from infomarket.registry import behaviours, payments
 
-
-#: Every behaviour registered when the tests are collected: each check compiles them all into its kernel,
-#: so the checks share one kernel per scheme (two more for waypoint paths) instead of two each.
-REGISTERED = sorted(behaviours())
+from .shared_kernel import BUILTIN, shared_kinds
 
 
-@pytest.mark.parametrize("name", REGISTERED)
+@pytest.mark.parametrize("name", sorted(behaviours()))
 def test_every_registered_behaviour_passes(name):
-    checks.check_behaviour(name, steps=1500, alongside=REGISTERED)
+    # every built-in behaviour compiled into each check's kernel: one kernel per scheme (two more for
+    # waypoint paths) instead of two per behaviour, shared with the tests that run behaviour mixes
+    checks.check_behaviour(name, steps=1500, alongside=BUILTIN)
 
 
 def test_a_run_on_a_shared_kernel_is_the_run_on_its_own():
     # saboteur is not first among the shared kinds: a robot's kind must index the kernel's kinds
     cfg = checks._swarm("saboteur", 10, "delayed", 0.0, 600)
     own = Simulation(cfg, 3, record_events=True)
-    shared = Simulation(cfg, 3, record_events=True, kernel_kinds=checks._kernel_kinds("saboteur", REGISTERED))
+    shared = Simulation(cfg, 3, record_events=True, kernel_kinds=shared_kinds(cfg))
+    assert shared.kinds == checks._kernel_kinds("saboteur", BUILTIN)  # the rule checks' kernel
     assert shared.kinds.index("saboteur") != own.kinds.index("saboteur")
     assert shared.kernel_source != own.kernel_source
     a, b = own.run(), shared.run()
