@@ -26,7 +26,7 @@ def shared_kinds(cfg) -> tuple[str, ...] | None:
     if not set(own) <= set(BUILTIN):
         return None
     paths = uses_paths(own)
-    return ("naive", *sorted({b for b in BUILTIN if get_behaviour(b).paths == paths} | set(own) - {"naive"}))
+    return ("naive", *sorted(({b for b in BUILTIN if get_behaviour(b).paths == paths} | set(own)) - {"naive"}))
 
 
 def simulation(cfg, seed: int, **kwargs) -> Simulation:
