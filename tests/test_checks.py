@@ -30,6 +30,17 @@ def test_a_run_on_a_shared_kernel_is_the_run_on_its_own():
     assert a.robots.equals(b.robots) and a.events.equals(b.events) and a.payments.equals(b.payments)
 
 
+def test_check_behaviours_names_a_rule_that_keeps_the_shared_kernel_from_compiling():
+    def three_values(w, me, site):
+        return True, 1.0, 0.0
+
+    im.register_behaviour("tmp_three_values", buy="naive", sell=three_values, honest=False, replace=True)
+    # naive is checked first, on the kernel of both: its own rules compile, so only checking each alone
+    # names the rule at fault
+    with pytest.raises(im.errors.RuleRunError, match="'tmp_three_values': its sell rule three_values .* returns"):
+        checks.check_behaviours(["naive", "tmp_three_values"], steps=300)
+
+
 def test_kernel_kinds_must_hold_the_experiments_behaviours_and_its_step():
     cfg = checks._swarm("saboteur", 10, "delayed", 0.0, 600)
     with pytest.raises(im.errors.ArgumentError, match="missing \\['saboteur'\\]"):

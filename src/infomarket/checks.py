@@ -117,10 +117,19 @@ def check_behaviour(name: str, *, robots: int = 10, steps: int = 3000, seed: int
 
 def check_behaviours(names, **kwargs) -> None:
     """``check_behaviour`` for each of ``names``, all on one kernel per scheme (two for those with waypoint
-    paths): a cold check of many behaviours compiles a few kernels, not two per behaviour."""
+    paths): a cold check of many behaviours compiles a few kernels, not two per behaviour.  An error other
+    than a failed check (a rule that keeps the shared kernel from compiling need not be the checked
+    behaviour's, so it may go unnamed) checks each behaviour alone, which names the rule at fault."""
     names = list(names)
-    for name in names:
-        check_behaviour(name, alongside=names, **kwargs)
+    try:
+        for name in names:
+            check_behaviour(name, alongside=names, **kwargs)
+    except CheckFailed:
+        raise
+    except Exception:
+        for name in names:
+            check_behaviour(name, **kwargs)
+        raise
 
 
 def _rule_where(func) -> tuple[str, int]:
