@@ -18,9 +18,9 @@ demo: venv
 	$(BIN)/infomarket demo
 
 # Two processes (CI has 2 cores), tests handed out one by one as a process frees up (worksteal): on a
-# fresh clone most of the time is compiling kernels, and a module that compiles many (the rule checks)
-# must not keep one process busy while the other idles.  A kernel one process compiled, the other loads
-# from the disk cache.  TEST_WORKERS=0 runs them inline.  Past fresh-clone timings: docs/test-timings.md.
+# fresh clone most of the time is compiling step kernels, and a module that compiles many must not keep one
+# process busy while the other idles.  A kernel one process compiled, the other loads from the disk cache;
+# tests share kernels where they can (docs/testing.md).  TEST_WORKERS=0 runs them inline.
 TEST_WORKERS ?= 2
 test: venv
 	$(BIN)/python -m pytest -q -n $(TEST_WORKERS) --dist worksteal
@@ -39,7 +39,7 @@ tools/solc/node_modules: tools/solc/package.json tools/solc/package-lock.json
 	cd tools/solc && npm ci --no-audit --no-fund
 	touch $@
 
-# Gas with cold storage per transaction (revm, sizes 1-512, small sizes cross-checked on py-evm):
+# Gas with cold storage per transaction (revm, sizes 1-512, small sizes cross-checked on py-evm; 50 s on 2026-11-24):
 # docs/gas.md, the bound; then the chain model's constants as they must read in src/infomarket/ledger/gas.py
 # (tests/chain/test_gas_constants.py fails until they do).
 gas: venv

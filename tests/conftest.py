@@ -9,6 +9,8 @@ from infomarket.engine import specialise
 from infomarket.engine.build import behaviour_kinds, build_world
 from infomarket.engine.world import kernel_view
 
+from . import shared_kernel  # noqa: F401  (imported first, so its list of built-in behaviours is only those)
+
 
 def make_config(robots: int = 2, behaviour: str = "naive", scheme: str = "delayed", **top):
     data = {"swarm": {"robots": robots, "groups": [{"behaviour": behaviour, "count": robots}]},

@@ -4,12 +4,51 @@ import pytest
 
 import infomarket as im
 from infomarket import checks
+from infomarket.engine.simulation import Simulation
 from infomarket.registry import behaviours, payments
+
+from .shared_kernel import BUILTIN, shared_kinds
 
 
 @pytest.mark.parametrize("name", sorted(behaviours()))
 def test_every_registered_behaviour_passes(name):
-    checks.check_behaviour(name, steps=1500)
+    # every built-in behaviour compiled into each check's kernel: one kernel per scheme (two more for
+    # waypoint paths) instead of two per behaviour, shared with the tests that run behaviour mixes
+    checks.check_behaviour(name, steps=1500, alongside=BUILTIN)
+
+
+def test_a_run_on_a_shared_kernel_is_the_run_on_its_own():
+    # saboteur is not first among the shared kinds: a robot's kind must index the kernel's kinds
+    cfg = checks._swarm("saboteur", 10, "delayed", 0.0, 600)
+    own = Simulation(cfg, 3, record_events=True)
+    shared = Simulation(cfg, 3, record_events=True, kernel_kinds=shared_kinds(cfg))
+    assert shared.kinds == checks._kernel_kinds("saboteur", BUILTIN)  # the rule checks' kernel
+    assert shared.kinds.index("saboteur") != own.kinds.index("saboteur")
+    assert shared.kernel_source != own.kernel_source
+    a, b = own.run(), shared.run()
+    assert len(a.events) > 50 and (a.events.kind == "purchase").any()
+    assert a.robots.equals(b.robots) and a.events.equals(b.events) and a.payments.equals(b.payments)
+
+
+def test_check_behaviours_names_a_rule_that_keeps_the_shared_kernel_from_compiling():
+    def three_values(w, me, site):
+        return True, 1.0, 0.0
+
+    im.register_behaviour("tmp_three_values", buy="naive", sell=three_values, honest=False, replace=True)
+    # naive is checked first, on the kernel of both: its own rules compile, so only checking each alone
+    # names the rule at fault
+    with pytest.raises(im.errors.RuleRunError, match="'tmp_three_values': its sell rule three_values .* returns"):
+        checks.check_behaviours(["naive", "tmp_three_values"], steps=300)
+
+
+def test_kernel_kinds_must_hold_the_experiments_behaviours_and_its_step():
+    cfg = checks._swarm("saboteur", 10, "delayed", 0.0, 600)
+    with pytest.raises(im.errors.ArgumentError, match="missing \\['saboteur'\\]"):
+        Simulation(cfg, 3, kernel_kinds=("naive", "greedy"))
+    with pytest.raises(im.errors.ArgumentError, match="waypoint paths"):
+        Simulation(cfg, 3, kernel_kinds=("naive", "saboteur", "waypoint"))
+    assert checks._kernel_kinds("saboteur", ["waypoint", "greedy", "naive"]) == ("naive", "greedy", "saboteur")
+    assert checks._kernel_kinds("waypoint", ["waypoint", "greedy", "naive"]) == ("naive", "waypoint")
 
 
 @pytest.mark.parametrize("name", sorted(payments()))

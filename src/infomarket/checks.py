@@ -13,7 +13,7 @@ import numba
 import numpy as np
 
 from .config import validate
-from .engine.simulation import simulate
+from .engine.simulation import Simulation
 from .errors import InfomarketError, RuleRunError
 from .ledger import LedgerEvent, replay_events
 from .ledger.replay import Ledger
@@ -43,23 +43,35 @@ def _invariants(res, what: str, initial: float, robots: int) -> None:
         raise CheckFailed(f"{what}: a purchase carried a non-finite vector")
 
 
-def _behaviour_bounds_checked(name: str, cfg, seed: int, steps: int) -> None:
+#: Each rule compiled with bounds checking, once per process (many behaviours share a rule).
+_BOUNDS_CHECKED: dict = {}
+
+
+def _with_bounds_check(py):
+    """``py`` compiled with numba's bounds checking (one dispatcher per function, so a rule shared by many
+    behaviours compiles once), or None where it does not compile here (the runs report it)."""
+    if py not in _BOUNDS_CHECKED:
+        try:
+            _BOUNDS_CHECKED[py] = numba.njit(boundscheck=True)(py)
+        except Exception:  # noqa: BLE001
+            _BOUNDS_CHECKED[py] = None
+    return _BOUNDS_CHECKED[py]
+
+
+def _behaviour_bounds_checked(name: str, cfg, seed: int, steps: int, kinds) -> None:
     """Run ``name``'s buy and sell rules once per robot of that behaviour, compiled with numba's bounds
     checking, on the world of a short run of ``cfg``; an index out of range is a CheckFailed naming the
     rule, its file and the line (found by running the same call in plain Python)."""
-    from .engine.simulation import Simulation
-
     spec = get_behaviour(name)
-    sim = Simulation(cfg, seed)
+    sim = Simulation(cfg, seed, kernel_kinds=kinds)
     sim.step(max(1, min(steps, 500)))
     w, view = sim.world, sim._view
     kind = sim.kinds.index(name)
     rng = np.random.default_rng(seed)
     for role, rule in (("sell", spec.sell), ("buy", spec.buy)):
         py = rule.py_func
-        try:
-            checked = numba.njit(boundscheck=True)(py)
-        except Exception:  # noqa: BLE001  (not compilable here: the runs report it)
+        checked = _with_bounds_check(py)
+        if checked is None:
             continue
         for me in np.flatnonzero(w.kind == kind):
             params = [float(w.bparams[me][spec.params.index(p)]) for p in rule.params]
@@ -75,20 +87,49 @@ def _behaviour_bounds_checked(name: str, cfg, seed: int, steps: int) -> None:
                                       + _located(exc, py, lambda: py(w, *args, *extra))) from None
 
 
-def check_behaviour(name: str, *, robots: int = 10, steps: int = 3000, seed: int = 0) -> None:
+def _kernel_kinds(name: str, alongside) -> tuple[str, ...]:
+    """The behaviours of the kernel that checks ``name``: naive, then ``name`` and those ``alongside`` that
+    keep waypoint paths on or off as ``name`` does (paths select another step), in sorted order, so every
+    check given the same ``alongside`` runs on one kernel."""
+    paths = get_behaviour(name).paths
+    same = {b for b in alongside if get_behaviour(b).paths == paths} | {name}
+    return ("naive", *sorted(same - {"naive"}))
+
+
+def check_behaviour(name: str, *, robots: int = 10, steps: int = 3000, seed: int = 0, alongside=()) -> None:
     """Run ``name`` among naive robots, with and without staking, twice each with the same seed; and its
     rules once each compiled with bounds checking (an index out of range is caught, named with the rule's
-    file and line)."""
+    file and line).  ``alongside``: more behaviours to compile into the step kernel, so that checks of many
+    behaviours, each given them all, compile one kernel per scheme instead of one per behaviour; the runs
+    are the same (``Simulation``'s ``kernel_kinds``)."""
     get_behaviour(name)  # a clear ConfigError for an unknown name
-    _behaviour_bounds_checked(name, _swarm(name, robots, *MARKETS["delayed"], steps), seed, steps)
+    kinds = _kernel_kinds(name, alongside) if alongside else None
+    _behaviour_bounds_checked(name, _swarm(name, robots, *MARKETS["delayed"], steps), seed, steps, kinds)
     for scheme, stake in (MARKETS["delayed"], MARKETS["staking"]):
         cfg = _swarm(name, robots, scheme, stake, steps)
-        a = simulate(cfg, seed, record_events=True)
-        b = simulate(cfg, seed, record_events=True)
+        a = Simulation(cfg, seed, record_events=True, kernel_kinds=kinds).run()
+        b = Simulation(cfg, seed, record_events=True, kernel_kinds=kinds).run()
         what = f"behaviour {name!r} under {scheme} (stake {stake})"
         if not (a.robots.equals(b.robots) and a.events.equals(b.events)):
             raise CheckFailed(f"{what}: the same seed gave different results")
         _invariants(a, what, cfg.payment.initial_wealth, robots)
+
+
+def check_behaviours(names, **kwargs) -> None:
+    """``check_behaviour`` for each of ``names``, all on one kernel per scheme (two for those with waypoint
+    paths): a cold check of many behaviours compiles a few kernels, not two per behaviour.  An error other
+    than a failed check (a rule that keeps the shared kernel from compiling need not be the checked
+    behaviour's, so it may go unnamed) checks each behaviour alone, which names the rule at fault."""
+    names = list(names)
+    try:
+        for name in names:
+            check_behaviour(name, alongside=names, **kwargs)
+    except CheckFailed:
+        raise
+    except Exception:
+        for name in names:
+            check_behaviour(name, **kwargs)
+        raise
 
 
 def _rule_where(func) -> tuple[str, int]:
@@ -242,8 +283,6 @@ def explain_run_failure(cfg, seed: int, exc: BaseException, step: int, *, record
     (compiled) up to the step before, then every rule the step calls is called on that world as the step
     calls it, in the step's order (sell, buy, weights); the first that raises the same kind of error is
     named with its file and line (from the same call in plain Python).  None when none does alone."""
-    from .engine.simulation import Simulation
-
     try:
         sim = Simulation(cfg, seed, record_events=record_events, history_every=history_every)
         if step > 1:
@@ -381,8 +420,6 @@ def _flagged(cfg, sim, flags) -> str | None:
 def _first_flagged_step(cfg, sim) -> int:
     """The step at which the run of ``sim`` first set an error bit: the compiled loop goes on to the end of
     its call before the host reads the bits, so the run is repeated one step at a time up to there."""
-    from .engine.simulation import Simulation
-
     try:
         again = Simulation(cfg, sim.seed, record_events=bool(sim.world.record))
     except Exception:  # noqa: BLE001

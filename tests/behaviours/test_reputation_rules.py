@@ -6,8 +6,9 @@ are those of ``infomarket.checks`` (naive robots and the rule under test) so the
 """
 import numpy as np
 import infomarket as im
-from infomarket.engine.simulation import Simulation
 from infomarket.ledger import LedgerEvent, replay_events
+
+from ..shared_kernel import simulate, simulation  # the kernel the rule checks compile
 
 NEVER = {"farm_record": 1e9, "farm_share": 1.0}   # a farmer that never reaches its threshold
 ALWAYS = {"farm_record": 0.0, "farm_reputation": 0.0}  # a farmer past its threshold from the start
@@ -27,40 +28,40 @@ def _same(a, b):
 
 
 def test_a_farmer_past_its_threshold_is_a_scaboteur():
-    farmer = im.simulate(_cfg("reputation_farmer", {"rotation_angle": 60.0, **ALWAYS}), 5)
-    liar = im.simulate(_cfg("scaboteur", {"rotation_angle": 60.0}), 5)
+    farmer = simulate(_cfg("reputation_farmer", {"rotation_angle": 60.0, **ALWAYS}), 5)
+    liar = simulate(_cfg("scaboteur", {"rotation_angle": 60.0}), 5)
     assert _same(farmer, liar)
 
 
 def test_a_farmer_below_its_threshold_is_honest_and_switches_when_it_passes():
-    honest = im.simulate(_cfg("sceptical"), 5)
-    assert _same(im.simulate(_cfg("reputation_farmer", {"rotation_angle": 60.0, **NEVER}), 5), honest)
-    farming = im.simulate(_cfg("reputation_farmer", {"rotation_angle": 60.0, "farm_record": 1.0,
+    honest = simulate(_cfg("sceptical"), 5)
+    assert _same(simulate(_cfg("reputation_farmer", {"rotation_angle": 60.0, **NEVER}), 5), honest)
+    farming = simulate(_cfg("reputation_farmer", {"rotation_angle": 60.0, "farm_record": 1.0,
                                                      "farm_reputation": 0.5, "farm_share": 1.0}), 5)
     assert not _same(farming, honest)  # its record passed the threshold during the run: it lied
 
 
 def test_the_surfer_lies_at_most_margin_times_theta():
-    capped = im.simulate(_cfg("theta_surfer", {"rotation_angle": 90.0, "margin": 0.5, "theta": 30.0}), 6)
-    assert _same(capped, im.simulate(_cfg("scaboteur", {"rotation_angle": 15.0}), 6))
-    small = im.simulate(_cfg("theta_surfer", {"rotation_angle": 10.0, "margin": 0.5, "theta": 30.0}), 6)
-    assert _same(small, im.simulate(_cfg("scaboteur", {"rotation_angle": 10.0}), 6))
+    capped = simulate(_cfg("theta_surfer", {"rotation_angle": 90.0, "margin": 0.5, "theta": 30.0}), 6)
+    assert _same(capped, simulate(_cfg("scaboteur", {"rotation_angle": 15.0}), 6))
+    small = simulate(_cfg("theta_surfer", {"rotation_angle": 10.0, "margin": 0.5, "theta": 30.0}), 6)
+    assert _same(small, simulate(_cfg("scaboteur", {"rotation_angle": 10.0}), 6))
 
 
 def test_against_the_adaptive_contract_the_surfer_follows_its_reputation():
     # theta_min = theta: the adaptive cap is theta whatever the reputation, as without adaptation
     flat = {"rotation_angle": 90.0, "margin": 0.5, "theta": 30.0, "theta_min": 30.0}
-    assert _same(im.simulate(_cfg("theta_surfer", {**flat, "adaptive": 1.0}), 6),
-                 im.simulate(_cfg("theta_surfer", {**flat, "adaptive": 0.0}), 6))
+    assert _same(simulate(_cfg("theta_surfer", {**flat, "adaptive": 1.0}), 6),
+                 simulate(_cfg("theta_surfer", {**flat, "adaptive": 0.0}), 6))
     # theta_min = 2: the cap is 2 + 28 x reputation < 30 once its record is below perfect
     steep = {**flat, "theta_min": 2.0}
-    assert not _same(im.simulate(_cfg("theta_surfer", {**steep, "adaptive": 1.0}), 6),
-                     im.simulate(_cfg("theta_surfer", {**steep, "adaptive": 0.0}), 6))
+    assert not _same(simulate(_cfg("theta_surfer", {**steep, "adaptive": 1.0}), 6),
+                     simulate(_cfg("theta_surfer", {**steep, "adaptive": 0.0}), 6))
 
 
 def _pending_and_purchases(params, seed=7, steps=2000):
     """The most pending purchases any reputation sceptic held, and how many purchases they made."""
-    sim = Simulation(_cfg("reputation_sceptic", params, steps=steps), seed, record_events=True)
+    sim = simulation(_cfg("reputation_sceptic", params, steps=steps), seed, record_events=True)
     most = 0
     for _ in range(steps // 10):
         sim.step(10)

@@ -8,7 +8,13 @@ import pytest
 from infomarket.config import validate
 from infomarket.engine.world import EXPLORING, FOOD, NEST
 
-from .conftest import FAR_SITES, place, seek_food, simulation
+from ..shared_kernel import simulation as shared_simulation
+from .conftest import FAR_SITES, place, seek_food
+
+
+def simulation(cfg):
+    # on the kernel the rule check of waypoint compiles (naive and waypoint, paths): nothing new to compile
+    return shared_simulation(cfg, 3)
 
 
 def waypoint_config(robots, obstacles=()):

@@ -123,9 +123,10 @@ def run_demo(args: argparse.Namespace) -> int:
         return report_error(f"infomarket chain needs the chain extra (pip install 'infomarket[chain]'): {exc}", 1)
     try:
         config = demo_config(load_experiment(args.experiment), args.robots, args.steps, args.scheme)
-        config = chain_config(config, getattr(args, "chain_period", None), getattr(args, "gas_price", None))
-        if config.chain.gas_price and not config.chain.enabled:
+        period, gas_price = getattr(args, "chain_period", None), getattr(args, "gas_price", None)
+        if gas_price and period is None and not config.chain.enabled:  # named by its flag, before the config's check
             raise ConfigError("--gas-price needs the chain model: give --chain-period P too")
+        config = chain_config(config, period, gas_price)
         if config.chain.enabled and (args.rpc or args.backend != "revm"):
             raise ConfigError("the block-by-block replay of the chain model needs the revm backend (its blocks "
                               "are set by the replay): drop --rpc and --backend py-evm")

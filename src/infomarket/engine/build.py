@@ -20,10 +20,11 @@ from .world import ChainWorld, World, kernel_view
 
 
 def build_world(cfg: Experiment, rng: np.random.Generator, *, record_events: bool = False,
-                history_every: int = 0) -> tuple[World, list[str]]:
+                history_every: int = 0, kinds: tuple[str, ...] | None = None) -> tuple[World, list[str]]:
     """A fresh world: robots in group order (ids follow the groups), uniform integer positions,
-    uniform headings, bimodal odometry biases, empty tables, initial wealth; and each robot's behaviour."""
-    kind, bparams, names = behaviour_table(cfg)
+    uniform headings, bimodal odometry biases, empty tables, initial wealth; and each robot's behaviour
+    (its ``kind`` an index into ``kinds``, the kernel's behaviours; by default the experiment's own)."""
+    kind, bparams, names = behaviour_table(cfg, kinds)
     params = build_params(cfg, bparams)
     swarm = build_swarm(cfg, rng, kind, params["grid_nx"] * params["grid_ny"])
     log = build_log(cfg.swarm.robots, record_events=record_events, history_every=history_every,

@@ -117,10 +117,11 @@ def behaviour_kinds(cfg: Experiment) -> tuple[str, ...]:
     return tuple(names)
 
 
-def behaviour_table(cfg: Experiment) -> tuple[np.ndarray, np.ndarray, list[str]]:
-    """Robots in group order (ids follow the groups): each one's kind, its parameter row, its name."""
+def behaviour_table(cfg: Experiment, kinds: tuple[str, ...] | None = None) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """Robots in group order (ids follow the groups): each one's kind (an index into ``kinds``, by default
+    ``behaviour_kinds(cfg)``), its parameter row, its name."""
     n = cfg.swarm.robots
-    kinds = behaviour_kinds(cfg)
+    kinds = behaviour_kinds(cfg) if kinds is None else kinds
     specs = behaviours()
     n_par = max([len(specs[b].params) for b in kinds] + [1])
     kind = np.empty(n, np.int64)

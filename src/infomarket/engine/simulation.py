@@ -61,16 +61,19 @@ class Simulation:
     it steps is ``self.world`` (``engine.world``: parameters, swarm, ledger and log side by side)."""
 
     def __init__(self, config: Experiment | str | Path, seed: int | None = None, *, record_events: bool = False,
-                 history_every: int | None = None):
+                 history_every: int | None = None, kernel_kinds: tuple[str, ...] | None = None):
+        """``kernel_kinds``: the behaviours the step kernel is compiled for, in kind order, when it is to hold
+        more than this experiment's own (``checks`` runs many small swarms on one kernel); the rules called,
+        hence the run, are the same."""
         config = as_experiment(config)
         self.config = config
         self.record_events = record_events
         self.seed = _checked_seed(config.seed if seed is None else seed)
         self.rng = np.random.default_rng(self.seed)
-        self.kinds = behaviour_kinds(config)
+        self.kinds = behaviour_kinds(config) if kernel_kinds is None else _checked_kinds(config, kernel_kinds)
         hist = config.history_every if history_every is None else _checked_history(history_every, config.steps)
         self.world, self.behaviour_names = build_world(config, self.rng, record_events=record_events,
-                                                       history_every=hist)
+                                                       history_every=hist, kinds=self.kinds)
         t0 = time.perf_counter()
         try:
             with compile_notice(self.kinds, config.payment.scheme), ctrl_c_survives_compiling():
@@ -281,6 +284,18 @@ def _checked_history(every, steps: int) -> int:
     if isinstance(every, bool) or not isinstance(every, (int, np.integer)) or not 0 <= int(every) <= steps:
         raise ConfigError(f"history_every must be an integer in [0, steps = {steps}] (0: no history), got {every!r}")
     return int(every)
+
+
+def _checked_kinds(config: Experiment, kinds) -> tuple[str, ...]:
+    kinds = tuple(kinds)
+    own = behaviour_kinds(config)
+    missing = [b for b in own if b not in kinds]
+    if missing or len(set(kinds)) != len(kinds):
+        raise ArgumentError(f"kernel_kinds must name each behaviour once and include the experiment's own; "
+                            f"got {kinds!r}, missing {missing!r}")
+    if specialise.uses_paths(kinds) != specialise.uses_paths(own):  # paths select another step
+        raise ArgumentError(f"kernel_kinds {kinds!r} must keep waypoint paths on or off as {own!r} does")
+    return kinds
 
 
 def _checked_seed(seed) -> int:

@@ -1,0 +1,89 @@
+"""Where a test run's CPU time goes: a pytest plugin that writes, per test, its CPU seconds and every numba
+compile it triggered (a cache miss: the function, its module, its CPU seconds), one JSON object a line.
+
+    INFOMARKET_CACHE_DIR=$(mktemp -d) NUMBA_CACHE_DIR=$(mktemp -d) KERNEL_PROFILE=prof.jsonl \\
+        .venv/bin/python -m pytest -q -n 0 -p tests.kernel_profile
+    .venv/bin/python -m tests.kernel_profile prof.jsonl      # the summary: kernels, their tests, top files
+
+CPU seconds (``time.process_time``), not wall time, so a busy machine does not change them; with fresh
+cache folders every kernel is compiled once, by the first test that needs it (docs/testing.md).
+"""
+from __future__ import annotations
+
+import collections
+import json
+import os
+import sys
+import time
+
+import pytest
+from numba.core import event
+
+_STATE = {"test": "<collection>", "depth": 0, "start": 0.0}
+_OUT: list = []
+
+
+def _emit(record: dict) -> None:
+    if not _OUT:
+        _OUT.append(open(os.environ.get("KERNEL_PROFILE", "kernel-profile.jsonl"), "a"))
+    _OUT[0].write(json.dumps(record) + "\n")
+    _OUT[0].flush()
+
+
+class _Compiles(event.Listener):
+    """numba fires ``numba:compile`` only when it compiles (not when it loads from its cache); nested
+    compiles (a kernel's callees) are counted inside the outermost one."""
+
+    def on_start(self, ev):
+        if _STATE["depth"] == 0:
+            _STATE["start"] = time.process_time()
+        _STATE["depth"] += 1
+
+    def on_end(self, ev):
+        _STATE["depth"] -= 1
+        if _STATE["depth"] == 0:
+            func = ev.data["dispatcher"].py_func
+            _emit({"compile": func.__qualname__, "module": func.__module__, "test": _STATE["test"],
+                   "cpu": time.process_time() - _STATE["start"]})
+
+
+def pytest_configure(config):
+    event.register("numba:compile", _Compiles())
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_protocol(item, nextitem):
+    _STATE["test"] = item.nodeid
+    start, children = time.process_time(), os.times()
+    yield
+    after = os.times()
+    _emit({"test": item.nodeid, "cpu": time.process_time() - start,
+           "children_cpu": after.children_user + after.children_system
+           - children.children_user - children.children_system})
+    _STATE["test"] = "<between tests>"
+
+
+def summary(path: str, top: int = 40) -> str:
+    tests, compiles = {}, []
+    for line in open(path):
+        record = json.loads(line)
+        if "compile" in record:
+            compiles.append(record)
+        else:
+            tests[record["test"]] = record
+    kernels = [c for c in compiles if c["module"].startswith("infomarket_kernel")]
+    files = collections.Counter()
+    for name, t in tests.items():
+        files[name.split("::")[0]] += t["cpu"] + t["children_cpu"]
+    lines = [f"{len(tests)} tests, {sum(t['cpu'] for t in tests.values()):.0f} CPU s in the test process, "
+             f"{sum(t['children_cpu'] for t in tests.values()):.0f} in processes they started",
+             f"{len(compiles)} compiles, {sum(c['cpu'] for c in compiles):.0f} CPU s; {len(kernels)} step kernels, "
+             f"{sum(c['cpu'] for c in kernels):.0f} CPU s", "", "step kernels (CPU s, the test that compiled it):"]
+    lines += [f"{c['cpu']:7.1f}  {c['module']}  {c['test']}" for c in sorted(kernels, key=lambda c: -c["cpu"])]
+    lines += ["", f"the {top} costliest files (CPU s, their processes included):"]
+    lines += [f"{cpu:7.1f}  {name}" for name, cpu in files.most_common(top)]
+    return "\n".join(lines)
+
+
+if __name__ == "__main__":
+    print(summary(sys.argv[1]))
