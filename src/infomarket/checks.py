@@ -315,6 +315,7 @@ def explain_compile_failure(cfg, exc: BaseException) -> str | None:
     the generated kernel): each rule is compiled alone with the argument types the step passes; the first
     that does not compile, or returns what its kind of rule must not (a sell rule returns four values), is
     named with its file.  None when every rule compiles alone and returns what it must."""
+    # the engine is imported on a failure only: the checker's own import stays light
     from .engine.build import build_world
     from .engine.params import behaviour_kinds
     from .engine.world import kernel_view
@@ -375,6 +376,7 @@ def explain(cfg, seed: int, exc: Exception, sim=None, *, record_events: bool = F
     """``exc``, raised by compiling the step kernel of ``cfg`` (``sim`` None) or by the compiled step of
     ``sim`` (a run with ``seed``), as a RuleRunError naming the rule, its file and line, and the step, or
     as a SimulationError naming the step; ``exc`` itself when nothing explains it.  Raise the result."""
+    # imported on a failure only (explain runs when something already went wrong)
     from .errors import SimulationError
     from .state.flags import ErrorFlags
 
@@ -401,7 +403,7 @@ def explain(cfg, seed: int, exc: Exception, sim=None, *, record_events: bool = F
 
 def _flagged(cfg, sim, flags) -> str | None:
     """The rule behind an error bit of the step (``state.flags``), named with its file, or None."""
-    from .state.flags import ErrorFlags
+    from .state.flags import ErrorFlags  # imported on a failure only
 
     step = _first_flagged_step(cfg, sim)
     if ErrorFlags.BAD_WEIGHTS in flags:

@@ -30,7 +30,7 @@ def _print_summary(robots, title: str) -> None:
     from rich.console import Console
     from rich.table import Table
 
-    from .analysis import summarise
+    from .analysis import summarise  # with the command: `infomarket --help` stays light
 
     table = Table(title=title)
     for col in ("behaviour", "robots/run", "honest", "median items", "median wealth share"):
@@ -43,6 +43,7 @@ def _print_summary(robots, title: str) -> None:
 
 # ---------------------------------------------------------------------------------------------- run
 def cmd_run(args) -> int:
+    # with the command: `infomarket --help` does not import the runner
     from .runner.execute import default_workers
     from .runner.progress import progress
     from .runner.run import RunInterrupted, prepare, run_experiment
@@ -79,7 +80,7 @@ def cmd_run(args) -> int:
 
 # --------------------------------------------------------------------------------------------- demo
 def cmd_demo(args) -> int:
-    from .demo import run_demo
+    from .demo import run_demo  # with the command: `infomarket --help` stays light
 
     return run_demo(runs=args.runs, workers=args.workers)
 
@@ -93,6 +94,7 @@ def cmd_list(args) -> int:
     from rich.console import Console
     from rich.table import Table
 
+    # with the command: `infomarket --help` stays light
     from .config import shipped_experiments
     from .registry import behaviours, payments
 
@@ -126,7 +128,7 @@ def cmd_list(args) -> int:
 
 
 def cmd_check(args) -> int:
-    from .config import chain as chain_rules, load_experiment
+    from .config import chain as chain_rules, load_experiment  # with the command: `--help` stays light
 
     cfg = load_experiment(args.experiment)
     if cfg.plugins:  # validating needs the rules they register: say that their code ran

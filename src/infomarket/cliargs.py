@@ -56,7 +56,7 @@ def writable_file(path: str | Path, option: str = "--out") -> Path:
 
 def seed_value(text: str) -> int:
     """A seed: an integer in [0, 2**63 - 1], as in experiment files and the Python API."""
-    from .seeds import MAX_SEED
+    from .seeds import MAX_SEED  # argument parsing is imported by every command; seeds only when parsed
 
     value = at_least(0)(text)
     if value > MAX_SEED:

@@ -75,7 +75,7 @@ def run_bytes(cfg, *, record_events: bool = False, history_every: int | None = N
     """Estimated bytes of one run of ``cfg``, by part."""
     n, steps = cfg.swarm.robots, cfg.steps
     every = cfg.history_every if history_every is None else history_every
-    from ..space.grid import grid_shape
+    from ..space.grid import grid_shape  # the config layer stays free of the compiled space code until sized
 
     _, nx, ny = grid_shape(cfg.arena.width, cfg.arena.height, cfg.robot.communication_range, n)
     cells = nx * ny

@@ -16,7 +16,7 @@ def site_overlap(cfg) -> str | None:
     A site must be reachable everywhere: a pick-up spot inside an obstacle could never be reached."""
     if not cfg.obstacles:
         return None
-    from ..space.obstacles import encode, distance
+    from ..space.obstacles import encode, distance  # compiled geometry, only for configs with obstacles
 
     kinds, geom = encode(cfg.obstacles)
     for key in ("food", "nest"):

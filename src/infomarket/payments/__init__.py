@@ -1,5 +1,6 @@
 """Payment schemes: weight rules over a buyer's open transactions (registered by ``infomarket.builtins``
 through the public ``register_payment``)."""
+from ..registry import get_payment
 
 #: The paper's stake (docs/model.md §5).
 PAPER_STAKE = 0.04
@@ -9,6 +10,5 @@ MARKETS = {"delayed": ("delayed", 0.0), "outlier": ("outlier", 0.0), "staking": 
 
 def default_theta() -> float:
     """Θ of the outlier scheme: its one definition is the rule's default (``schemes.outlier_weights``)."""
-    from ..registry import get_payment
 
     return get_payment("outlier").defaults["theta"]

@@ -56,9 +56,10 @@ def add_subcommand(sub) -> None:
 
 def cmd_rl_train(args) -> int:
     try:
-        from .envs import AttackVectorEnv
+        from .envs import AttackVectorEnv  # gymnasium is an optional extra: refused with a message if missing
     except ModuleNotFoundError as exc:
         raise UsageError(f"rl-train needs {exc.name}: pip install 'infomarket[rl]'") from None
+    # with the command, after the optional extra is known to be there
     from ..runner.progress import progress
     from .run import compare, describe
 
@@ -84,7 +85,7 @@ def cmd_rl_train(args) -> int:
     t0 = time.perf_counter()
     env = AttackVectorEnv(args.experiment, 2 * args.pairs, cell=cell or None, steps=args.steps,
                           transitory=args.transitory, interval=args.interval)
-    from .train import train
+    from .train import train  # after the environment is built: a bad argument is refused before this import
 
     with progress("ES", args.iterations * 2 * args.pairs, enabled=not (args.quiet or args.json)) as bar:
         bar.skip(0)

@@ -43,6 +43,7 @@ def _reductions(st, declared, exp, chosen, all_cells, args) -> list[str]:
 
 
 def cmd_attack_search(args) -> int:
+    # with the command: `infomarket --help` does not import the search, runner and store
     from ..config import load_experiment
     from ..runner.execute import default_workers, local_executor, warm
     from ..runner.progress import progress

@@ -256,7 +256,7 @@ def layout_type(name: str) -> WorldType:
 def view_module(name: str):
     """The module with ``make_view`` for a layout, generated once per layout and cached on disk like the
     kernels (compiling it costs a few seconds, so every kernel shares it)."""
-    from ..generated import generated_digest, load_generated
+    from ..generated import generated_digest, load_generated  # generated imports the engine, which imports this
 
     source = constructor_source(_LAYOUTS[name], name)
     return load_generated(f"view{name}", generated_digest(source).hexdigest()[:20], source)
