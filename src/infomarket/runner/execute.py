@@ -31,12 +31,15 @@ import pandas as pd
 
 from .. import plugins
 from ..config.schema import Experiment
-from ..engine.simulation import Simulation
+from ..engine.simulation import Simulation, Simulations
 from ..checks import explain
 from ..errors import InfomarketError, RuleRunError
 from .plan import Condition
 
 MAX_ERROR_CHARS = 4000
+#: Runs of one configuration stepped together in one compiled call (their worlds are alive at once; a
+#: run that records events keeps its whole log, so those go one at a time).
+TOGETHER = 16
 
 
 class RunFailed(InfomarketError, RuntimeError):
@@ -76,6 +79,20 @@ def run_one(cfg: Experiment, run: int, seed: int, record_events: bool = False) -
         r = sim.run()
     except Exception as exc:  # a rule's error (or an error bit a rule set): named, else as it is
         raise explain(cfg, seed, exc, sim, record_events=record_events) from exc
+    return output(r, run)
+
+
+def run_together(cfg: Experiment, items: list[tuple[int, int]], record_events: bool = False) -> list[RunOutput]:
+    """Runs ``items`` (run, seed) of ``cfg`` stepped back to back in one compiled call
+    (``engine.simulation.Simulations``: one kernel load, worlds that start with the room earlier runs
+    grew to); the same rows as ``run_one`` for each.  Raises the first run's error, named."""
+    sims = Simulations(cfg, [seed for _, seed in items], record_events=record_events)
+    return [output(r, run) for r, (run, _) in zip(sims.run(), items)]
+
+
+def output(r, run: int) -> RunOutput:
+    """A run's ``Result`` as the store keeps it: every table labelled with ``run`` (and ``seed``)."""
+    seed = r.seed
     robots = r.robots
     robots.insert(0, "run", np.int64(run))
     hist, events, payments = r.history, r.events, r.payments
@@ -117,13 +134,29 @@ def _failed(run: int, seed: int, exc: BaseException) -> RunOutput:
 
 
 def run_chunk(cfg: Experiment, items: list[tuple[int, int]], record_events: bool = False) -> list[RunOutput]:
-    """Run ``items`` (run, seed) of ``cfg`` in this process; a run that raises becomes a RunOutput with its
-    error text and the others still run.  Ctrl-C (KeyboardInterrupt) is not caught."""
+    """Run ``items`` (run, seed) of ``cfg`` in this process, up to ``TOGETHER`` at a time in one compiled
+    call (``run_together``); a run that raises becomes a RunOutput with its error text and the others
+    still run (its group is run again one run at a time).  Ctrl-C (KeyboardInterrupt) is not caught."""
     try:
         for entry in cfg.plugins:  # rules registered by plugins must exist in this worker too
             plugins.load(entry)
     except Exception as exc:
         return [_failed(run, seed, exc) for run, seed in items]
+    out: list[RunOutput] = []
+    size = 1 if record_events else TOGETHER
+    for k in range(0, len(items), size):
+        group = items[k:k + size]
+        if len(group) > 1:
+            try:
+                out += run_together(cfg, group, record_events)
+                continue
+            except Exception:  # noqa: BLE001 - run alone, so each run's error is its own and the others go on
+                pass
+        out += _alone(cfg, group, record_events)
+    return out
+
+
+def _alone(cfg: Experiment, items: list[tuple[int, int]], record_events: bool) -> list[RunOutput]:
     out = []
     for run, seed in items:
         try:
