@@ -156,10 +156,15 @@ def _print_many(m: dict) -> None:
     e = m["engine"]["env_steps_per_second"]
     print(f"many runs of {m['setup']}, {m['steps']} steps a run, per CPU second of this process:")
     print(f"  engine      {e:>12,.0f} env-steps/s")
-    for k in ("sweep", "search"):
-        r = m[k]
-        print(f"  {k:10s}  {r['env_steps_per_second']:>12,.0f} env-steps/s  {r['ratio_to_engine']:.2f} of the engine's "
-              f"(goal >= {r['goal']}; {r['runs']} runs)")
+    for k in ("sweep", "search", "search_pool"):
+        r = m.get(k)
+        if r:
+            print(f"  {k:10s}  {r['env_steps_per_second']:>12,.0f} env-steps/s  {r['ratio_to_engine']:.2f} of the "
+                  f"engine's (goal >= {r['goal']}; {r['runs']} runs)")
+    p = m.get("search_pool")
+    if p:
+        print(f"  {p['workers']} workers: {p['wall_env_steps_per_second']:,.0f} env-steps per wall second, "
+              f"{p['wall_ratio_to_engine_per_worker']:.2f} of the engine's on every worker (a quiet machine only)")
     v = m.get("vector_env")
     if v:
         print(f"  vector env  {v['vector_env_steps_per_second']:>12,.0f} env-steps/s  {v['ratio_to_engine']:.2f} of the "

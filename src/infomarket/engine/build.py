@@ -19,11 +19,16 @@ from .world import ChainWorld, World, kernel_view
 
 
 def build_world(cfg: Experiment, rng: np.random.Generator, *, record_events: bool = False,
-                history_every: int = 0) -> tuple[World, list[str]]:
+                history_every: int = 0, params: dict | None = None) -> tuple[World, list[str]]:
     """A fresh world: robots in group order (ids follow the groups), uniform integer positions,
-    uniform headings, bimodal odometry biases, empty tables, initial wealth; and each robot's behaviour."""
+    uniform headings, bimodal odometry biases, empty tables, initial wealth; and each robot's behaviour.
+    ``params``: ``build_params`` of ``cfg`` made earlier (its arrays are copied), for many runs of one
+    configuration; they draw nothing from ``rng``."""
     kind, bparams, names = behaviour_table(cfg)
-    params = build_params(cfg, bparams)
+    if params is None:
+        params = build_params(cfg, bparams)
+    else:
+        params = {k: v.copy() if isinstance(v, np.ndarray) else v for k, v in params.items()}
     swarm = build_swarm(cfg, rng, kind, params["grid_nx"] * params["grid_ny"])
     log = build_log(cfg.swarm.robots, record_events=record_events, history_every=history_every,
                     history_rows=cfg.steps // history_every if history_every else 0,

@@ -29,7 +29,7 @@ from ..generated import ctrl_c_survives_compiling, generated_digest, load_genera
 from ..seeds import MAX_SEED
 from ..state.flags import ErrorFlags
 from .build import build_world, make_room, room_of, with_room
-from .params import behaviour_kinds
+from .params import behaviour_kinds, behaviour_table, build_params
 from .world import EVENT_NAMES, SITE_NAMES, STATE_NAMES, headings, kernel_view
 
 
@@ -74,6 +74,7 @@ class Simulation:
         self._room_key = (self.kinds, config.payment.scheme, config.terrain, config.chain.enabled, record_events,
                           tuple((g.behaviour, g.count) for g in config.swarm.groups))
         self._kernel = None
+        self._params = build_params(config, behaviour_table(config)[1])  # the same for every run: made once
         self.reset(config.seed if seed is None else seed)
         t0 = time.perf_counter()
         try:
@@ -95,7 +96,7 @@ class Simulation:
         self.seed = checked_seed(seed)
         self.rng = np.random.default_rng(self.seed)
         world, self.behaviour_names = build_world(self.config, self.rng, record_events=self.record_events,
-                                                  history_every=self._history)
+                                                  history_every=self._history, params=self._params)
         world = with_room(world, _ROOM.get(self._room_key))
         if into:
             for name, array in into.items():
@@ -138,6 +139,8 @@ class Simulation:
             if status == self._kernel.DONE:
                 break
             self.grow()
+        if t_end >= self.config.steps:
+            self.remember_room()
         self.run_seconds += time.perf_counter() - t0
 
     def check_flags(self) -> None:
@@ -151,6 +154,11 @@ class Simulation:
         the next run of this kernel in this process."""
         self.world = make_room(self.world)
         self._view = kernel_view(self.world)
+        self.remember_room()
+
+    def remember_room(self) -> None:
+        """Keep the room this world has (the compiled step also moves a buyer's transactions to a larger
+        block of the pool without the host) for the next run of this kernel in this process."""
         room = room_of(self.world, _ROOM.get(self._room_key))
         if room is not None:
             _ROOM[self._room_key] = room
@@ -357,7 +365,11 @@ class Simulations:
             for b in np.flatnonzero(self._status):
                 self.sims[b].grow()
                 self._views[b] = self.sims[b]._view
-        made = self.clocks - before
+        now = self.clocks
+        for sim, clock, at in zip(self.sims, now, before):
+            if clock >= sim.config.steps > at:  # a run just ended: keep its room for the next ones
+                sim.remember_room()
+        made = now - before
         if made.sum():
             seconds = (time.perf_counter() - t0) * made / made.sum()
             for sim, sec in zip(self.sims, seconds):

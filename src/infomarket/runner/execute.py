@@ -176,8 +176,9 @@ def run_calls(calls: list[tuple]) -> list[RunOutput]:
 class Task:
     condition: Condition
     runs: tuple[int, ...]
-    #: further (condition, runs) in the same task: the points of a sampled design, which have a run or
-    #: two each, are grouped so that a study of thousands of points is not thousands of tasks (and parts)
+    #: further (condition, runs) in the same task: conditions of a few runs each (the points of a sampled
+    #: design, an attack search's candidates) are grouped so that thousands of them are not thousands of
+    #: tasks (and store parts)
     more: tuple[tuple[Condition, tuple[int, ...]], ...] = ()
 
     @property
@@ -200,14 +201,22 @@ class Task:
         return f"{c.experiment}-{tag}-{self.runs[0]:05d}-{self.runs[-1]:05d}"
 
 
+#: Tasks per worker a sweep aims at (enough to balance the workers' loads), and the most runs in one task
+#: (one store part: its tables are written, checksummed and read back once, whatever the runs in it).
+TASKS_PER_WORKER = 4
+MAX_TASK = 64
+
+
 def make_tasks(conds: list[Condition], done: set, workers: int) -> list[Task]:
-    """The runs of ``conds`` not in ``done`` ((experiment, condition, run) keys), grouped per condition
-    into tasks of a few runs each, longest first."""
+    """The runs of ``conds`` not in ``done`` ((experiment, condition, run) keys), grouped into tasks of
+    up to ``total / (workers x TASKS_PER_WORKER)`` runs (at most ``MAX_TASK``): a condition's runs are
+    split into tasks of that size, conditions with fewer runs (the points of a sampled design, the
+    candidates of an attack search) share tasks with the next ones of the same experiment.  Longest first."""
     todo = [(c, [r for r in range(c.runs) if (c.experiment, c.id, r) not in done]) for c in conds]
     total = sum(len(r) for _, r in todo)
-    size = max(1, min(16, math.ceil(total / max(1, workers * 8))))
+    size = max(1, min(MAX_TASK, math.ceil(total / max(1, workers * TASKS_PER_WORKER))))
     tasks = []
-    group: list[tuple[Condition, tuple[int, ...]]] = []  # points of a sampled design, filled up to ``size``
+    group: list[tuple[Condition, tuple[int, ...]]] = []  # conditions of a few runs each, filled up to ``size``
 
     def flush() -> None:
         if group:
@@ -215,7 +224,7 @@ def make_tasks(conds: list[Condition], done: set, workers: int) -> list[Task]:
             group.clear()
 
     for c, runs in todo:
-        if c.design is not None and 0 < len(runs) < size:
+        if 0 < len(runs) < size:
             if group and (group[0][0].experiment != c.experiment
                           or sum(len(r) for _, r in group) + len(runs) > size):
                 flush()
@@ -285,8 +294,9 @@ def stop_pool(pool: ProcessPoolExecutor) -> None:
 
 # ---------------------------------------------------------------------------------------- warm-up
 def warm(cfg: Experiment) -> None:
-    """Compile (or load) the configuration's kernel in this process, so forked workers inherit it."""
-    Simulation(cfg, 0)  # loads every compiled entry point (view constructor, step loop)
+    """Compile (or load) the configuration's kernel in this process, so forked workers inherit it: the
+    view constructor, the step loop, and the batch driver with its list of views (``run_together``)."""
+    Simulations(cfg, [0, 1]).advance(0)
 
 
 def preflight(configs: Iterable[Experiment]) -> None:
