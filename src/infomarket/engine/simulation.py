@@ -270,22 +270,29 @@ from numba import njit
 from {kernel} import run_steps, DONE
 {finish}
 
+FLAGGED = {flagged}
+
 
 @njit(cache=True)
-def step_all(views, rngs, t_end, status, extra):
-    """Run world b to step t_end[b], one after the other (status[b]: DONE or NEED_ROOM; -1 left on the
-    run whose step raised); when every run is DONE, ``finish(views, extra)``.  Returns the count of
-    runs that need room."""
+def step_all(views, rngs, t_end, status, clocks, extra):
+    """Run world b to step t_end[b], one after the other (status[b]: DONE or NEED_ROOM, FLAGGED when
+    an error bit is set; -1 left on the run whose step raised) and write its clock; when every run is
+    DONE, ``finish(views, extra)``.  Returns the count of runs that are not DONE."""
     short = 0
     for b in range(len(views)):
         status[b] = -1
         status[b] = run_steps(views[b], rngs[b], t_end[b])
+        clocks[b] = views[b].clock[0]
+        if views[b].flags[0] != 0:
+            status[b] = FLAGGED
         if status[b] != DONE:
             short += 1
     if short == 0:
         finish(views, extra)
     return short
 '''
+#: ``step_all``'s status of a run whose world has an error bit set (the kernel's own are 0 and 1).
+FLAGGED = 2
 _NO_FINISH = """
 @njit
 def finish(views, extra):
@@ -303,7 +310,7 @@ def batch_module(kernel, finish: str | None = None):
         module, name = finish.split(":")
         head = f"from {module} import {name} as finish"
         digest_of = Path(importlib.util.find_spec(module).origin).read_bytes()
-    source = _BATCH_SOURCE.format(kernel=kernel.__name__, finish=head)
+    source = _BATCH_SOURCE.format(kernel=kernel.__name__, finish=head, flagged=FLAGGED)
     digest = generated_digest(source)
     digest.update(digest_of)
     return load_generated("batch", digest.hexdigest()[:20], source)
@@ -328,13 +335,15 @@ class Simulations:
         self._views = typed.List([s._view for s in self.sims])
         self._rngs = typed.List([s.rng for s in self.sims])
         self._status = np.zeros(len(self.sims), np.int64)
+        self._clocks = np.zeros(len(self.sims), np.int64)
 
     def __len__(self) -> int:
         return len(self.sims)
 
     @property
     def clocks(self) -> np.ndarray:
-        return np.array([int(s.world.clock[0]) for s in self.sims], np.int64)
+        """Each run's step (a copy)."""
+        return self._clocks.copy()
 
     def reset(self, b: int, seed: int, into: dict | None = None) -> None:
         """Start run ``b`` afresh with ``seed`` (``Simulation.reset``)."""
@@ -342,38 +351,39 @@ class Simulations:
         sim.reset(seed, into)
         self._views[b] = sim._view
         self._rngs[b] = sim.rng
+        self._clocks[b] = sim.clock
 
     def advance(self, t_end, extra=0) -> None:
         """Run world b up to step ``t_end[b]`` (an array, or one step for all); seconds are shared among
         the runs by the steps each made."""
         t_end = np.ascontiguousarray(np.broadcast_to(np.asarray(t_end, np.int64), (len(self.sims),)))
-        before = self.clocks
+        before = self._clocks.copy()
         t0 = time.perf_counter()
         while True:
             try:
-                short = self._batch.step_all(self._views, self._rngs, t_end, self._status, extra)
+                short = self._batch.step_all(self._views, self._rngs, t_end, self._status, self._clocks, extra)
             except Exception as exc:  # a rule raised in the step of the run left at -1
                 sim = self.sims[int(np.argmax(self._status == -1))]
                 raise _explained(sim.config, sim.seed, exc, sim) from exc
-            for sim in self.sims:
-                try:
-                    sim.check_flags()
-                except SimulationError as exc:
-                    raise _explained(sim.config, sim.seed, exc, sim) from exc
             if not short:
                 break
             for b in np.flatnonzero(self._status):
-                self.sims[b].grow()
-                self._views[b] = self.sims[b]._view
-        now = self.clocks
-        for sim, clock, at in zip(self.sims, now, before):
-            if clock >= sim.config.steps > at:  # a run just ended: keep its room for the next ones
-                sim.remember_room()
-        made = now - before
-        if made.sum():
-            seconds = (time.perf_counter() - t0) * made / made.sum()
-            for sim, sec in zip(self.sims, seconds):
-                sim.run_seconds += float(sec)
+                sim = self.sims[b]
+                if self._status[b] == FLAGGED:  # an error bit a rule (or the engine) set: named
+                    try:
+                        sim.check_flags()
+                    except SimulationError as exc:
+                        raise _explained(sim.config, sim.seed, exc, sim) from exc
+                sim.grow()
+                self._views[b] = sim._view
+        made = self._clocks - before
+        for b in np.flatnonzero((self._clocks >= self.config.steps) & (before < self.config.steps)):
+            self.sims[b].remember_room()  # a run just ended: keep its room for the next ones
+        total = int(made.sum())
+        if total:
+            seconds = (time.perf_counter() - t0) / total
+            for b in np.flatnonzero(made):
+                self.sims[b].run_seconds += seconds * int(made[b])
 
     def run(self) -> list[Result]:
         """Every run to the configuration's ``steps``; their results, in order."""
