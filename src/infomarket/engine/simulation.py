@@ -336,6 +336,7 @@ class Simulations:
         self._rngs = typed.List([s.rng for s in self.sims])
         self._status = np.zeros(len(self.sims), np.int64)
         self._clocks = np.zeros(len(self.sims), np.int64)
+        self._seconds = np.zeros(len(self.sims))  # each run's share of the calls' seconds (``run``)
 
     def __len__(self) -> int:
         return len(self.sims)
@@ -352,6 +353,7 @@ class Simulations:
         self._views[b] = sim._view
         self._rngs[b] = sim.rng
         self._clocks[b] = sim.clock
+        self._seconds[b] = 0.0
 
     def advance(self, t_end, extra=0) -> None:
         """Run world b up to step ``t_end[b]`` (an array, or one step for all); seconds are shared among
@@ -381,13 +383,14 @@ class Simulations:
             self.sims[b].remember_room()  # a run just ended: keep its room for the next ones
         total = int(made.sum())
         if total:
-            seconds = (time.perf_counter() - t0) / total
-            for b in np.flatnonzero(made):
-                self.sims[b].run_seconds += seconds * int(made[b])
+            self._seconds += (time.perf_counter() - t0) / total * made
 
     def run(self) -> list[Result]:
-        """Every run to the configuration's ``steps``; their results, in order."""
+        """Every run to the configuration's ``steps``; their results, in order (each run's ``run_seconds``
+        its share of the calls' seconds, by the steps it made)."""
         self.advance(self.config.steps)
+        for sim, seconds in zip(self.sims, self._seconds):
+            sim.run_seconds = float(seconds)
         return [s.result() for s in self.sims]
 
 
