@@ -138,7 +138,7 @@ def _env(args) -> int:
 def _many(repeats: int) -> dict:
     """The many-run paths at the attack search's own run length, beside the engine (``bench.many``), and
     the RL vector env (``bench.env``) when Gymnasium is installed."""
-    from .many import run_many_bench
+    from .many import run_many_bench  # imports the search and the store: only when asked for
 
     many = run_many_bench(repeats=min(repeats, 5))
     try:
@@ -146,7 +146,7 @@ def _many(repeats: int) -> dict:
     except ModuleNotFoundError:
         many["vector_env"] = None
         return many
-    from .env import run_env_bench
+    from .env import run_env_bench  # imports Gymnasium (an optional dependency)
 
     many["vector_env"] = run_env_bench(repeats=min(repeats, 5))
     return many

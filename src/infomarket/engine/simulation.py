@@ -1,7 +1,8 @@
 """The engine's host side: build a world, call the compiled kernel, grow logs, collect results.
 
 ``Simulation`` is stateful (``step``/``run``, used by the viewer); ``simulate`` runs one experiment
-once and returns a ``Result`` of pandas DataFrames.  No Python runs per robot per step: the kernel
+once and returns a ``Result`` of pandas DataFrames; ``Simulations`` steps many runs of one
+configuration in one compiled call (sweeps, the attack search, the RL interface: docs/performance.md).  No Python runs per robot per step: the kernel
 advances the whole swarm for as many steps as asked in one call.
 """
 from __future__ import annotations
