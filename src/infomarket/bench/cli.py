@@ -159,7 +159,7 @@ def _print_many(m: dict) -> None:
     for k in ("sweep", "search", "search_pool"):
         r = m.get(k)
         if r:
-            print(f"  {k:10s}  {r['env_steps_per_second']:>12,.0f} env-steps/s  {r['ratio_to_engine']:.2f} of the "
+            print(f"  {k:11s} {r['env_steps_per_second']:>12,.0f} env-steps/s  {r['ratio_to_engine']:.2f} of the "
                   f"engine's (goal >= {r['goal']}; {r['runs']} runs)")
     p = m.get("search_pool")
     if p:
