@@ -113,3 +113,14 @@ def test_an_experiment_without_attackers_is_refused():
 def test_actions_must_be_policy_parameters_once(cfg, actions):
     with pytest.raises(ConfigError, match="policy parameters"):
         Runs(cfg, 1, actions=actions)
+
+
+def test_chain_runs_are_simulate_bit_for_bit(cfg):
+    # the RL interface runs the engine's own driver, so a chain run is a run like any other
+    chain = cfg.with_overrides(steps=400, chain={"consensus": "poa", "period": 10, "out_of_turn_delay": 5})
+    runs = Runs(chain, 2)
+    play(runs, SEEDS[:2], 50)
+    for b, seed in enumerate(SEEDS[:2]):
+        ref = simulate(chain, seed)
+        np.testing.assert_array_equal(runs.worlds[b].balance, ref.robots.wealth.to_numpy())
+        assert int(runs.worlds[b].chn_blocks[0]) == ref.totals["chain"]["blocks"] > 0

@@ -38,6 +38,10 @@ def add_subcommand(sub) -> None:
     mode.add_argument("--env", action="store_true",
                       help="instead: the RL vector environment's agent-steps/s and env-steps/s beside the engine's "
                            "own env-steps/s on the attack_search setup (docs/rl.md; --steps default 3000 here)")
+    b.add_argument("--many", action="store_true",
+                   help="with the setups: also many runs of the attack search's cell (a sweep, a reduced attack "
+                        "search and the RL vector env), each as a ratio to the engine's rate measured in the same "
+                        "run, per CPU second (docs/performance.md)")
     b.add_argument("--batch", type=at_least(1), help="with --env: runs per vector env (B, default 64)")
     b.add_argument("--interval", type=at_least(1), help="with --env: engine steps per decision (K, default 10)")
     b.set_defaults(func=run)
@@ -86,6 +90,8 @@ def run(args) -> int:
                   f"of {args.robots[0]:,}")
         return 0
     report = run_bench(SETUPS, steps=args.steps, repeats=args.repeats)
+    if args.many:
+        report["many"] = _many(args.repeats)
     if args.json:
         print(json.dumps(report, indent=2))
         return 0
@@ -104,6 +110,8 @@ def run(args) -> int:
     for name, r in report["setups"].items():
         if "ratio_to_instant" in r:
             print(f"{name}: {r['ratio_to_instant']:.2f} x the env-steps/s of the instant ledger (goal: >= 0.5)")
+    if args.many:
+        _print_many(report["many"])
     print("x floor: how many times the floor kernel's time per step (neighbour search, one Gaussian draw, "
           "the rotation and dead reckoning per robot) each setup takes, measured in this run")
     return 0
@@ -152,3 +160,40 @@ def _env(args) -> int:
     print(f"engine      {'':>12}                {r['engine_env_steps_per_second']:>12,.0f} env-steps/s")
     print(f"ratio {r['ratio_to_engine']:.2f} of the engine's env-steps/s (goal: >= {r['goal']})")
     return 0
+
+
+def _many(repeats: int) -> dict:
+    """The many-run paths at the attack search's own run length, beside the engine (``bench.many``), and
+    the RL vector env (``bench.env``) when Gymnasium is installed."""
+    from .many import run_many_bench  # imports the search and the store: only when asked for
+
+    many = run_many_bench(repeats=min(repeats, 5))
+    try:
+        import gymnasium  # noqa: F401
+    except ModuleNotFoundError:
+        many["vector_env"] = None
+        return many
+    from .env import run_env_bench  # imports Gymnasium (an optional dependency)
+
+    many["vector_env"] = run_env_bench(repeats=min(repeats, 5))
+    return many
+
+
+def _print_many(m: dict) -> None:
+    e = m["engine"]["env_steps_per_second"]
+    print(f"many runs of {m['setup']}, {m['steps']} steps a run, per CPU second of this process:")
+    print(f"  engine      {e:>12,.0f} env-steps/s")
+    for k in ("sweep", "search", "search_pool"):
+        r = m.get(k)
+        if r:
+            print(f"  {k:11s} {r['env_steps_per_second']:>12,.0f} env-steps/s  {r['ratio_to_engine']:.2f} of the "
+                  f"engine's (goal >= {r['goal']}; {r['runs']} runs)")
+    p = m.get("search_pool")
+    if p:
+        print(f"  {p['workers']} workers: {p['wall_env_steps_per_second']:,.0f} env-steps per wall second, "
+              f"{p['wall_ratio_to_engine_per_worker']:.2f} of the engine's on every worker (a quiet machine only)")
+    v = m.get("vector_env")
+    if v:
+        print(f"  vector env  {v['vector_env_steps_per_second']:>12,.0f} env-steps/s  {v['ratio_to_engine']:.2f} of the "
+              f"engine's {v['engine_env_steps_per_second']:,.0f} on {v['steps']}-step episodes (goal >= {v['goal']}; "
+              f"B = {v['batch']})")

@@ -2,14 +2,15 @@
 (``rl.AttackVectorEnv``, B runs stepped K engine steps per ``step`` in one compiled call) against the
 engine alone (``Simulation.run``) on the same setup, in the same process.
 
-Rates, each a median over ``repeats``:
+Rates, each a median over ``repeats``, per second of this process's CPU time (``time.process_time``: the
+machine may be shared, and CPU time charges each side only for what it did):
 
-- engine env-steps/s: one run of ``steps`` steps, timed by ``Simulation`` (world building excluded);
-- vector env-steps/s: B x ``steps`` over the wall time of ``reset(seed=...)`` plus the ``steps / K`` calls
+- engine env-steps/s: one run of ``steps`` steps, ``Simulation.run`` alone (world building excluded);
+- vector env-steps/s: B x ``steps`` over the CPU time of ``reset(seed=...)`` plus the ``steps / K`` calls
   of ``step`` of one episode, through the Gymnasium API (worlds built, actions written, observations and
   rewards computed: everything an RL loop pays, except the policy);
 - agent-steps/s: agent decisions per second, vector env-steps/s x agents / K;
-- ratio: vector env-steps/s over engine env-steps/s (issue 23's goal: at least 0.5 at B = 64, K = 10).
+- ratio: vector env-steps/s over engine env-steps/s (goal ``GOAL`` at B = 64, K = 10).
 """
 from __future__ import annotations
 
@@ -25,7 +26,7 @@ from ..seeds import run_seed
 #: The setup: the attack search's base cell (22 sceptics, 3 `attacker` robots, outlier penalisation with
 #: staking), whose attackers are the environments' agents.
 ENV_SETUP = "attack_search"
-GOAL = 0.5
+GOAL = 0.9
 
 
 def run_env_bench(*, steps: int = 3000, batch: int = 64, interval: int = 10, repeats: int = 5,
@@ -42,13 +43,14 @@ def run_env_bench(*, steps: int = 3000, batch: int = 64, interval: int = 10, rep
     engine, vector = [], []
     for i in range(repeats):  # the two interleaved, so a busy machine slows both alike
         sim = Simulation(cfg, run_seed(cfg.seed, i))
+        t = time.process_time()
         sim.run()
-        engine.append(sim.run_seconds)
-        t = time.perf_counter()
+        engine.append(time.process_time() - t)
+        t = time.process_time()
         env.reset(seed=run_seed(cfg.seed, i))
         for _ in range(calls):
             env.step(action)
-        vector.append(time.perf_counter() - t)
+        vector.append(time.process_time() - t)
     e_rate = steps / statistics.median(engine)
     v_wall = statistics.median(vector)
     v_rate = batch * steps / v_wall
@@ -61,4 +63,4 @@ def run_env_bench(*, steps: int = 3000, batch: int = 64, interval: int = 10, rep
             "vector_calls_per_second": calls / v_wall,
             "ratio_to_engine": v_rate / e_rate, "goal": GOAL,
             "vector_seconds_per_episode": v_wall, "engine_seconds_per_run": statistics.median(engine),
-            "compile_seconds": compile_seconds}
+            "compile_seconds": compile_seconds, "clock": "process CPU time"}

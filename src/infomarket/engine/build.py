@@ -20,12 +20,18 @@ from .world import ChainWorld, World, kernel_view
 
 
 def build_world(cfg: Experiment, rng: np.random.Generator, *, record_events: bool = False,
-                history_every: int = 0, kinds: tuple[str, ...] | None = None) -> tuple[World, list[str]]:
+                history_every: int = 0, kinds: tuple[str, ...] | None = None,
+                params: dict | None = None) -> tuple[World, list[str]]:
     """A fresh world: robots in group order (ids follow the groups), uniform integer positions,
     uniform headings, bimodal odometry biases, empty tables, initial wealth; and each robot's behaviour
-    (its ``kind`` an index into ``kinds``, the kernel's behaviours; by default the experiment's own)."""
+    (its ``kind`` an index into ``kinds``, the kernel's behaviours; by default the experiment's own).
+    ``params``: ``build_params`` of ``cfg`` (with the same ``kinds``) made earlier (its arrays are copied),
+    for many runs of one configuration; they draw nothing from ``rng``."""
     kind, bparams, names = behaviour_table(cfg, kinds)
-    params = build_params(cfg, bparams)
+    if params is None:
+        params = build_params(cfg, bparams)
+    else:
+        params = {k: v.copy() if isinstance(v, np.ndarray) else v for k, v in params.items()}
     swarm = build_swarm(cfg, rng, kind, params["grid_nx"] * params["grid_ny"])
     log = build_log(cfg.swarm.robots, record_events=record_events, history_every=history_every,
                     history_rows=cfg.steps // history_every if history_every else 0,
@@ -60,6 +66,45 @@ def chain_of(cfg: Experiment, ledger: dict, rng: np.random.Generator) -> dict:
                               gas_table=list(zip(gas.GAS_DEPOSIT_N, deposit)), seed=chain_seed(rng),
                               finality=c.finality, partition=c.partition,
                               cache_weights=not (rule.wants_market or rule.wants_rng))
+
+
+#: The swarm's pending-purchase lists: their last axis is the room per robot and neighbour slot.
+PENDING = ("pend_vec", "pend_age", "pend_seller")
+
+
+def room_of(world: World, room: dict | None) -> dict | None:
+    """The room ``world`` has now (neighbour and pending widths, each buyer's transaction block, the event
+    and payment logs), at least ``room``; None for a chain world, which ``with_room`` leaves as built."""
+    if isinstance(world, ChainWorld):
+        return None
+    now = {"nbr": world.nbr.shape[1], "pend": world.pend_seller.shape[2], "tx": world.tx_cap.copy(),
+           "events": world.ev_step.shape[0], "payments": world.pay_step.shape[0]}
+    if room is None:
+        return now
+    return {"nbr": max(now["nbr"], room["nbr"]), "pend": max(now["pend"], room["pend"]),
+            "tx": np.maximum(now["tx"], room["tx"]) if len(room["tx"]) == len(now["tx"]) else now["tx"],
+            "events": max(now["events"], room["events"]), "payments": max(now["payments"], room["payments"])}
+
+
+def with_room(world: World, room: dict | None) -> World:
+    """A freshly built ``world`` with at least the capacities ``room`` records (``room_of`` of earlier runs
+    of the same kernel), so the run need not stop to grow them; its values are those of the built world
+    (every list empty).  Capacities never change what a run does, only when the host grows them."""
+    if room is None or isinstance(world, ChainWorld):
+        return world
+    n = world.pos.shape[0]
+    changes = {}
+    if room["nbr"] > world.nbr.shape[1]:
+        changes["nbr"] = np.zeros((n, room["nbr"]), world.nbr.dtype)
+    if room["pend"] > world.pend_seller.shape[2]:
+        for f in PENDING:
+            old = getattr(world, f)
+            changes[f] = np.zeros(old.shape[:2] + (room["pend"],) + old.shape[3:], old.dtype)
+    if len(room["tx"]) == n:  # blocks of at least the recorded size (grow_ledger: max(2 x size, need + 8))
+        changes.update(grow_ledger(world, np.maximum(room["tx"] - 8, 0)))
+    if world.record:
+        changes.update(grow_log(world, room["events"], room["payments"]))
+    return world._replace(**changes) if changes else world
 
 
 def make_room(world: World, tx_need: np.ndarray | None = None) -> World:

@@ -1,11 +1,14 @@
 """The engine's host side: build a world, call the compiled kernel, grow logs, collect results.
 
 ``Simulation`` is stateful (``step``/``run``, used by the viewer); ``simulate`` runs one experiment
-once and returns a ``Result`` of pandas DataFrames.  No Python runs per robot per step: the kernel
+once and returns a ``Result`` of pandas DataFrames; ``Simulations`` steps many runs of one
+configuration in one compiled call (sweeps, the attack search, the RL interface: docs/performance.md).  No Python runs per robot per step: the kernel
 advances the whole swarm for as many steps as asked in one call.
 """
 from __future__ import annotations
 
+import copy
+import importlib.util
 import os
 import sys
 import threading
@@ -16,17 +19,18 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from numba import typed
 
 from ..config.schema import Experiment
 from ..config.load import load_experiment
 from ..errors import ArgumentError, ConfigError, InputTypeError, SimulationError
 from ..registry import behaviours
 from . import specialise
-from ..generated import ctrl_c_survives_compiling
+from ..generated import ctrl_c_survives_compiling, generated_digest, load_generated
 from ..seeds import MAX_SEED
 from ..state.flags import ErrorFlags
-from .build import build_world, make_room
-from .params import behaviour_kinds
+from .build import build_world, make_room, room_of, with_room
+from .params import behaviour_kinds, behaviour_table, build_params
 from .world import EVENT_NAMES, SITE_NAMES, STATE_NAMES, headings, kernel_view
 
 
@@ -68,12 +72,14 @@ class Simulation:
         config = as_experiment(config)
         self.config = config
         self.record_events = record_events
-        self.seed = _checked_seed(config.seed if seed is None else seed)
-        self.rng = np.random.default_rng(self.seed)
         self.kinds = behaviour_kinds(config) if kernel_kinds is None else _checked_kinds(config, kernel_kinds)
-        hist = config.history_every if history_every is None else _checked_history(history_every, config.steps)
-        self.world, self.behaviour_names = build_world(config, self.rng, record_events=record_events,
-                                                       history_every=hist, kinds=self.kinds)
+        self._history = config.history_every if history_every is None else _checked_history(history_every,
+                                                                                              config.steps)
+        self._room_key = (self.kinds, config.payment.scheme, config.terrain, config.chain.enabled, record_events,
+                          tuple((g.behaviour, g.count) for g in config.swarm.groups))
+        self._kernel = None
+        self._params = build_params(config, behaviour_table(config, self.kinds)[1])  # the same for every run
+        self.reset(config.seed if seed is None else seed)
         t0 = time.perf_counter()
         try:
             with compile_notice(self.kinds, config.payment.scheme), ctrl_c_survives_compiling():
@@ -84,7 +90,33 @@ class Simulation:
         except Exception as exc:  # a rule that keeps the kernel from compiling: named
             raise _explained(config, self.seed, exc) from exc
         self.compile_seconds = time.perf_counter() - t0
+
+    def reset(self, seed: int, into: dict | None = None) -> None:
+        """Start afresh at step 0 with ``seed``: the run ``Simulation(config, seed)`` makes, on the kernel
+        already loaded.  The world starts with the room this process's earlier runs of the same kernel
+        grew to (``build.with_room``), so a batch of runs grows its arrays once, not in every run.
+        ``into``: field -> array the world is to use instead of its own (its values copied in; the RL
+        interface keeps every run's behaviour parameters in one array)."""
+        self.seed = checked_seed(seed)
+        self.rng = np.random.default_rng(self.seed)
+        world, self.behaviour_names = build_world(self.config, self.rng, record_events=self.record_events,
+                                                  history_every=self._history, kinds=self.kinds,
+                                                  params=self._params)
+        world = with_room(world, _ROOM.get(self._room_key))
+        if into:
+            for name, array in into.items():
+                array[...] = getattr(world, name)
+            world = world._replace(**into)
+        self.world = world
+        self._view = kernel_view(world) if self._kernel is not None else None
         self.run_seconds = 0.0
+
+    def another(self, seed: int) -> "Simulation":
+        """A new run of the same configuration with ``seed``, sharing this one's loaded kernel."""
+        sim = copy.copy(self)
+        sim.compile_seconds = 0.0
+        sim.reset(seed)
+        return sim
 
     @property
     def kernel_source(self) -> Path:
@@ -106,16 +138,35 @@ class Simulation:
         while True:
             try:
                 status = self._kernel.run_steps(self._view, self.rng, t_end)
-                flags = ErrorFlags(int(self.world.flags[0]))
-                if flags:
-                    raise SimulationError(f"step {self.clock}: {flags.describe()}")
+                self.check_flags()
             except Exception as exc:  # a rule's error, or an error bit a rule set: named with the step
                 raise _explained(self.config, self.seed, exc, self) from exc
             if status == self._kernel.DONE:
                 break
-            self.world = make_room(self.world)
-            self._view = kernel_view(self.world)
+            self.grow()
+        if t_end >= self.config.steps:
+            self.remember_room()
         self.run_seconds += time.perf_counter() - t0
+
+    def check_flags(self) -> None:
+        """Raise SimulationError if the last call set an error bit (a rule's, or the engine's)."""
+        flags = ErrorFlags(int(self.world.flags[0]))
+        if flags:
+            raise SimulationError(f"step {self.clock}: {flags.describe()}")
+
+    def grow(self) -> None:
+        """Grow what the next step might outgrow (the kernel said NEED_ROOM), and remember the room for
+        the next run of this kernel in this process."""
+        self.world = make_room(self.world)
+        self._view = kernel_view(self.world)
+        self.remember_room()
+
+    def remember_room(self) -> None:
+        """Keep the room this world has (the compiled step also moves a buyer's transactions to a larger
+        block of the pool without the host) for the next run of this kernel in this process."""
+        room = room_of(self.world, _ROOM.get(self._room_key))
+        if room is not None:
+            _ROOM[self._room_key] = room
 
     def run(self, steps: int | None = None) -> Result:
         self.advance_to(self.config.steps if steps is None else steps)
@@ -213,6 +264,141 @@ class Simulation:
         return snap
 
 
+#: The room (array capacities) runs of each kernel grew to in this process, by ``Simulation._room_key``:
+#: a fresh world of the same kernel starts with it (``build.with_room``).  Capacities never change results.
+_ROOM: dict[tuple, dict] = {}
+
+
+_BATCH_SOURCE = '''\
+# Generated by infomarket.engine.simulation: B worlds of one kernel stepped in one call (do not edit).
+from numba import njit
+from {kernel} import run_steps, DONE
+{finish}
+
+FLAGGED = {flagged}
+
+
+@njit(cache=True)
+def step_all(views, rngs, t_end, status, clocks, extra):
+    """Run world b to step t_end[b], one after the other (status[b]: DONE or NEED_ROOM, FLAGGED when
+    an error bit is set; -1 left on the run whose step raised) and write its clock; when every run is
+    DONE, ``finish(views, extra)``.  Returns the count of runs that are not DONE."""
+    short = 0
+    for b in range(len(views)):
+        status[b] = -1
+        status[b] = run_steps(views[b], rngs[b], t_end[b])
+        clocks[b] = views[b].clock[0]
+        if views[b].flags[0] != 0:
+            status[b] = FLAGGED
+        if status[b] != DONE:
+            short += 1
+    if short == 0:
+        finish(views, extra)
+    return short
+'''
+#: ``step_all``'s status of a run whose world has an error bit set (the kernel's own are 0 and 1).
+FLAGGED = 2
+_NO_FINISH = """
+@njit
+def finish(views, extra):
+    return None
+"""
+
+
+def batch_module(kernel, finish: str | None = None):
+    """The generated ``step_all`` for ``kernel``; ``finish``: ``"module:function"``, a compiled
+    ``function(views, extra)`` run once every world is done (the RL interface's observation), whose
+    module's source is hashed into the generated module's name (numba would not see it change)."""
+    head = _NO_FINISH
+    digest_of = b""
+    if finish:
+        module, name = finish.split(":")
+        head = f"from {module} import {name} as finish"
+        digest_of = Path(importlib.util.find_spec(module).origin).read_bytes()
+    source = _BATCH_SOURCE.format(kernel=kernel.__name__, finish=head, flagged=FLAGGED)
+    digest = generated_digest(source)
+    digest.update(digest_of)
+    return load_generated("batch", digest.hexdigest()[:20], source)
+
+
+class Simulations:
+    """B runs of one configuration stepped together: ``advance`` runs every world up to its own step in
+    one compiled call (back to back), grows the worlds that ran short and calls again, and raises a run's
+    error named as ``Simulation`` names it.  Each run is the run ``Simulation(config, seed)`` makes.
+
+    ``finish``: see ``batch_module``; ``extra`` (``advance``) is what it receives beside the views."""
+
+    def __init__(self, config, seeds, *, record_events: bool = False, history_every: int | None = None,
+                 finish: str | None = None):
+        seeds = list(seeds)
+        if not seeds:
+            raise ArgumentError("Simulations: at least one seed")
+        first = Simulation(config, seeds[0], record_events=record_events, history_every=history_every)
+        self.config = first.config
+        self.sims = [first] + [first.another(s) for s in seeds[1:]]
+        self._batch = batch_module(first._kernel, finish)
+        self._views = typed.List([s._view for s in self.sims])
+        self._rngs = typed.List([s.rng for s in self.sims])
+        self._status = np.zeros(len(self.sims), np.int64)
+        self._clocks = np.zeros(len(self.sims), np.int64)
+        self._seconds = np.zeros(len(self.sims))  # each run's share of the calls' seconds (``run``)
+
+    def __len__(self) -> int:
+        return len(self.sims)
+
+    @property
+    def clocks(self) -> np.ndarray:
+        """Each run's step (a copy)."""
+        return self._clocks.copy()
+
+    def reset(self, b: int, seed: int, into: dict | None = None) -> None:
+        """Start run ``b`` afresh with ``seed`` (``Simulation.reset``)."""
+        sim = self.sims[b]
+        sim.reset(seed, into)
+        self._views[b] = sim._view
+        self._rngs[b] = sim.rng
+        self._clocks[b] = sim.clock
+        self._seconds[b] = 0.0
+
+    def advance(self, t_end, extra=0) -> None:
+        """Run world b up to step ``t_end[b]`` (an array, or one step for all); seconds are shared among
+        the runs by the steps each made."""
+        t_end = np.ascontiguousarray(np.broadcast_to(np.asarray(t_end, np.int64), (len(self.sims),)))
+        before = self._clocks.copy()
+        t0 = time.perf_counter()
+        while True:
+            try:
+                short = self._batch.step_all(self._views, self._rngs, t_end, self._status, self._clocks, extra)
+            except Exception as exc:  # a rule raised in the step of the run left at -1
+                sim = self.sims[int(np.argmax(self._status == -1))]
+                raise _explained(sim.config, sim.seed, exc, sim) from exc
+            if not short:
+                break
+            for b in np.flatnonzero(self._status):
+                sim = self.sims[b]
+                if self._status[b] == FLAGGED:  # an error bit a rule (or the engine) set: named
+                    try:
+                        sim.check_flags()
+                    except SimulationError as exc:
+                        raise _explained(sim.config, sim.seed, exc, sim) from exc
+                sim.grow()
+                self._views[b] = sim._view
+        made = self._clocks - before
+        for b in np.flatnonzero((self._clocks >= self.config.steps) & (before < self.config.steps)):
+            self.sims[b].remember_room()  # a run just ended: keep its room for the next ones
+        total = int(made.sum())
+        if total:
+            self._seconds += (time.perf_counter() - t0) / total * made
+
+    def run(self) -> list[Result]:
+        """Every run to the configuration's ``steps``; their results, in order (each run's ``run_seconds``
+        its share of the calls' seconds, by the steps it made)."""
+        self.advance(self.config.steps)
+        for sim, seconds in zip(self.sims, self._seconds):
+            sim.run_seconds = float(seconds)
+        return [s.result() for s in self.sims]
+
+
 #: How an error raised while compiling or stepping becomes one that names the rule, its file and line,
 #: and the step: ``checks.explain``, installed by the package root (the engine cannot import the
 #: checkers, which import the engine).  Empty: errors pass as they are.
@@ -298,7 +484,8 @@ def _checked_kinds(config: Experiment, kinds) -> tuple[str, ...]:
     return kinds
 
 
-def _checked_seed(seed) -> int:
+def checked_seed(seed) -> int:
+    """``seed`` as a run's seed (an integer in [0, 2**63 - 1]), else ConfigError."""
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or not 0 <= int(seed) <= MAX_SEED:
         raise ConfigError(f"seed must be an integer in [0, 2**63 - 1] (as in experiment files and on the "
                           f"command line), got {seed!r}")

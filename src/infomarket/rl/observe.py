@@ -29,7 +29,8 @@ def _capped(x, scale):
 
 
 @njit  # not cached on its own: numba would not see a change in the helpers it calls (behaviours.*); the
-# generated ``step_all`` (rl.runs), whose file name hashes the package's source, caches it with itself
+# engine's generated ``step_all`` (``observe_all`` its finish), whose file name hashes the package's source
+# and this file, caches it with itself
 def observe_run(w, agents, known, honest, steps, obs, shares):
     """Fill ``obs[a]`` (float32, len(OBSERVATION)) and ``shares[a]`` (the wealth share) for each agent
     robot ``agents[a]``; ``known`` = the attacker's columns of theta, theta_min, adaptive in ``w.bparams``.
@@ -63,3 +64,12 @@ def observe_run(w, agents, known, honest, steps, obs, shares):
     for j in range(honest.shape[0]):
         total += w.items[honest[j]]
     return total
+
+
+@njit
+def observe_all(views, extra):
+    """Observe every run (the engine's batch driver calls it once all B runs reached their step):
+    ``extra`` = (agents, known, honest, steps, obs [B, A, O], items [B], shares [B, A])."""
+    agents, known, honest, steps, obs, items, shares = extra
+    for b in range(len(views)):
+        items[b] = observe_run(views[b], agents, known, honest, steps, obs[b], shares[b])

@@ -31,12 +31,15 @@ import pandas as pd
 
 from .. import plugins
 from ..config.schema import Experiment
-from ..engine.simulation import Simulation
+from ..engine.simulation import Simulation, Simulations
 from ..checks import explain
 from ..errors import InfomarketError, RuleRunError
 from .plan import Condition
 
 MAX_ERROR_CHARS = 4000
+#: Runs of one configuration stepped together in one compiled call (their worlds are alive at once; a
+#: run that records events keeps its whole log, so those go one at a time).
+TOGETHER = 16
 
 
 class RunFailed(InfomarketError, RuntimeError):
@@ -76,6 +79,20 @@ def run_one(cfg: Experiment, run: int, seed: int, record_events: bool = False) -
         r = sim.run()
     except Exception as exc:  # a rule's error (or an error bit a rule set): named, else as it is
         raise explain(cfg, seed, exc, sim, record_events=record_events) from exc
+    return output(r, run)
+
+
+def run_together(cfg: Experiment, items: list[tuple[int, int]], record_events: bool = False) -> list[RunOutput]:
+    """Runs ``items`` (run, seed) of ``cfg`` stepped back to back in one compiled call
+    (``engine.simulation.Simulations``: one kernel load, worlds that start with the room earlier runs
+    grew to); the same rows as ``run_one`` for each.  Raises the first run's error, named."""
+    sims = Simulations(cfg, [seed for _, seed in items], record_events=record_events)
+    return [output(r, run) for r, (run, _) in zip(sims.run(), items)]
+
+
+def output(r, run: int) -> RunOutput:
+    """A run's ``Result`` as the store keeps it: every table labelled with ``run`` (and ``seed``)."""
+    seed = r.seed
     robots = r.robots
     robots.insert(0, "run", np.int64(run))
     hist, events, payments = r.history, r.events, r.payments
@@ -117,13 +134,29 @@ def _failed(run: int, seed: int, exc: BaseException) -> RunOutput:
 
 
 def run_chunk(cfg: Experiment, items: list[tuple[int, int]], record_events: bool = False) -> list[RunOutput]:
-    """Run ``items`` (run, seed) of ``cfg`` in this process; a run that raises becomes a RunOutput with its
-    error text and the others still run.  Ctrl-C (KeyboardInterrupt) is not caught."""
+    """Run ``items`` (run, seed) of ``cfg`` in this process, up to ``TOGETHER`` at a time in one compiled
+    call (``run_together``); a run that raises becomes a RunOutput with its error text and the others
+    still run (its group is run again one run at a time).  Ctrl-C (KeyboardInterrupt) is not caught."""
     try:
         for entry in cfg.plugins:  # rules registered by plugins must exist in this worker too
             plugins.load(entry)
     except Exception as exc:
         return [_failed(run, seed, exc) for run, seed in items]
+    out: list[RunOutput] = []
+    size = 1 if record_events else TOGETHER
+    for k in range(0, len(items), size):
+        group = items[k:k + size]
+        if len(group) > 1:
+            try:
+                out += run_together(cfg, group, record_events)
+                continue
+            except Exception:  # noqa: BLE001 - run alone, so each run's error is its own and the others go on
+                pass
+        out += _alone(cfg, group, record_events)
+    return out
+
+
+def _alone(cfg: Experiment, items: list[tuple[int, int]], record_events: bool) -> list[RunOutput]:
     out = []
     for run, seed in items:
         try:
@@ -143,8 +176,9 @@ def run_calls(calls: list[tuple]) -> list[RunOutput]:
 class Task:
     condition: Condition
     runs: tuple[int, ...]
-    #: further (condition, runs) in the same task: the points of a sampled design, which have a run or
-    #: two each, are grouped so that a study of thousands of points is not thousands of tasks (and parts)
+    #: further (condition, runs) in the same task: conditions of a few runs each (the points of a sampled
+    #: design, an attack search's candidates) are grouped so that thousands of them are not thousands of
+    #: tasks (and store parts)
     more: tuple[tuple[Condition, tuple[int, ...]], ...] = ()
 
     @property
@@ -167,14 +201,22 @@ class Task:
         return f"{c.experiment}-{tag}-{self.runs[0]:05d}-{self.runs[-1]:05d}"
 
 
+#: Tasks per worker a sweep aims at (enough to balance the workers' loads), and the most runs in one task
+#: (one store part: its tables are written, checksummed and read back once, whatever the runs in it).
+TASKS_PER_WORKER = 4
+MAX_TASK = 64
+
+
 def make_tasks(conds: list[Condition], done: set, workers: int) -> list[Task]:
-    """The runs of ``conds`` not in ``done`` ((experiment, condition, run) keys), grouped per condition
-    into tasks of a few runs each, longest first."""
+    """The runs of ``conds`` not in ``done`` ((experiment, condition, run) keys), grouped into tasks of
+    up to ``total / (workers x TASKS_PER_WORKER)`` runs (at most ``MAX_TASK``): a condition's runs are
+    split into tasks of that size, conditions with fewer runs (the points of a sampled design, the
+    candidates of an attack search) share tasks with the next ones of the same experiment.  Longest first."""
     todo = [(c, [r for r in range(c.runs) if (c.experiment, c.id, r) not in done]) for c in conds]
     total = sum(len(r) for _, r in todo)
-    size = max(1, min(16, math.ceil(total / max(1, workers * 8))))
+    size = max(1, min(MAX_TASK, math.ceil(total / max(1, workers * TASKS_PER_WORKER))))
     tasks = []
-    group: list[tuple[Condition, tuple[int, ...]]] = []  # points of a sampled design, filled up to ``size``
+    group: list[tuple[Condition, tuple[int, ...]]] = []  # conditions of a few runs each, filled up to ``size``
 
     def flush() -> None:
         if group:
@@ -182,7 +224,7 @@ def make_tasks(conds: list[Condition], done: set, workers: int) -> list[Task]:
             group.clear()
 
     for c, runs in todo:
-        if c.design is not None and 0 < len(runs) < size:
+        if 0 < len(runs) < size:
             if group and (group[0][0].experiment != c.experiment
                           or sum(len(r) for _, r in group) + len(runs) > size):
                 flush()
@@ -252,8 +294,9 @@ def stop_pool(pool: ProcessPoolExecutor) -> None:
 
 # ---------------------------------------------------------------------------------------- warm-up
 def warm(cfg: Experiment) -> None:
-    """Compile (or load) the configuration's kernel in this process, so forked workers inherit it."""
-    Simulation(cfg, 0)  # loads every compiled entry point (view constructor, step loop)
+    """Compile (or load) the configuration's kernel in this process, so forked workers inherit it: the
+    view constructor, the step loop, and the batch driver with its list of views (``run_together``)."""
+    Simulations(cfg, [0, 1]).advance(0)
 
 
 def preflight(configs: Iterable[Experiment]) -> None:

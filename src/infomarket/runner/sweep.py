@@ -144,22 +144,26 @@ def config_json(cfg: Experiment) -> str:
 
 def run_sweep(conds: list[Condition], store: Store, *, workers: int = 1, executor: Executor | None = None,
               on_done: Callable[[int], None] | None = None, on_plan: Callable[[int], None] | None = None,
-              record_events: bool = False, retry_failed: bool = False) -> SweepReport:
+              record_events: bool = False, retry_failed: bool = False,
+              on_part: Callable[[dict], None] | None = None) -> SweepReport:
     """Run every missing run of ``conds`` into ``store``: on ``executor`` (any ``concurrent.futures``
     Executor, e.g. ``process_pool(n)`` or a Dask ``client.get_executor(pure=False)``; never shut down
     here), else inline when ``workers`` is 1, else on a local pool of ``workers`` processes made here.
     ``record_events``: also store each run's event log; ``retry_failed``: rerun the failed runs.
     The store is locked throughout (a second writer gets StoreError at once, before writing anything).
-    A kernel that a user's rule keeps from compiling is refused first (RuleRunError), nothing written."""
+    A kernel that a user's rule keeps from compiling is refused first (RuleRunError), nothing written.
+    ``on_part(tables)``: called with each part's tables once it is committed (what a caller that reads the
+    runs back at once would otherwise read from the store)."""
     preflight(c.config for c in conds)
     with store.writing():
         return sweep_locked(conds, store, workers=workers, executor=executor, on_done=on_done, on_plan=on_plan,
-                            record_events=record_events, retry_failed=retry_failed)
+                            record_events=record_events, retry_failed=retry_failed, on_part=on_part)
 
 
 def sweep_locked(conds: list[Condition], store: Store, *, workers: int = 1, executor: Executor | None = None,
                  on_done: Callable[[int], None] | None = None, on_plan: Callable[[int], None] | None = None,
-                 record_events: bool = False, retry_failed: bool = False) -> SweepReport:
+                 record_events: bool = False, retry_failed: bool = False,
+                 on_part: Callable[[dict], None] | None = None) -> SweepReport:
     """``run_sweep`` for a caller already inside ``store.writing()`` (``runner.run`` decides what to keep
     under the same lock)."""
     store.check()  # a damaged store is refused until repaired
@@ -167,7 +171,7 @@ def sweep_locked(conds: list[Condition], store: Store, *, workers: int = 1, exec
     _save_designs(store, conds)  # refuses a store holding another design of the same experiment
     retried = store.uncommit_failed() if retry_failed else 0
     store.remove_orphans()
-    report = _run(conds, store, workers, executor, on_done, on_plan, record_events)
+    report = _run(conds, store, workers, executor, on_done, on_plan, record_events, on_part)
     report.retried = retried
     return report
 
@@ -180,7 +184,7 @@ def _save_designs(store: Store, conds: list[Condition]) -> None:
         save(store, design)
 
 
-def _run(conds, store, workers, executor, on_done, on_plan, record_events) -> SweepReport:
+def _run(conds, store, workers, executor, on_done, on_plan, record_events, on_part=None) -> SweepReport:
     tasks = make_tasks(conds, store.completed_runs(), workers)
     planned = sum(c.runs for c in conds)
     todo = sum(t.size for t in tasks)
@@ -195,6 +199,8 @@ def _run(conds, store, workers, executor, on_done, on_plan, record_events) -> Sw
         tables = _frames(task, outputs)
         keys = dict.fromkeys(k for c, _ in task.members for k in c.keys)
         store.write_part(task.part_id, **tables, keys=keys)
+        if on_part:
+            on_part(tables)
         env_steps += int(tables["runs"].steps.sum())
         run_seconds += float(tables["runs"].duration_s.sum())
         compile_seconds = max([compile_seconds] + [o.compile_seconds for o in outputs])

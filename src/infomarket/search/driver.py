@@ -92,8 +92,9 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
              for k, (n, p) in enumerate(hand)]
     done, skipped = run(start) if start else (0, 0)
     x0, start_from = np.full(dim, 0.5), ""
+    robots = getattr(run, "robots", None) or (lambda conds: _robots(store, cell))
     if start:
-        values = _values(store, cell, start, s.objective)
+        values = _values(robots(start), start, s.objective)
         scores = [float(loss(values.loc[c.id].mean(), s.objective)) for c in start]
         k = int(np.argmin(scores))  # ties: the first declared
         x0, start_from = np.clip(space.to_unit(hand[k][1]), 0.0, 1.0), hand[k][0]
@@ -107,7 +108,7 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
                             transitory) for i, x in enumerate(X)]
         made, found = run(conds)
         done, skipped = done + made, skipped + found
-        values = _values(store, cell, conds, s.objective)
+        values = _values(robots(conds), conds, s.objective)
         fitness = [float(loss(values.loc[c.id].mean(), s.objective)) for c in conds]
         es.tell(X, fitness)
         for i, (c, f) in enumerate(zip(conds, fitness)):
@@ -138,9 +139,10 @@ def _robots(store: Store, cell: Cell) -> pd.DataFrame:
     return r[r.experiment == cell.experiment]
 
 
-def _values(store: Store, cell: Cell, conds: list[Condition], objective: str) -> pd.Series:
-    """The objective's per-run values of ``conds``, indexed by condition id."""
-    per = per_run(_robots(store, cell))
+def _values(robots: pd.DataFrame, conds: list[Condition], objective: str) -> pd.Series:
+    """The objective's per-run values of ``conds`` (from ``robots``, which holds their rows), indexed by
+    condition id."""
+    per = per_run(robots)
     per = per[per.condition.isin({c.id for c in conds})]
     return per.set_index("condition")[objective]
 
@@ -148,12 +150,34 @@ def _values(store: Store, cell: Cell, conds: list[Condition], objective: str) ->
 def store_runner(store: Store, *, workers: int = 1, executor=None,
                  on_done: Callable[[int], None] | None = None,
                  on_skip: Callable[[int], None] | None = None) -> Callable[[list[Condition]], tuple[int, int]]:
-    """``run(conds)`` for ``search_cell``: their missing runs into ``store`` on the sweep machinery."""
+    """``run(conds)`` for ``search_cell``: their missing runs into ``store`` on the sweep machinery.
+    ``run.robots(conds)``: the robots rows of ``conds``, kept from the parts just written when every run of
+    theirs was made by this runner (the store is read back only for a search that resumes): reading the
+    whole store after every generation cost the parent more the larger the store grew, while the
+    workers waited."""
+    kept: dict[tuple[str, str], list[pd.DataFrame]] = {}
+    made: dict[tuple[str, str], set[int]] = {}
+
+    def keep(tables: dict) -> None:
+        ok = tables["runs"][tables["runs"].status == "ok"]
+        for (exp, cid), g in ok.groupby(["experiment", "condition"], sort=False):
+            made.setdefault((exp, cid), set()).update(int(r) for r in g.run)
+        if tables["robots"] is not None:
+            for (exp, cid), g in tables["robots"].groupby(["experiment", "condition"], sort=False):
+                kept.setdefault((exp, cid), []).append(g)
+
+    def robots(conds: list[Condition]) -> pd.DataFrame:
+        if all(made.get((c.experiment, c.id)) == set(range(c.runs)) and (c.experiment, c.id) in kept for c in conds):
+            frames = [f for c in conds for f in kept.pop((c.experiment, c.id), [])]
+            return pd.concat(frames, ignore_index=True).sort_values(["experiment", "condition", "run", "robot"],
+                                                                    kind="stable")
+        r = store.robots()
+        return r[r.experiment.isin({c.experiment for c in conds})]
 
     def run(conds: list[Condition]) -> tuple[int, int]:
         planned = sum(c.runs for c in conds)
         rep = run_sweep(conds, store, workers=workers, executor=executor, on_done=on_done,
-                        on_plan=(lambda todo: on_skip(planned - todo)) if on_skip else None)
+                        on_plan=(lambda todo: on_skip(planned - todo)) if on_skip else None, on_part=keep)
         if rep.failed:
             from ..errors import SimulationError
 
@@ -161,4 +185,5 @@ def store_runner(store: Store, *, workers: int = 1, executor=None,
                                   f"`infomarket store failed {store.root}` lists them")
         return rep.done, rep.skipped
 
+    run.robots = robots
     return run

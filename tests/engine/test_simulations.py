@@ -1,0 +1,76 @@
+"""engine.simulation.Simulations: B runs stepped together in one compiled call are the runs Simulation
+makes one at a time, and fresh worlds start with the room earlier runs of the same kernel grew to."""
+import numpy as np
+import pandas as pd
+import pytest
+
+from infomarket.config import load_experiment
+from infomarket.engine import build, simulation
+from infomarket.engine.simulation import Simulation, Simulations
+from infomarket.errors import ConfigError
+
+SEEDS = [3, 41, 977]
+
+
+@pytest.fixture(scope="module")
+def cfg():
+    return load_experiment("fig4C").with_overrides(steps=1500, transitory=500, history_every=250)
+
+
+def test_runs_stepped_together_are_the_runs_made_alone(cfg):
+    simulation._ROOM.clear()  # every run starts from the built capacities: the batch must grow its worlds
+    together = Simulations(cfg, SEEDS).run()
+    for r, seed in zip(together, SEEDS):
+        simulation._ROOM.clear()
+        alone = Simulation(cfg, seed).run()
+        assert r.seed == seed and r.steps == cfg.steps
+        pd.testing.assert_frame_equal(r.robots, alone.robots, check_exact=True)
+        pd.testing.assert_frame_equal(r.history, alone.history, check_exact=True)
+
+
+def test_runs_advanced_in_steps_of_their_own_and_reset_are_the_runs_made_alone(cfg):
+    sims = Simulations(cfg, SEEDS)
+    sims.advance([100, 700, 1500])
+    assert sims.clocks.tolist() == [100, 700, 1500]
+    sims.reset(2, 5)  # a new run in slot 2, started from step 0
+    sims.advance(cfg.steps)
+    for sim, seed in zip(sims.sims, [3, 41, 5]):
+        np.testing.assert_array_equal(sim.world.balance, Simulation(cfg, seed).run().robots.wealth.to_numpy())
+    assert sims.sims[2].seed == 5
+
+
+def test_a_fresh_world_starts_with_the_room_earlier_runs_grew_to(cfg, monkeypatch):
+    grown = []
+    real = simulation.make_room
+    monkeypatch.setattr(simulation, "make_room", lambda w, *a: grown.append(1) or real(w, *a))
+    simulation._ROOM.clear()
+    first = Simulation(cfg, SEEDS[0])
+    built = first.world.nbr.shape[1], first.world.pend_seller.shape[2], first.world.tx_cap.copy()
+    first.run()
+    assert grown, "the first run of a kernel grows its arrays"
+    grown.clear()
+    second = Simulation(cfg, SEEDS[0])
+    assert second.world.nbr.shape[1] >= first.world.nbr.shape[1] >= built[0]
+    assert (second.world.tx_cap >= built[2]).all() and (second.world.tx_cap > built[2]).any()
+    r = second.run()
+    assert not grown, "the same run again starts with the room it needs"
+    pd.testing.assert_frame_equal(r.robots, first.result().robots, check_exact=True)
+
+
+def test_a_bad_seed_in_a_batch_is_refused(cfg):
+    with pytest.raises(ConfigError, match="seed must be an integer"):
+        Simulations(cfg, [1, -2])
+
+
+def test_room_of_keeps_the_largest_capacities():
+    cfg = load_experiment("fig2A").with_overrides(steps=10)
+    w, _ = build.build_world(cfg, np.random.default_rng(0))
+    small = build.room_of(w, None)
+    assert (small["tx"] == 16).all()
+    big = {**small, "nbr": small["nbr"] + 5, "tx": small["tx"] + 20}
+    room = build.room_of(w, big)
+    assert room["nbr"] == small["nbr"] + 5 and (room["tx"] == 36).all()
+    wide = build.with_room(w, room)
+    assert wide.nbr.shape == (w.nbr.shape[0], small["nbr"] + 5) and not wide.nbr.any()
+    # a block of 16 asked for 36: grow_ledger gives max(2 x 16, 36) = 36, blocks laid end to end, empty
+    assert (wide.tx_cap == 36).all() and (wide.tx_off == 36 * np.arange(25)).all() and wide.tx_count.sum() == 0
