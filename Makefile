@@ -39,7 +39,7 @@ tools/solc/node_modules: tools/solc/package.json tools/solc/package-lock.json
 	cd tools/solc && npm ci --no-audit --no-fund
 	touch $@
 
-# Gas with cold storage per transaction (revm, sizes 1-512, small sizes cross-checked on py-evm; 50 s on 2026-11-24):
+# Gas with cold storage per transaction (revm, sizes 1-512, small sizes cross-checked on py-evm):
 # docs/gas.md, the bound; then the chain model's constants as they must read in src/infomarket/ledger/gas.py
 # (tests/chain/test_gas_constants.py fails until they do).
 gas: venv

@@ -17,18 +17,8 @@ RECORDS = ("[[amendments]]", "[[deviations]]")
 
 #: values stores have fingerprinted (store.declarations): the terrain questions' `revised` notes
 FINGERPRINTED = {"analysis/terrain_questions.toml": {"revised"}}
-#: files outside the pipeline branch that still carry an issue number, for their owners (the lead empties this
-#: after the merge): path -> what to do
-ELSEWHERE = {
-    "experiments/terrain/corridor_waypoints.toml": "comment line 1",
-    "experiments/future/__init__.py": "docstring line 1",
-    "store/results.py": "Store.declarations' docstring",
-    "behaviours/paths.py": "docstring line 1",
-    "behaviours/weighted.py": "docstring line 2",
-    "behaviours/attacks.py": "docstring line 1",
-    "bench/setups.py": "comment on the goal ratio",
-    "bench/env.py": "docstring on the goal ratio",
-}
+#: files allowed to carry history outside records (none: every file is kept clean); path -> why
+ELSEWHERE: dict[str, str] = {}
 
 
 def history_lines(text: str, toml: bool = False, fingerprinted: set[str] = frozenset()) -> list[int]:

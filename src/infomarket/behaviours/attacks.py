@@ -1,4 +1,4 @@
-"""A family of Byzantine attack policies whose behaviour is a parameter vector (issue 23), and the
+"""A family of Byzantine attack policies whose behaviour is a parameter vector, and the
 hand-written threats the earlier attacks lacked, all plain rules over the public API.
 
 One sell rule, :func:`policy_sell`, decides per step and site what a Byzantine robot offers, as a

@@ -1,4 +1,4 @@
-"""Public helpers for rules that trade waypoint paths instead of one vector (issue 14, item 4).
+"""Public helpers for rules that trade waypoint paths instead of one vector.
 
 A robot's entry for a site may be a short polyline (``engine.paths``): the entry itself is the first
 waypoint and up to ``PATH_POINTS - 1`` further waypoints follow, the last being the site, all positions

@@ -1,5 +1,5 @@
 """A defence by continuous trust: honest robots that average bought information in with a weight that
-grows with the seller's reputation (issue 23, item 4), instead of the sceptic's yes/no confirmation.
+grows with the seller's reputation, instead of the sceptic's yes/no confirmation.
 (Registered as ``reputation_weighted`` by ``infomarket.builtins``.)"""
 from .api import buy, current, install, next_younger
 from .market import seller_reputation

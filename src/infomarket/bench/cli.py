@@ -5,6 +5,7 @@ import argparse
 import json
 
 from ..cliargs import at_least
+from ..errors import ConfigError, UsageError
 
 SETUPS = ("fig2A", "fig2D", "fig4C", "fig4C+chain")
 
@@ -48,7 +49,7 @@ def add_subcommand(sub) -> None:
 
 
 def run(args) -> int:
-    from ..errors import UsageError
+    # with the command: `infomarket --help` does not import the benches
     from . import run_bench, run_scaling, run_swarm_sizes
 
     if args.chain and not args.robots:  # the default bench times fig4C+chain already; --chain alone did nothing
@@ -119,8 +120,8 @@ def run(args) -> int:
 
 def _check_sizes(args) -> None:
     """Every swarm size of --robots fits in memory, checked here before any process starts."""
-    from ..errors import ConfigError, UsageError
-    from .setups import chain_at  # with the command: `infomarket --help` stays light
+    # with the command: `infomarket --help` stays light
+    from .setups import chain_at
     from .swarm import scaled_config
 
     for n in args.robots:
@@ -132,14 +133,13 @@ def _check_sizes(args) -> None:
 
 
 def _env(args) -> int:
-    from ..errors import UsageError
-
-    try:
+    try:  # the vector env needs the optional rl extra: refused with a message if missing
         from .env import run_env_bench
         import gymnasium  # noqa: F401
     except ModuleNotFoundError as exc:
         raise UsageError(f"bench --env needs {exc.name}: pip install 'infomarket[rl]'") from exc
-    from ..config import sizes  # with the command: `infomarket --help` stays light
+    # with the command, once the rl extra is known to be there
+    from ..config import sizes
     from ..rl.envs import configured
     from .env import ENV_SETUP
 

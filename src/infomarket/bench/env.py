@@ -31,7 +31,7 @@ GOAL = 0.9
 
 def run_env_bench(*, steps: int = 3000, batch: int = 64, interval: int = 10, repeats: int = 5,
                   setup: str = ENV_SETUP) -> dict:
-    from ..rl.envs import AttackVectorEnv, configured
+    from ..rl.envs import AttackVectorEnv, configured  # the optional rl extra: only when this bench runs
 
     cfg = configured(setup, None, steps, min(1000, steps // 3))
     t0 = time.perf_counter()

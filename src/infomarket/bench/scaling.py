@@ -12,6 +12,7 @@ def run_scaling(experiment: str = "fig2A", runs: int = 32, steps: int = 15000) -
     local pool's forked workers inherit it from the parent; Dask workers load it from the disk cache)."""
     import tempfile
 
+    # the runner and store only when this bench runs (`infomarket bench` imports this module)
     from ..runner.execute import warm
     from ..runner.sweep import plan, run_sweep
     from ..store import Store

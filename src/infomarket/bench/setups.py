@@ -15,7 +15,7 @@ from .floor import floor_steps_per_second
 #: A setup named ``NAME+chain`` is the shipped setup NAME with every robot a blockchain node
 #: (docs/chain-model.md): Proof-of-Authority blocks every 10 steps, out-of-turn signers 5 steps later,
 #: transactions and blocks spreading over the robots' own links only.  Its ``ratio_to_instant`` is its
-#: env-steps/s over NAME's when NAME is benched in the same run (issue 25's goal: at least 0.5).
+#: env-steps/s over NAME's when NAME is benched in the same run.
 CHAIN_SUFFIX = "+chain"
 CHAIN_BENCH = {"consensus": "poa", "period": 10, "out_of_turn_delay": 5}
 

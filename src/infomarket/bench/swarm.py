@@ -46,7 +46,7 @@ def measure(robots: int, steps: int, seed: int = 1, chain: dict | None = None) -
     is short, else one run) and the peak RSS of the process."""
     import statistics
 
-    from ..engine.simulation import Simulation
+    from ..engine.simulation import Simulation  # in the measuring interpreter only, after its memory baseline
 
     cfg = scaled_config(robots, steps, chain=chain)
     repeats = 5 if robots * steps < 5_000_000 else 1
@@ -65,7 +65,7 @@ def measure(robots: int, steps: int, seed: int = 1, chain: dict | None = None) -
 def run_swarm_sizes(sizes: list[int], steps: int, on_done=None, chain: bool = False) -> dict:
     """``measure`` for each size, each in a fresh interpreter (peak memory must not carry over); with
     ``chain``, every robot a blockchain node (``setups.chain_at``)."""
-    from .setups import chain_at
+    from .setups import chain_at  # setups imports the engine: only when sizes are measured
 
     out = {}
     for n in sizes:

@@ -32,6 +32,7 @@ from ..state.flags import ErrorFlags
 from .build import build_world, make_room, room_of, with_room
 from .params import behaviour_kinds, behaviour_table, build_params
 from .world import EVENT_NAMES, SITE_NAMES, STATE_NAMES, headings, kernel_view
+from ..config.load import validate
 
 
 @dataclass
@@ -255,7 +256,7 @@ class Simulation:
                 "behaviour": list(self.behaviour_names), "honest": [specs[b].honest for b in self.behaviour_names],
                 "sites": SITE_NAMES, "chain": None}
         if self.config.chain.enabled:
-            from ..ledger.blocklog import chain_views
+            from ..ledger.blocklog import chain_views  # chain runs only
 
             height, lag, branch = chain_views(w)
             snap["chain"] = {"height": int(w.blk_height[w.chn_canon[0]]), "forks": int(w.chn_forks[0]),
@@ -457,7 +458,6 @@ def as_experiment(config) -> Experiment:
     if isinstance(config, Experiment):
         return config
     if isinstance(config, dict):
-        from ..config.load import validate
 
         return validate(config, "simulate()/Simulation() experiment")
     if isinstance(config, (str, Path)):

@@ -25,6 +25,7 @@ from ..engine.simulation import Simulations, as_experiment, compile_notice
 from ..errors import ConfigError
 from ..registry import behaviours, get_behaviour
 from .observe import OBSERVATION
+from ..runner.plan import conditions
 
 #: The behaviour whose robots are the agents.
 AGENT_BEHAVIOUR = "attacker"
@@ -45,7 +46,6 @@ def select_cell(experiment, cell: dict | None = None) -> Experiment:
     exp = as_experiment(experiment)
     if not cell:
         return exp
-    from ..runner.plan import conditions
 
     conds = conditions(exp)
     hits = [c for c in conds if all(str(c.keys.get(k)) == str(v) for k, v in cell.items())]

@@ -27,6 +27,7 @@ from ..errors import ConfigError, UsageError
 from ..store import Store
 from .plan import BASE, Condition
 from .sweep import SweepReport, sweep_locked
+from .execute import preflight
 
 #: What ``infomarket run`` wrote before it wrote a results store (``--force`` replaces these).
 LEGACY_FILES = ("robots.parquet", "wealth_history.parquet", "sites.parquet")
@@ -87,7 +88,6 @@ def run_experiment(cond: Condition, out: str | Path, *, workers: int = 1, force:
     store = Store(out)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {out}: exists and is not a directory")
-    from .execute import preflight
 
     preflight([cond.config])  # a rule that keeps the kernel from compiling: refused, nothing written
     replaced = _legacy_files(store, force)

@@ -178,7 +178,7 @@ def sweep_locked(conds: list[Condition], store: Store, *, workers: int = 1, exec
 
 def _save_designs(store: Store, conds: list[Condition]) -> None:
     """Keep each sampled design in the store before its points run (``runner.design``)."""
-    from .design import save
+    from .design import save  # sampled designs only: design imports SALib, which is slow to import
 
     for design in {id(c.design): c.design for c in conds if c.design is not None}.values():
         save(store, design)

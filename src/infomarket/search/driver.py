@@ -179,7 +179,7 @@ def store_runner(store: Store, *, workers: int = 1, executor=None,
         rep = run_sweep(conds, store, workers=workers, executor=executor, on_done=on_done,
                         on_plan=(lambda todo: on_skip(planned - todo)) if on_skip else None, on_part=keep)
         if rep.failed:
-            from ..errors import SimulationError
+            from ..errors import SimulationError  # only when a run failed
 
             raise SimulationError(f"{rep.failed} of {rep.done} runs failed (the first: {rep.first_error}); "
                                   f"`infomarket store failed {store.root}` lists them")

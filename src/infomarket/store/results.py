@@ -59,6 +59,7 @@ from ..errors import InfomarketError
 from .dictionary import TABLES as TABLES_DICT
 from .dictionary import annotate
 from .files import sha256_file, write_atomic, write_text_atomic
+from ..config.load import validate
 
 FORMAT = 1
 DATA_TABLES = ("robots", "history", "events", "payments", "sites", "configs", "chain")
@@ -162,9 +163,9 @@ class StoreLock:
 
 
 def _declarations() -> dict:
-    """Hashes of the files declaring questions and decision rules (issue 24): a report flags any rule
+    """Hashes of the files declaring questions and decision rules: a report flags any rule
     edited after the store's first run (``store.declarations``, read by ``analysis.declared``)."""
-    from .declarations import fingerprint
+    from .declarations import fingerprint  # declarations reads the package's questions files: when a store is made
 
     return fingerprint()
 
@@ -628,7 +629,6 @@ class Store:
         """The configuration (an ``Experiment``) the runs of ``experiment`` [``condition``] used, steps and
         all: ``simulate(store.config(name), seed=row.seed)`` gives exactly the rows of the run ``row`` of
         the runs table."""
-        from ..config.load import validate
 
         df = self.configs()
         rows = df[(df.experiment == experiment) & (df.condition == condition)] if len(df) else df

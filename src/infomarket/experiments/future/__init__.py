@@ -1,1 +1,1 @@
-"""The paper's open questions (issue 10): reputation-aware defences against attacks that target them."""
+"""The paper's open questions: reputation-aware defences against attacks that target them."""
