@@ -1,4 +1,4 @@
-"""engine.simulation.Simulations: B runs stepped together in one compiled call are the runs Simulation
+"""engine.batch.Simulations: B runs stepped together in one compiled call are the runs Simulation
 makes one at a time, and fresh worlds start with the room earlier runs of the same kernel grew to."""
 import numpy as np
 import pandas as pd
@@ -6,7 +6,8 @@ import pytest
 
 from infomarket.config import load_experiment
 from infomarket.engine import build, simulation
-from infomarket.engine.simulation import Simulation, Simulations
+from infomarket.engine.batch import Simulations
+from infomarket.engine.simulation import Simulation
 from infomarket.errors import ConfigError
 
 SEEDS = [3, 41, 977]

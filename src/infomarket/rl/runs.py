@@ -7,7 +7,7 @@ rules read every step), so actions change between calls without recompiling anyt
 itself is untouched.  All B runs' ``bparams`` are slices of one [B, n, P] array, so one numpy assignment
 sets every agent of every run.
 
-The runs are the engine's own (``engine.simulation.Simulations``, the driver sweeps use): ``advance``
+The runs are the engine's own (``engine.batch.Simulations``, the driver sweeps use): ``advance``
 steps each world to its ``t_end``, grows the worlds that ran short and names a rule's error as
 ``Simulation`` does; its finishing call (``observe.observe_all``, compiled with it) computes every
 observation, the honest robots' items and every agent's wealth share.  A run built here with seed s is
@@ -21,7 +21,8 @@ import numpy as np
 from ..behaviours.attacks import POLICY
 from ..config.schema import Experiment
 from ..engine.params import behaviour_kinds
-from ..engine.simulation import Simulations, as_experiment, compile_notice
+from ..engine.batch import Simulations
+from ..engine.simulation import as_experiment, compile_notice
 from ..errors import ConfigError
 from ..registry import behaviours, get_behaviour
 from .observe import OBSERVATION

@@ -31,7 +31,8 @@ import pandas as pd
 
 from .. import plugins
 from ..config.schema import Experiment
-from ..engine.simulation import Simulation, Simulations
+from ..engine.batch import Simulations
+from ..engine.simulation import Simulation
 from ..checks import explain
 from ..errors import InfomarketError, RuleRunError
 from .plan import Condition
@@ -84,7 +85,7 @@ def run_one(cfg: Experiment, run: int, seed: int, record_events: bool = False) -
 
 def run_together(cfg: Experiment, items: list[tuple[int, int]], record_events: bool = False) -> list[RunOutput]:
     """Runs ``items`` (run, seed) of ``cfg`` stepped back to back in one compiled call
-    (``engine.simulation.Simulations``: one kernel load, worlds that start with the room earlier runs
+    (``engine.batch.Simulations``: one kernel load, worlds that start with the room earlier runs
     grew to); the same rows as ``run_one`` for each.  Raises the first run's error, named."""
     sims = Simulations(cfg, [seed for _, seed in items], record_events=record_events)
     return [output(r, run) for r, (run, _) in zip(sims.run(), items)]
