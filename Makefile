@@ -39,8 +39,9 @@ tools/solc/node_modules: tools/solc/package.json tools/solc/package-lock.json
 	cd tools/solc && npm ci --no-audit --no-fund
 	touch $@
 
-# Gas with cold storage per transaction (revm, sizes 1-512, small sizes cross-checked on py-evm):
-# docs/gas.md, the bound; then the chain model's constants as they must read in src/infomarket/ledger/gas.py
+# Gas with cold storage per transaction (revm, sizes 1-512, small sizes cross-checked on py-evm, the bound at
+# 512 distinct sellers for every scheme): docs/gas.md; then the chain model's constants as they must read in
+# src/infomarket/ledger/gas.py
 # (tests/chain/test_gas_constants.py fails until they do).
 gas: venv
 	$(BIN)/python -m infomarket.chain.gasreport

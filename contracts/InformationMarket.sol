@@ -18,15 +18,24 @@ pragma solidity 0.8.28;
 /// (docs/model.md §4), and "within theta" is decided on those integer vectors with dot products
 /// against a fixed cos(theta), exactly. A stake never stays locked for ever: records older than
 /// `stakeExpiry` blocks (never 0) give their stake back to their seller (anyone may trigger it), and a
-/// deposit not settled within `settlementDeadline` blocks returns its stakes to their sellers and the
-/// share to the robot. Every call does a bounded amount of work: a round trip holds at most
-/// `maxRecordsPerTrip` (<= 512) live records, and `buyItem`, `settle` and `refundExpired` each do at
-/// most `settleBatch` (<= 64) units of work, so no call exceeds the gas bound docs/gas.md declares,
-/// measured with cold storage, whatever the number of records.
+/// deposit not weighed within `settlementDeadline` blocks is paid by the delayed rule instead (stake
+/// plus an equal part of the share per live record), so a buyer gains nothing by leaving its
+/// settlement unfinished. Every call does a bounded amount of work: a round trip holds at most
+/// `maxRecordsPerTrip` (<= 512) live records, one seller at most `maxRecordsPerSeller` of them, and
+/// `buyItem`, `settle` and `refundExpired` each do at most `settleBatch` (<= 48) units of work, so no
+/// call exceeds the gas bound docs/gas.md declares, measured with cold storage, whatever the number of
+/// records or sellers. A registered robot that settles someone's deposit earns `settleBounty` per unit
+/// of work, taken from the share, so settling is worth doing for whoever does it.
 ///
-/// Only accounts the market registered (`grantWealth`, once per robot, at most `maxGrant`) may buy,
-/// sell or be paid a reward. A light contract names the buyer's round trip it belongs to, so a reveal
-/// after the buyer's deposit is refused rather than paid from the next item.
+/// Trust (docs/chain.md, "Trust model"): roles, as in OpenZeppelin's AccessControl. The admin grants
+/// and revokes roles (key rotation; several accounts may hold a role). A robot is registered when
+/// `registrarThreshold` distinct registrars approved the same (robot, grant), and a registrar approves
+/// at most `registrarQuota` robots per `registrarPeriod` blocks. A depositor submits a deposit only
+/// with its evidence: the robot's signature over its round trip and a nest's acknowledgement of it. A
+/// pauser stops registrations, reveals and deposits; settlements and refunds go on while paused, so no
+/// stake is ever held by a pause. Only registered robots may buy, sell or be paid a reward. A light
+/// contract names the buyer's round trip it belongs to, so a reveal after the buyer's deposit is
+/// refused rather than paid from the next item.
 ///
 /// Fixed point: token amounts in units of 1e-9 token; positions and vectors in micro arena units
 /// (signed); cos(theta) in units of 1e-9.
@@ -115,18 +124,30 @@ contract InformationMarket {
         uint16 prevGap;
     }
 
-    /// @dev A buyer's records are `_records[buyer][i]`; its open round trip is [start, count).
-    /// `trip` numbers its round trips (for the per-seller bound).
+    /// @dev A buyer's records are `_records[buyer][i]`; its open round trip is [start, count) and began
+    /// at index `first` (refunds move `start`, never `first`). `trip` numbers its round trips.
     struct Round {
         uint64 start;
         uint64 count;
         uint64 trip;
+        uint64 first;
+    }
+
+    /// @notice What a deposit carries: the robot's signature over `Deposit(robot, trip)` (it ends that
+    /// round trip) and a nest's signature over the same message (it received the item).
+    struct DepositEvidence {
+        uint8 robotV;
+        bytes32 robotR;
+        bytes32 robotS;
+        uint8 nestV;
+        bytes32 nestR;
+        bytes32 nestS;
     }
 
     /// @dev A deposited round trip being settled, records [next, end) still to process in `phase`
     /// (in the weighing phase `next` is the next record to weigh).
     /// `escrow` holds the reward share and the stakes not yet paid out; `amount` is what the live
-    /// records share (fixed when the expired ones are refunded); `live` is the first live record.
+    /// records share (fixed when paying starts); `live` is the first live record.
     struct Settlement {
         uint64 next;
         uint64 end;
@@ -205,6 +226,36 @@ contract InformationMarket {
     /// @param amount Share paid, 1e-9 units.
     event RewardShared(address indexed robot, address indexed seller, uint256 index, uint256 weight, uint256 amount);
 
+    /// @notice `caller` earned `amount` for settling `robot`'s deposit (`settleBounty` per unit of work).
+    /// @param caller The registered robot that called `settle`.
+    /// @param robot The depositing robot.
+    /// @param amount Bounty paid, 1e-9 units.
+    event SettlementBountyPaid(address indexed caller, address indexed robot, uint256 amount);
+
+    /// @notice `registrar` approved registering `robot` with initial wealth `amount`.
+    /// @param registrar The approving registrar.
+    /// @param robot The robot.
+    /// @param amount The grant approved, 1e-9 units.
+    /// @param approvals Distinct registrars that approved this (robot, amount) so far.
+    event RegistrationApproved(address indexed registrar, address indexed robot, uint256 amount, uint256 approvals);
+
+    /// @notice `account` received `role` from `sender`.
+    /// @param role The role.
+    /// @param account The account.
+    /// @param sender The admin that granted it.
+    event RoleGranted(bytes32 indexed role, address indexed account, address indexed sender);
+
+    /// @notice `account` lost `role` (revoked by an admin, or renounced by `account` itself).
+    /// @param role The role.
+    /// @param account The account.
+    /// @param sender Who revoked it.
+    event RoleRevoked(bytes32 indexed role, address indexed account, address indexed sender);
+
+    /// @notice Registrations, reveals and deposits stopped (`paused` true) or resumed.
+    /// @param account The pauser.
+    /// @param paused The new state.
+    event PauseSet(address indexed account, bool paused);
+
     /// @notice A round trip's settlement finished: `shared` went to the sellers of its live records and
     /// `kept` (rounding dust, or the whole share when no record was live) back to `robot`.
     /// @param robot Depositing robot.
@@ -217,9 +268,33 @@ contract InformationMarket {
     // Errors (EIP-6093 style: domain prefix and the values that explain the refusal)
     // ------------------------------------------------------------------------------------------------
 
-    /// @notice `caller` is not the market account, the only one allowed to mint or buy items.
+    /// @notice `caller` lacks `role`, which the call needs.
     /// @param caller Sender of the refused call.
-    error InfoMarketUnauthorizedMarket(address caller);
+    /// @param role The role it needs.
+    error InfoMarketUnauthorized(address caller, bytes32 role);
+
+    /// @notice Registrations, reveals and deposits are paused.
+    error InfoMarketPaused();
+
+    /// @notice `registrar` already approved this (robot, amount).
+    /// @param registrar The registrar.
+    /// @param robot The robot.
+    error InfoMarketAlreadyApproved(address registrar, address robot);
+
+    /// @notice `registrar` already approved `limit` registrations in the current period.
+    /// @param registrar The registrar.
+    /// @param limit `registrarQuota`.
+    error InfoMarketRegistrarQuotaExceeded(address registrar, uint256 limit);
+
+    /// @notice The deposit's robot signature does not recover to the robot (for its open round trip).
+    /// @param robot The depositing robot.
+    /// @param recovered Address the signature recovers to (zero when none).
+    error InfoMarketInvalidDepositSignature(address robot, address recovered);
+
+    /// @notice The deposit's acknowledgement is not signed by an account holding the nest role.
+    /// @param robot The depositing robot.
+    /// @param signer Address the acknowledgement recovers to (zero when none).
+    error InfoMarketUnacknowledgedDeposit(address robot, address signer);
 
     /// @notice `caller` submitted a light contract whose seller is `seller`; only the seller may reveal.
     /// @param caller Sender of the refused reveal.
@@ -329,18 +404,34 @@ contract InformationMarket {
     /// test stays below 2^250.
     int256 private constant _COS_SCALE = 1e9;
     int256 private constant _MAX_COMPONENT = 2 ** 47;
-    /// @dev Pair comparisons that count as one record of settlement work.
+    /// @dev Pair comparisons that count as one unit of settlement work: a distinct-seller comparison
+    /// costs more (it looks up the other record's seller), so fewer of them make a unit.
     uint256 private constant _PAIRS_PER_UNIT = 64;
+    uint256 private constant _DISTINCT_PAIRS_PER_UNIT = 40;
     /// @dev Most live records a round trip may ever hold, and most work units one call may do: the
     /// bounds the declared gas per transaction is measured at (docs/gas.md).
     uint256 private constant _MAX_TRIP_RECORDS = 512;
-    uint256 private constant _MAX_SETTLE_BATCH = 64;
+    uint256 private constant _MAX_SETTLE_BATCH = 48;
+    /// @dev Most units of work one settlement can take: a refund, a weighing (at most
+    /// ceil(512 / 40) = 13 units) and a payment per record. The bounty of them all fits in the share.
+    uint256 private constant _MAX_SETTLEMENT_UNITS = _MAX_TRIP_RECORDS * 15;
     /// @dev Scale of an OutlierDistinct weight (distinct sellers / seller's records, as a fixed point).
     uint256 private constant _DISTINCT_SCALE = 1e27;
     uint8 private constant _EXPIRE = 0;
     uint8 private constant _WEIGH = 1;
     uint8 private constant _PAY = 2;
-    uint8 private constant _REFUND = 3;
+    uint8 private constant _EQUAL = 3;
+
+    /// @notice Role that grants and revokes every role (as AccessControl's DEFAULT_ADMIN_ROLE).
+    bytes32 public constant ADMIN_ROLE = 0x00;
+    /// @notice Role whose holders approve registrations (`grantWealth`).
+    bytes32 public constant REGISTRAR_ROLE = keccak256("REGISTRAR_ROLE");
+    /// @notice Role whose holders submit deposits (`buyItem`).
+    bytes32 public constant DEPOSITOR_ROLE = keccak256("DEPOSITOR_ROLE");
+    /// @notice Role whose holders acknowledge deposits (sign `Deposit(robot, trip)`).
+    bytes32 public constant NEST_ROLE = keccak256("NEST_ROLE");
+    /// @notice Role whose holders pause and unpause.
+    bytes32 public constant PAUSER_ROLE = keccak256("PAUSER_ROLE");
     /// @dev secp256k1 order / 2: a larger s is the malleated twin of a valid signature (EIP-2).
     uint256 private constant _HALF_ORDER = 0x7fffffffffffffffffffffffffffffff5d576e7357a4501ddfe92f46681b20a0;
 
@@ -352,10 +443,10 @@ contract InformationMarket {
         "Acceptance(Offer offer,address buyer,int64 sellerX,int64 sellerY,uint64 trip)"
         "Offer(address seller,uint8 site,uint32 age,uint64 maxBlock,bytes32 pathHash)"
     );
+    bytes32 private constant _DEPOSIT_TYPEHASH = keccak256("Deposit(address robot,uint64 trip)");
     bytes32 private constant _NAME_HASH = keccak256("InformationMarket");
-    bytes32 private constant _VERSION_HASH = keccak256("3");
+    bytes32 private constant _VERSION_HASH = keccak256("4");
 
-    address private immutable _market;
     Scheme private immutable _scheme;
     uint256 private immutable _reward;
     uint256 private immutable _informationShare;
@@ -368,6 +459,10 @@ contract InformationMarket {
     uint256 private immutable _settleBatch;
     uint64 private immutable _settlementDeadline;
     uint256 private immutable _maxGrant;
+    uint256 private immutable _settleBounty;
+    uint256 private immutable _registrarThreshold;
+    uint256 private immutable _registrarQuota;
+    uint64 private immutable _registrarPeriod;
     uint256 private immutable _cachedChainId;
     bytes32 private immutable _cachedDomainSeparator;
 
@@ -387,9 +482,16 @@ contract InformationMarket {
     mapping(address buyer => mapping(address seller => uint256)) private _sold;
     mapping(bytes32 key => bool) private _revealed;
     mapping(address robot => bool) private _registered;
+    mapping(bytes32 role => mapping(address account => bool)) private _roles;
+    /// @dev Approvals per keccak256(robot, amount), and by whom.
+    mapping(bytes32 request => uint256) private _approvals;
+    mapping(bytes32 request => mapping(address registrar => bool)) private _approvedBy;
+    /// @dev (period << 128) | approvals the registrar made in that period.
+    mapping(address registrar => uint256) private _quotaUsed;
+    bool private _paused;
 
-    /// @notice Deploys a market with a fixed payment scheme; `market` alone can grant wealth and buy items.
-    /// @param market_ Account of the market node.
+    /// @notice Deploys a market with a fixed payment scheme and its trust policy.
+    /// @param market_ Account of the market node: it receives the admin, depositor and pauser roles.
     /// @param scheme_ Payment scheme.
     /// @param reward_ Reward R per item, 1e-9 units.
     /// @param informationShare_ Part of R shared with the sellers, as a WAD (0.5 = 5e17); at most 1e18.
@@ -404,6 +506,13 @@ contract InformationMarket {
     /// @param settlementDeadline_ Blocks after `buyItem` from which an unfinished settlement returns its
     /// stakes to their sellers and the share to the robot instead of weighing (>= 1).
     /// @param maxGrant_ Most initial wealth the market may grant one robot, 1e-9 units.
+    /// @param registrars_ Accounts that receive the registrar role (at least `registrarThreshold_`).
+    /// @param registrarThreshold_ Distinct registrar approvals that register a robot (>= 1).
+    /// @param registrarQuota_ Most approvals one registrar may make per period (>= 1).
+    /// @param registrarPeriod_ Length of that period, blocks (>= 1).
+    /// @param nest_ Account that receives the nest role (acknowledges deposits).
+    /// @param settleBounty_ Paid to a registered robot per unit of settlement work it does, 1e-9 units;
+    /// the bounty of the largest settlement must fit in the reward's share.
     constructor(
         address market_,
         Scheme scheme_,
@@ -417,9 +526,24 @@ contract InformationMarket {
         uint64 maxValidity_,
         uint256 settleBatch_,
         uint64 settlementDeadline_,
-        uint256 maxGrant_
+        uint256 maxGrant_,
+        address[] memory registrars_,
+        uint256 registrarThreshold_,
+        uint256 registrarQuota_,
+        uint64 registrarPeriod_,
+        address nest_,
+        uint256 settleBounty_
     ) {
         if (market_ == address(0)) revert InfoMarketInvalidParameter("market", 0);
+        if (nest_ == address(0)) revert InfoMarketInvalidParameter("nest", 0);
+        if (registrarThreshold_ == 0 || registrarThreshold_ > registrars_.length) {
+            revert InfoMarketInvalidParameter("registrarThreshold", int256(registrarThreshold_));
+        }
+        if (registrarQuota_ == 0) revert InfoMarketInvalidParameter("registrarQuota", 0);
+        if (registrarPeriod_ == 0) revert InfoMarketInvalidParameter("registrarPeriod", 0);
+        if (settleBounty_ * _MAX_SETTLEMENT_UNITS > (reward_ * informationShare_) / _WAD) {
+            revert InfoMarketInvalidParameter("settleBounty", int256(settleBounty_));
+        }
         if (informationShare_ > _WAD) revert InfoMarketInvalidParameter("informationShare", int256(informationShare_));
         if (scheme_ == Scheme.Delayed && stake_ != 0) revert InfoMarketInvalidParameter("stake", int256(stake_));
         if (cosTheta_ > _COS_SCALE || cosTheta_ < -_COS_SCALE) revert InfoMarketInvalidParameter("cosTheta", cosTheta_);
@@ -435,7 +559,18 @@ contract InformationMarket {
             revert InfoMarketInvalidParameter("settleBatch", int256(settleBatch_));
         }
         if (settlementDeadline_ == 0) revert InfoMarketInvalidParameter("settlementDeadline", 0);
-        _market = market_;
+        _grantRole(ADMIN_ROLE, market_);
+        _grantRole(DEPOSITOR_ROLE, market_);
+        _grantRole(PAUSER_ROLE, market_);
+        _grantRole(NEST_ROLE, nest_);
+        for (uint256 i; i < registrars_.length; ++i) {
+            if (registrars_[i] == address(0)) revert InfoMarketInvalidParameter("registrars", int256(i));
+            _grantRole(REGISTRAR_ROLE, registrars_[i]);
+        }
+        _registrarThreshold = registrarThreshold_;
+        _registrarQuota = registrarQuota_;
+        _registrarPeriod = registrarPeriod_;
+        _settleBounty = settleBounty_;
         _scheme = scheme_;
         _reward = reward_;
         _informationShare = informationShare_;
@@ -456,16 +591,33 @@ contract InformationMarket {
     // Market functions
     // ------------------------------------------------------------------------------------------------
 
-    /// @notice Registers `robot` and mints it `amount` tokens: how robots join the market and receive
-    /// their initial wealth (0 allowed). Only registered robots may buy, sell or deposit.
-    /// @dev Requirements: the caller is the market; `robot` is not registered yet; `amount` is at most
-    /// `maxGrant`. Emits a {WealthGranted} event.
+    /// @notice Approves registering `robot` with `amount` tokens of initial wealth (0 allowed); the
+    /// `registrarThreshold`-th distinct registrar to approve the same (robot, amount) registers it and
+    /// mints the grant. Only registered robots may buy, sell or deposit.
+    /// @dev Requirements: the caller is a registrar within its quota for the period; not paused;
+    /// `robot` is not registered yet; `amount` is at most `maxGrant`; the caller has not approved this
+    /// (robot, amount) yet. Emits {RegistrationApproved}, and {WealthGranted} when it registers.
     /// @param robot Receiving account.
     /// @param amount Tokens, 1e-9 units.
-    function grantWealth(address robot, uint256 amount) external {
-        _requireMarket();
+    /// @return registered Whether this approval registered the robot.
+    function grantWealth(address robot, uint256 amount) external returns (bool registered) {
+        _requireRole(REGISTRAR_ROLE);
+        _requireNotPaused();
         if (_registered[robot]) revert InfoMarketAlreadyRegistered(robot);
         if (amount > _maxGrant) revert InfoMarketGrantTooLarge(amount, _maxGrant);
+        uint256 period = block.number / _registrarPeriod;
+        uint256 used = _quotaUsed[msg.sender];
+        used = used >> 128 == period ? used & type(uint128).max : 0;
+        if (used >= _registrarQuota) revert InfoMarketRegistrarQuotaExceeded(msg.sender, _registrarQuota);
+        _quotaUsed[msg.sender] = (period << 128) | (used + 1);
+        bytes32 request = keccak256(abi.encode(robot, amount));
+        if (_approvedBy[request][msg.sender]) revert InfoMarketAlreadyApproved(msg.sender, robot);
+        _approvedBy[request][msg.sender] = true;
+        uint256 count = _approvals[request] + 1;
+        _approvals[request] = count;
+        emit RegistrationApproved(msg.sender, robot, amount, count);
+        if (count < _registrarThreshold) return false;
+        registered = true;
         _registered[robot] = true;
         _balances[robot] += amount;
         _totalSupply += amount;
@@ -477,16 +629,25 @@ contract InformationMarket {
     /// @dev The reward share and the pot go into the settlement's escrow. Settling refunds the records
     /// that expired before this block, weighs the live ones and pays each floor(amount * w / sum w);
     /// the remainder goes back to `robot`, so the supply changes by exactly the reward.
-    /// Requirements: the caller is the market; the robot is registered; its previous round trip is fully
-    /// settled. Emits {ItemBought}, then what {settle} emits.
+    /// Requirements: the caller is a depositor; not paused; the robot is registered; its previous round
+    /// trip is fully settled; the evidence holds the robot's signature over `Deposit(robot, trip)` for
+    /// its open round trip and a nest's signature over the same. Emits {ItemBought}, then what
+    /// {settle} emits.
     /// @param robot The depositing robot.
+    /// @param evidence The robot's and the nest's signatures.
     /// @return done Whether the round trip is fully settled.
-    function buyItem(address robot) external returns (bool done) {
-        _requireMarket();
+    function buyItem(address robot, DepositEvidence calldata evidence) external returns (bool done) {
+        _requireRole(DEPOSITOR_ROLE);
+        _requireNotPaused();
         if (!_registered[robot]) revert InfoMarketUnregistered(robot);
         Settlement storage s = _settlements[robot];
         if (s.end != 0) revert InfoMarketSettlementPending(robot, s.end - s.next);
         Round storage round = _rounds[robot];
+        bytes32 digest = depositDigest(robot, round.trip);
+        address signer = _recover(digest, evidence.robotV, evidence.robotR, evidence.robotS);
+        if (signer == address(0) || signer != robot) revert InfoMarketInvalidDepositSignature(robot, signer);
+        signer = _recover(digest, evidence.nestV, evidence.nestR, evidence.nestS);
+        if (signer == address(0) || !_roles[NEST_ROLE][signer]) revert InfoMarketUnacknowledgedDeposit(robot, signer);
         uint256 pot = _pots[robot];
         uint256 share = (_reward * _informationShare) / _WAD;
         // The robot receives the reward and escrows the share: never negative since share <= reward.
@@ -496,6 +657,7 @@ contract InformationMarket {
         uint64 start = round.start;
         uint64 end = round.count;
         round.start = end;
+        round.first = end;
         round.trip += 1;
         emit ItemBought(robot, _reward, pot, end - start);
         s.next = start;
@@ -508,9 +670,10 @@ contract InformationMarket {
     }
 
     /// @notice Continues the settlement of `robot`'s deposited round trip for at most `maxRecords`
-    /// records of work; anyone may call it (it moves money only by the market's rules).
-    /// @dev Requirements: a settlement is pending. Emits {RecordExpired}, {RewardShared} and, at the
-    /// end, {SettlementCompleted}.
+    /// records of work; anyone may call it (it moves money only by the market's rules), and a
+    /// registered caller earns `settleBounty` per unit of work, from the share.
+    /// @dev Requirements: a settlement is pending. Emits {RecordExpired}, {RewardShared},
+    /// {SettlementBountyPaid} and, at the end, {SettlementCompleted}.
     /// @param robot The depositing robot.
     /// @param maxRecords Work bound, capped at `settleBatch`: each record refunded or paid counts one,
     /// each record weighed ceil(m / 64) for m live records (at least one record is weighed when the
@@ -542,6 +705,44 @@ contract InformationMarket {
     }
 
     // ------------------------------------------------------------------------------------------------
+    // Roles and pause
+    // ------------------------------------------------------------------------------------------------
+
+    /// @notice Gives `role` to `account` (a second key, or the new key of a rotation).
+    /// @dev Requirements: the caller is an admin. Emits {RoleGranted} when it was not held.
+    /// @param role The role.
+    /// @param account The account.
+    function grantRole(bytes32 role, address account) external {
+        _requireRole(ADMIN_ROLE);
+        _grantRole(role, account);
+    }
+
+    /// @notice Takes `role` from `account` (the old key of a rotation, or a compromised one).
+    /// @dev Requirements: the caller is an admin. Emits {RoleRevoked} when it was held.
+    /// @param role The role.
+    /// @param account The account.
+    function revokeRole(bytes32 role, address account) external {
+        _requireRole(ADMIN_ROLE);
+        _revokeRole(role, account);
+    }
+
+    /// @notice Gives up `role` held by the caller.
+    /// @param role The role.
+    function renounceRole(bytes32 role) external {
+        _revokeRole(role, msg.sender);
+    }
+
+    /// @notice Stops (`paused_` true) or resumes registrations, reveals and deposits. Settlements and
+    /// stake refunds never stop.
+    /// @dev Requirements: the caller is a pauser. Emits {PauseSet}.
+    /// @param paused_ The new state.
+    function setPaused(bool paused_) external {
+        _requireRole(PAUSER_ROLE);
+        _paused = paused_;
+        emit PauseSet(msg.sender, paused_);
+    }
+
+    // ------------------------------------------------------------------------------------------------
     // Seller function
     // ------------------------------------------------------------------------------------------------
 
@@ -551,13 +752,14 @@ contract InformationMarket {
     /// agreed max block, which lies at most `maxValidity` blocks ahead; buyer and seller are registered;
     /// the buyer's EIP-712 signature over the acceptance is valid and not malleable; it names the
     /// buyer's open round trip; (site, age, max block, buyer, seller, path hash) was never revealed
-    /// before; the information hashes to the committed value; the seller's vector is in range; the
+    /// before; not paused; the information hashes to the committed value; the seller's vector is in range; the
     /// round trip holds fewer than `maxRecordsPerTrip` live records; the seller has not reached
     /// `maxRecordsPerSeller` in this round trip; it can lock the stake.
     /// Emits {StakeLocked} (under staking) and {InformationRevealed}.
     /// @param lc The double-signed light contract.
     /// @param info The path information in the buyer's frame.
     function revealInformation(LightContract calldata lc, PathInfo calldata info) external {
+        _requireNotPaused();
         Offer calldata offer = lc.offer;
         address seller = offer.seller;
         address buyer = lc.buyer;
@@ -625,8 +827,8 @@ contract InformationMarket {
     /// @notice Whether `robot` has a deposited round trip still to settle, and where it stands.
     /// @param robot The account.
     /// @return pending True until the settlement completes.
-    /// @return phase 0 refunding expired records, 1 weighing, 2 paying, 3 refunding every stake (past the
-    /// settlement deadline).
+    /// @return phase 0 refunding expired records, 1 weighing, 2 paying by weight, 3 paying equal parts
+    /// (weighing missed the settlement deadline).
     /// @return remaining Records left in the current phase.
     function pendingSettlement(address robot) external view returns (bool pending, uint8 phase, uint256 remaining) {
         Settlement storage s = _settlements[robot];
@@ -662,6 +864,38 @@ contract InformationMarket {
     /// @return The open round trip's number.
     function roundTrip(address buyer) external view returns (uint64) {
         return _rounds[buyer].trip;
+    }
+
+    /// @notice Whether `account` holds `role`.
+    /// @param role The role.
+    /// @param account The account.
+    /// @return True when held.
+    function hasRole(bytes32 role, address account) external view returns (bool) {
+        return _roles[role][account];
+    }
+
+    /// @notice Whether registrations, reveals and deposits are paused.
+    /// @return True when paused.
+    function paused() external view returns (bool) {
+        return _paused;
+    }
+
+    /// @notice Approvals the registration of `robot` with `amount` has so far.
+    /// @param robot The robot.
+    /// @param amount The grant.
+    /// @return The number of distinct registrars that approved it.
+    function approvals(address robot, uint256 amount) external view returns (uint256) {
+        return _approvals[keccak256(abi.encode(robot, amount))];
+    }
+
+    /// @notice The EIP-712 digest a robot and a nest sign for the deposit that ends round trip `trip`.
+    /// @param robot The depositing robot.
+    /// @param trip Its round trip.
+    /// @return The digest of `Deposit(robot, trip)`.
+    function depositDigest(address robot, uint64 trip) public view returns (bytes32) {
+        return keccak256(
+            abi.encodePacked(hex"1901", _domainSeparator(), keccak256(abi.encode(_DEPOSIT_TYPEHASH, robot, trip)))
+        );
     }
 
     /// @notice Whether the market registered `robot`.
@@ -732,7 +966,7 @@ contract InformationMarket {
     /// @notice The EIP-712 domain (EIP-5267), so that clients sign for this contract on this chain only.
     /// @return fields Bit mask of the fields used (name, version, chainId, verifyingContract).
     /// @return name "InformationMarket".
-    /// @return version "3".
+    /// @return version "4".
     /// @return chainId Current chain id.
     /// @return verifyingContract This contract.
     /// @return salt Unused.
@@ -750,11 +984,10 @@ contract InformationMarket {
             uint256[] memory extensions
         )
     {
-        return (hex"0f", "InformationMarket", "3", block.chainid, address(this), bytes32(0), new uint256[](0));
+        return (hex"0f", "InformationMarket", "4", block.chainid, address(this), bytes32(0), new uint256[](0));
     }
 
-    /// @notice The market's configuration (the constructor's arguments).
-    /// @return market_ Market account.
+    /// @notice The market's configuration (the constructor's economic arguments; `policy` has the rest).
     /// @return scheme_ Payment scheme.
     /// @return reward_ Reward per item, 1e-9 units.
     /// @return informationShare_ Shared part of the reward, WAD.
@@ -767,11 +1000,11 @@ contract InformationMarket {
     /// @return settleBatch_ Work units per call.
     /// @return settlementDeadline_ Blocks after a deposit from which its settlement refunds instead.
     /// @return maxGrant_ Most initial wealth per robot.
+    /// @return settleBounty_ Bounty per unit of settlement work.
     function configuration()
         external
         view
         returns (
-            address market_,
             Scheme scheme_,
             uint256 reward_,
             uint256 informationShare_,
@@ -783,11 +1016,11 @@ contract InformationMarket {
             uint64 maxValidity_,
             uint256 settleBatch_,
             uint64 settlementDeadline_,
-            uint256 maxGrant_
+            uint256 maxGrant_,
+            uint256 settleBounty_
         )
     {
         return (
-            _market,
             _scheme,
             _reward,
             _informationShare,
@@ -799,22 +1032,54 @@ contract InformationMarket {
             _maxValidity,
             _settleBatch,
             _settlementDeadline,
-            _maxGrant
+            _maxGrant,
+            _settleBounty
         );
+    }
+
+    /// @notice The registration policy.
+    /// @return threshold Distinct registrar approvals that register a robot.
+    /// @return quota Most approvals per registrar per period.
+    /// @return period Its length, blocks.
+    function policy() external view returns (uint256 threshold, uint256 quota, uint64 period) {
+        return (_registrarThreshold, _registrarQuota, _registrarPeriod);
     }
 
     // ------------------------------------------------------------------------------------------------
     // Internal
     // ------------------------------------------------------------------------------------------------
 
-    function _requireMarket() private view {
-        if (msg.sender != _market) revert InfoMarketUnauthorizedMarket(msg.sender);
+    function _requireRole(bytes32 role) private view {
+        if (!_roles[role][msg.sender]) revert InfoMarketUnauthorized(msg.sender, role);
+    }
+
+    function _requireNotPaused() private view {
+        if (_paused) revert InfoMarketPaused();
+    }
+
+    function _grantRole(bytes32 role, address account) private {
+        if (!_roles[role][account]) {
+            _roles[role][account] = true;
+            emit RoleGranted(role, account, msg.sender);
+        }
+    }
+
+    function _revokeRole(bytes32 role, address account) private {
+        if (_roles[role][account]) {
+            _roles[role][account] = false;
+            emit RoleRevoked(role, account, msg.sender);
+        }
+    }
+
+    /// @dev The signer of `digest`, refusing the malleated (high-s) twin of a signature; zero when none.
+    function _recover(bytes32 digest, uint8 v, bytes32 r, bytes32 s) private pure returns (address) {
+        if (uint256(s) > _HALF_ORDER) revert InfoMarketMalleableSignature(s);
+        return ecrecover(digest, v, r, s);
     }
 
     function _checkBuyerSignature(LightContract calldata lc) private view {
-        if (uint256(lc.s) > _HALF_ORDER) revert InfoMarketMalleableSignature(lc.s);
         bytes32 digest = acceptanceDigest(lc.offer, lc.buyer, lc.sellerX, lc.sellerY, lc.trip);
-        address recovered = ecrecover(digest, lc.v, lc.r, lc.s);
+        address recovered = _recover(digest, lc.v, lc.r, lc.s);
         if (recovered == address(0) || recovered != lc.buyer) revert InfoMarketInvalidBuyerSignature(lc.buyer, recovered);
     }
 
@@ -861,41 +1126,40 @@ contract InformationMarket {
         emit RecordExpired(buyer, seller, index, amount);
     }
 
-    /// @dev Runs the pending settlement of `robot` for at most `budget` records of work, phase by
-    /// phase: refund the expired prefix, weigh the live records, pay them; then return the rest. From
-    /// `settlementDeadline` blocks after the deposit, a settlement still refunding or weighing refunds
-    /// every live record's stake instead and returns the share to the robot.
+    /// @dev Runs the pending settlement of `robot` for at most `budget` units of work, phase by phase:
+    /// refund the expired prefix, weigh the live records, pay them; then return the rest. Weighing not
+    /// finished `settlementDeadline` blocks after the deposit stops there, and the live records are paid
+    /// equal parts instead (the delayed rule), so the robot gains nothing by a settlement left pending.
+    /// A registered caller earns `settleBounty` per unit: for refunding and weighing from the escrow
+    /// before the paid amount is fixed, for paying from each record's share.
     function _settle(address robot, uint256 budget) private returns (bool) {
         Settlement storage s = _settlements[robot];
+        uint256 rate = _settleBounty != 0 && _registered[msg.sender] ? _settleBounty : 0;
+        uint256 units = budget;
         uint64 next = s.next;
         uint64 end = s.end;
-        if (s.phase < _PAY && block.number >= uint256(s.closedAt) + _settlementDeadline) {
-            if (s.phase == _EXPIRE) s.live = next;
-            next = s.live;
-            s.phase = _REFUND;
-        }
-        if (s.phase == _EXPIRE) {
+        uint256 escrow = s.escrow;
+        uint8 phase = s.phase;
+        if (phase == _EXPIRE) {
             uint64 closedAt = s.closedAt;
-            uint256 escrow = s.escrow;
             while (next < end && budget > 0 && _expired(_records[robot][next].openedAt, closedAt)) {
                 escrow -= _refund(robot, next);
                 ++next;
                 --budget;
             }
-            s.escrow = escrow;
-            if (next < end && budget == 0) {
-                s.next = next;
-                return false;
-            }
+            if (next < end && budget == 0) return _pause(robot, next, escrow, rate * units);
             s.live = next;
-            s.amount = escrow;
-            s.phase = _scheme == Scheme.Delayed ? _PAY : _WEIGH;
-            if (_scheme == Scheme.Delayed) s.totalWeight = end - next;
+            phase = _scheme == Scheme.Delayed ? _PAY : _WEIGH;
         }
-        if (s.phase == _WEIGH) {
-            // Weighing one record compares it with every live record: it costs ceil(m / 64) units of
-            // the budget, so a batch's gas stays bounded (m <= maxRecordsPerTrip <= 512, docs/gas.md).
-            uint256 cost = (end - s.live + _PAIRS_PER_UNIT - 1) / _PAIRS_PER_UNIT;
+        if (phase == _WEIGH && block.number >= uint256(s.closedAt) + _settlementDeadline) {
+            phase = _EQUAL;
+            next = s.live;
+        }
+        if (phase == _WEIGH) {
+            // Weighing one record compares it with every live record: it costs ceil(m / pairs per unit)
+            // units of the budget, so a batch's gas stays bounded (m <= 512, docs/gas.md).
+            uint256 per = _scheme == Scheme.OutlierDistinct ? _DISTINCT_PAIRS_PER_UNIT : _PAIRS_PER_UNIT;
+            uint256 cost = (end - s.live + per - 1) / per;
             if (cost == 0) cost = 1; // no live record: nothing to weigh
             uint256 affordable = budget / cost;
             if (next < end && affordable == 0 && budget == _settleBatch) affordable = 1;
@@ -907,44 +1171,59 @@ contract InformationMarket {
                 next = stop;
             }
             if (next < end) {
-                s.next = next;
-                return false;
+                s.phase = _WEIGH;
+                return _pause(robot, next, escrow, rate * (units - budget));
             }
-            s.phase = _PAY;
+            phase = _PAY;
             next = s.live;
         }
-        uint256 escrowLeft = s.escrow;
-        if (s.phase == _REFUND) {
-            while (next < end && budget > 0) {
-                escrowLeft -= _refund(robot, next);
-                ++next;
-                --budget;
-            }
-            s.escrow = escrowLeft;
-            if (next < end) {
-                s.next = next;
-                return false;
-            }
-            return _finish(robot, escrowLeft, 0, 0);
+        uint256 bounty;
+        if (phase != s.phase) {
+            // Paying starts: the work so far is paid from the escrow, then what the live records share
+            // is fixed.
+            bounty = rate * (units - budget);
+            escrow -= bounty;
+            s.amount = escrow;
+            if (phase == _EQUAL || _scheme == Scheme.Delayed) s.totalWeight = end - s.live;
+            s.phase = phase;
         }
         uint256 amount = s.amount;
         uint256 total = s.totalWeight;
+        bool equal = phase == _EQUAL || _scheme == Scheme.Delayed;
         while (next < end && budget > 0) {
             Information storage record = _records[robot][next];
-            uint256 weight = _scheme == Scheme.Delayed ? 1 : record.weight;
+            uint256 weight = equal ? 1 : record.weight;
             uint256 share = (amount * weight) / total;
-            _balances[record.seller] += share;
-            escrowLeft -= share;
-            emit RewardShared(robot, record.seller, next, weight, share);
+            uint256 cut = rate < share ? rate : share;
+            _balances[record.seller] += share - cut;
+            escrow -= share;
+            bounty += cut;
+            emit RewardShared(robot, record.seller, next, weight, share - cut);
             ++next;
             --budget;
         }
-        s.escrow = escrowLeft;
+        _payBounty(robot, bounty);
         if (next < end) {
             s.next = next;
+            s.escrow = escrow;
             return false;
         }
-        return _finish(robot, escrowLeft, s.live < end ? amount - escrowLeft : 0, total);
+        return _finish(robot, escrow, s.live < end ? amount - escrow : 0, total);
+    }
+
+    /// @dev Stops a settlement call before paying: records where it stands and pays the bounty.
+    function _pause(address robot, uint64 next, uint256 escrow, uint256 bounty) private returns (bool) {
+        Settlement storage s = _settlements[robot];
+        s.next = next;
+        s.escrow = escrow - bounty;
+        _payBounty(robot, bounty);
+        return false;
+    }
+
+    function _payBounty(address robot, uint256 bounty) private {
+        if (bounty == 0) return;
+        _balances[msg.sender] += bounty;
+        emit SettlementBountyPaid(msg.sender, robot, bounty);
     }
 
     /// @dev Ends a settlement: what the escrow still holds goes back to the robot.
@@ -956,11 +1235,14 @@ contract InformationMarket {
         emit SettlementCompleted(robot, shared, kept, total);
         delete _settlements[robot];
         // When nothing was revealed to the robot since its deposit, its next round trip can start
-        // again at index 0 and rewrite warm slots (about 5k gas each) instead of fresh ones (22k).
+        // again at index 0 and rewrite warm slots (about 5k gas each) instead of fresh ones (22k). Not
+        // when its open round trip holds records, even all refunded: their sellers' links (`_sold`)
+        // point at their indices.
         Round storage round = _rounds[robot];
-        if (round.start == round.count) {
+        if (round.count == round.first) {
             round.start = 0;
             round.count = 0;
+            round.first = 0;
         }
         return true;
     }

@@ -118,7 +118,6 @@ def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
 
 #: circles other branches remove (the lead empties this after merging them): modules -> the branch
 KNOWN_CIRCLES = {
-    ("infomarket.chain.backends", "infomarket.chain.market"): "contract (revert_data moves to the module both use)",
 }
 
 #: function-local imports of project modules without a comment saying why, in files the pipeline branch does

@@ -49,7 +49,7 @@ def make_market(chain, robots, artifact):
         market = ChainMarket.deploy(params, backend=chain, artifact=artifact)
         wealths = wealth if isinstance(wealth, list) else [wealth] * len(robots)
         for account, amount in zip(robots, wealths):  # registers every robot, with or without wealth
-            market.grant_wealth(account.address, to_units(amount))
+            market.grant_wealth(account, to_units(amount))
         return market
 
     return make

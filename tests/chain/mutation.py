@@ -41,10 +41,10 @@ MUTANTS = [
      ["test_revealed_information_must_match"]),
     ("seller can lock the stake", "balance < stake_",
      ["test_a_seller_that_cannot_lock_the_stake"]),
-    ("caller is the market", "msg.sender != _market",
-     ["test_only_the_market_account"]),
-    ("signature s is low", "uint256(lc.s) > _HALF_ORDER",
-     ["test_a_malleated_high_s_signature"]),
+    ("caller holds the role", "!_roles[role][msg.sender]",
+     ["test_only_a_depositor", "test_only_registrars_approve", "test_the_admin_rotates"]),
+    ("signature s is low", "uint256(s) > _HALF_ORDER",
+     ["test_a_malleated_high_s_signature", "test_a_deposit_needs_the_robots"]),
     ("seller vector in range", "dx >= _MAX_COMPONENT || dx <= -_MAX_COMPONENT || dy >= _MAX_COMPONENT || dy <= -_MAX_COMPONENT",
      ["test_malformed_site_and_vector_out_of_range"]),
     ("records per seller bounded", "n >= _maxRecordsPerSeller",
@@ -53,7 +53,6 @@ MUTANTS = [
      ["test_a_light_contract_cannot_stay_open"]),
     ("previous settlement finished", "s.end != 0",
      ["test_a_pending_settlement_blocks"]),
-    # issue 22
     ("round trip below its live-record bound", "index - round.start >= _maxRecordsPerTrip",
      ["test_a_buyer_that_signs_many_offers"]),
     ("the signed round trip is the open one", "lc.trip != round.trip",
@@ -65,10 +64,23 @@ MUTANTS = [
     ("grant within its cap", "amount > _maxGrant", ["test_the_market_grants_wealth_once"]),
     ("trip bound at most 512", "maxRecordsPerTrip_ == 0 || maxRecordsPerTrip_ > _MAX_TRIP_RECORDS",
      ["test_the_trip_bound_and_the_batch_bound"]),
-    ("batch at most 64", "settleBatch_ == 0 || settleBatch_ > _MAX_SETTLE_BATCH",
+    ("batch at most 48", "settleBatch_ == 0 || settleBatch_ > _MAX_SETTLE_BATCH",
      ["test_the_trip_bound_and_the_batch_bound"]),
     ("stake expiry never off", "stakeExpiry_ == 0", ["test_the_trip_bound_and_the_batch_bound"]),
     ("settlement deadline never off", "settlementDeadline_ == 0", ["test_the_trip_bound_and_the_batch_bound"]),
+    ("registrar threshold within the registrars", "registrarThreshold_ == 0 || registrarThreshold_ > registrars_.length",
+     ["test_the_trip_bound_and_the_batch_bound"]),
+    ("registrar quota never 0", "registrarQuota_ == 0", ["test_the_trip_bound_and_the_batch_bound"]),
+    ("registrar period never 0", "registrarPeriod_ == 0", ["test_the_trip_bound_and_the_batch_bound"]),
+    ("largest bounty within the share",
+     "settleBounty_ * _MAX_SETTLEMENT_UNITS > (reward_ * informationShare_) / _WAD",
+     ["test_the_trip_bound_and_the_batch_bound"]),
+    ("not paused", "_paused", ["test_a_pause_stops"]),
+    ("a registrar approves a request once", "_approvedBy[request][msg.sender]", ["test_one_registrar_cannot"]),
+    ("a registrar within its quota", "used >= _registrarQuota", ["test_only_registrars_approve_and_each_within"]),
+    ("deposit signed by the robot", "signer == address(0) || signer != robot", ["test_a_deposit_needs_the_robots"]),
+    ("deposit acknowledged by a nest", "signer == address(0) || !_roles[NEST_ROLE][signer]",
+     ["test_a_deposit_needs_the_robots"]),
 ]
 
 #: (the rule broken, text replaced, its wrong replacement, tests that must then fail)
@@ -84,13 +96,13 @@ REWRITES = [
     ("expired records refunded at settlement", "return uint256(openedAt) + _stakeExpiry <= now_;",
      "return uint256(openedAt) + _stakeExpiry < now_;",
      ["test_a_robot_that_dies", "test_settlement_drops_expired"]),
-    # issue 22
     ("settle capped at one batch", "return _settle(robot, maxRecords < _settleBatch ? maxRecords : _settleBatch);",
      "return _settle(robot, maxRecords);", ["test_no_call_does_more_than_one_batch"]),
     ("refundExpired capped at one batch", "if (maxRecords > _settleBatch) maxRecords = _settleBatch;", "",
      ["test_no_call_does_more_than_one_batch"]),
-    ("settlement deadline refunds", "if (s.phase < _PAY && block.number >= uint256(s.closedAt) + _settlementDeadline) {",
-     "if (false) {", ["test_a_deposit_not_settled_by_its_deadline"]),
+    ("the deadline pays equal parts",
+     "if (phase == _WEIGH && block.number >= uint256(s.closedAt) + _settlementDeadline) {",
+     "if (false) {", ["test_a_deposit_not_weighed_by_its_deadline", "test_past_the_deadline"]),
     ("a seller counts once", "if (sites[j] != site || mark[rank[j]] == i + 1) continue;",
      "if (sites[j] != site || j == i) continue;",
      ["test_a_repeating_seller_gets_one_sellers_share", "test_a_copying_seller"]),
@@ -104,6 +116,21 @@ REWRITES = [
      ["test_a_second_different_sale"]),
     ("similar() range-checked", "(ax, ay) = _sellerVector(ax, ay, 0, 0);", "(ax, ay) = _nonZero(ax, ay);",
      ["test_similar_refuses_vectors_beyond"]),
+    ("indices restart only under an empty round trip", "if (round.count == round.first) {",
+     "if (round.start == round.count) {", ["test_a_refunded_record_under_a_pending_settlement"]),
+    ("registration needs the threshold", "if (count < _registrarThreshold) return false;", "",
+     ["test_one_registrar_cannot", "test_a_single_compromised_registrar"]),
+    ("a revoked role is gone", "            _roles[role][account] = false;\n", "",
+     ["test_the_admin_rotates"]),
+    ("bounty for registered robots only", "_settleBounty != 0 && _registered[msg.sender] ? _settleBounty : 0",
+     "_settleBounty", ["test_the_depositor_earns_no_bounty", "test_a_pending_settlement_blocks"]),
+    ("bounty cut from each payment", "uint256 cut = rate < share ? rate : share;", "uint256 cut = 0;",
+     ["test_a_robot_that_settles_earns_the_bounty"]),
+    ("distinct weighing costs more units",
+     "uint256 per = _scheme == Scheme.OutlierDistinct ? _DISTINCT_PAIRS_PER_UNIT : _PAIRS_PER_UNIT;",
+     "uint256 per = _PAIRS_PER_UNIT;", ["test_a_distinct_seller_weighing_costs"]),
+    ("batch bound 48", "uint256 private constant _MAX_SETTLE_BATCH = 48;",
+     "uint256 private constant _MAX_SETTLE_BATCH = 64;", ["test_the_trip_bound_and_the_batch_bound"]),
 ]
 
 
@@ -118,7 +145,7 @@ def compile_variant(source: str, workdir: Path, name: str) -> Path:
 def run_tests(artifact: Path, selected: list[str]) -> tuple[int, str]:
     """Run the chain tests whose names contain one of ``selected``; (exit code, summary line)."""
     env = dict(os.environ, INFOMARKET_CHAIN_ARTIFACT=str(artifact), INFOMARKET_CHAIN_BACKENDS="revm")
-    files = [str(TESTS / name) for name in ("test_attacks.py", "test_market.py")]
+    files = [str(TESTS / name) for name in ("test_attacks.py", "test_market.py", "attacks")]
     done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", *files,
                            "-k", " or ".join(selected)],
                           env=env, capture_output=True, text=True, cwd=ROOT)

@@ -12,7 +12,7 @@ from eth_account import Account
 from eth_account.messages import encode_typed_data
 
 from infomarket.chain.errors import ContractRevert
-from infomarket.chain.market import derived_account
+from infomarket.chain.market import ROLES, derived_account
 from infomarket.chain.protocol import (
     FOOD,
     SECP256K1_N,
@@ -87,8 +87,8 @@ def test_the_same_light_contract_cannot_be_revealed_twice(market, robots):
 
 
 def test_a_second_different_sale_with_the_same_site_age_and_max_block_is_allowed(market, robots):
-    """Finding: the uniqueness key omitted pathHash, so a second, different sale with the same
-    (site, age, maxBlock) was refused as a replay. The key now includes the committed information."""
+    """The uniqueness key includes the committed information, so a second, different sale with the same
+    (site, age, maxBlock) is not mistaken for a replay."""
     seller, buyer = robots[1], robots[0]
     lc, info = deal(market, seller, buyer)
     market.reveal(seller, lc, info)
@@ -147,12 +147,12 @@ def test_a_seller_that_cannot_lock_the_stake_is_refused(make_market, robots, wea
     assert market.contributors(buyer.address) == [] and market.locked_stake(buyer.address) == 0
 
 
-def test_only_the_market_account_may_buy_items(market, robots):
+def test_only_a_depositor_may_buy_items(market, robots):
     seller, buyer = robots[1], robots[0]
     lc, info = deal(market, seller, buyer)
     market.reveal(seller, lc, info)
-    refused(lambda: market.buy_item(buyer.address, sender=buyer), "InfoMarketUnauthorizedMarket",
-            caller=buyer.address)
+    refused(lambda: market.buy_item(buyer.address, sender=buyer), "InfoMarketUnauthorized",
+            caller=buyer.address, role=ROLES["depositor"])
     assert market.balance_of(buyer.address) == 1_000_000_000
     assert len(market.contributors(buyer.address)) == 1
 
@@ -216,9 +216,8 @@ def test_a_light_contract_cannot_stay_open_for_longer_than_max_validity(make_mar
 
 
 def test_a_saboteurs_rotated_vector_gets_the_outliers_weight_whatever_it_says(market, robots):
-    """The bypass of the old contract: a saboteur commits its vector rotated by 90 degrees but
-    declared the honest direction, and the contract weighed the declaration. Now there is nothing to
-    declare: the weight comes from the committed vector minus the buyer-signed seller position."""
+    """A saboteur commits its vector rotated by 90 degrees: there is no direction to declare, the weight
+    comes from the committed vector minus the buyer-signed seller position."""
     buyer, saboteur = robots[0], robots[4]
     # The seller stands far from the buyer, so the purchased vectors (position + rotated vector) all
     # point roughly the same way: only the seller's own vector tells the saboteur apart.
@@ -245,7 +244,7 @@ def _recover(domain, lc) -> str:
                                    vrs=(lc.v, int.from_bytes(lc.r, "big"), int.from_bytes(lc.s, "big")))
 
 
-# -- Findings of the second security review (issue 22): each test failed on the contract before it ----
+# -- Bounds, expiry, registration and one voice per seller -------------------------------------------
 
 
 def _sell(market, seller, buyer, direction=10.0, age=0, site=FOOD):
@@ -259,9 +258,9 @@ def _sell(market, seller, buyer, direction=10.0, age=0, site=FOOD):
 
 
 def test_a_buyer_that_signs_many_offers_cannot_grow_a_round_trip_past_its_bound(make_market, robots):
-    """Finding (high): the round trip had no bound, so a buyer signing thousands of offers made a deposit
-    that no transaction could settle. Now the open round trip holds at most maxRecordsPerTrip live records
-    (the declared gas bound is measured at the largest, 512) and the reveal beyond is refused."""
+    """A buyer signing thousands of offers cannot make a deposit that no transaction could settle: the open
+    round trip holds at most maxRecordsPerTrip live records (the declared gas bound is measured at the
+    largest, 512) and the reveal beyond is refused."""
     market = make_market("outlier", stake=0.04, max_records_per_trip=3)
     buyer = robots[0]
     for age, seller in enumerate(robots[1:4]):
@@ -276,12 +275,18 @@ def test_a_buyer_that_signs_many_offers_cannot_grow_a_round_trip_past_its_bound(
 
 def test_the_trip_bound_and_the_batch_bound_cannot_be_configured_away(make_market):
     for option, value, name in (("max_records_per_trip", 513, "maxRecordsPerTrip"),
-                                ("settle_batch", 65, "settleBatch"), ("stake_expiry", 0, "stakeExpiry"),
-                                ("settlement_deadline", 0, "settlementDeadline")):
+                                ("settle_batch", 49, "settleBatch"), ("stake_expiry", 0, "stakeExpiry"),
+                                ("settlement_deadline", 0, "settlementDeadline"),
+                                ("registrar_threshold", 4, "registrarThreshold"),  # of 3 registrars
+                                ("registrar_quota", 0, "registrarQuota"), ("registrar_period", 0, "registrarPeriod"),
+                                # 512 * 15 units of the largest settlement at 65_105 units exceed the
+                                # 500_000_000 units of the share; 65_104 fit
+                                ("settle_bounty", 65_105, "settleBounty")):
         with pytest.raises(ContractRevert) as info:
             make_market("outlier", **{option: value})
         assert info.value.name == "InfoMarketInvalidParameter"
         assert info.value.args_by_name == {"parameter": name.encode().ljust(32, b"\0"), "value": value}
+    make_market("outlier", settle_bounty=65_104, wealth=0.0)
 
 
 def test_no_call_does_more_than_one_batch_of_work_whatever_it_asks(make_market, robots):
@@ -301,32 +306,35 @@ def test_no_call_does_more_than_one_batch_of_work_whatever_it_asks(make_market, 
     assert len(market.refund_expired(buyer.address, 2**200).of("RecordExpired")) == 2
 
 
-def test_a_deposit_not_settled_by_its_deadline_returns_the_stakes_and_the_share(make_market, robots):
-    """Finding (high): stakes of a trip that could not be settled were locked for ever. From
-    settlementDeadline blocks after the deposit, settling refunds every live stake to its seller and the
-    share to the robot, in bounded calls."""
+def test_a_deposit_not_weighed_by_its_deadline_pays_every_live_record_equally(make_market, robots):
+    """Stakes of a round trip that no one settles are never locked for ever, and the buyer gains nothing
+    by leaving it: from settlementDeadline blocks after the deposit, weighing stops and every live
+    record is paid an equal part of the share plus the stakes (the delayed rule), in bounded calls. By
+    hand: 3 sellers at 10, 15 and 20 degrees and one outlier at 100; (0.5 + 4 * 0.04) / 4 = 0.165 token
+    each, where the weighted rule would pay the outlier 1/10 of 0.66."""
     market = make_market("outlier", stake=0.04, settle_batch=1, settlement_deadline=3)
     buyer = robots[0]
-    for age, seller in enumerate(robots[1:4]):
-        _sell(market, seller, buyer, age=age)
+    for age, (seller, direction) in enumerate(zip(robots[1:5], (10.0, 15.0, 20.0, 100.0))):
+        _sell(market, seller, buyer, direction, age=age)
     market.buy_item(buyer.address)  # one unit of work: the settlement stays pending
     market.backend.advance_to(market.backend.block_number + 3)
     results = []
     while market.pending_settlement(buyer.address)[0]:
         results.append(market.settle(buyer.address, 1))
-    refunds = [e for r in results for e in r.of("RecordExpired")]
-    assert [(e["seller"], e["amount"]) for e in refunds] == [(s.address, 40_000_000) for s in robots[1:4]]
+    shares = [e for r in results for e in r.of("RewardShared")]
+    assert [(e["seller"], e["weight"], e["amount"]) for e in shares] == [(s.address, 1, 165_000_000)
+                                                                         for s in robots[1:5]]
     (done,) = results[-1].of("SettlementCompleted")
-    assert done == {"robot": buyer.address, "shared": 0, "kept": 500_000_000, "totalWeight": 0}
-    for seller in robots[1:4]:
-        assert market.balance_of(seller.address) == 1_000_000_000
-    assert market.balance_of(buyer.address) == 2_000_000_000
+    assert done == {"robot": buyer.address, "shared": 660_000_000, "kept": 0, "totalWeight": 4}
+    for seller in robots[1:5]:
+        assert market.balance_of(seller.address) == 1_000_000_000 - 40_000_000 + 165_000_000
+    assert market.balance_of(buyer.address) == 1_500_000_000
     assert market.locked_stake(buyer.address) == 0
 
 
 def test_an_unregistered_account_can_neither_sell_nor_be_paid_a_reward(make_market, robots):
-    """Finding (medium): a fresh zero-balance address could sell (under delayed payment no stake is
-    needed) and the market could pay a reward to any address. Only registered robots take part."""
+    """A fresh zero-balance address cannot sell (under delayed payment no stake is needed) nor be paid a
+    reward: only registered robots take part."""
     market = make_market("delayed", stake=0.0)
     sybil, buyer = derived_account("sybil", 0), robots[0]
     market.backend.fund([sybil.address])
@@ -340,7 +348,7 @@ def test_an_unregistered_account_can_neither_sell_nor_be_paid_a_reward(make_mark
 
 
 def test_the_market_grants_wealth_once_per_robot_and_within_its_cap(make_market, robots):
-    """Finding: the market account could mint without limit."""
+    """The registrars cannot mint without limit: once per robot, within maxGrant."""
     market = make_market("outlier", stake=0.04, max_grant=5.0)
     supply = market.total_supply()
     refused(lambda: market.grant_wealth(robots[0].address, 1), "InfoMarketAlreadyRegistered",
@@ -353,8 +361,8 @@ def test_the_market_grants_wealth_once_per_robot_and_within_its_cap(make_market,
 
 
 def test_a_repeating_seller_gets_one_sellers_share_under_outlier_distinct(make_market, robots):
-    """Finding (medium): a saboteur selling one 90-degree-rotated vector 5 times took 25/34 = 73.5 % of
-    the share against three honest sellers. Under outlier_distinct it counts once: 1/10."""
+    """A saboteur selling one 90-degree-rotated vector 5 times takes 25/34 = 73.5 % of the share against
+    three honest sellers under outlier; under outlier_distinct it counts once: 1/10."""
     market = make_market("outlier_distinct", stake=0.0)
     buyer, saboteur = robots[0], robots[4]
     for age, (seller, d) in enumerate(zip(robots[1:4], (10.0, 15.0, 20.0))):
@@ -385,8 +393,8 @@ def test_a_copying_seller_gets_no_more_than_one_honest_sellers_share(make_market
 
 
 def test_a_reveal_after_the_buyers_deposit_is_refused(make_market, robots):
-    """Finding (low): a seller could hold a signed contract and reveal it after the buyer's deposit,
-    choosing its trip; it was then paid from the next item. The buyer now signs its round trip."""
+    """A seller cannot hold a signed contract and reveal it after the buyer's deposit, to be paid from
+    the next item: the buyer signs its round trip."""
     market = make_market("outlier", stake=0.04)
     seller, buyer = robots[1], robots[0]
     lc, info = deal(market, seller, buyer)
@@ -397,7 +405,7 @@ def test_a_reveal_after_the_buyers_deposit_is_refused(make_market, robots):
 
 
 def test_similar_refuses_vectors_beyond_the_exact_range(make_market):
-    """Finding: similar() overflowed for components beyond the reveal path's range."""
+    """similar() refuses components beyond the reveal path's range instead of overflowing."""
     market = make_market("outlier", stake=0.0)
     for args, (dx, dy) in (((2**62, 1, 1, 1), (2**62, 1)), ((1, 1, -(2**62), 1), (-(2**62), 1))):
         with pytest.raises(ContractRevert) as info:
@@ -407,8 +415,8 @@ def test_similar_refuses_vectors_beyond_the_exact_range(make_market):
 
 
 def test_the_client_needs_the_seller_position_and_caps_its_acceptances(make_market, robots):
-    """Finding: light_contract defaulted seller_position to (0, 0), which reopens the rotated-vector
-    bypass; and the client signed any number of offers."""
+    """light_contract has no default seller_position ((0, 0) would reopen the rotated-vector bypass), and
+    the client signs a bounded number of offers."""
     import inspect
 
     from infomarket.chain.market import ChainMarket

@@ -68,7 +68,7 @@ def test_the_deposit_rule_interpolates_and_stops_at_the_bound():
 def test_the_report_prints_the_constants_it_was_rendered_from():
     rows = [GasRow(s, n, 100_000.0 + n + k, 150_000, 9, 10 * n + k, 1, 9)
             for k, s in ((0, "delayed"), (7, "outlier + staking")) for n in (1, 16)]
-    text = render(rows, [WorstCall("outlier", 512, 1, 2, 3)])
+    text = render(rows, [WorstCall("outlier", 512, 512, 1, 2, 3, 4, 5)])
     assert parse(text) == rows
     assert constants(parse(text)) == "\n".join([
         "GAS_REVEAL = {", '    "delayed": 100_016,', '    "outlier + staking": 100_023,', "}",

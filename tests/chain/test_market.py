@@ -155,7 +155,11 @@ def test_a_pending_settlement_blocks_the_next_deposit_until_settled(make_market,
     sell(market, robots[3], buyer, age=7)  # the buyer may buy again meanwhile: a new round trip
     while market.pending_settlement(buyer.address)[0]:
         market.settle(buyer.address, 1, sender=robots[5])  # anyone may push the settlement on
-    assert market.balance_of(robots[1].address) == market.balance_of(robots[2].address) == 1_250_000_000
+    # buyItem (the depositor, no bounty) paid robot 1 a half share; robot 5 paid robot 2 and earned the
+    # bounty, 500_000_000 // 50_000 units per unit of work, out of robot 2's share.
+    assert market.balance_of(robots[1].address) == 1_250_000_000
+    assert market.balance_of(robots[2].address) == 1_250_000_000 - 10_000
+    assert market.balance_of(robots[5].address) == 1_000_000_000 + 10_000
     assert [r[0] for r in market.contributors(buyer.address)] == [robots[3].address]
     with pytest.raises(ContractRevert) as refused:
         market.settle(buyer.address, 1)

@@ -39,9 +39,10 @@ class Twin:
             backend.fund([a.address for a in everyone])
         artifact = load_artifact()
         ctor = next(e for e in artifact["abi"] if e["type"] == "constructor")
-        params = MarketParams.from_floats(scheme, stake=stake, **options)
+        # the owner is every role's one key: one approval registers a robot
+        params = MarketParams.from_floats(scheme, stake=stake, registrars=1, registrar_threshold=1, **options)
         code = bytes.fromhex(artifact["bytecode"].removeprefix("0x")) + abi_encode(
-            get_abi_input_types(ctor), list(params.constructor_args(owner.address)))
+            get_abi_input_types(ctor), list(params.constructor_args(owner.address, [owner.address], owner.address)))
         #: (what, gas on py-evm, gas on revm) of every transaction, in order
         self.gas: list[tuple[str, int, int]] = []
         self._align()
@@ -49,7 +50,9 @@ class Twin:
                                                                     for b in (self.ref, self.fast))
         assert ref_address == fast_address  # same deployer, same nonce: the light contracts sign alike
         self.gas.append(("deploy", ref_receipt.gas_used, fast_receipt.gas_used))
-        self.markets = [ChainMarket(b, ref_address, owner, artifact["abi"]) for b in (self.ref, self.fast)]
+        self.owner = owner
+        self.markets = [ChainMarket(b, ref_address, owner, artifact["abi"], registrars=[owner], nest=owner)
+                        for b in (self.ref, self.fast)]
         for account, amount in zip(self.sellers + self.buyers, wealth):
             self.tx("grantWealth", None, account.address, to_units(amount))
 
@@ -85,9 +88,13 @@ class Twin:
 
     def deposit(self, buyer, label: str) -> None:
         """buyItem, then settle until the round trip is settled (on py-evm's word, checked on revm's)."""
-        self.tx("buyItem", None, buyer.address, label=f"buyItem {label}")
+        self.tx("buyItem", None, buyer.address, self.evidence(buyer), label=f"buyItem {label}")
         while self.markets[0].pending_settlement(buyer.address)[0]:
             self.tx("settle", None, buyer.address, 48, label=f"settle {label}")
+
+    def evidence(self, robot) -> tuple:
+        """The deposit's signatures (robot and nest), made once and sent to both chains."""
+        return self.markets[0].deposit_evidence(robot, self.owner, self.markets[0].round_trip(robot.address))
 
     def advance(self, blocks: int) -> None:
         self.ref.advance_to(self.ref.block_number + blocks)
@@ -154,7 +161,7 @@ def test_a_large_round_trip_settles_at_the_same_gas_on_revm():
 
 def test_expired_stakes_and_a_missed_settlement_deadline_refund_at_the_same_gas_on_revm():
     """refundExpired after the stake expiry, and settle calls after the settlement deadline (which
-    refund the stakes instead of weighing), in small batches."""
+    pay every live record an equal part instead of weighing), in small batches."""
     twin = Twin("refunds", "outlier", 0.04, [1.0] * SELLERS + [0.0, 0.0], stake_expiry=4, settle_batch=2,
                 settlement_deadline=3)
     buyer, other = twin.buyers
@@ -165,7 +172,7 @@ def test_expired_stakes_and_a_missed_settlement_deadline_refund_at_the_same_gas_
     twin.tx("refundExpired", None, buyer.address, 2, label="refundExpired")
     for k in range(4):
         twin.sell(twin.sellers[k], other, 10 + k)
-    twin.tx("buyItem", None, other.address, label="buyItem")
+    twin.tx("buyItem", None, other.address, twin.evidence(other), label="buyItem")
     twin.advance(3)
     while twin.markets[0].pending_settlement(other.address)[0]:
         twin.tx("settle", None, other.address, 2, label="settle after the deadline")

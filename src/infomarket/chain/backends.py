@@ -31,8 +31,9 @@ database writes are logged once ``snapshot`` is first called, so that ``revert``
 ``tests/chain/test_revm_gas.py`` sends the same transactions to both backends and finds the same gas
 for each. The block's coinbase stays in the journal, as it is warm for every transaction (EIP-3651).
 
-Both raise ``ContractRevert`` (with the custom error's name and arguments) through
-``market.decode_revert``, and both return a ``Receipt`` whose logs are raw (address, topics, data).
+Both raise ``RevertedCall`` with the raw revert bytes (the market decodes them into ``ContractRevert``,
+the custom error's name and arguments), and both return a ``Receipt`` whose logs are raw (address,
+topics, data).
 """
 from __future__ import annotations
 
@@ -41,7 +42,7 @@ from typing import NamedTuple
 
 from eth_utils import keccak, to_checksum_address
 
-from .errors import ChainError
+from .errors import ChainError, revert_data
 
 #: Gas money given to every robot and to the market account (wei); far above what a demo spends.
 GAS_ALLOWANCE_WEI = 10**20
@@ -121,8 +122,6 @@ class Web3Backend:
             self.w3.eth.wait_for_transaction_receipt(h)
 
     def call(self, sender: str, to: str, data: bytes, static: bool = False) -> bytes:
-        from .market import revert_data
-
         try:
             return bytes(self.w3.eth.call({"from": sender, "to": to, "data": data, "gas": self.gas_limit}, "pending"))
         except Exception as exc:  # noqa: BLE001 - anything that is not a revert is re-raised as it came
@@ -150,8 +149,6 @@ class Web3Backend:
         return Receipt(receipt.gasUsed, receipt.blockNumber, logs)
 
     def deploy(self, sender, code: bytes) -> tuple[str, Receipt]:
-        from .market import revert_data
-
         try:
             self.w3.eth.call({"from": sender.address, "data": code, "gas": self.gas_limit}, "pending")
         except Exception as exc:  # noqa: BLE001
@@ -170,15 +167,59 @@ class Web3Backend:
 
 
 _REVERT_OUTPUT = re.compile(r"output: 0x([0-9a-fA-F]*)")
+#: The pyrevm whose journal print ``journal_accounts`` reads.
+PYREVM_VERSION = "0.3.7"
 #: In pyrevm's ``journal_str`` (revm's Debug print of the journaled state): what follows an account's
 #: address in the state map, its info, and one storage slot with the value it was loaded with and the
 #: value it holds now. (The print holds the contract's code too: found with str.find, not a regex scan.)
+_STATE = "JournaledState { state: {"
 _ACCOUNT = ": Account { info: AccountInfo { balance: "
 _INFO = re.compile(r"(\d+), nonce: (\d+), code_hash: 0x([0-9a-f]{64})")
 _SLOT = re.compile(r"[{ ](\d+): StorageSlot \{ previous_or_original_value: (\d+), present_value: (\d+) \}")
 _EMPTY_CODE_HASH = keccak(b"")
 #: (balance, nonce, code hash) of an account that was never written
 _NO_ACCOUNT = (0, 0, _EMPTY_CODE_HASH)
+
+
+class JournalAccount(NamedTuple):
+    """One account of revm's journaled state: its (balance, nonce, code hash) and every storage slot
+    the transaction loaded, as (key, value it was loaded with, value now)."""
+
+    address: str
+    info: tuple[int, int, bytes]
+    slots: list[tuple[int, int, int]]
+
+
+def journal_accounts(text: str) -> list[JournalAccount]:
+    """The accounts in pyrevm's ``journal_str``, revm's Debug print of its journaled state: the only
+    place that reads the print (pyrevm has no call that returns a transaction's changes), so a pyrevm
+    whose print differs stops here with an error rather than losing a write."""
+    end = text.find(", transient_storage: ")
+    if not text.startswith(_STATE) or end < 0:
+        raise ChainError(f"revm: unexpected journal print {text[:80]!r} (is pyrevm newer than {PYREVM_VERSION}?)")
+    if text.find("SelfDestructed", 0, end) >= 0:  # the market's contract never self-destructs
+        raise ChainError("revm backend: a transaction that self-destructs an account is not supported")
+    accounts = []
+    at = text.find(_ACCOUNT, 0, end)
+    while at >= 0:
+        address = text[at - 42:at]
+        found = _INFO.match(text, at + len(_ACCOUNT))
+        begin = text.find("storage: {", found.end()) if found else -1
+        stop = text.find(", status: AccountStatus", begin) if begin >= 0 else -1
+        if not address.startswith("0x") or stop < 0:
+            raise ChainError(f"revm: unexpected journal print at {text[at - 42:at + 80]!r} (is pyrevm newer "
+                             f"than {PYREVM_VERSION}?)")
+        info = (int(found.group(1)), int(found.group(2)), bytes.fromhex(found.group(3)))
+        storage = text[begin + len("storage: ") - 1:stop]
+        slots = [(int(m.group(1)), int(m.group(2)), int(m.group(3))) for m in _SLOT.finditer(storage)]
+        if _SLOT.sub("", storage).strip("{}, "):  # something in the map that is not a slot as printed
+            raise ChainError(f"revm: unexpected storage slot print in {storage[:160]!r} (is pyrevm newer than "
+                             f"{PYREVM_VERSION}?)")
+        accounts.append(JournalAccount(address, info, slots))
+        at = text.find(_ACCOUNT, stop, end)
+    if len(accounts) != text.count("Account { info:", 0, end) or (not accounts and text[len(_STATE)] != "}"):
+        raise ChainError(f"revm: unexpected account print in {text[:160]!r} (is pyrevm newer than {PYREVM_VERSION}?)")
+    return accounts
 
 
 class RevmBackend:
@@ -302,31 +343,16 @@ class RevmBackend:
         return out
 
     def _changes(self) -> tuple[dict, list]:
-        """What the transaction just executed changed, read from the journaled state (which holds
-        only what it loaded): accounts whose (balance, nonce, code hash) differ from the database's,
-        and slots whose present value differs from the value they were loaded with."""
-        text = self.evm.journal_str
-        end = text.index(", transient_storage: ")
-        if text.find("SelfDestructed", 0, end) >= 0:  # the market's contract never self-destructs
-            raise ChainError("revm backend: a transaction that self-destructs an account is not supported")
+        """What the transaction just executed changed: accounts whose (balance, nonce, code hash)
+        differ from the database's, and slots whose present value differs from the value they were
+        loaded with."""
         infos, slots = {}, []
-        at = text.find(_ACCOUNT, 0, end)
-        while at >= 0:
-            address = text[at - 42:at]
-            found = _INFO.match(text, at + len(_ACCOUNT))
-            if not address.startswith("0x") or found is None:
-                raise ChainError("revm: unexpected journal print (is pyrevm newer than 0.3.7?)")
-            info = (int(found.group(1)), int(found.group(2)), bytes.fromhex(found.group(3)))
+        for address, info, loaded in journal_accounts(self.evm.journal_str):
             old = self._accounts.get(address, _NO_ACCOUNT)
             if info != old:
                 code = self._deployed_code(address, info[2]) if info[2] != old[2] else None
                 infos[address] = (info, code)
-            begin = text.index("storage: {", found.end())
-            stop = text.index(", status: AccountStatus", begin)
-            for slot in _SLOT.finditer(text, begin, stop):
-                if slot.group(2) != slot.group(3):
-                    slots.append((address, int(slot.group(1)), int(slot.group(3)), int(slot.group(2))))
-            at = text.find(_ACCOUNT, stop, end)
+            slots += [(address, key, now, was) for key, was, now in loaded if was != now]
         return infos, slots
 
     def _deployed_code(self, address: str, code_hash: bytes) -> bytes:

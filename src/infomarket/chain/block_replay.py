@@ -129,7 +129,7 @@ def replay_blocks(blocks, purchase_of: dict, config, *, seed: int = 0, backend: 
     chain.fund([a.address for a in accounts])
     wealth = to_units(config.payment.initial_wealth)
     for a in accounts:
-        market.grant_wealth(a.address, wealth)
+        market.grant_wealth(a, wealth)
     base = chain.block_number + 1
     report = BlockReplayReport(robots, backend=chain.name, cold_storage=chain.cold_storage)
     bound = [0] * robots

@@ -5,6 +5,7 @@ tests check *which* rule refused and with what values, not a message string.
 """
 from __future__ import annotations
 
+import ast
 from typing import Any
 
 from ..errors import InfomarketError
@@ -31,3 +32,44 @@ class ContractRevert(ChainError):
 
 def _show(value: Any) -> str:
     return "0x" + value.hex() if isinstance(value, bytes) else str(value)
+
+
+def revert_data(exc: BaseException) -> bytes | None:
+    """The raw revert bytes, wherever the backend put them.
+
+    A JSON-RPC node's answer reaches us as web3's ``ContractCustomError``/``ContractLogicError`` with a
+    hex ``data`` (Hardhat Network nests it: ``{"message": ..., "data": "0x..."}``). eth-tester raises ``TransactionFailed`` whose message is the bytes' repr, and web3
+    re-raises it with a message of its own (sometimes a string it guessed out of the bytes), so the
+    repr is looked for along the exception's cause/context chain.
+    """
+    pending: list[BaseException | None] = [exc]
+    seen: set[int] = set()
+    while pending:
+        e = pending.pop(0)
+        if e is None or id(e) in seen:
+            continue
+        seen.add(id(e))
+        data = getattr(e, "data", None)
+        if isinstance(data, dict):  # Hardhat Network: {"message": ..., "data": "0x..."}
+            data = data.get("data")
+        if isinstance(data, str) and data.startswith("0x"):
+            return bytes.fromhex(data[2:])
+        first = e.args[0] if e.args else None
+        if isinstance(first, str):
+            first = _bytes_literal(first.removeprefix("execution reverted: "))
+        if isinstance(first, bytes):
+            return first
+        if isinstance(first, BaseException):
+            pending.append(first)
+        pending += [e.__cause__, e.__context__]
+    return None
+
+
+def _bytes_literal(text: str) -> bytes | None:
+    if text[:2] not in ("b'", 'b"'):
+        return None
+    try:
+        value = ast.literal_eval(text)
+    except (ValueError, SyntaxError):
+        return None
+    return value if isinstance(value, bytes) else None

@@ -137,7 +137,7 @@ def replay_on_chain(events: Iterable[Mapping] | object, *, robots: int, params: 
     chain.fund([a.address for a in accounts])
     wealth = to_units(initial_wealth)
     for a in accounts:
-        market.grant_wealth(a.address, wealth)  # registers every robot, with or without wealth
+        market.grant_wealth(a, wealth)  # registers every robot, with or without wealth
     base = chain.block_number + 1
     chain.advance_to(base)
 

@@ -1,7 +1,9 @@
 """A deployed ``InformationMarket`` and the accounts that use it.
 
-Every robot is an account with its own secp256k1 key; the market node is one more account, the only
-one allowed to grant wealth and buy items. Where the contract runs is a backend (backends.py): revm
+Every robot is an account with its own secp256k1 key. The market node is one more account (admin,
+depositor and pauser); registrars approve registrations, a nest acknowledges deposits (docs/chain.md,
+"Trust model"); the client holds all their keys, as a simulation's single operator does. Where the
+contract runs is a backend (backends.py): revm
 in process (the default, fast), py-evm in process (the reference EVM), or a JSON-RPC node.
 ``ChainMarket`` only encodes calls with the contract's ABI, hands them to the backend and decodes what
 comes back, so the same client and the same tests run on every backend.
@@ -11,7 +13,6 @@ backend.
 """
 from __future__ import annotations
 
-import ast
 import json
 import math
 from dataclasses import dataclass
@@ -30,34 +31,47 @@ from ..errors import ConfigError
 from ..payments import default_theta
 from .backends import Receipt, RevertedCall, make_backend
 from .errors import ChainError, ContractRevert
-from .protocol import Domain, LightContract, Offer, PathInfo, ProtocolError, accept_offer, sign_offer
+from .protocol import Domain, LightContract, Offer, PathInfo, ProtocolError, accept_offer, sign_deposit, sign_offer
 from .units import COS_SCALE, share_to_wad, to_units
 
 SCHEMES = {"delayed": 0, "outlier": 1, "outlier_distinct": 2}
-#: Most records one seller may sell one buyer per round trip: far above what a paper run reaches
-#: (82 at most in a 25-robot, 15 000-step run), low enough that no seller can crowd out the rest.
-DEFAULT_MAX_RECORDS_PER_SELLER = 256
-#: Most live records one round trip may hold (the contract's hard bound is 512): a 25-robot,
-#: 15 000-step paper run reaches 197. The declared gas bound is measured at this size.
+#: The contract's roles (docs/chain.md, "Trust model"), by name.
+ROLES = {"admin": bytes(32), **{name: keccak(text=f"{name.upper()}_ROLE")
+                                for name in ("registrar", "depositor", "nest", "pauser")}}
+#: Most records one seller may sell one buyer per round trip: above what the paper's runs reach
+#: (docs/chain.md), well below the round trip's bound, so that it takes ceil(512 / 96) = 6 sellers to
+#: fill a round trip.
+DEFAULT_MAX_RECORDS_PER_SELLER = 96
+#: Most live records one round trip may hold (the contract's hard bound, at which the declared gas
+#: bound is measured).
 DEFAULT_MAX_RECORDS_PER_TRIP = 512
-#: Most offers a buyer's client accepts (signs) per round trip. Above the contract's live-record bound
-#: because an accepted offer whose seller cannot lock the stake never lands: a paper run's buyer signs
-#: up to 1 495 per round trip, 197 of which land.
+#: Most offers a buyer's client accepts (signs) per round trip, and per seller in it: 8 times the
+#: contract's bounds, because an accepted offer whose seller cannot lock the stake never lands.
 DEFAULT_MAX_ACCEPTANCES_PER_TRIP = 8 * DEFAULT_MAX_RECORDS_PER_TRIP
+DEFAULT_MAX_ACCEPTANCES_PER_SELLER = 8 * DEFAULT_MAX_RECORDS_PER_SELLER
 #: Furthest a light contract's last block may lie ahead of its reveal.
 DEFAULT_MAX_VALIDITY = 256
 #: Blocks after which an undeposited record's stake goes back to its seller (on by default; the
 #: contract refuses 0): about 17 hours of 12-second blocks.
 DEFAULT_STAKE_EXPIRY = 5_000
-#: Blocks after a deposit from which an unfinished settlement refunds the stakes instead of weighing.
+#: Blocks after a deposit from which unfinished weighing stops and the live records are paid equally.
 DEFAULT_SETTLEMENT_DEADLINE = 1_000
-#: Most initial wealth the market may grant one robot, 1e-9 units (1 000 tokens).
+#: Most initial wealth the registrars may grant one robot, 1e-9 units (1 000 tokens).
 DEFAULT_MAX_GRANT = 1_000 * 10**9
-#: Work units of one ``buyItem``/``settle``/``refundExpired`` call (the contract caps it at 64).
+#: Work units of one ``buyItem``/``settle``/``refundExpired`` call (the contract's maximum).
 DEFAULT_SETTLE_BATCH = 48
 SETTLE_BATCH = 48
-#: The most gas any one call of the contract may take, measured with cold storage (py-evm) at the
-#: largest round trip (512 live records, every pair similar), docs/gas.md; tests check it.
+#: The registration policy: registrar keys, approvals that register a robot, and how many robots one
+#: registrar may approve per period of blocks (a swarm of 25 registers well within one period).
+DEFAULT_REGISTRARS = 3
+DEFAULT_REGISTRAR_THRESHOLD = 2
+DEFAULT_REGISTRAR_QUOTA = 32
+DEFAULT_REGISTRAR_PERIOD = 5_000
+#: The settlement bounty per unit of work is the reward's share divided by this: the bounty of the
+#: largest settlement (512 records, 7 680 units) is at most 15 % of the share.
+SETTLE_BOUNTY_DIVISOR = 50_000
+#: The most gas any one call of the contract may take, measured with cold storage at the largest round
+#: trip (512 live records of 512 distinct sellers, every pair similar, every scheme), docs/gas.md.
 DECLARED_MAX_TX_GAS = 6_000_000
 
 
@@ -90,6 +104,19 @@ class MarketParams:
     settle_batch: int = DEFAULT_SETTLE_BATCH
     settlement_deadline: int = DEFAULT_SETTLEMENT_DEADLINE
     max_grant: int = DEFAULT_MAX_GRANT
+    registrars: int = DEFAULT_REGISTRARS
+    registrar_threshold: int = DEFAULT_REGISTRAR_THRESHOLD
+    registrar_quota: int = DEFAULT_REGISTRAR_QUOTA
+    registrar_period: int = DEFAULT_REGISTRAR_PERIOD
+    #: per unit of settlement work, 1e-9 units; None: the share over ``SETTLE_BOUNTY_DIVISOR``
+    settle_bounty: int | None = None
+
+    @property
+    def bounty(self) -> int:
+        """The settlement bounty per unit of work, 1e-9 units."""
+        if self.settle_bounty is not None:
+            return self.settle_bounty
+        return self.reward * self.information_share // 10**18 // SETTLE_BOUNTY_DIVISOR
 
     @classmethod
     def from_floats(cls, scheme: str, *, reward: float = 1.0, information_share: float = 0.5,
@@ -98,19 +125,20 @@ class MarketParams:
                     max_records_per_trip: int = DEFAULT_MAX_RECORDS_PER_TRIP,
                     max_validity: int = DEFAULT_MAX_VALIDITY, settle_batch: int = DEFAULT_SETTLE_BATCH,
                     settlement_deadline: int = DEFAULT_SETTLEMENT_DEADLINE,
-                    max_grant: float | None = None) -> MarketParams:
+                    max_grant: float | None = None, **policy) -> MarketParams:
         if scheme not in SCHEMES:
             raise ConfigError(f"scheme must be one of {sorted(SCHEMES)}, not {scheme!r}")
         theta = default_theta() if theta_deg is None else theta_deg  # the outlier rule's own default
         grant = DEFAULT_MAX_GRANT if max_grant is None else to_units(max_grant)
         return cls(scheme, to_units(reward), share_to_wad(information_share), to_units(stake),
                    cos_theta(theta), stake_expiry, max_records_per_seller, max_records_per_trip, max_validity,
-                   settle_batch, settlement_deadline, grant)
+                   settle_batch, settlement_deadline, grant, **policy)
 
-    def constructor_args(self, market: str) -> tuple:
+    def constructor_args(self, market: str, registrars: list[str], nest: str) -> tuple:
         return (market, SCHEMES[self.scheme], self.reward, self.information_share, self.stake,
                 self.cos_theta, self.stake_expiry, self.max_records_per_seller, self.max_records_per_trip,
-                self.max_validity, self.settle_batch, self.settlement_deadline, self.max_grant)
+                self.max_validity, self.settle_batch, self.settlement_deadline, self.max_grant, registrars,
+                self.registrar_threshold, self.registrar_quota, self.registrar_period, nest, self.bounty)
 
 
 class Event(NamedTuple):
@@ -189,58 +217,117 @@ def _checksum(value):
     return to_checksum_address(value) if isinstance(value, str) and value.startswith("0x") and len(value) == 42 else value
 
 
-class ChainMarket:
-    """One deployed market and the account of its market node."""
+Robot = LocalAccount | str
 
-    def __init__(self, backend, address: str, market: LocalAccount, abi: list | None = None,
-                 max_acceptances_per_trip: int = DEFAULT_MAX_ACCEPTANCES_PER_TRIP):
+
+class ChainMarket:
+    """One deployed market, the keys of its market node, registrars and nest, and the robots' clients."""
+
+    def __init__(self, backend, address: str, market: LocalAccount, abi: list | None = None, *,
+                 registrars: list[LocalAccount] = (), threshold: int = 1, nest: LocalAccount | None = None,
+                 max_acceptances_per_trip: int = DEFAULT_MAX_ACCEPTANCES_PER_TRIP,
+                 max_acceptances_per_seller: int = DEFAULT_MAX_ACCEPTANCES_PER_SELLER):
         self.backend = backend
         self.market = market
+        self.registrars = list(registrars) or [market]
+        self.threshold = threshold
+        self.nest = nest or market
         self.address = to_checksum_address(address)
         self.codec = _Codec(abi or load_artifact()["abi"])
-        #: the buyers' clients: acceptances signed per (buyer, round trip), capped
+        #: the buyers' clients: acceptances signed per (buyer, round trip) and per (buyer, seller, round
+        #: trip), capped
         self.max_acceptances_per_trip = max_acceptances_per_trip
+        self.max_acceptances_per_seller = max_acceptances_per_seller
         self._accepted: dict[str, tuple[int, int]] = {}
+        self._accepted_from: dict[tuple[str, str], tuple[int, int]] = {}
+        #: robots' keys, to sign their deposits (every account this client has seen)
+        self._keys: dict[str, LocalAccount] = {}
 
     @classmethod
     def deploy(cls, params: MarketParams, *, backend=None, market: LocalAccount | None = None,
                artifact: dict | None = None, seed: int = 0) -> ChainMarket:
-        """Deploy a fresh market from ``market`` (funded with gas money first)."""
+        """Deploy a fresh market from ``market``, with ``params.registrars`` registrar keys and a nest
+        key derived from ``seed`` (all funded with gas money first)."""
         backend = backend or connect()
         artifact = artifact or load_artifact()
         market = market or derived_account("market", 0, seed)
-        backend.fund([market.address])
+        registrars = [derived_account("registrar", i, seed) for i in range(params.registrars)]
+        nest = derived_account("nest", 0, seed)
+        backend.fund([market.address, nest.address] + [r.address for r in registrars])
         codec = _Codec(artifact["abi"])
         ctor = next(e for e in artifact["abi"] if e["type"] == "constructor")
-        code = bytes.fromhex(artifact["bytecode"].removeprefix("0x")) + abi_encode(
-            get_abi_input_types(ctor), list(params.constructor_args(market.address)))
+        args = params.constructor_args(market.address, [r.address for r in registrars], nest.address)
+        code = bytes.fromhex(artifact["bytecode"].removeprefix("0x")) + abi_encode(get_abi_input_types(ctor), list(args))
         try:
             address, _ = backend.deploy(market, code)
         except RevertedCall as exc:
             raise codec.refusal(exc.data) or exc from exc
-        return cls(backend, address, market, artifact["abi"])
+        return cls(backend, address, market, artifact["abi"], registrars=registrars,
+                   threshold=params.registrar_threshold, nest=nest,
+                   max_acceptances_per_seller=8 * params.max_records_per_seller)
 
     # -- transactions -------------------------------------------------------------------------------
 
-    def grant_wealth(self, robot: str, amount: int) -> TxResult:
-        """Market mints ``amount`` units to ``robot`` (initial wealth)."""
-        return self.transact(self.market, "grantWealth", robot, amount)
+    def grant_wealth(self, robot: Robot, amount: int) -> TxResult:
+        """Register ``robot`` with ``amount`` units of initial wealth: the first ``threshold``
+        registrars approve it; the last approval's result (which registers it) is returned."""
+        address = self._remember(robot)
+        results = [self.approve(registrar, address, amount) for registrar in self.registrars[:self.threshold]]
+        return results[-1]
 
-    def buy_item(self, robot: str, sender: LocalAccount | None = None) -> TxResult:
-        """Market buys ``robot``'s deposited item and settles what fits in one batch (``sender`` only
-        to test who may call it)."""
-        return self.transact(sender or self.market, "buyItem", robot)
+    def approve(self, registrar: LocalAccount, robot: str, amount: int) -> TxResult:
+        """One registrar's approval of registering ``robot`` with ``amount``."""
+        return self.transact(registrar, "grantWealth", robot, amount)
+
+    def buy_item(self, robot: Robot, sender: LocalAccount | None = None, evidence: tuple | None = None) -> TxResult:
+        """The depositor buys ``robot``'s deposited item, with the robot's signed round trip and the
+        nest's acknowledgement, and settles what fits in one batch (``sender`` and ``evidence`` only to
+        test who may call it and what it must carry)."""
+        address = self._remember(robot)
+        if evidence is None:
+            evidence = self.deposit_evidence(self._key(address), self.nest, self.round_trip(address))
+        return self.transact(sender or self.market, "buyItem", address, evidence)
+
+    def deposit_evidence(self, robot: LocalAccount, nest: LocalAccount, trip: int) -> tuple:
+        """``buyItem``'s evidence: ``robot``'s and ``nest``'s signatures over ``Deposit(robot, trip)``."""
+        return (*sign_deposit(robot.key, self.domain, robot.address, trip),
+                *sign_deposit(nest.key, self.domain, robot.address, trip))
+
+    def _remember(self, robot: Robot) -> str:
+        if isinstance(robot, str):
+            return to_checksum_address(robot)
+        self._keys[robot.address] = robot
+        return robot.address
+
+    def _key(self, address: str) -> LocalAccount:
+        try:
+            return self._keys[address]
+        except KeyError:
+            raise ChainError(f"no key for robot {address}: pass its account to sign its deposit") from None
 
     def settle(self, robot: str, max_records: int = SETTLE_BATCH, sender: LocalAccount | None = None) -> TxResult:
         """Continue ``robot``'s pending settlement (anyone may; the market by default)."""
         return self.transact(sender or self.market, "settle", robot, max_records)
 
-    def deposit(self, robot: str, batch: int = SETTLE_BATCH) -> list[TxResult]:
+    def deposit(self, robot: Robot, batch: int = SETTLE_BATCH) -> list[TxResult]:
         """``buyItem`` and as many ``settle`` calls as the round trip needs: a whole deposit."""
-        results = [self.buy_item(robot)]
-        while self.pending_settlement(robot)[0]:
-            results.append(self.settle(robot, batch))
+        address = self._remember(robot)
+        results = [self.buy_item(address)]
+        while self.pending_settlement(address)[0]:
+            results.append(self.settle(address, batch))
         return results
+
+    def grant_role(self, role: str, account: str, sender: LocalAccount | None = None) -> TxResult:
+        """The admin gives ``role`` (a key of ``ROLES``) to ``account``."""
+        return self.transact(sender or self.market, "grantRole", ROLES[role], account)
+
+    def revoke_role(self, role: str, account: str, sender: LocalAccount | None = None) -> TxResult:
+        """The admin takes ``role`` from ``account``."""
+        return self.transact(sender or self.market, "revokeRole", ROLES[role], account)
+
+    def set_paused(self, paused: bool, sender: LocalAccount | None = None) -> TxResult:
+        """A pauser stops or resumes registrations, reveals and deposits."""
+        return self.transact(sender or self.market, "setPaused", paused)
 
     def refund_expired(self, buyer: str, max_records: int = 2**32, sender: LocalAccount | None = None) -> TxResult:
         """Return the stakes of ``buyer``'s expired records to their sellers (anyone may)."""
@@ -292,7 +379,8 @@ class ChainMarket:
         ``seller_position`` (the seller's position in the buyer's frame, as the buyer senses it) has no
         default: the weight of the sale is computed from the vector minus this position, so a client
         that left it out would weigh the purchased vector instead. The buyer's client signs at most
-        ``max_acceptances_per_trip`` acceptances per round trip (``ProtocolError`` beyond)."""
+        ``max_acceptances_per_trip`` acceptances per round trip, and ``max_acceptances_per_seller`` per
+        seller in it (``ProtocolError`` beyond)."""
         if seller_position is None or len(seller_position) != 2:
             raise ProtocolError("seller_position (the seller's position in the buyer's frame) is required")
         domain = domain or self.domain
@@ -302,10 +390,19 @@ class ChainMarket:
         if count >= self.max_acceptances_per_trip:
             raise ProtocolError(f"buyer {buyer.address} already accepted {count} offers in round trip {trip}: "
                                 f"its client accepts at most {self.max_acceptances_per_trip} per round trip")
+        pair = (buyer.address, seller.address)
+        seen_trip, from_seller = self._accepted_from.get(pair, (trip, 0))
+        from_seller = from_seller if seen_trip == trip else 0
+        if from_seller >= self.max_acceptances_per_seller:
+            raise ProtocolError(f"buyer {buyer.address} already accepted {from_seller} offers of seller "
+                                f"{seller.address} in round trip {trip}: its client accepts at most "
+                                f"{self.max_acceptances_per_seller} per seller and round trip")
+        self._keys[buyer.address], self._keys[seller.address] = buyer, seller
         offer = Offer(seller.address, site, age, self.backend.block_number - 1 + blocks_valid, info.digest())
         signature = sign_offer(seller.key, domain, offer)
         lc = accept_offer(buyer.key, domain, offer, signature, seller_position, trip)
         self._accepted[buyer.address] = (trip, count + 1)
+        self._accepted_from[pair] = (trip, from_seller + 1)
         return lc
 
     # -- views --------------------------------------------------------------------------------------
@@ -313,6 +410,9 @@ class ChainMarket:
     def view(self, fn: str, *args) -> Any:
         """Any view function, called by the market account."""
         return self._call(self.market.address, fn, *args)
+
+    def has_role(self, role: str, account: str) -> bool:
+        return self.view("hasRole", ROLES[role], account)
 
     def balance_of(self, robot: str) -> int:
         return self.view("balanceOf", robot)
@@ -345,44 +445,3 @@ def _error_table(abi: list) -> dict[bytes, tuple[str, list[str], list[str]]]:
         types = [i["type"] for i in e["inputs"]]
         table[keccak(text=f"{e['name']}({','.join(types)})")[:4]] = (e["name"], [i["name"] for i in e["inputs"]], types)
     return table
-
-
-def revert_data(exc: BaseException) -> bytes | None:
-    """The raw revert bytes, wherever the backend put them.
-
-    A JSON-RPC node's answer reaches us as web3's ``ContractCustomError``/``ContractLogicError`` with a
-    hex ``data`` (Hardhat Network nests it: ``{"message": ..., "data": "0x..."}``). eth-tester raises ``TransactionFailed`` whose message is the bytes' repr, and web3
-    re-raises it with a message of its own (sometimes a string it guessed out of the bytes), so the
-    repr is looked for along the exception's cause/context chain.
-    """
-    pending: list[BaseException | None] = [exc]
-    seen: set[int] = set()
-    while pending:
-        e = pending.pop(0)
-        if e is None or id(e) in seen:
-            continue
-        seen.add(id(e))
-        data = getattr(e, "data", None)
-        if isinstance(data, dict):  # Hardhat Network: {"message": ..., "data": "0x..."}
-            data = data.get("data")
-        if isinstance(data, str) and data.startswith("0x"):
-            return bytes.fromhex(data[2:])
-        first = e.args[0] if e.args else None
-        if isinstance(first, str):
-            first = _bytes_literal(first.removeprefix("execution reverted: "))
-        if isinstance(first, bytes):
-            return first
-        if isinstance(first, BaseException):
-            pending.append(first)
-        pending += [e.__cause__, e.__context__]
-    return None
-
-
-def _bytes_literal(text: str) -> bytes | None:
-    if text[:2] not in ("b'", 'b"'):
-        return None
-    try:
-        value = ast.literal_eval(text)
-    except (ValueError, SyntaxError):
-        return None
-    return value if isinstance(value, bytes) else None

@@ -69,7 +69,7 @@ class Domain:
     chain_id: int
     verifying_contract: str
     name: str = "InformationMarket"
-    version: str = "3"
+    version: str = "4"
 
     def as_dict(self) -> dict:
         return {
@@ -195,6 +195,21 @@ def _sign(key: bytes, digest: bytes) -> tuple[int, bytes, bytes]:
     """(v, r, s) of a low-s signature of ``digest`` (v is 27 or 28)."""
     sig = keys.PrivateKey(bytes(key)).sign_msg_hash(digest)
     return sig.v + 27, sig.r.to_bytes(32, "big"), sig.s.to_bytes(32, "big")
+
+
+_DEPOSIT_TYPEHASH = keccak(text="Deposit(address robot,uint64 trip)")
+
+
+def deposit_digest(domain: Domain, robot: str, trip: int) -> bytes:
+    """The EIP-712 digest of ``Deposit(robot, trip)`` (the contract's ``depositDigest``): what the robot
+    signs to end round trip ``trip`` with a deposit, and what the nest signs to acknowledge it."""
+    struct = keccak(abi_encode(["bytes32", "address", "uint64"], [_DEPOSIT_TYPEHASH, to_checksum_address(robot), trip]))
+    return keccak(b"\x19\x01" + _separator(domain) + struct)
+
+
+def sign_deposit(key: bytes, domain: Domain, robot: str, trip: int) -> tuple[int, bytes, bytes]:
+    """(v, r, s) of ``key``'s signature over ``Deposit(robot, trip)``."""
+    return _sign(key, deposit_digest(domain, robot, trip))
 
 
 def sign_offer(seller_key: bytes, domain: Domain, offer: Offer) -> bytes:
