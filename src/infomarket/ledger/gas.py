@@ -16,19 +16,19 @@ from numba import njit
 #: calls) by the number of reveals it settles, GAS_DEPOSIT_N ("deposit, later trips": the steady state of
 #: a running swarm).  The last size is the contract's bound of live records per round trip.
 GAS_REVEAL = {
-    "delayed": 112_918,
-    "outlier": 112_917,
-    "outlier + staking": 126_228,
-    "outlier_distinct": 112_914,
-    "outlier_distinct + staking": 126_229,
+    "delayed": 115_342,
+    "outlier": 115_341,
+    "outlier + staking": 128_652,
+    "outlier_distinct": 115_343,
+    "outlier_distinct + staking": 128_655,
 }
 GAS_DEPOSIT_N = (1, 4, 16, 64, 128, 256, 512)
 GAS_DEPOSIT = {
-    "delayed": (138_938, 164_044, 264_460, 709_854, 1_188_461, 2_262_122, 4_295_701),
-    "outlier": (148_514, 197_329, 518_131, 4_498_750, 17_274_507, 78_109_480, 410_714_463),
-    "outlier + staking": (150_754, 199_569, 516_131, 4_496_750, 17_272_507, 78_107_480, 410_712_463),
-    "outlier_distinct": (149_740, 206_204, 643_986, 4_220_732, 14_866_435, 67_388_548, 378_389_059),
-    "outlier_distinct + staking": (151_980, 208_444, 641_986, 4_218_732, 14_864_435, 67_386_548, 378_387_059),
+    "delayed": (153_856, 179_593, 282_592, 747_580, 1_245_533, 2_360_156, 4_473_377),
+    "outlier": (163_520, 213_335, 548_425, 4_657_410, 17_832_915, 80_239_542, 419_124_911),
+    "outlier + staking": (165_760, 215_575, 546_425, 4_655_410, 17_830_915, 80_237_542, 419_122_911),
+    "outlier_distinct": (164_767, 222_099, 669_344, 4_736_283, 18_962_603, 98_892_425, 629_538_919),
+    "outlier_distinct + staking": (167_007, 224_339, 667_344, 4_734_283, 18_960_603, 98_890_425, 629_536_919),
 }
 
 
