@@ -28,6 +28,9 @@ from __future__ import annotations
 from dataclasses import dataclass, field, replace
 from statistics import mean
 
+from ..ledger.gas import GAS_DEPOSIT_N, gas_schedule, table_gas
+from ..ledger.lock import STAKE_TOLERANCE
+
 from .errors import ChainError, ContractRevert
 from .evm_replay import FLOAT_SLACK_UNITS, REPLAY_NO_EXPIRY, BalanceRow, SITE_CODES, _count_rounding, market_params
 from .market import ChainMarket, connect, derived_account
@@ -111,9 +114,6 @@ def replay_blocks(blocks, purchase_of: dict, config, *, seed: int = 0, backend: 
     one EVM block per modelled block, checking every balance after every block.  ``purchase_of``: each
     reveal's purchase event by transaction seq (``match_purchases``); ``config``: the run's experiment."""
     import numpy as np
-
-    from ..ledger.gas import GAS_DEPOSIT_N, gas_schedule, table_gas
-    from ..ledger.lock import STAKE_TOLERANCE
 
     robots = config.swarm.robots
     params = market_params(config)

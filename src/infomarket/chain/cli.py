@@ -114,6 +114,7 @@ def chain_config(config, period: int | None, gas_price: float | None):
 def run_demo(args: argparse.Namespace) -> int:
     """Handler of ``infomarket chain demo``; returns the exit status."""
     try:
+        # the chain extra (web3, py-evm, pyrevm) is optional: refused with a message if it is missing
         from .. import load_experiment, simulate
         from ..errors import ConfigError
         from .errors import ChainError
@@ -167,6 +168,7 @@ def _run_chain_demo(config, args) -> int:
     """The chain model's demo: simulate with a block log, then replay the canonical chain block by block."""
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
+    # with the command: `infomarket --help` does not import the engine or the EVM client
     from ..engine.simulation import Simulation
     from ..ledger.blocklog import BlockLog
     from .block_replay import match_purchases, replay_blocks
