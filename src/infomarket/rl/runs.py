@@ -25,7 +25,8 @@ from ..engine.params import behaviour_kinds
 from ..engine.simulation import _checked_seed, as_experiment, compile_notice
 from ..engine.world import kernel_view
 from ..errors import ConfigError, SimulationError
-from ..generated import generated_digest, load_generated
+from .. import interrupts
+from ..generated import compile_marker, generated_digest, load_generated
 from ..registry import behaviours, get_behaviour
 from ..state.flags import ErrorFlags
 from .observe import OBSERVATION
@@ -147,7 +148,9 @@ class Runs:
         self.items = np.zeros(self.size, np.int64)
         self.shares = np.zeros((self.size, a))
         self._status = np.zeros(self.size, np.int64)
-        self.reset(np.arange(self.size), np.arange(self.size))
+        # the first observation compiles (or loads) step_all: in a child a signal can stop at once
+        interrupts.compiled_apart(lambda: self.reset(np.arange(self.size), np.arange(self.size)),
+                                  compile_marker(self._batch, "runs"))
 
     def _build(self, seed: int):
         rng = np.random.default_rng(seed)

@@ -54,7 +54,7 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from .. import __version__
+from .. import __version__, interrupts
 from ..errors import InfomarketError
 from .dictionary import TABLES as TABLES_DICT
 from .dictionary import annotate
@@ -570,7 +570,8 @@ class Store:
             con.execute("SET enable_external_access = false")
             con.execute("SET lock_configuration = true")
             try:
-                return con.execute(query).df()
+                # in a thread: DuckDB does not look at signals, so Ctrl-C interrupts the query (interrupts.wait_for)
+                return interrupts.wait_for(lambda: con.execute(query).df(), con.interrupt)
             except duckdb.Error as exc:
                 raise SqlError(f"{self.root}: the query failed: {exc} (tables: "
                                f"{', '.join(r[0] for r in con.execute('SHOW TABLES').fetchall())})") from None

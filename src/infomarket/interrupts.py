@@ -1,0 +1,208 @@
+"""Ctrl-C and SIGTERM stop every infomarket command at once, whatever it is doing, without a race.
+
+Python turns SIGINT into ``KeyboardInterrupt``, but only when the main thread runs Python bytecode, and an
+exception raised there is not always delivered.  A command spends its time in three places where that
+fails, and each has its own remedy here, none of which waits for or guesses at a moment:
+
+* **Compiling** (numba and LLVM, up to a minute for a step kernel on a busy machine) runs in C: no Python
+  handler can run until it ends.  ``compiled_apart`` compiles in a forked child and waits for it; the wait
+  is a system call that a signal interrupts, so the parent kills the child's process group at once and
+  stops.  A child that finished has written numba's disk cache, from which the parent then loads.
+* **LLVM's callbacks into Python** (llvmlite's object cache, through ctypes): an exception raised inside
+  one is printed as "Exception ignored" and dropped, and the compile goes on.  The handler never raises
+  while llvmlite is on the stack: it raises the signal again (``signal.raise_signal``), so the handler
+  runs again at the next bytecode, and raises once Python is out of llvmlite.  Nothing is timed.
+* **Pool workers and children**: ``detach`` puts each in its own process group with the default
+  dispositions (a signal ends it at once, even inside a kernel), and makes it die with its parent
+  (Linux ``PR_SET_PDEATHSIG``); the parent ends them with SIGKILL to their group (``kill_group``).
+
+The request to stop is sticky: ``check`` raises again at the safe points (after each kernel call, after
+each finished task), so a ``KeyboardInterrupt`` lost anyway (raised inside a finalizer, say) cannot let a
+command run on.  SIGTERM takes the same path as Ctrl-C (finished work kept, the resume command printed)
+and exits with 143 instead of 130.
+
+``handling()`` is active for the duration of one command line (``cli.main``); elsewhere (the Python API,
+tests) nothing here changes Python's own behaviour.
+"""
+from __future__ import annotations
+
+import contextlib
+import ctypes
+import os
+import signal
+import sys
+import threading
+from collections.abc import Callable
+from pathlib import Path
+from typing import TypeVar
+
+T = TypeVar("T")
+SIGNALS = (signal.SIGINT, signal.SIGTERM)
+_LLVMLITE = os.sep + "llvmlite" + os.sep
+_PR_SET_PDEATHSIG = 1
+
+
+class _State:
+    active = False  # handling() is in force in this process
+    signum = 0  # the first stop signal received while active (sticky)
+
+
+_state = _State()
+
+
+# ------------------------------------------------------------------------------------------ handler
+def _in_llvmlite(frame) -> bool:
+    while frame is not None:
+        if _LLVMLITE in frame.f_code.co_filename:
+            return True
+        frame = frame.f_back
+    return False
+
+
+def _handler(signum, frame) -> None:
+    _state.signum = _state.signum or signum
+    if _in_llvmlite(frame):  # raised here it would be dropped: come back at the next bytecode instead
+        signal.raise_signal(signum)
+        return
+    raise KeyboardInterrupt
+
+
+@contextlib.contextmanager
+def handling():
+    """SIGINT and SIGTERM stop the command (``KeyboardInterrupt``) while the block runs, even where the
+    parent left SIGINT ignored or blocked (a script's background job): a command that cannot be stopped
+    is worse.  The previous handlers are put back after it.  Main thread only; elsewhere it does nothing."""
+    if threading.current_thread() is not threading.main_thread() or _state.active:
+        yield
+        return
+    before = {s: signal.getsignal(s) for s in SIGNALS}
+    _state.active, _state.signum = True, 0
+    for s in SIGNALS:
+        signal.signal(s, _handler)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, set(SIGNALS))
+    try:
+        yield
+    finally:
+        for s, h in before.items():
+            signal.signal(s, h if h is not None else signal.SIG_DFL)
+        _state.active, _state.signum = False, 0
+
+
+def requested() -> int:
+    """The stop signal received (0: none) while ``handling()`` is in force."""
+    return _state.signum
+
+
+def check() -> None:
+    """A safe point: raise ``KeyboardInterrupt`` if a stop was asked for (again, if one was lost)."""
+    if _state.signum:
+        raise KeyboardInterrupt
+
+
+def exit_code() -> int:
+    """The exit status of a stopped command: 128 + the signal (130 for Ctrl-C, 143 for SIGTERM)."""
+    return 128 + (_state.signum or signal.SIGINT)
+
+
+def _forked() -> None:
+    """In every forked child of a command: the default dispositions (a signal ends it at once), no stop
+    inherited.  The child's own code decides the rest (``detach``)."""
+    if _state.active:
+        for s in SIGNALS:
+            signal.signal(s, signal.SIG_DFL)
+        _state.active, _state.signum = False, 0
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(after_in_child=_forked)
+
+
+# ----------------------------------------------------------------------------------------- children
+def detach(parent: int | None = None) -> None:
+    """In a freshly forked child (a pool worker, a compile): its own process group, so a terminal's Ctrl-C
+    reaches only the command, which then ends the group; the default signal dispositions; and death with
+    ``parent`` (Linux), so that no child outlives a command killed outright."""
+    for s in SIGNALS:
+        signal.signal(s, signal.SIG_DFL)
+    with contextlib.suppress(OSError):
+        os.setpgid(0, 0)
+    if sys.platform.startswith("linux"):
+        with contextlib.suppress(OSError, AttributeError):
+            ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+    if parent is not None and os.getppid() != parent:  # the parent died before the line above
+        os._exit(1)
+
+
+def kill_group(pid: int) -> None:
+    """SIGKILL the process ``pid`` and its process group (one that ``detach`` made): cannot be caught,
+    so it ends the child even inside compiled code."""
+    for kill in (os.killpg, os.kill):
+        with contextlib.suppress(ProcessLookupError, PermissionError):
+            kill(pid, signal.SIGKILL)
+
+
+def compiled_apart(compile_: Callable[[], T], marker: Path | None) -> T:
+    """``compile_()``, whose first call in a process compiles and caches on disk, made stoppable: while a
+    command is running (``handling``) and ``marker`` does not exist yet, it is first run in a forked
+    child (which creates ``marker`` when it succeeds), so a signal during the compile kills the child at
+    once; then it runs here, loading from the cache.  A child that failed leaves the error to the call
+    here.  ``marker`` None (not cacheable), outside a command, off the main thread or without ``fork``:
+    just ``compile_()``."""
+    if (marker is None or not _state.active or marker.exists() or not hasattr(os, "fork")
+            or threading.current_thread() is not threading.main_thread()):
+        return _here(compile_)
+    parent = os.getpid()
+    pid = os.fork()
+    if pid == 0:  # pragma: no cover - the child (its coverage is not collected)
+        code = 1
+        try:
+            detach(parent)
+            compile_()
+            marker.touch()
+            code = 0
+        finally:
+            os._exit(code)
+    try:
+        os.waitpid(pid, 0)  # a signal raises KeyboardInterrupt here, at once
+    except BaseException:
+        kill_group(pid)
+        with contextlib.suppress(ChildProcessError):
+            os.waitpid(pid, 0)
+        raise
+    return _here(compile_)
+
+
+def _here(compile_: Callable[[], T]) -> T:
+    check()
+    out = compile_()
+    check()  # a stop that came in an LLVM callback near the end is raised here at the latest
+    return out
+
+
+def wait_for(call: Callable[[], T], cancel: Callable[[], object]) -> T:
+    """``call()`` (a blocking call into a library that does not look at signals, e.g. a DuckDB query) run
+    in a thread while this thread waits: a signal stops the wait at once, ``cancel()`` asks the library
+    to stop, and ``KeyboardInterrupt`` propagates once the call has returned (so that its resources can
+    be closed), or at once on a second signal."""
+    box: dict[str, object] = {}
+    done = threading.Event()
+
+    def work() -> None:
+        try:
+            box["value"] = call()
+        except BaseException as exc:  # noqa: BLE001 - handed to the waiting thread
+            box["error"] = exc
+        finally:
+            done.set()
+
+    threading.Thread(target=work, daemon=True, name="infomarket-wait").start()
+    try:
+        done.wait()
+    except BaseException:
+        with contextlib.suppress(Exception):
+            cancel()
+        done.wait()
+        raise
+    if "error" in box:
+        raise box["error"]
+    return box["value"]
