@@ -209,23 +209,30 @@ def main(argv: list[str] | None = None) -> int:
     if quiet:  # the engine's "compiling the step kernel..." line too (workers inherit the variable)
         os.environ["INFOMARKET_COMPILE_NOTICE"] = "0"
     try:
-        with interrupts.handling():  # Ctrl-C and SIGTERM stop any command at once (docs/sweeps.md)
-            try:
-                return int(args.func(args) or 0)
-            except KeyboardInterrupt:
-                return report("interrupted", interrupts.exit_code())
-    except InfomarketError as exc:
-        # bad input (configuration, options, store) is a ValueError: exit 2; anything else: 1
-        return report(exc)
-    except BrokenPipeError:  # output piped into e.g. `head`: stop quietly, like other Unix tools
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return 0
+        with interrupts.handling() as stop:  # Ctrl-C and SIGTERM stop any command at once (docs/sweeps.md)
+            code = _run(args)
     finally:
         if quiet:
             if notice is None:
                 os.environ.pop("INFOMARKET_COMPILE_NOTICE", None)
             else:
                 os.environ["INFOMARKET_COMPILE_NOTICE"] = notice
+    if stop.signum and argv is None:  # the program itself, stopped: what it keeps is kept, leave now
+        interrupts.exit_now(code)
+    return code
+
+
+def _run(args) -> int:
+    try:
+        return int(args.func(args) or 0)
+    except KeyboardInterrupt:
+        return report("interrupted", interrupts.exit_code())
+    except InfomarketError as exc:
+        # bad input (configuration, options, store) is a ValueError: exit 2; anything else: 1
+        return report(exc)
+    except BrokenPipeError:  # output piped into e.g. `head`: stop quietly, like other Unix tools
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -47,6 +47,12 @@ class _State:
     signum = 0  # the first stop signal received while active (sticky)
 
 
+class Stop:
+    """What ``handling()`` yields: ``signum``, the stop signal received in the block (0: none), kept after it."""
+
+    signum = 0
+
+
 _state = _State()
 
 
@@ -72,8 +78,9 @@ def handling():
     """SIGINT and SIGTERM stop the command (``KeyboardInterrupt``) while the block runs, even where the
     parent left SIGINT ignored or blocked (a script's background job): a command that cannot be stopped
     is worse.  The previous handlers are put back after it.  Main thread only; elsewhere it does nothing."""
+    stop = Stop()
     if threading.current_thread() is not threading.main_thread() or _state.active:
-        yield
+        yield stop
         return
     before = {s: signal.getsignal(s) for s in SIGNALS}
     _state.active, _state.signum = True, 0
@@ -81,10 +88,11 @@ def handling():
         signal.signal(s, _handler)
     signal.pthread_sigmask(signal.SIG_UNBLOCK, set(SIGNALS))
     try:
-        yield
+        yield stop
     finally:
         for s, h in before.items():
             signal.signal(s, h if h is not None else signal.SIG_DFL)
+        stop.signum = _state.signum
         _state.active, _state.signum = False, 0
 
 
@@ -102,6 +110,16 @@ def check() -> None:
 def exit_code() -> int:
     """The exit status of a stopped command: 128 + the signal (130 for Ctrl-C, 143 for SIGTERM)."""
     return 128 + (_state.signum or signal.SIGINT)
+
+
+def exit_now(code: int) -> None:
+    """End the program now, after a stop: what it keeps is committed, its children are ended and its
+    files closed, so the interpreter's own teardown (finalizers of numba's and LLVM's objects, seconds
+    on a loaded machine) would only delay the exit.  Only for the program itself, never a library call."""
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(Exception):
+            stream.flush()
+    os._exit(code)
 
 
 def _forked() -> None:
