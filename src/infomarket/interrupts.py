@@ -10,8 +10,9 @@ fails, and each has its own remedy here, none of which waits for or guesses at a
   stops.  A child that finished has written numba's disk cache, from which the parent then loads.
 * **LLVM's callbacks into Python** (llvmlite's object cache, through ctypes): an exception raised inside
   one is printed as "Exception ignored" and dropped, and the compile goes on.  The handler never raises
-  while llvmlite is on the stack: it raises the signal again (``signal.raise_signal``), so the handler
-  runs again at the next bytecode, and raises once Python is out of llvmlite.  Nothing is timed.
+  while llvmlite is on the stack: it sets a profile function (``sys.setprofile``) that raises at the
+  first call or return made with no llvmlite frame left, i.e. as soon as Python is out of llvmlite.
+  Nothing is timed and nothing is sent again.
 * **Pool workers and children**: ``detach`` puts each in its own process group with the default
   dispositions (a signal ends it at once, even inside a kernel), and makes it die with its parent
   (Linux ``PR_SET_PDEATHSIG``); the parent ends them with SIGKILL to their group (``kill_group``).
@@ -45,6 +46,7 @@ _PR_SET_PDEATHSIG = 1
 class _State:
     active = False  # handling() is in force in this process
     signum = 0  # the first stop signal received while active (sticky)
+    profile = None  # the profile function ``_deliver`` stands in for
 
 
 class Stop:
@@ -67,9 +69,20 @@ def _in_llvmlite(frame) -> bool:
 
 def _handler(signum, frame) -> None:
     _state.signum = _state.signum or signum
-    if _in_llvmlite(frame):  # raised here it would be dropped: come back at the next bytecode instead
-        signal.raise_signal(signum)
+    if _in_llvmlite(frame):  # raised here it would be dropped: raise it at the first event outside llvmlite
+        if sys.getprofile() is not _deliver:
+            _state.profile = sys.getprofile()
+            sys.setprofile(_deliver)
         return
+    raise KeyboardInterrupt
+
+
+def _deliver(frame, event, arg) -> None:
+    """A profile function, set only after a stop landed in llvmlite: at the first call or return with no
+    llvmlite frame on the stack it puts the previous profile function back and raises there."""
+    if _in_llvmlite(frame):
+        return
+    sys.setprofile(_state.profile)
     raise KeyboardInterrupt
 
 
@@ -92,6 +105,8 @@ def handling():
     finally:
         for s, h in before.items():
             signal.signal(s, h if h is not None else signal.SIG_DFL)
+        if sys.getprofile() is _deliver:
+            sys.setprofile(_state.profile)
         stop.signum = _state.signum
         _state.active, _state.signum = False, 0
 
