@@ -47,6 +47,7 @@ class _State:
     active = False  # handling() is in force in this process
     signum = 0  # the first stop signal received while active (sticky)
     profile = None  # the profile function ``_deliver`` stands in for
+    held = False  # the stop signals are blocked for a fork (``_before_fork``)
 
 
 class Stop:
@@ -137,17 +138,36 @@ def exit_now(code: int) -> None:
     os._exit(code)
 
 
-def _forked() -> None:
-    """In every forked child of a command: the default dispositions (a signal ends it at once), no stop
-    inherited.  The child's own code decides the rest (``detach``)."""
+def _before_fork() -> None:
+    """Signals held while a command forks: between the fork and the child's own setup a signal to the
+    command's process group reaches the child too, where the command's handler would raise inside the
+    fork's bookkeeping (printed as "Exception ignored")."""
+    if _state.active:
+        _state.held = True
+        signal.pthread_sigmask(signal.SIG_BLOCK, set(SIGNALS))
+
+
+def _after_fork_in_parent() -> None:
+    if _state.held:
+        _state.held = False
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, set(SIGNALS))
+
+
+def _after_fork_in_child() -> None:
+    """In every forked child of a command: the default dispositions (a signal ends it at once, quietly),
+    no stop inherited; then the signals held for the fork are let through."""
     if _state.active:
         for s in SIGNALS:
             signal.signal(s, signal.SIG_DFL)
         _state.active, _state.signum = False, 0
+    if _state.held:
+        _state.held = False
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, set(SIGNALS))
 
 
 if hasattr(os, "register_at_fork"):
-    os.register_at_fork(after_in_child=_forked)
+    os.register_at_fork(before=_before_fork, after_in_parent=_after_fork_in_parent,
+                        after_in_child=_after_fork_in_child)
 
 
 # ----------------------------------------------------------------------------------------- children
