@@ -23,7 +23,7 @@ N = 25
 
 
 def run(coro):
-    return asyncio.run(asyncio.wait_for(coro, 60))
+    return asyncio.run(asyncio.wait_for(coro, HANG))
 
 
 async def client_for(config, seed=2, **kw) -> TestClient:
@@ -32,7 +32,7 @@ async def client_for(config, seed=2, **kw) -> TestClient:
     return client
 
 
-async def recv(ws, timeout=10.0):
+async def recv(ws, timeout=HANG):
     """('json', dict) or ('frame', Frame)."""
     msg = await ws.receive(timeout=timeout)
     if msg.type == WSMsgType.BINARY:
@@ -94,7 +94,7 @@ def test_greeting_describes_the_run_and_frames_come_from_the_engine(fig2b):
             assert scene["kind"].count(1) == 1 and len(scene["bias"]) == N
             assert first.step == 0
             await ws.send_json({"cmd": "step", "n": 37})
-            raw = await ws.receive(timeout=10)
+            raw = await ws.receive(timeout=HANG)
             assert raw.type == WSMsgType.BINARY
             status = await expect(ws, "json", "status")
             assert status["step"] == 37 and not status["playing"]
@@ -256,7 +256,7 @@ def test_server_stops_when_the_last_page_closes(fig2b):
             ws = await http.ws_connect(url + "ws")
             await expect(ws, "json", "scene")
             await ws.close()
-        await asyncio.wait_for(task, 10)
+        await asyncio.wait_for(task, HANG)
 
     run(go())
     assert any("last page was closed" in s for s in said)
