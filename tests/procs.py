@@ -58,6 +58,17 @@ def session_members(sid: int) -> list[int]:
     return found
 
 
+def catches(pid: int, sig: int) -> bool:
+    """Whether process ``pid`` has a handler for ``sig`` now (Linux: ``SigCgt`` in /proc/PID/status); an
+    infomarket command catches SIGTERM once it has started (``interrupts.handling``)."""
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except OSError:
+        return False
+    mask = int(next(line.split()[1] for line in status.splitlines() if line.startswith("SigCgt:")), 16)
+    return bool(mask >> (sig - 1) & 1)
+
+
 class Procs:
     """Processes started for one test; all killed (their sessions) at ``close``."""
 

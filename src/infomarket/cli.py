@@ -233,6 +233,10 @@ def _run(args) -> int:
     except BrokenPipeError:  # output piped into e.g. `head`: stop quietly, like other Unix tools
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+    except Exception:
+        if interrupts.requested():  # after a stop signal, an error on the way out is the stop's
+            return report("interrupted", interrupts.exit_code())
+        raise
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -123,6 +123,14 @@ def check() -> None:
         raise KeyboardInterrupt
 
 
+def raise_stopped(exc: BaseException):
+    """Raise ``exc`` as the stop it is: a ``KeyboardInterrupt`` when a stop signal came (a signal that lands
+    inside threading's own bookkeeping can surface as another error, e.g. "release unlocked lock")."""
+    if _state.signum and not isinstance(exc, KeyboardInterrupt):
+        raise KeyboardInterrupt from exc
+    raise exc
+
+
 def exit_code() -> int:
     """The exit status of a stopped command: 128 + the signal (130 for Ctrl-C, 143 for SIGTERM)."""
     return 128 + (_state.signum or signal.SIGINT)
@@ -235,27 +243,24 @@ def _here(compile_: Callable[[], T]) -> T:
 def wait_for(call: Callable[[], T], cancel: Callable[[], object]) -> T:
     """``call()`` (a blocking call into a library that does not look at signals, e.g. a DuckDB query) run
     in a thread while this thread waits: a signal stops the wait at once, ``cancel()`` asks the library
-    to stop, and ``KeyboardInterrupt`` propagates once the call has returned (so that its resources can
-    be closed), or at once on a second signal."""
+    to stop, and ``KeyboardInterrupt`` propagates without waiting for it (a cancel that came before the
+    library's call began may be ignored: the thread then ends with the call, or with the program)."""
     box: dict[str, object] = {}
-    done = threading.Event()
 
     def work() -> None:
         try:
             box["value"] = call()
         except BaseException as exc:  # noqa: BLE001 - handed to the waiting thread
             box["error"] = exc
-        finally:
-            done.set()
 
-    threading.Thread(target=work, daemon=True, name="infomarket-wait").start()
     try:
-        done.wait()
-    except BaseException:
+        thread = threading.Thread(target=work, daemon=True, name="infomarket-wait")
+        thread.start()
+        thread.join()  # a plain lock wait, which a signal interrupts cleanly
+    except BaseException as exc:
         with contextlib.suppress(Exception):
             cancel()
-        done.wait()
-        raise
+        raise_stopped(exc)
     if "error" in box:
         raise box["error"]
     return box["value"]

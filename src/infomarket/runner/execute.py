@@ -332,10 +332,10 @@ def execute(tasks: list[Task], finished: Callable[[Task, list[RunOutput]], None]
         for fut in as_completed(futures):  # the wait is interrupted by a signal at once
             finished(futures[fut], fut.result())
             interrupts.check()
-    except BaseException:
+    except BaseException as exc:
         for f in futures:
             f.cancel()
-        raise
+        interrupts.raise_stopped(exc)
     return warm_seconds
 
 

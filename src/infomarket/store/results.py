@@ -576,7 +576,10 @@ class Store:
                 raise SqlError(f"{self.root}: the query failed: {exc} (tables: "
                                f"{', '.join(r[0] for r in con.execute('SHOW TABLES').fetchall())})") from None
         finally:
-            con.close()
+            try:
+                con.close()
+            except duckdb.Error:  # still busy with a query that Ctrl-C interrupted (interrupts.wait_for)
+                pass
 
     def runs(self) -> pd.DataFrame:
         """One row per committed run, ``status`` ``ok`` or ``failed`` (then ``error`` says why)."""
