@@ -89,6 +89,10 @@ def main() -> int:
               f"{args.earliest}-{args.latest} s (seed {seed}), {args.busy} busy loop(s), "
               f"{'shared warm' if args.warm else 'fresh cold'} kernel cache; load {os.getloadavg()[0]:.1f}",
               flush=True)
+        if args.warm:  # fill the shared cache first: the trials then load the kernel and run
+            subprocess.run([sys.executable, "-m", "infomarket.cli", *args.words, "--runs", "1", "--steps", "10",
+                            "--quiet", "--out", str(work / "warm")], env={**env, "INFOMARKET_CACHE_DIR": str(work / "cache")},
+                           check=True)
         for k in range(args.trials):
             cache = work / ("cache" if args.warm else f"cache{k}")
             out = work / f"out{k}"
