@@ -1,5 +1,5 @@
-"""``infomarket.interrupts``: a stop is never lost, a compile in a child is killed at once, a library's
-blocking call is left at once, and ``store sql`` stops on Ctrl-C in the middle of a query."""
+"""``infomarket.interrupts``: a stop is never lost, a compile in a child is killed at once, and ``store sql``
+stops on Ctrl-C in the middle of a query (a library's blocking call left at once: ``wait_for``)."""
 from __future__ import annotations
 
 import os
@@ -45,28 +45,6 @@ def test_a_stop_is_sticky_and_handling_puts_the_handlers_back():
     assert (signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)) == before
     interrupts.check()  # outside a command nothing is pending
     assert interrupts.requested() == 0 and interrupts.exit_code() == 130
-
-
-def test_wait_for_leaves_a_blocking_call_at_once_and_cancels_it():
-    started, release, cancelled = threading.Event(), threading.Event(), []
-
-    def blocking():
-        started.set()
-        release.wait(HANG)  # a library call that looks at no signal until it is cancelled
-        return "finished"
-
-    def cancel():
-        cancelled.append(True)
-        release.set()
-
-    _signal_when(started)
-    with interrupts.handling(), pytest.raises(KeyboardInterrupt):
-        interrupts.wait_for(blocking, cancel)
-    assert cancelled == [True]
-    with interrupts.handling():
-        assert interrupts.wait_for(lambda: 6 * 7, cancel) == 42
-        with pytest.raises(ZeroDivisionError):  # the call's own error, in the waiting thread
-            interrupts.wait_for(lambda: 1 / 0, cancel)
 
 
 def test_a_compile_in_a_child_is_killed_at_once_and_a_finished_one_is_loaded_here(tmp_path):

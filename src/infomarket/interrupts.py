@@ -245,6 +245,7 @@ def wait_for(call: Callable[[], T], cancel: Callable[[], object]) -> T:
     in a thread while this thread waits: a signal stops the wait at once, ``cancel()`` asks the library
     to stop, and ``KeyboardInterrupt`` propagates without waiting for it (a cancel that came before the
     library's call began may be ignored: the thread then ends with the call, or with the program)."""
+    check()  # a stop swallowed before the call (the call itself would never see it)
     box: dict[str, object] = {}
 
     def work() -> None:
