@@ -94,13 +94,22 @@ def test_a_compile_in_a_child_is_killed_at_once_and_a_finished_one_is_loaded_her
     assert interrupts.compiled_apart(lambda: "plain", None) == "plain"  # outside a command: just the call
 
 
+def _threads(pid: int) -> int:
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except OSError:
+        return 0
+    return int(next(line.split()[1] for line in status.splitlines() if line.startswith("Threads:")))
+
+
 def test_ctrl_c_stops_store_sql_in_the_middle_of_a_query(tmp_path, procs):
     store = write_store(tmp_path / "s", paper_like(), only=("fig2A",))
     endless = "SELECT sum(a.range * b.range) FROM range(1000000000) a, range(1000000000) b"
     proc = procs.cli("store", "sql", store.root, endless, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + HANG
-    while not catches(proc.pid, signal.SIGTERM) and proc.poll() is None and time.monotonic() < deadline:
-        time.sleep(0.01)  # until the command has started (its imports done); the query never ends
+    while not (catches(proc.pid, signal.SIGTERM) and _threads(proc.pid) > 3) and proc.poll() is None \
+            and time.monotonic() < deadline:
+        time.sleep(0.01)  # until the command has started and DuckDB's threads are there; the query never ends
     assert proc.poll() is None, proc.communicate()
     os.killpg(proc.pid, signal.SIGINT)
     out, err = proc.communicate(timeout=HANG)

@@ -228,6 +228,8 @@ def _run(args) -> int:
     except KeyboardInterrupt:
         return report("interrupted", interrupts.exit_code())
     except InfomarketError as exc:
+        if interrupts.requested():  # e.g. a Ctrl-C inside `import duckdb`, raised as "needs DuckDB"
+            return report("interrupted", interrupts.exit_code())
         # bad input (configuration, options, store) is a ValueError: exit 2; anything else: 1
         return report(exc)
     except BrokenPipeError:  # output piped into e.g. `head`: stop quietly, like other Unix tools

@@ -48,6 +48,7 @@ class _State:
     signum = 0  # the first stop signal received while active (sticky)
     profile = None  # the profile function ``_deliver`` stands in for
     held = False  # the stop signals are blocked for a fork (``_before_fork``)
+    deferred = False  # inside ``held()``: a stop is noted, raised at its end
 
 
 class Stop:
@@ -70,6 +71,8 @@ def _in_llvmlite(frame) -> bool:
 
 def _handler(signum, frame) -> None:
     _state.signum = _state.signum or signum
+    if _state.deferred:  # inside ``held``: raised when it ends
+        return
     if _in_llvmlite(frame):  # raised here it would be dropped: raise it at the first event outside llvmlite
         if sys.getprofile() is not _deliver:
             _state.profile = sys.getprofile()
@@ -110,6 +113,22 @@ def handling():
             sys.setprofile(_state.profile)
         stop.signum = _state.signum
         _state.active, _state.signum = False, 0
+
+
+@contextlib.contextmanager
+def held():
+    """A stop held back for the block: for a stretch that an exception must not land in, e.g. a C
+    extension's import that aborts the program when one does; a stop meanwhile is raised when the block
+    ends, so it is delayed, never lost.  Main thread, inside ``handling`` only."""
+    if not _state.active or _state.deferred or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    _state.deferred = True  # the handler notes the stop and returns (another thread may take the signal)
+    try:
+        yield
+    finally:
+        _state.deferred = False
+    check()
 
 
 def requested() -> int:

@@ -544,7 +544,8 @@ class Store:
         read those parts' files only and write no file (DuckDB's external access is switched off).  A table
         with no rows in the store has no view.  Needs DuckDB: ``pip install 'infomarket[sql]'``."""
         try:
-            import duckdb
+            with interrupts.held():  # DuckDB's import breaks (an abort) when a KeyboardInterrupt lands in it
+                import duckdb
         except ImportError:
             raise StoreError("Store.sql needs DuckDB: pip install 'infomarket[sql]'") from None
         if not self.exists():
