@@ -17,7 +17,8 @@ fails, and each has its own remedy here, none of which waits for or guesses at a
   dispositions (a signal ends it at once, even inside a kernel), and makes it die with its parent
   (Linux ``PR_SET_PDEATHSIG``); the parent ends them with SIGKILL to their group (``kill_group``).
 
-The request to stop is sticky: ``check`` raises again at the safe points (after each kernel call, after
+A stretch that an exception must not land in (DuckDB's import aborts when one does) runs in ``held()``,
+whose end raises a stop that came meanwhile.  The request to stop is sticky: ``check`` raises again at the safe points (after each kernel call, after
 each finished task), so a ``KeyboardInterrupt`` lost anyway (raised inside a finalizer, say) cannot let a
 command run on.  SIGTERM takes the same path as Ctrl-C (finished work kept, the resume command printed)
 and exits with 143 instead of 130.
