@@ -49,3 +49,12 @@ class Handle:
 @pytest.fixture
 def world2():
     return Handle(make_config(2))
+
+
+@pytest.fixture
+def procs():
+    """The one way a test starts a process (tests/procs.py): each in its own session, all killed at the end."""
+    from .procs import Procs
+
+    with Procs() as started:
+        yield started

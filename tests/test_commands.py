@@ -4,7 +4,6 @@ the current folder, and a new compiled kernel when a rule's source changes."""
 from __future__ import annotations
 
 import os
-import subprocess
 import sys
 import textwrap
 
@@ -54,7 +53,7 @@ def test_reproduce_scale_takes_that_fraction_of_every_conditions_runs(tmp_path, 
     assert {c.runs for c in seen} == {2}  # never fewer than two runs per condition
 
 
-def test_rules_from_the_infomarket_plugins_entry_point_are_registered(tmp_path):
+def test_rules_from_the_infomarket_plugins_entry_point_are_registered(tmp_path, procs):
     """An installed distribution that declares ``[infomarket.plugins]`` gets its module imported."""
     (tmp_path / "ep_rules_demo.py").write_text(textwrap.dedent("""
         import infomarket as im
@@ -69,10 +68,10 @@ def test_rules_from_the_infomarket_plugins_entry_point_are_registered(tmp_path):
     (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: ep-rules-demo\nVersion: 1.0\n")
     (dist / "entry_points.txt").write_text("[infomarket.plugins]\nrules = ep_rules_demo\n")
     code = "import infomarket as im; print(sorted(im.registry.behaviours()))"
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")])}
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, check=True).stdout
+    env = {"PYTHONPATH": os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")])}
+    out = procs.run([sys.executable, "-c", code], env=env, check=True).stdout
     assert "ep_silent" in out
-    bare = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    bare = procs.run([sys.executable, "-c", code], check=True).stdout
     assert "ep_silent" not in bare  # it came from the entry point, not from anywhere else
 
 

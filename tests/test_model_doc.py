@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import re
 import shutil
-import subprocess
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -17,6 +16,8 @@ OUTSIDE = ("MODEL" + ".md", ".." + "/shared", "/work" + "/shared")
 #: ``.ci/run`` is the CI harness's entry point (a comment on how CI lays out its checkout), not the
 #: project's; the project must not depend on what it mentions.
 STILL_ALLOWED: frozenset = frozenset()
+from .procs import Procs
+
 CITATION = re.compile(r"docs/model\.md §(\d+)(?:\s*[-–]\s*§?(\d+))?")
 SECTION = re.compile(r"^## (\d+)\. \S", re.MULTILINE)
 
@@ -25,8 +26,9 @@ def repository_files() -> dict[str, str]:
     """Every text file of the checkout that git would commit (tracked or new), by relative path."""
     git = shutil.which("git")
     if git and (ROOT / ".git").exists():
-        listed = subprocess.run([git, "ls-files", "-z", "--cached", "--others", "--exclude-standard"], cwd=ROOT,
-                                capture_output=True, check=True).stdout.decode().split("\0")
+        with Procs() as procs:
+            listed = procs.run([git, "ls-files", "-z", "--cached", "--others", "--exclude-standard"], cwd=ROOT,
+                               check=True).stdout.split("\0")
         paths = [ROOT / p for p in listed if p]
     else:  # an unpacked source tree
         skip = {".git", ".venv", "node_modules", "__pycache__", ".pytest_cache"}

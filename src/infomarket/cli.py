@@ -13,7 +13,7 @@ import sys
 import warnings
 from pathlib import Path
 
-from . import __version__
+from . import __version__, interrupts
 from .bench import cli as bench_cli
 from .cliargs import Parser, at_least, seed_value
 from .errors import EXIT_FAILED, EXIT_USAGE, ConfigWarning, InfomarketError, report, show_warning
@@ -23,7 +23,6 @@ SUBCOMMAND_MODULES = ("infomarket.runner.cli", "infomarket.analysis.cli", "infom
 SUBCOMMAND_MODULES += ("infomarket.analysis.terrain",)  # terrain-report (docs/terrain.md)
 SUBCOMMAND_MODULES += ("infomarket.search.cli",)  # attack-search (docs/attack-search.md)
 SUBCOMMAND_MODULES += ("infomarket.rl.cli",)  # rl-train (docs/rl.md)
-EXIT_INTERRUPTED = 130
 
 
 def _print_summary(robots, title: str) -> None:
@@ -58,9 +57,9 @@ def cmd_run(args) -> int:
                                  on_plan=lambda todo: bar.skip(runs - todo))
     except RunInterrupted as stop:
         if not stop.kept:
-            return report(f"interrupted before any of the {runs} runs finished; nothing kept", EXIT_INTERRUPTED)
+            return report(f"interrupted before any of the {runs} runs finished; nothing kept", interrupts.exit_code())
         return report(f"interrupted: kept the {stop.kept} of {runs} runs that had finished in the store {out}; "
-                      f"the same command again runs only the others", EXIT_INTERRUPTED)
+                      f"the same command again runs only the others", interrupts.exit_code())
     done = res.sweep
     if not args.quiet and len(res.robots):
         _print_summary(res.robots, f"{cfg.name}: {res.runs_done} runs x {cfg.steps} steps, master seed {seed}")
@@ -216,25 +215,40 @@ def main(argv: list[str] | None = None) -> int:
     if quiet:  # the engine's "compiling the step kernel..." line too (workers inherit the variable)
         os.environ["INFOMARKET_COMPILE_NOTICE"] = "0"
     try:
-        with warnings.catch_warnings():  # a configuration's warning as one `infomarket: warning:` line
-            warnings.showwarning = show_warning
-            if quiet:  # --quiet prints nothing but errors
-                warnings.simplefilter("ignore", ConfigWarning)
-            return int(args.func(args) or 0)
-    except InfomarketError as exc:
-        # bad input (configuration, options, store) is a ValueError: exit 2; anything else: 1
-        return report(exc)
-    except KeyboardInterrupt:
-        return report("interrupted", EXIT_INTERRUPTED)
-    except BrokenPipeError:  # output piped into e.g. `head`: stop quietly, like other Unix tools
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        return 0
+        with interrupts.handling() as stop:  # Ctrl-C and SIGTERM stop any command at once (docs/sweeps.md)
+            code = _run(args, quiet)
     finally:
         if quiet:
             if notice is None:
                 os.environ.pop("INFOMARKET_COMPILE_NOTICE", None)
             else:
                 os.environ["INFOMARKET_COMPILE_NOTICE"] = notice
+    if stop.signum and argv is None:  # the program itself, stopped: what it keeps is kept, leave now
+        interrupts.exit_now(code)
+    return code
+
+
+def _run(args, quiet: bool = False) -> int:
+    try:
+        with warnings.catch_warnings():  # a configuration's warning as one `infomarket: warning:` line
+            warnings.showwarning = show_warning
+            if quiet:  # --quiet prints nothing but errors
+                warnings.simplefilter("ignore", ConfigWarning)
+            return int(args.func(args) or 0)
+    except KeyboardInterrupt:
+        return report("interrupted", interrupts.exit_code())
+    except InfomarketError as exc:
+        if interrupts.requested():  # e.g. a Ctrl-C inside `import duckdb`, raised as "needs DuckDB"
+            return report("interrupted", interrupts.exit_code())
+        # bad input (configuration, options, store) is a ValueError: exit 2; anything else: 1
+        return report(exc)
+    except BrokenPipeError:  # output piped into e.g. `head`: stop quietly, like other Unix tools
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
+    except Exception:
+        if interrupts.requested():  # after a stop signal, an error on the way out is the stop's
+            return report("interrupted", interrupts.exit_code())
+        raise
 
 
 if __name__ == "__main__":  # pragma: no cover

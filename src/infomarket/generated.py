@@ -9,11 +9,8 @@ from __future__ import annotations
 import hashlib
 import importlib.util
 import os
-import signal
 import sys
 import tempfile
-import threading
-from contextlib import contextmanager
 from pathlib import Path
 from types import ModuleType
 
@@ -101,53 +98,11 @@ def generated_digest(source: str):
     return digest
 
 
-# ------------------------------------------------------------------------------ Ctrl-C while compiling
-_LLVMLITE = os.sep + "llvmlite" + os.sep
-
-
-def _in_llvmlite(frame) -> bool:
-    while frame is not None:
-        if _LLVMLITE in frame.f_code.co_filename:
-            return True
-        frame = frame.f_back
-    return False
-
-
-@contextmanager
-def ctrl_c_survives_compiling():
-    """Keep a Ctrl-C that arrives while numba compiles.  LLVM calls back into Python through ctypes
-    (llvmlite's object-cache callbacks); a KeyboardInterrupt raised inside such a callback is printed as
-    "Exception ignored" and lost, and the compile, then the whole run, goes on.  Inside this block a
-    Ctrl-C that finds llvmlite on the stack is sent again a moment later (raised once Python is back
-    outside the callback) and at the latest when the block ends; anywhere else it is raised at once, as
-    usual.  Only in the main thread, and only where Python's own Ctrl-C handler is in place."""
-    if (threading.current_thread() is not threading.main_thread()
-            or signal.getsignal(signal.SIGINT) is not signal.default_int_handler):
-        yield
-        return
-    state = {"pending": False, "timer": None, "inside": True}
-
-    def again() -> None:
-        if state["inside"]:
-            os.kill(os.getpid(), signal.SIGINT)
-
-    def handler(signum, frame):
-        if _in_llvmlite(frame):
-            state["pending"] = True
-            state["timer"] = threading.Timer(0.05, again)
-            state["timer"].daemon = True
-            state["timer"].start()
-            return
-        state["pending"] = False
-        raise KeyboardInterrupt
-
-    signal.signal(signal.SIGINT, handler)
-    try:
-        yield
-    finally:
-        state["inside"] = False
-        if state["timer"] is not None:
-            state["timer"].cancel()
-        signal.signal(signal.SIGINT, signal.default_int_handler)
-    if state["pending"]:
-        raise KeyboardInterrupt
+def compile_marker(module: ModuleType, tag: str) -> Path | None:
+    """The file that notes that ``module``'s functions were compiled (for ``tag``, a use of them) and are
+    in numba's disk cache (``interrupts.compiled_apart``); None when the module is not in the cache folder
+    (compiled in a temporary one: a child's compile would not be found)."""
+    path = Path(module.__file__)
+    if path.parent != cache_dir():
+        return None
+    return path.with_name(f"{path.stem}.{tag}.compiled")

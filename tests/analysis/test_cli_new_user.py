@@ -1,5 +1,4 @@
 """Issue 21: the analysis commands as a new user meets them."""
-import subprocess
 import sys
 
 from infomarket.cli import main
@@ -7,9 +6,8 @@ from infomarket.cli import main
 from .synthetic import paper_like, write_store
 
 
-def test_sensitivity_help_shows_a_plain_percent_sign():
-    out = subprocess.run([sys.executable, "-m", "infomarket.cli", "sensitivity", "--help"],
-                         capture_output=True, text=True, check=True).stdout
+def test_sensitivity_help_shows_a_plain_percent_sign(procs):
+    out = procs.run([sys.executable, "-m", "infomarket.cli", "sensitivity", "--help"], check=True).stdout
     assert "95 % intervals" in " ".join(out.split()) and "%%" not in out
 
 

@@ -15,14 +15,15 @@ Exit status 0 when every mutant is caught (a test guarding it fails) and the unp
 """
 from __future__ import annotations
 
-import os
 import re
-import subprocess
 import sys
 import tempfile
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT))  # a script: the checkout's tests package, for its one way to start a process
+from tests.procs import Procs  # noqa: E402
+
 SOURCE = ROOT / "contracts" / "InformationMarket.sol"
 COMPILER = ROOT / "tools" / "solc" / "compile.js"
 TESTS = ROOT / "tests" / "chain"
@@ -137,18 +138,18 @@ REWRITES = [
 def compile_variant(source: str, workdir: Path, name: str) -> Path:
     sol, out = workdir / f"{name}.sol", workdir / f"{name}.json"
     sol.write_text(source)
-    subprocess.run(["node", str(COMPILER), "--source", str(sol), "--out", str(out), "--allow-warnings"],
-                   check=True, capture_output=True, text=True)
+    with Procs() as procs:
+        procs.run(["node", str(COMPILER), "--source", str(sol), "--out", str(out), "--allow-warnings"], check=True)
     return out
 
 
 def run_tests(artifact: Path, selected: list[str]) -> tuple[int, str]:
     """Run the chain tests whose names contain one of ``selected``; (exit code, summary line)."""
-    env = dict(os.environ, INFOMARKET_CHAIN_ARTIFACT=str(artifact), INFOMARKET_CHAIN_BACKENDS="revm")
+    env = dict(INFOMARKET_CHAIN_ARTIFACT=str(artifact), INFOMARKET_CHAIN_BACKENDS="revm")
     files = [str(TESTS / name) for name in ("test_attacks.py", "test_market.py", "attacks")]
-    done = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", *files,
-                           "-k", " or ".join(selected)],
-                          env=env, capture_output=True, text=True, cwd=ROOT)
+    with Procs() as procs:
+        done = procs.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", *files,
+                          "-k", " or ".join(selected)], env=env, cwd=ROOT)
     summary = done.stdout.strip().splitlines()[-1] if done.stdout.strip() else done.stderr.strip()[-200:]
     return done.returncode, summary
 

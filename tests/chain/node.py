@@ -15,8 +15,9 @@ from pathlib import Path
 
 import pytest
 
+from ..procs import HANG, Procs
+
 TOOLS = Path(__file__).resolve().parents[2] / "tools" / "node"
-START_TIMEOUT_S = 90
 
 
 def _free_port() -> int:
@@ -32,29 +33,21 @@ def running_node():
     if node is None or npm is None:
         pytest.skip("node and npm are not installed: cannot start the JSON-RPC node")
     binary = TOOLS / "node_modules" / ".bin" / "hardhat"
-    if not binary.exists():
-        subprocess.run([npm, "ci", "--no-audit", "--no-fund"], cwd=TOOLS, check=True, capture_output=True)
-    port = _free_port()
-    url = f"http://127.0.0.1:{port}"
-    proc = subprocess.Popen([str(binary), "node", "--hostname", "127.0.0.1", "--port", str(port)], cwd=TOOLS,
-                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
-    try:
+    with Procs() as procs:  # the node, and whatever it started, killed on leaving
+        if not binary.exists():
+            procs.run([npm, "ci", "--no-audit", "--no-fund"], cwd=TOOLS, check=True)
+        port = _free_port()
+        url = f"http://127.0.0.1:{port}"
+        proc = procs.start([binary, "node", "--hostname", "127.0.0.1", "--port", str(port)], cwd=TOOLS,
+                           stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
         from web3 import Web3
 
         w3 = Web3(Web3.HTTPProvider(url))
-        deadline = time.monotonic() + START_TIMEOUT_S
+        deadline = time.monotonic() + HANG
         while not w3.is_connected():
             if proc.poll() is not None:
                 raise RuntimeError(f"the node exited: {proc.stderr.read().decode()[-2000:]}")
             if time.monotonic() > deadline:
-                raise RuntimeError(f"the node did not answer at {url} within {START_TIMEOUT_S} s")
+                raise RuntimeError(f"the node did not answer at {url} within {HANG:.0f} s: it hangs")
             time.sleep(0.2)
         yield url
-    finally:
-        proc.terminate()
-        try:
-            proc.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
-        proc.stderr.close()

@@ -5,7 +5,6 @@ from __future__ import annotations
 import hashlib
 import json
 import shutil
-import subprocess
 from pathlib import Path
 
 import pytest
@@ -32,13 +31,13 @@ def test_compiler_is_pinned_to_one_exact_version():
     assert load_artifact()["compiler"]["version"].startswith(f"{wanted}+commit.")
 
 
-def test_recompiling_reproduces_the_committed_artifact(tmp_path):
+def test_recompiling_reproduces_the_committed_artifact(tmp_path, procs):
     node, npm = shutil.which("node"), shutil.which("npm")
     if node is None or npm is None:
         pytest.skip("node and npm are not installed: cannot recompile the contract to check the artifact")
     if not (TOOLS / "node_modules" / "solc").is_dir():
-        subprocess.run([npm, "ci", "--no-audit", "--no-fund"], cwd=TOOLS, check=True, capture_output=True)
+        procs.run([npm, "ci", "--no-audit", "--no-fund"], cwd=TOOLS, check=True)
     fresh = tmp_path / "InformationMarket.json"
-    subprocess.run([node, str(TOOLS / "compile.js"), "--out", str(fresh)], check=True, capture_output=True)
+    procs.run([node, str(TOOLS / "compile.js"), "--out", str(fresh)], check=True)
     assert json.loads(fresh.read_text()) == load_artifact(), (
         "the committed artifact is stale: run `make contracts` and commit src/infomarket/chain/artifacts")

@@ -1,5 +1,4 @@
 """Malformed experiment files: one clear message naming the key, exit code 2, no traceback, nothing written."""
-import subprocess
 import sys
 from pathlib import Path
 
@@ -45,9 +44,9 @@ def test_bad_file_is_rejected_before_anything_is_written(name, tmp_path, capsys)
     assert not out.exists()
 
 
-def test_real_process_exit_code_and_no_traceback(tmp_path):
-    proc = subprocess.run([sys.executable, "-m", "infomarket.cli", "run", str(BAD / "03_negative_speed.toml"),
-                           "--out", str(tmp_path / "o")], capture_output=True, text=True)
+def test_real_process_exit_code_and_no_traceback(tmp_path, procs):
+    proc = procs.run([sys.executable, "-m", "infomarket.cli", "run", str(BAD / "03_negative_speed.toml"),
+                      "--out", str(tmp_path / "o")])
     assert proc.returncode == 2
     assert "robot.speed" in proc.stderr and "Traceback" not in proc.stderr
     assert not (tmp_path / "o").exists()

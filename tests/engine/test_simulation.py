@@ -1,7 +1,5 @@
 """Whole-run invariants: determinism, money conservation, the plain-Python path, log growth."""
 import json
-import os
-import subprocess
 import sys
 
 import numpy as np
@@ -99,15 +97,14 @@ print(json.dumps({"pos": sim.world.pos.tolist(), "hdir": sim.world.hdir.tolist()
 """
 
 
-def test_plain_python_path_runs_the_same_code():
+def test_plain_python_path_runs_the_same_code(procs):
     """NUMBA_DISABLE_JIT=1 runs the rules and kernels as ordinary Python, with the same numbers: over a
     window with deposits, purchases and refused purchases, positions, items, wealth and every event."""
     from ..engine.test_reference import SETUP
 
     setup = {**SETUP, "transitory": 0, "payment": {**SETUP["payment"], "initial_wealth": 1.0}}
-    env = {**os.environ, "NUMBA_DISABLE_JIT": "1"}
-    proc = subprocess.run([sys.executable, "-c", PLAIN_CODE, json.dumps(setup), str(PLAIN_STEPS)],
-                          capture_output=True, text=True, env=env, timeout=600)
+    proc = procs.run([sys.executable, "-c", PLAIN_CODE, json.dumps(setup), str(PLAIN_STEPS)],
+                     env={"NUMBA_DISABLE_JIT": "1"})
     assert proc.returncode == 0, proc.stderr
     plain = json.loads(proc.stdout)
     sim = im.Simulation(validate(setup), seed=11, record_events=True)

@@ -1,7 +1,6 @@
 """Sweeps into a results store: plans, seeds, executors, resuming, refusing bad input."""
 import os
 import signal
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -15,6 +14,8 @@ from infomarket.errors import ConfigError
 from infomarket.runner.plan import conditions
 from infomarket.runner.sweep import plan, run_sweep
 from infomarket.store import Store
+
+from ..procs import HANG
 
 SWEEP = """
 name = "tiny"
@@ -145,28 +146,27 @@ def test_bad_targets_exit_2(tmp_path, capsys):
     assert main(["sweep", str(path), "--out", str(other), "--quiet"]) == 2
     assert "not an infomarket results store" in capsys.readouterr().err
     assert (other / "notes.txt").read_text() == "mine"
-    t0 = time.monotonic()
     assert main(["sweep", str(path), "--out", str(tmp_path / "d"), "--scheduler", "tcp://127.0.0.1:9", "--quiet"]) == 2
     assert "no Dask scheduler answers" in capsys.readouterr().err
-    assert time.monotonic() - t0 < 60
     assert not (tmp_path / "d").exists()  # nothing written
 
 
-def test_killed_sweep_resumes_with_every_run_exactly_once(tmp_path):
+def test_killed_sweep_resumes_with_every_run_exactly_once(tmp_path, procs):
     path = write(tmp_path, steps=3000, runs=12)
     out = tmp_path / "s"
     cmd = [sys.executable, "-m", "infomarket.cli", "sweep", str(path), "--out", str(out), "--workers", "2"]
     log = open(tmp_path / "log.txt", "w")
-    proc = subprocess.Popen(cmd, stdout=log, stderr=log, start_new_session=True)
-    deadline = time.monotonic() + 300
+    proc = procs.start(cmd, stdout=log, stderr=log)
+    deadline = time.monotonic() + HANG
     while proc.poll() is None and time.monotonic() < deadline and len(list((out / "runs").glob("*.parquet"))) < 2:
         time.sleep(0.05)
     assert proc.poll() is None, (tmp_path / "log.txt").read_text()  # still running: kill it now
-    os.killpg(proc.pid, signal.SIGKILL)  # the sweep and its workers, mid-way
+    for pid in procs.leftovers(proc):  # the sweep and its workers (in process groups of their own), mid-way
+        os.kill(pid, signal.SIGKILL)
     proc.wait()
     committed = len(Store(out).runs())
     assert 0 < committed < 48, "the kill should land in the middle of the sweep"
-    assert subprocess.run(cmd + ["--quiet"], capture_output=True).returncode == 0
+    assert procs.run(cmd + ["--quiet"]).returncode == 0
     runs = Store(out).runs()
     assert len(runs) == 48 and not runs.duplicated(["experiment", "condition", "run"]).any()
     robots = Store(out).robots()

@@ -10,12 +10,12 @@ from infomarket.store import Store
 
 SWEEP = ["--workers", "1", "--quiet"]
 HOLD = """
-import sys, time
+import sys
 from infomarket.store import Store
 s = Store(sys.argv[1]).create()
 with s.lock():
     print("locked", flush=True)
-    time.sleep(120)
+    sys.stdin.read()  # until the test closes it, or kills this process
 """
 
 
@@ -23,16 +23,17 @@ def sweep(exp, out, *extra):
     return main(["sweep", str(exp), "--out", str(out), *SWEEP, *extra])
 
 
-def hold_lock(out):
+def hold_lock(procs, out):
     """A separate process holding the store's lock, as a sweep does while it writes."""
-    proc = subprocess.Popen([sys.executable, "-c", HOLD, str(out)], stdout=subprocess.PIPE, text=True)
+    proc = procs.start([sys.executable, "-c", HOLD, str(out)], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                       text=True)
     assert proc.stdout.readline().strip() == "locked"
     return proc
 
 
-def test_a_second_writer_is_refused_and_a_killed_ones_lock_dies_with_it(tiny, tmp_path, capsys):
+def test_a_second_writer_is_refused_and_a_killed_ones_lock_dies_with_it(tiny, tmp_path, capsys, procs):
     out = tmp_path / "s"
-    holder = hold_lock(out)
+    holder = hold_lock(procs, out)
     try:
         assert sweep(tiny(), out) == 2
         assert "another infomarket process is writing this store" in capsys.readouterr().err

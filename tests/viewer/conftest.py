@@ -10,6 +10,8 @@ from aiohttp import web
 import infomarket as im
 from infomarket.viewer.server import bind, create_app
 
+from ..procs import HANG
+
 
 @pytest.fixture(scope="session")
 def fig2b():
@@ -41,7 +43,7 @@ class ServerThread:
         self.thread.start()
         self._call(self._start())
 
-    def _call(self, coro, timeout=30):
+    def _call(self, coro, timeout=HANG):
         return asyncio.run_coroutine_threadsafe(coro, self.loop).result(timeout)
 
     async def _start(self):

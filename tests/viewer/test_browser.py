@@ -22,6 +22,7 @@ from selenium.webdriver.common.by import By
 
 from infomarket.viewer.recording import record, write_html
 
+from ..procs import HANG
 from .conftest import ServerThread, thousand_robots
 
 CHROMIUM = next(filter(None, (shutil.which(b) for b in ("chromium", "chromium-browser"))), None)
@@ -63,8 +64,8 @@ def driver():
     shutil.rmtree(profile, ignore_errors=True)
 
 
-def wait_for(driver, script, timeout=20.0, what=None):
-    """Poll a JS expression until it is truthy; return its value."""
+def wait_for(driver, script, timeout=HANG, what=None):
+    """Poll a JS expression until it is truthy (``timeout``: a hang guard); return its value."""
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         value = driver.execute_script(f"return {script}")
@@ -152,10 +153,15 @@ def test_live_page_draws_plays_steps_and_inspects_a_robot(driver, server_2b, tmp
 
 
 # Holds every binary message (a frame) back for 1.5 s, so the scene has been drawn long before the first frame.
-DELAY_FRAMES = """
+# Frames (binary messages) are held back until the test calls releaseFrames(): however slow the machine,
+# the page has its scene and no frame for as long as the test looks.
+HOLD_FRAMES = """
 const set = Object.getOwnPropertyDescriptor(WebSocket.prototype, 'onmessage').set;
+const held = [];
+let released = false;
+window.releaseFrames = () => { released = true; held.splice(0).forEach((deliver) => deliver()); };
 Object.defineProperty(WebSocket.prototype, 'onmessage', { configurable: true, set(handler) {
-  set.call(this, (ev) => typeof ev.data === 'string' ? handler(ev) : setTimeout(() => handler(ev), 1500));
+  set.call(this, (ev) => typeof ev.data === 'string' || released ? handler(ev) : held.push(() => handler(ev)));
 }});
 """
 
@@ -164,12 +170,13 @@ def test_frames_drawn_counts_only_drawings_with_robots(driver, fig2b):
     """framesDrawn > 0 promises robots on the canvas: passes drawn while the scene waits for its first frame
     do not count (they did, and the live test once read a blank canvas under CI's load)."""
     server = ServerThread(fig2b, seed=2)
-    script = driver.execute_cdp_cmd("Page.addScriptToEvaluateOnNewDocument", {"source": DELAY_FRAMES})
+    script = driver.execute_cdp_cmd("Page.addScriptToEvaluateOnNewDocument", {"source": HOLD_FRAMES})
     try:
         driver.get(server.url)
         wait_for(driver, "window.infomarketViewer && infomarketViewer.robots === 25", what="the scene")
         time.sleep(0.4)  # several animation frames with the scene and no frame yet
         assert driver.execute_script("return [infomarketViewer.ready, infomarketViewer.framesDrawn]") == [False, 0]
+        driver.execute_script("releaseFrames()")
         wait_for(driver, "infomarketViewer.framesDrawn > 0", what="the first frame drawn")
         blue, red = driver.execute_script(COUNT_COLOURS)
         assert blue > 24 * 15 and red > 10, f"robot discs on the canvas: {blue} blue, {red} red pixels"
@@ -189,7 +196,9 @@ def test_playing_draws_new_frames(driver, fig2b, robots, record_property):
         assert driver.execute_script("return infomarketViewer.robots") == robots
         driver.find_element(By.ID, "play").click()
         wait_for(driver, "infomarketViewer.step > 50", what="playing")
+        drawn = driver.execute_script("return infomarketViewer.framesDrawn")
         fps, steps_per_s, raf = measure_fps(driver)
+        wait_for(driver, f"infomarketViewer.framesDrawn > {drawn}", what="a new frame drawn while playing")
         driver.find_element(By.ID, "play").click()
     finally:
         server.stop()
@@ -198,7 +207,6 @@ def test_playing_draws_new_frames(driver, fig2b, robots, record_property):
     assert not js_errors(driver), "the server closes the socket cleanly"
     record_property(f"fps_{robots}", round(fps, 1))
     print(f"\n{robots} robots: {fps:.1f} frames/s drawn, {steps_per_s:.0f} steps/s, rAF {raf:.0f}/s")
-    assert fps > 0 and steps_per_s > 0, f"{robots} robots: no new frame drawn in 3 s of playing"
 
 
 def test_replay_opens_from_disk_and_plays(driver, fig2b, tmp_path):

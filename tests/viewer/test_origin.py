@@ -10,6 +10,8 @@ from aiohttp.test_utils import TestClient, TestServer
 
 from infomarket.viewer.server import create_app
 
+from ..procs import HANG
+
 
 def run(coro):
     return asyncio.run(asyncio.wait_for(coro, 60))
@@ -69,7 +71,7 @@ def test_a_websocket_from_the_viewers_own_page_is_served(fig2b):
         try:
             own = f"http://127.0.0.1:{client.port}"
             ws = await client.ws_connect("/ws", origin=own)
-            msg = await ws.receive_json(timeout=30)
+            msg = await ws.receive_json(timeout=HANG)
             assert msg["type"] == "scene" and msg["name"] == "fig2B"
             await ws.close()
         finally:

@@ -3,12 +3,9 @@ from __future__ import annotations
 
 import asyncio
 import json
-import os
 import signal
 import socket
 import subprocess
-import sys
-import time
 
 import aiohttp
 import numpy as np
@@ -20,11 +17,13 @@ import infomarket as im
 from infomarket.viewer.frames import decode, encode
 from infomarket.viewer.server import MAX_IN_FLIGHT, bind, create_app, serve
 
+from ..procs import HANG
+
 N = 25
 
 
 def run(coro):
-    return asyncio.run(asyncio.wait_for(coro, 60))
+    return asyncio.run(asyncio.wait_for(coro, HANG))
 
 
 async def client_for(config, seed=2, **kw) -> TestClient:
@@ -33,7 +32,7 @@ async def client_for(config, seed=2, **kw) -> TestClient:
     return client
 
 
-async def recv(ws, timeout=10.0):
+async def recv(ws, timeout=HANG):
     """('json', dict) or ('frame', Frame)."""
     msg = await ws.receive(timeout=timeout)
     if msg.type == WSMsgType.BINARY:
@@ -95,7 +94,7 @@ def test_greeting_describes_the_run_and_frames_come_from_the_engine(fig2b):
             assert scene["kind"].count(1) == 1 and len(scene["bias"]) == N
             assert first.step == 0
             await ws.send_json({"cmd": "step", "n": 37})
-            raw = await ws.receive(timeout=10)
+            raw = await ws.receive(timeout=HANG)
             assert raw.type == WSMsgType.BINARY
             status = await expect(ws, "json", "status")
             assert status["step"] == 37 and not status["playing"]
@@ -257,48 +256,36 @@ def test_server_stops_when_the_last_page_closes(fig2b):
             ws = await http.ws_connect(url + "ws")
             await expect(ws, "json", "scene")
             await ws.close()
-        await asyncio.wait_for(task, 10)
+        await asyncio.wait_for(task, HANG)
 
     run(go())
     assert any("last page was closed" in s for s in said)
 
 
-def _ignore_ctrl_c() -> None:
-    """What a script's background job (or a test runner's worker) may hand its children."""
-    signal.signal(signal.SIGINT, signal.SIG_IGN)
-
-
-@pytest.mark.parametrize("sig,inherit", [(signal.SIGINT, None), (signal.SIGTERM, None),
-                                         (signal.SIGINT, _ignore_ctrl_c)],
+@pytest.mark.parametrize("sig,ignored", [(signal.SIGINT, False), (signal.SIGTERM, False), (signal.SIGINT, True)],
                          ids=["ctrl-c", "sigterm", "ctrl-c-after-a-parent-ignored-it"])
-def test_view_command_prints_the_url_and_stops_cleanly_on_a_signal(sig, inherit):
-    env = {**os.environ, "PYTHONUNBUFFERED": "1"}
-    proc = subprocess.Popen([sys.executable, "-m", "infomarket.cli", "view", "fig2B", "--port", "0"],
-                            stderr=subprocess.PIPE, stdout=subprocess.PIPE, text=True, env=env,
-                            preexec_fn=inherit)
-    try:
-        url = None
-        deadline = time.monotonic() + 60
-        lines = []
-        while url is None and time.monotonic() < deadline:
-            line = proc.stdout.readline()  # the address is on stdout (issue 21), progress on stderr
-            if not line:
-                break
-            lines.append(line)
-            if "open http://127.0.0.1:" in line:
-                url = line.split("open ")[1].strip()
-        assert url, "".join(lines)
-        host, port = url.removeprefix("http://").rstrip("/").split(":")
-        with socket.create_connection((host, int(port)), timeout=5):
-            pass  # it listens, on loopback
-        proc.send_signal(sig)
-        rest = proc.communicate(timeout=30)[1]  # a hang guard
-        assert proc.returncode == 0, rest
-        assert "viewer stopped" in rest and "Traceback" not in rest
-    finally:
-        if proc.poll() is None:
-            proc.kill()
-            proc.wait()
+def test_view_command_prints_the_url_and_stops_cleanly_on_a_signal(sig, ignored, procs):
+    """``ignored``: what a script's background job (or a test runner's worker) may hand its children."""
+    proc = procs.cli("view", "fig2B", "--port", "0", env={"PYTHONUNBUFFERED": "1"}, ignore_ctrl_c=ignored,
+                     stderr=subprocess.PIPE, stdout=subprocess.PIPE, text=True)
+    url = None
+    lines = []
+    while url is None:
+        line = proc.stdout.readline()  # the address is on stdout (issue 21), progress on stderr
+        if not line:
+            break
+        lines.append(line)
+        if "open http://127.0.0.1:" in line:
+            url = line.split("open ")[1].strip()
+    assert url, "".join(lines)
+    host, port = url.removeprefix("http://").rstrip("/").split(":")
+    with socket.create_connection((host, int(port)), timeout=HANG):
+        pass  # it listens, on loopback
+    proc.send_signal(sig)
+    rest = proc.communicate(timeout=HANG)[1]
+    assert proc.returncode == 0, rest
+    assert "viewer stopped" in rest and "Traceback" not in rest
+    assert procs.leftovers(proc) == []
 
 
 def test_frames_go_uncompressed_even_when_the_page_offers_deflate(fig2b):

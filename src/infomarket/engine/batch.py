@@ -91,6 +91,11 @@ class Simulations:
         self._clocks = np.zeros(len(self.sims), np.int64)
         self._seconds = np.zeros(len(self.sims))  # each run's share of the calls' seconds (``run``)
 
+    @property
+    def batch(self):
+        """The generated module whose ``step_all`` steps these runs (``batch_module``)."""
+        return self._batch
+
     def __len__(self) -> int:
         return len(self.sims)
 

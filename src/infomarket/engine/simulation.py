@@ -24,13 +24,19 @@ from ..config.load import load_experiment
 from ..errors import ArgumentError, ConfigError, InputTypeError, SimulationError
 from ..registry import behaviours
 from . import specialise
-from ..generated import ctrl_c_survives_compiling
+from .. import interrupts
+from ..generated import compile_marker
 from ..seeds import MAX_SEED
 from ..state.flags import ErrorFlags
 from .build import build_world, make_room, room_of, with_room
 from .params import behaviour_kinds, behaviour_table, build_params
 from .world import EVENT_NAMES, SITE_NAMES, STATE_NAMES, headings, kernel_view
 from ..config.load import validate
+
+
+#: Robot-steps one kernel call may run (``Simulation.advance_to``): a bound on the work between two
+#: moments when Python can act on a signal, small beside a run and large beside a call's own cost.
+CALL_ROBOT_STEPS = 1 << 17
 
 
 @dataclass
@@ -81,11 +87,10 @@ class Simulation:
         self.reset(config.seed if seed is None else seed)
         t0 = time.perf_counter()
         try:
-            with compile_notice(self.kinds, config.payment.scheme), ctrl_c_survives_compiling():
+            with compile_notice(self.kinds, config.payment.scheme):
                 self._kernel = specialise.kernel_module(self.kinds, config.payment.scheme, config.terrain,
                                                         config.chain.enabled)
-                self._view = kernel_view(self.world)
-                self._kernel.run_steps(self._view, self.rng, 0)  # compile or load from cache; runs no step
+                self._view = interrupts.compiled_apart(self._load, compile_marker(self._kernel, "simulation"))
         except Exception as exc:  # a rule that keeps the kernel from compiling: named
             raise _explained(config, self.seed, exc) from exc
         self.compile_seconds = time.perf_counter() - t0
@@ -117,6 +122,13 @@ class Simulation:
         sim.reset(seed)
         return sim
 
+    def _load(self):
+        """The world's kernel view, with the view constructor and the step loop compiled or loaded from
+        the cache (a call that runs no step); a stop signal meanwhile stops it (``interrupts``)."""
+        view = kernel_view(self.world)
+        self._kernel.run_steps(view, self.rng, 0)
+        return view
+
     @property
     def kernel_source(self) -> Path:
         """The generated module this simulation's loop was compiled from (its header names every source)."""
@@ -133,15 +145,23 @@ class Simulation:
         self.advance_to(self.clock + int(k))
 
     def advance_to(self, t_end: int) -> None:
+        """Run to step ``t_end`` in kernel calls of at most ``CALL_ROBOT_STEPS`` robot-steps each: Python,
+        and so Ctrl-C (``interrupts``), gets control between calls, however long the run (the kernel
+        resumes exactly where it stopped, so the calls do not change the run)."""
         t0 = time.perf_counter()
+        per_call = max(1, CALL_ROBOT_STEPS // max(1, self.world.pos.shape[0]))
         while True:
+            stop = min(t_end, self.clock + per_call)
             try:
-                status = self._kernel.run_steps(self._view, self.rng, t_end)
+                status = self._kernel.run_steps(self._view, self.rng, stop)
                 self.check_flags()
             except Exception as exc:  # a rule's error, or an error bit a rule set: named with the step
                 raise _explained(self.config, self.seed, exc, self) from exc
+            interrupts.check()  # between kernel calls: a stop asked for while the kernel ran
             if status == self._kernel.DONE:
-                break
+                if stop >= t_end:
+                    break
+                continue
             self.grow()
         if t_end >= self.config.steps:
             self.remember_room()

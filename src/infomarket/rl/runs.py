@@ -24,6 +24,8 @@ from ..engine.params import behaviour_kinds
 from ..engine.batch import Simulations
 from ..engine.simulation import as_experiment, compile_notice
 from ..errors import ConfigError
+from .. import interrupts
+from ..generated import compile_marker
 from ..registry import behaviours, get_behaviour
 from .observe import OBSERVATION
 from ..runner.plan import conditions
@@ -97,7 +99,9 @@ class Runs:
         self.items = np.zeros(self.size, np.int64)
         self.shares = np.zeros((self.size, a))
         self.seeds = np.zeros(self.size, np.int64)
-        self.reset(np.arange(self.size), np.arange(self.size))
+        # the first observation compiles (or loads) step_all: in a child a signal can stop at once
+        interrupts.compiled_apart(lambda: self.reset(np.arange(self.size), np.arange(self.size)),
+                                  compile_marker(self.sims.batch, "runs"))
 
     @property
     def worlds(self) -> list:

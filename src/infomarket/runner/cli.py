@@ -3,10 +3,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from .. import interrupts
 from ..cliargs import UsageError, at_least, fraction, seed_value
 from ..errors import EXIT_FAILED, EXIT_USAGE, report
-
-EXIT_INTERRUPTED = 130
 
 PAPER = ("fig2A", "fig2B", "fig2C", "fig2D", "fig3A", "fig3B", "fig3C", "fig4A", "fig4B", "fig4C",
          "fig5", "fig6A", "fig6B", "fig7")
@@ -72,7 +71,7 @@ def _execute(experiments, args, label: str) -> int:
                              on_plan=lambda todo: bar.skip(total - todo),
                              record_events=args.events, retry_failed=args.retry_failed)
     except KeyboardInterrupt:
-        return report(_interrupted(store, conds, total, args), EXIT_INTERRUPTED)
+        return report(_interrupted(store, conds, total, args), interrupts.exit_code())
     finally:
         if client is not None:
             client.close()

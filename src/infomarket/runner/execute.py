@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from .. import plugins
+from .. import interrupts, plugins
 from ..config.schema import Experiment
 from ..engine.batch import Simulations
 from ..engine.simulation import Simulation
@@ -258,9 +258,12 @@ def default_workers() -> int:
 
 
 def process_pool(workers: int) -> ProcessPoolExecutor:
-    """A local pool.  On Linux workers are forked, so kernels already loaded here cost them nothing."""
+    """A local pool.  On Linux workers are forked, so kernels already loaded here cost them nothing.  Each
+    worker is detached (``interrupts.detach``: its own process group, default signal dispositions, dies
+    with this process), so Ctrl-C reaches this process alone, which then ends the workers (``stop_pool``)."""
     ctx = multiprocessing.get_context("fork") if sys.platform.startswith("linux") else None
-    return ProcessPoolExecutor(max_workers=workers, mp_context=ctx)
+    return ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=interrupts.detach,
+                               initargs=(os.getpid(),))
 
 
 @contextmanager
@@ -281,16 +284,14 @@ def local_executor(workers: int):
 
 
 def stop_pool(pool: ProcessPoolExecutor) -> None:
-    """Cancel what has not started and end the workers now (``terminate_workers`` from Python 3.14)."""
-    if hasattr(pool, "terminate_workers"):
-        pool.terminate_workers()
-        return
+    """Cancel what has not started and end the workers now: SIGKILL to each worker's process group, which
+    no worker can delay (a worker inside a kernel runs no Python), then reap them."""
     processes = list((getattr(pool, "_processes", None) or {}).values())
     pool.shutdown(wait=False, cancel_futures=True)
     for proc in processes:
-        proc.terminate()
+        interrupts.kill_group(proc.pid)
     for proc in processes:
-        proc.join(timeout=10)
+        proc.join()  # SIGKILL cannot be caught or ignored: each ends
 
 
 # ---------------------------------------------------------------------------------------- warm-up
@@ -365,18 +366,20 @@ def execute(tasks: list[Task], finished: Callable[[Task, list[RunOutput]], None]
     if executor is None or isinstance(executor, InlineExecutor):  # no other process: nothing to warm
         for t in tasks:
             finished(t, run_calls(_calls(t, record_events)))
+            interrupts.check()
         return 0.0
     warm_seconds = sum(warm_up(c.config for t in tasks for c, _ in t.members).values())
     futures: dict[Future, Task] = {}
     try:
         for t in tasks:
             futures[executor.submit(run_calls, _calls(t, record_events))] = t
-        for fut in as_completed(futures):
+        for fut in as_completed(futures):  # the wait is interrupted by a signal at once
             finished(futures[fut], fut.result())
-    except BaseException:
+            interrupts.check()
+    except BaseException as exc:
         for f in futures:
             f.cancel()
-        raise
+        interrupts.raise_stopped(exc)
     return warm_seconds
 
 

@@ -54,7 +54,7 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from .. import __version__
+from .. import __version__, interrupts
 from ..errors import InfomarketError
 from .dictionary import TABLES as TABLES_DICT
 from .dictionary import annotate
@@ -556,7 +556,8 @@ class Store:
         if not query.strip():
             raise SqlError("the query is empty; e.g. \"SELECT count(*) FROM robots\"")
         try:
-            import duckdb
+            with interrupts.held():  # DuckDB's import breaks (an abort) when a KeyboardInterrupt lands in it
+                import duckdb
         except ImportError:
             raise StoreError("Store.sql needs DuckDB: pip install 'infomarket[sql]'") from None
         self._require()
@@ -581,7 +582,8 @@ class Store:
             con.execute("SET enable_external_access = false")
             con.execute("SET lock_configuration = true")
             try:
-                result = con.execute(query)
+                # in a thread: DuckDB does not look at signals, so Ctrl-C interrupts the query (interrupts.wait_for)
+                result = interrupts.wait_for(lambda: con.execute(query), con.interrupt)
                 if result is None or result.description is None:  # only ';' or comments: no statement
                     raise SqlError(f"the query {query.strip()[:60]!r} holds no SQL statement that returns rows; "
                                    f"e.g. \"SELECT count(*) FROM robots\"")
@@ -590,7 +592,10 @@ class Store:
                 raise SqlError(f"{self.root}: the query failed: {exc} (tables: "
                                f"{', '.join(r[0] for r in con.execute('SHOW TABLES').fetchall())})") from None
         finally:
-            con.close()
+            try:
+                con.close()
+            except duckdb.Error:  # still busy with a query that Ctrl-C interrupted (interrupts.wait_for)
+                pass
 
     def runs(self) -> pd.DataFrame:
         """One row per committed run, ``status`` ``ok`` or ``failed`` (then ``error`` says why)."""

@@ -67,17 +67,6 @@ def _warm_up(cfg, seed: int | None) -> None:
 
 
 # ---------------------------------------------------------------------------------------------- view
-def _ctrl_c_works() -> None:
-    """The viewer says "press Ctrl-C to stop", so make it true even when the parent left SIGINT ignored
-    or blocked (a background job of a script, some test runners): asyncio only turns SIGINT into a
-    clean stop when its handler is Python's default one."""
-    import signal
-
-    if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
-        signal.signal(signal.SIGINT, signal.default_int_handler)
-    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
-
-
 def _quiet(args) -> None:
     global QUIET
     QUIET = bool(getattr(args, "quiet", False))
@@ -92,8 +81,7 @@ def cmd_view(args) -> int:
     except ImportError as exc:  # aiohttp is a dependency; say so rather than show a traceback
         raise InfomarketError(f"the viewer needs the aiohttp package ({exc}); pip install aiohttp") from None
     cfg = _load(args.experiment)
-    _ctrl_c_works()
-    _warm_up(cfg, args.seed)
+    _warm_up(cfg, args.seed)  # a signal meanwhile stops it at once (cli.main's interrupts.handling)
     try:
         asyncio.run(serve(cfg, args.seed, port=args.port, keep_running=args.keep_running, say=_say,
                           announce=_announce))

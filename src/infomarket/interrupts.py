@@ -1,0 +1,287 @@
+"""Ctrl-C and SIGTERM stop every infomarket command at once, whatever it is doing, without a race.
+
+Python turns SIGINT into ``KeyboardInterrupt``, but only when the main thread runs Python bytecode, and an
+exception raised there is not always delivered.  A command spends its time in three places where that
+fails, and each has its own remedy here, none of which waits for or guesses at a moment:
+
+* **Compiling** (numba and LLVM, up to a minute for a step kernel on a busy machine) runs in C: no Python
+  handler can run until it ends.  ``compiled_apart`` compiles in a forked child and waits for it; the wait
+  is a system call that a signal interrupts, so the parent kills the child's process group at once and
+  stops.  A child that finished has written numba's disk cache, from which the parent then loads.
+* **LLVM's callbacks into Python** (llvmlite's object cache, through ctypes): an exception raised inside
+  one is printed as "Exception ignored" and dropped, and the compile goes on.  The handler never raises
+  while llvmlite is on the stack: it sets a profile function (``sys.setprofile``) that raises at the
+  first call or return made with no llvmlite frame left, i.e. as soon as Python is out of llvmlite.
+  Nothing is timed and nothing is sent again.
+* **Pool workers and children**: ``detach`` puts each in its own process group with the default
+  dispositions (a signal ends it at once, even inside a kernel), and makes it die with its parent
+  (Linux ``PR_SET_PDEATHSIG``); the parent ends them with SIGKILL to their group (``kill_group``).
+
+A stretch that an exception must not land in (DuckDB's import aborts when one does) runs in ``held()``,
+whose end raises a stop that came meanwhile.  The request to stop is sticky: ``check`` raises again at the safe points (after each kernel call, after
+each finished task), so a ``KeyboardInterrupt`` lost anyway (raised inside a finalizer, say) cannot let a
+command run on.  SIGTERM takes the same path as Ctrl-C (finished work kept, the resume command printed)
+and exits with 143 instead of 130.
+
+``handling()`` is active for the duration of one command line (``cli.main``); elsewhere (the Python API,
+tests) nothing here changes Python's own behaviour.
+"""
+from __future__ import annotations
+
+import contextlib
+import ctypes
+import os
+import signal
+import sys
+import threading
+from collections.abc import Callable
+from pathlib import Path
+from typing import TypeVar
+
+T = TypeVar("T")
+SIGNALS = (signal.SIGINT, signal.SIGTERM)
+_LLVMLITE = os.sep + "llvmlite" + os.sep
+_PR_SET_PDEATHSIG = 1
+
+
+class _State:
+    active = False  # handling() is in force in this process
+    signum = 0  # the first stop signal received while active (sticky)
+    profile = None  # the profile function ``_deliver`` stands in for
+    held = False  # the stop signals are blocked for a fork (``_before_fork``)
+    deferred = False  # inside ``held()``: a stop is noted, raised at its end
+
+
+class Stop:
+    """What ``handling()`` yields: ``signum``, the stop signal received in the block (0: none), kept after it."""
+
+    signum = 0
+
+
+_state = _State()
+
+
+# ------------------------------------------------------------------------------------------ handler
+def _in_llvmlite(frame) -> bool:
+    while frame is not None:
+        if _LLVMLITE in frame.f_code.co_filename:
+            return True
+        frame = frame.f_back
+    return False
+
+
+def _handler(signum, frame) -> None:
+    _state.signum = _state.signum or signum
+    if _state.deferred:  # inside ``held``: raised when it ends
+        return
+    if _in_llvmlite(frame):  # raised here it would be dropped: raise it at the first event outside llvmlite
+        if sys.getprofile() is not _deliver:
+            _state.profile = sys.getprofile()
+            sys.setprofile(_deliver)
+        return
+    raise KeyboardInterrupt
+
+
+def _deliver(frame, event, arg) -> None:
+    """A profile function, set only after a stop landed in llvmlite: at the first call or return with no
+    llvmlite frame on the stack it puts the previous profile function back and raises there."""
+    if _in_llvmlite(frame):
+        return
+    sys.setprofile(_state.profile)
+    raise KeyboardInterrupt
+
+
+@contextlib.contextmanager
+def handling():
+    """SIGINT and SIGTERM stop the command (``KeyboardInterrupt``) while the block runs, even where the
+    parent left SIGINT ignored or blocked (a script's background job): a command that cannot be stopped
+    is worse.  The previous handlers are put back after it.  Main thread only; elsewhere it does nothing."""
+    stop = Stop()
+    if threading.current_thread() is not threading.main_thread() or _state.active:
+        yield stop
+        return
+    before = {s: signal.getsignal(s) for s in SIGNALS}
+    _state.active, _state.signum = True, 0
+    for s in SIGNALS:
+        signal.signal(s, _handler)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, set(SIGNALS))
+    try:
+        yield stop
+    finally:
+        for s, h in before.items():
+            signal.signal(s, h if h is not None else signal.SIG_DFL)
+        if sys.getprofile() is _deliver:
+            sys.setprofile(_state.profile)
+        stop.signum = _state.signum
+        _state.active, _state.signum = False, 0
+
+
+@contextlib.contextmanager
+def held():
+    """A stop held back for the block: for a stretch that an exception must not land in, e.g. a C
+    extension's import that aborts the program when one does; a stop meanwhile is raised when the block
+    ends, so it is delayed, never lost.  Main thread, inside ``handling`` only."""
+    if not _state.active or _state.deferred or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    _state.deferred = True  # the handler notes the stop and returns (another thread may take the signal)
+    try:
+        yield
+    finally:
+        _state.deferred = False
+    check()
+
+
+def requested() -> int:
+    """The stop signal received (0: none) while ``handling()`` is in force."""
+    return _state.signum
+
+
+def check() -> None:
+    """A safe point: raise ``KeyboardInterrupt`` if a stop was asked for (again, if one was lost)."""
+    if _state.signum:
+        raise KeyboardInterrupt
+
+
+def raise_stopped(exc: BaseException):
+    """Raise ``exc`` as the stop it is: a ``KeyboardInterrupt`` when a stop signal came (a signal that lands
+    inside threading's own bookkeeping can surface as another error, e.g. "release unlocked lock")."""
+    if _state.signum and not isinstance(exc, KeyboardInterrupt):
+        raise KeyboardInterrupt from exc
+    raise exc
+
+
+def exit_code() -> int:
+    """The exit status of a stopped command: 128 + the signal (130 for Ctrl-C, 143 for SIGTERM)."""
+    return 128 + (_state.signum or signal.SIGINT)
+
+
+def exit_now(code: int) -> None:
+    """End the program now, after a stop: what it keeps is committed, its children are ended and its
+    files closed, so the interpreter's own teardown (finalizers of numba's and LLVM's objects, seconds
+    on a loaded machine) would only delay the exit.  Only for the program itself, never a library call."""
+    for stream in (sys.stdout, sys.stderr):
+        with contextlib.suppress(Exception):
+            stream.flush()
+    os._exit(code)
+
+
+def _before_fork() -> None:
+    """Signals held while a command forks: between the fork and the child's own setup a signal to the
+    command's process group reaches the child too, where the command's handler would raise inside the
+    fork's bookkeeping (printed as "Exception ignored")."""
+    if _state.active:
+        _state.held = True
+        signal.pthread_sigmask(signal.SIG_BLOCK, set(SIGNALS))
+
+
+def _after_fork_in_parent() -> None:
+    if _state.held:
+        _state.held = False
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, set(SIGNALS))
+
+
+def _after_fork_in_child() -> None:
+    """In every forked child of a command: the default dispositions (a signal ends it at once, quietly),
+    no stop inherited; then the signals held for the fork are let through."""
+    if _state.active:
+        for s in SIGNALS:
+            signal.signal(s, signal.SIG_DFL)
+        _state.active, _state.signum = False, 0
+    if _state.held:
+        _state.held = False
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, set(SIGNALS))
+
+
+if hasattr(os, "register_at_fork"):
+    os.register_at_fork(before=_before_fork, after_in_parent=_after_fork_in_parent,
+                        after_in_child=_after_fork_in_child)
+
+
+# ----------------------------------------------------------------------------------------- children
+def detach(parent: int | None = None) -> None:
+    """In a freshly forked child (a pool worker, a compile): its own process group, so a terminal's Ctrl-C
+    reaches only the command, which then ends the group; the default signal dispositions; and death with
+    ``parent`` (Linux), so that no child outlives a command killed outright."""
+    for s in SIGNALS:
+        signal.signal(s, signal.SIG_DFL)
+    with contextlib.suppress(OSError):
+        os.setpgid(0, 0)
+    if sys.platform.startswith("linux"):
+        with contextlib.suppress(OSError, AttributeError):
+            ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, signal.SIGKILL, 0, 0, 0)
+    if parent is not None and os.getppid() != parent:  # the parent died before the line above
+        os._exit(1)
+
+
+def kill_group(pid: int) -> None:
+    """SIGKILL the process ``pid`` and its process group (one that ``detach`` made): cannot be caught,
+    so it ends the child even inside compiled code."""
+    for kill in (os.killpg, os.kill):
+        with contextlib.suppress(ProcessLookupError, PermissionError):
+            kill(pid, signal.SIGKILL)
+
+
+def compiled_apart(compile_: Callable[[], T], marker: Path | None) -> T:
+    """``compile_()``, whose first call in a process compiles and caches on disk, made stoppable: while a
+    command is running (``handling``) and ``marker`` does not exist yet, it is first run in a forked
+    child (which creates ``marker`` when it succeeds), so a signal during the compile kills the child at
+    once; then it runs here, loading from the cache.  A child that failed leaves the error to the call
+    here.  ``marker`` None (not cacheable), outside a command, off the main thread or without ``fork``:
+    just ``compile_()``."""
+    if (marker is None or not _state.active or marker.exists() or not hasattr(os, "fork")
+            or threading.current_thread() is not threading.main_thread()):
+        return _here(compile_)
+    parent = os.getpid()
+    pid = os.fork()
+    if pid == 0:  # pragma: no cover - the child (its coverage is not collected)
+        code = 1
+        try:
+            detach(parent)
+            compile_()
+            marker.touch()
+            code = 0
+        finally:
+            os._exit(code)
+    try:
+        os.waitpid(pid, 0)  # a signal raises KeyboardInterrupt here, at once
+    except BaseException:
+        kill_group(pid)
+        with contextlib.suppress(ChildProcessError):
+            os.waitpid(pid, 0)
+        raise
+    return _here(compile_)
+
+
+def _here(compile_: Callable[[], T]) -> T:
+    check()
+    out = compile_()
+    check()  # a stop that came in an LLVM callback near the end is raised here at the latest
+    return out
+
+
+def wait_for(call: Callable[[], T], cancel: Callable[[], object]) -> T:
+    """``call()`` (a blocking call into a library that does not look at signals, e.g. a DuckDB query) run
+    in a thread while this thread waits: a signal stops the wait at once, ``cancel()`` asks the library
+    to stop, and ``KeyboardInterrupt`` propagates without waiting for it (a cancel that came before the
+    library's call began may be ignored: the thread then ends with the call, or with the program)."""
+    check()  # a stop swallowed before the call (the call itself would never see it)
+    box: dict[str, object] = {}
+
+    def work() -> None:
+        try:
+            box["value"] = call()
+        except BaseException as exc:  # noqa: BLE001 - handed to the waiting thread
+            box["error"] = exc
+
+    try:
+        thread = threading.Thread(target=work, daemon=True, name="infomarket-wait")
+        thread.start()
+        thread.join()  # a plain lock wait, which a signal interrupts cleanly
+    except BaseException as exc:
+        with contextlib.suppress(Exception):
+            cancel()
+        raise_stopped(exc)
+    if "error" in box:
+        raise box["error"]
+    return box["value"]

@@ -1,0 +1,118 @@
+"""``infomarket.interrupts``: a stop is never lost, a compile in a child is killed at once, and ``store sql``
+stops on Ctrl-C in the middle of a query (a library's blocking call left at once: ``wait_for``)."""
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import threading
+import time
+from pathlib import Path
+
+import pytest
+
+from infomarket import interrupts
+
+from .analysis.synthetic import paper_like, write_store
+from .procs import HANG, catches, session_members
+
+
+def _signal_when(event: threading.Event, sig=signal.SIGINT) -> threading.Thread:
+    """A thread that sends ``sig`` to this process once ``event`` is set."""
+    def send():
+        if event.wait(HANG):
+            os.kill(os.getpid(), sig)
+
+    t = threading.Thread(target=send, daemon=True)
+    t.start()
+    return t
+
+
+def test_a_stop_is_sticky_and_handling_puts_the_handlers_back():
+    before = signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)
+    with interrupts.handling() as stop:
+        try:
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(HANG)  # interrupted by the handler's KeyboardInterrupt
+        except KeyboardInterrupt:
+            pass  # swallowed, as a finalizer would
+        assert interrupts.requested() == signal.SIGTERM and interrupts.exit_code() == 143
+        with pytest.raises(KeyboardInterrupt):
+            interrupts.check()  # raised again at the next safe point
+        with pytest.raises(KeyboardInterrupt):
+            interrupts.check()
+    assert stop.signum == signal.SIGTERM
+    assert (signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)) == before
+    interrupts.check()  # outside a command nothing is pending
+    assert interrupts.requested() == 0 and interrupts.exit_code() == 130
+
+
+def test_a_compile_in_a_child_is_killed_at_once_and_a_finished_one_is_loaded_here(tmp_path):
+    """The child blocks for ever where a compile would run for a minute: a signal to the command kills
+    it (it is reaped, no marker); a child that finishes leaves the marker, and the call then runs here."""
+    parent = os.getpid()
+    calls = tmp_path / "calls"
+    calls.mkdir()
+    child_started = threading.Event()
+
+    def compile_forever():
+        (calls / str(os.getpid())).touch()
+        if os.getpid() != parent:
+            while True:
+                time.sleep(1)
+        return "here"
+
+    def watch():
+        deadline = time.monotonic() + HANG
+        while not [p for p in calls.iterdir() if int(p.name) != parent] and time.monotonic() < deadline:
+            time.sleep(0.01)
+        child_started.set()
+
+    threading.Thread(target=watch, daemon=True).start()
+    _signal_when(child_started)
+    marker = tmp_path / "kernel.simulation.compiled"
+    try:
+        with interrupts.handling(), pytest.raises(KeyboardInterrupt):
+            interrupts.compiled_apart(compile_forever, marker)
+        child = int(next(p.name for p in calls.iterdir()))
+        assert child != parent and not Path(f"/proc/{child}").exists()  # killed and reaped
+        assert not marker.exists()
+    finally:
+        for p in calls.iterdir():
+            if int(p.name) != parent and Path(f"/proc/{p.name}").exists():
+                os.kill(int(p.name), signal.SIGKILL)
+
+    for p in calls.iterdir():
+        p.unlink()
+    with interrupts.handling():
+        assert interrupts.compiled_apart(lambda: (calls / str(os.getpid())).touch() or "loaded", marker) == "loaded"
+        assert marker.exists() and len(list(calls.iterdir())) == 2  # the child's call, then this one
+        for p in calls.iterdir():
+            p.unlink()
+        assert interrupts.compiled_apart(lambda: (calls / str(os.getpid())).touch() or "again", marker) == "again"
+        assert [p.name for p in calls.iterdir()] == [str(parent)]  # marked: no child any more
+    assert interrupts.compiled_apart(lambda: "plain", None) == "plain"  # outside a command: just the call
+
+
+def _threads(pid: int) -> int:
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except OSError:
+        return 0
+    return int(next(line.split()[1] for line in status.splitlines() if line.startswith("Threads:")))
+
+
+def test_ctrl_c_stops_store_sql_in_the_middle_of_a_query(tmp_path, procs):
+    store = write_store(tmp_path / "s", paper_like(), only=("fig2A",))
+    endless = "SELECT sum(a.range * b.range) FROM range(1000000000) a, range(1000000000) b"
+    proc = procs.cli("store", "sql", store.root, endless, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + HANG
+    while not (catches(proc.pid, signal.SIGTERM) and _threads(proc.pid) > 3) and proc.poll() is None \
+            and time.monotonic() < deadline:
+        time.sleep(0.01)  # until the command has started and DuckDB's threads are there; the query never ends
+    assert proc.poll() is None, proc.communicate()
+    os.killpg(proc.pid, signal.SIGINT)
+    out, err = proc.communicate(timeout=HANG)
+    assert proc.returncode == 130, err
+    assert err == "infomarket: error: interrupted\n" and out == ""
+    assert session_members(proc.pid) == []
