@@ -47,10 +47,10 @@ tools/solc/node_modules: tools/solc/package.json tools/solc/package-lock.json
 # Gas with cold storage per transaction (revm, sizes 1-512, small sizes cross-checked on py-evm, the bound at
 # 512 distinct sellers for every scheme): docs/gas.md; then the chain model's constants as they must read in
 # src/infomarket/ledger/gas.py
-# (tests/chain/test_gas_constants.py fails until they do).
+# (tests/evm/test_gas_constants.py fails until they do).
 gas: venv
-	$(BIN)/python -m infomarket.chain.gasreport
-	$(BIN)/python -m infomarket.chain.gasreport --constants
+	$(BIN)/python -m infomarket.evm.gasreport
+	$(BIN)/python -m infomarket.evm.gasreport --constants
 
 # A local JSON-RPC node (Hardhat Network, pinned in tools/node) that the conformance suite runs against.
 node: tools/node/node_modules

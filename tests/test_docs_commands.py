@@ -46,9 +46,9 @@ NOT_RUN = {
     "infomarket run examples/age_liar.toml": "a full run; the example is tested in tests/test_extending.py",
     "infomarket chain demo --robots 25 --steps 15000 --scheme staking":
         "a paper-length replay on the EVM (revm, cold storage: 86 s CPU, 7 min wall on the busy machine, "
-        "2026-11-24); tests/chain/test_cli.py runs short ones",
+        "2026-11-24); tests/evm/test_cli.py runs short ones",
     "infomarket chain demo --chain-period 5":
-        "a 3 000-step chain run replayed block by block (~15 s); tests/chain/test_block_replay.py runs this very command",
+        "a 3 000-step chain run replayed block by block (~15 s); tests/evm/test_block_replay.py runs this very command",
     "infomarket store verify STORE": "a placeholder store; verify is tested in tests/store/test_integrity.py",
     "infomarket store repair STORE": "a placeholder store; repair is tested in tests/store/test_integrity.py",
     "infomarket sweep EXP --out STORE": "a placeholder experiment; sweeps are tested in tests/runner",
@@ -201,7 +201,7 @@ SMALL_NOT_RUN = {
     "infomarket sweep attack_search": "sweep has no --steps: 24 runs of 30 000 steps at the least; `check "
                                       "attack_search` (run above) builds and validates each of its conditions",
     "infomarket chain demo --chain-period P":
-        "an EVM replay of a 3 000-step run; tests/chain/test_block_replay.py runs `chain demo --chain-period 5`",
+        "an EVM replay of a 3 000-step run; tests/evm/test_block_replay.py runs `chain demo --chain-period 5`",
 }
 
 

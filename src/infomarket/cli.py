@@ -19,7 +19,7 @@ from .cliargs import Parser, at_least, seed_value
 from .errors import EXIT_FAILED, EXIT_USAGE, ConfigWarning, InfomarketError, report, show_warning
 
 SUBCOMMAND_MODULES = ("infomarket.runner.cli", "infomarket.analysis.cli", "infomarket.viewer.cli",
-                      "infomarket.chain.cli", "infomarket.analysis.sensitivity_cli")
+                      "infomarket.evm.cli", "infomarket.analysis.sensitivity_cli")
 SUBCOMMAND_MODULES += ("infomarket.analysis.terrain",)  # terrain-report (docs/terrain.md)
 SUBCOMMAND_MODULES += ("infomarket.search.cli",)  # attack-search (docs/attack-search.md)
 SUBCOMMAND_MODULES += ("infomarket.rl.cli",)  # rl-train (docs/rl.md)

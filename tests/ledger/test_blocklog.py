@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from infomarket import load_experiment
-from infomarket.chain.cli import demo_config
+from infomarket.evm.cli import demo_config
 from infomarket.engine.simulation import Simulation
 from infomarket.errors import SimulationError
 from infomarket.ledger.blocklog import BlockLog

@@ -1,5 +1,5 @@
 """The stake-expiry rule in the engine's step loop (the replay and the contract are checked against an
-exact ledger in tests/chain/test_conformance.py)."""
+exact ledger in tests/evm/test_conformance.py)."""
 import numpy as np
 import pytest
 

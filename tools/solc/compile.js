@@ -1,11 +1,11 @@
 #!/usr/bin/env node
 // Compiles contracts/InformationMarket.sol with the solc-js version pinned in package.json and writes
-// the ABI + bytecode artifact that the Python package ships (src/infomarket/chain/artifacts/), so that
+// the ABI + bytecode artifact that the Python package ships (src/infomarket/evm/artifacts/), so that
 // nothing on the Python side ever needs Node or a compiler.
 //
 // Usage: node tools/solc/compile.js [--source FILE] [--out FILE] [--allow-warnings]
 //   --source  Solidity file to compile (default: contracts/InformationMarket.sol); used by the
-//             mutation check (tests/chain/mutation.py) to compile a patched copy under the same name.
+//             mutation check (tests/evm/mutation.py) to compile a patched copy under the same name.
 //   --out     where to write the artifact (default: the committed one).
 //   --allow-warnings  do not fail on compiler warnings (only for such patched copies).
 // The output is deterministic (same source and compiler, same bytes), which is what lets a test
@@ -30,7 +30,7 @@ const SETTINGS = {
 function parseArgs(argv) {
   const args = {
     source: path.join(ROOT, SOURCE_NAME),
-    out: path.join(ROOT, 'src', 'infomarket', 'chain', 'artifacts', `${CONTRACT}.json`),
+    out: path.join(ROOT, 'src', 'infomarket', 'evm', 'artifacts', `${CONTRACT}.json`),
     allowWarnings: false,
   };
   for (let i = 0; i < argv.length; i += 1) {

@@ -34,12 +34,12 @@ def _client(args):
 def _execute(experiments, args, label: str) -> int:
     import time
 
+    # with the command: `infomarket --help` does not import the runner, the engine or the store
+    from ..config import sizes
     from ..runner.execute import default_workers
     from ..runner.progress import progress
     from ..runner.sweep import plan, run_sweep
     from ..store import Store
-
-    from ..config import sizes
 
     conds = plan(experiments, runs=getattr(args, "runs", None), seed=getattr(args, "seed", None),
                  scale=getattr(args, "scale", 1.0))
@@ -115,6 +115,7 @@ def _interrupted(store, conds, total: int, args) -> str:
 
 
 def cmd_sweep(args) -> int:
+    # with the command: `infomarket --help` stays light
     from ..config import load_experiment
     from ..config.load import looks_like_path
 
@@ -130,6 +131,7 @@ def cmd_sweep(args) -> int:
 
 def _with_samples(exp, samples: int):
     """``exp`` with another base sample size of its sampled design (a quick look at a big study)."""
+    # with the command: `infomarket --help` stays light
     from ..config.load import validate
     from ..errors import ConfigError
 
@@ -144,7 +146,7 @@ def _with_samples(exp, samples: int):
 
 
 def cmd_reproduce(args) -> int:
-    from ..config import load_experiment
+    from ..config import load_experiment  # with the command: `infomarket --help` stays light
 
     if args.what != "paper":
         raise UsageError(f"reproduce: unknown target {args.what!r}; allowed: paper")
@@ -204,7 +206,7 @@ def add_subcommand(sub) -> None:
 
 
 def _open(path: str):
-    from ..store import Store, StoreError
+    from ..store import Store, StoreError  # with the command: `infomarket --help` does not import pyarrow
 
     store = Store(path)
     if not store.exists():

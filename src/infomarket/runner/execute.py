@@ -33,7 +33,8 @@ from .. import interrupts, plugins
 from ..config.schema import Experiment
 from ..engine.batch import Simulations
 from ..engine.simulation import Simulation
-from ..checks import explain
+from ..engine.specialise import kernel_id
+from ..checks import explain, explain_compile_failure
 from ..errors import InfomarketError, RuleRunError
 from .plan import Condition
 
@@ -305,9 +306,6 @@ def preflight(configs: Iterable[Experiment]) -> None:
     """Compile (or load) each distinct kernel in this process before anything is written or run: a kernel
     that cannot compile because of a user's rule is a RuleRunError naming the rule and what is wrong with
     it (numba's own error points into the generated kernel).  Other errors are left to the runs."""
-    from ..checks import explain_compile_failure
-    from ..engine.specialise import kernel_id
-
     seen: set[str] = set()
     for cfg in configs:
         try:
@@ -332,8 +330,6 @@ def warm_up(configs: Iterable[Experiment]) -> dict[str, float]:
     ``engine.specialise.kernel_id`` (behaviours, scheme and terrain: the kernel's real key); returns the
     seconds spent per kernel id.  A configuration whose warm-up raises is left to its runs, which record
     the error as failed runs."""
-    from ..engine.specialise import kernel_id
-
     seconds: dict[str, float] = {}
     for cfg in configs:
         try:

@@ -40,7 +40,7 @@ def _announce(text: str) -> None:
 
 
 def _load(experiment: str, steps: int | None = None):
-    from ..config import load_experiment
+    from ..config import load_experiment  # with the command: `infomarket --help` stays light
 
     cfg = load_experiment(experiment)
     if steps is not None and steps != cfg.steps:
@@ -51,7 +51,7 @@ def _load(experiment: str, steps: int | None = None):
 def _warm_up(cfg, seed: int | None) -> None:
     """Build one swarm before serving: checks the seed and compiles (or loads) the step kernel, so a page
     opens in a fraction of a second instead of waiting for the compiler."""
-    from ..engine import Simulation
+    from ..engine import Simulation  # with the command: `infomarket --help` does not import the engine
 
     t0 = time.perf_counter()
     _say("preparing the step kernel (the first use of a behaviour mix compiles for a few seconds)...")
@@ -77,7 +77,7 @@ def cmd_view(args) -> int:
 
     _quiet(args)
     try:
-        from .server import serve
+        from .server import serve  # aiohttp, with the command only
     except ImportError as exc:  # aiohttp is a dependency; say so rather than show a traceback
         raise InfomarketError(f"the viewer needs the aiohttp package ({exc}); pip install aiohttp") from None
     cfg = _load(args.experiment)
@@ -106,7 +106,7 @@ class _Ticker:
 
 
 def cmd_replay(args) -> int:
-    from .recording import record, write_html
+    from .recording import record, write_html  # with the command: `infomarket --help` stays light
 
     _quiet(args)
     if not args.out and not args.movie:
@@ -117,7 +117,7 @@ def cmd_replay(args) -> int:
                          + ("; for a movie use --movie" if movie else ""))
     out = writable_file(args.out) if args.out else None  # before simulating: fail fast
     if args.movie:
-        from .movie import check_movie_path
+        from .movie import check_movie_path  # matplotlib and ffmpeg, for a movie only
 
         check_movie_path(args.movie)
         writable_file(args.movie, "--movie")
@@ -130,7 +130,7 @@ def cmd_replay(args) -> int:
         write_html(rec, out)
         _say(f"wrote {out} ({out.stat().st_size / 1e6:.1f} MB); open it in a browser")
     if args.movie:
-        from .movie import write_movie
+        from .movie import write_movie  # matplotlib and ffmpeg, for a movie only
 
         path = write_movie(rec, args.movie, on_progress=_Ticker("movie frames"))
         _say(f"wrote {path} ({path.stat().st_size / 1e6:.1f} MB)")

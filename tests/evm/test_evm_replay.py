@@ -1,4 +1,4 @@
-"""Replaying a ledger event log through the contract (infomarket.chain.replay)."""
+"""Replaying a ledger event log through the contract (infomarket.evm.replay)."""
 from __future__ import annotations
 
 import json
@@ -7,9 +7,9 @@ from pathlib import Path
 
 import pytest
 
-from infomarket.chain.errors import ChainError
-from infomarket.chain.market import MarketParams
-from infomarket.chain.evm_replay import BalanceRow, replay_on_chain
+from infomarket.evm.errors import ChainError
+from infomarket.evm.market import MarketParams
+from infomarket.evm.evm_replay import BalanceRow, replay_on_chain
 
 from .exact_ledger import SELLER_POSITION, ExactLedger, vector_for
 

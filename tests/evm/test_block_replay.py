@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 from infomarket import load_experiment
-from infomarket.chain.block_replay import match_purchases, replay_blocks
+from infomarket.evm.block_replay import match_purchases, replay_blocks
 from infomarket.ledger.gas import table_gas
-from infomarket.chain.cli import chain_config, demo_config, main
+from infomarket.evm.cli import chain_config, demo_config, main
 from infomarket.engine.simulation import Simulation
 from infomarket.ledger.blocklog import Block, BlockLog, ChainTx
 

@@ -1,11 +1,11 @@
 """One conformance suite, two ledgers: the simulated ledger (the engine's compiled ledger code, through
-``infomarket.ledger.replay``) and the contract (through ``infomarket.chain.replay``, every purchase a
+``infomarket.ledger.replay``) and the contract (through ``infomarket.evm.replay``, every purchase a
 real light contract, every deposit ``buyItem`` plus ``settle``).
 
 ``LedgerConformance`` is written once; each subclass says how to run an event sequence on its ledger.
 Both must reproduce the 32 payment vectors of the original simulator (tests/fixtures) and, on random
 event sequences (up to 25 robots and 1 000 operations, stake expiry on or off), the exact rational
-model of tests/chain/exact_ledger.py: the simulated ledger to 1e-9 token, the contract within its
+model of tests/evm/exact_ledger.py: the simulated ledger to 1e-9 token, the contract within its
 rounding bound (one unit per share a robot took part in). The property runs 200 examples on the
 simulated ledger and on the contract over revm, and a smaller sample over py-evm (a pure-Python EVM
 takes about a second per hundred transactions).
@@ -21,9 +21,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from infomarket.chain.market import MarketParams
-from infomarket.chain.evm_replay import FLOAT_SLACK_UNITS, replay_on_chain
-from infomarket.chain.units import TOKEN_UNIT
+from infomarket.evm.market import MarketParams
+from infomarket.evm.evm_replay import FLOAT_SLACK_UNITS, replay_on_chain
+from infomarket.evm.units import TOKEN_UNIT
 from infomarket.ledger.replay import replay_events
 
 from .exact_ledger import SELLER_POSITION, ExactLedger, vector_for
@@ -229,8 +229,8 @@ class TestContractLedgerOnNode(TestContractLedger):
         """The gas figures (docs/gas.md, the declared bound) come from py-evm: on the same calls, a real
         node charges the same gas, transaction by transaction, within 1 % (calldata differs slightly:
         the signatures are over each chain's domain)."""
-        from infomarket.chain.market import ChainMarket, connect, derived_account
-        from infomarket.chain.protocol import PathInfo
+        from infomarket.evm.market import ChainMarket, connect, derived_account
+        from infomarket.evm.protocol import PathInfo
 
         def gas(backend):
             market = ChainMarket.deploy(MarketParams.from_floats("outlier_distinct", stake=0.04), backend=backend)

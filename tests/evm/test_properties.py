@@ -5,7 +5,7 @@ enough that stakes get refused), after every operation:
 - every token is accounted for: balances + locked stakes == totalSupply == wealth granted + rewards;
 - the contract accepts exactly the sales the model accepts (a refused one fails with
   InfoMarketInsufficientStake, never with an arithmetic panic), so no balance is ever driven below 0;
-- every balance is within its rounding bound of the exact rational model (tests/chain/exact_ledger.py).
+- every balance is within its rounding bound of the exact rational model (tests/evm/exact_ledger.py).
 """
 from __future__ import annotations
 
@@ -15,9 +15,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from infomarket.chain.errors import ContractRevert
-from infomarket.chain.protocol import PathInfo
-from infomarket.chain.units import TOKEN_UNIT, to_units
+from infomarket.evm.errors import ContractRevert
+from infomarket.evm.protocol import PathInfo
+from infomarket.evm.units import TOKEN_UNIT, to_units
 
 from .exact_ledger import SELLER_POSITION, ExactLedger, vector_for
 

@@ -11,8 +11,8 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from infomarket.chain.gasreport import SCHEMES, gas_backend, worst_call
-from infomarket.chain.market import DECLARED_MAX_TX_GAS
+from infomarket.evm.gasreport import SCHEMES, gas_backend, worst_call
+from infomarket.evm.market import DECLARED_MAX_TX_GAS
 
 from .helpers import sell
 

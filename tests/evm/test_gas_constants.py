@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from infomarket.chain.gasreport import GasRow, WorstCall, constants, parse, render
+from infomarket.evm.gasreport import GasRow, WorstCall, constants, parse, render
 from infomarket.ledger import gas
 
 REPORT = Path(__file__).resolve().parents[2] / "docs" / "gas.md"
@@ -78,7 +78,7 @@ def test_the_report_prints_the_constants_it_was_rendered_from():
 
 
 def test_constants_from_a_missing_or_tableless_report_is_a_clear_error(tmp_path, capsys):
-    from infomarket.chain.gasreport import main
+    from infomarket.evm.gasreport import main
 
     assert main(["--constants", "--out", str(tmp_path / "none.md")]) == 2
     assert "none.md: no such report" in capsys.readouterr().err

@@ -1,10 +1,10 @@
-"""``infomarket chain demo`` (infomarket.chain.cli): argument errors, and the on-chain replay of a
+"""``infomarket chain demo`` (infomarket.evm.cli): argument errors, and the on-chain replay of a
 simulated swarm agreeing with the simulation's ledger."""
 from __future__ import annotations
 
 import pytest
 
-from infomarket.chain.cli import demo_config, main
+from infomarket.evm.cli import demo_config, main
 
 
 @pytest.mark.parametrize("argv, message", [
@@ -66,7 +66,7 @@ def test_on_chain_balances_equal_the_simulated_ledger(capsys):
     """The issue's acceptance check, in short: a staking swarm with deposits, purchases and refusals,
     every one through the contract; every balance within its rounding bound of the simulation's."""
     load_experiment, simulate = _simulator()
-    from infomarket.chain.evm_replay import replay_result
+    from infomarket.evm.evm_replay import replay_result
 
     result = simulate(demo_config(load_experiment("fig4C"), 5, 4000, "staking"), seed=2, record_events=True)
     kinds = result.events["kind"].value_counts()
@@ -103,7 +103,7 @@ def test_a_run_without_deposits_is_refused_not_compared(capsys):
 
 def test_the_demo_defaults_make_deposits():
     load_experiment, simulate = _simulator()
-    from infomarket.chain.cli import add_subcommand
+    from infomarket.evm.cli import add_subcommand
     import argparse
 
     parser = argparse.ArgumentParser()

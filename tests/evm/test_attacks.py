@@ -1,6 +1,6 @@
 """Every way to cheat the market that the contract must refuse, each with its custom error and values.
 
-Each test also checks that nothing changed on a refusal. tests/chain/mutation.py removes each check
+Each test also checks that nothing changed on a refusal. tests/evm/mutation.py removes each check
 from a copy of the contract in turn and shows that the test guarding it then fails.
 """
 from __future__ import annotations
@@ -11,9 +11,9 @@ import pytest
 from eth_account import Account
 from eth_account.messages import encode_typed_data
 
-from infomarket.chain.errors import ContractRevert
-from infomarket.chain.market import ROLES, derived_account
-from infomarket.chain.protocol import (
+from infomarket.evm.errors import ContractRevert
+from infomarket.evm.market import ROLES, derived_account
+from infomarket.evm.protocol import (
     FOOD,
     SECP256K1_N,
     Domain,
@@ -419,8 +419,8 @@ def test_the_client_needs_the_seller_position_and_caps_its_acceptances(make_mark
     the client signs a bounded number of offers."""
     import inspect
 
-    from infomarket.chain.market import ChainMarket
-    from infomarket.chain.protocol import ProtocolError
+    from infomarket.evm.market import ChainMarket
+    from infomarket.evm.protocol import ProtocolError
 
     assert inspect.signature(ChainMarket.light_contract).parameters["seller_position"].default is inspect.Parameter.empty
     market = make_market("outlier", stake=0.04)

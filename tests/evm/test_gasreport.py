@@ -1,12 +1,12 @@
-"""The gas report (infomarket.chain.gasreport) and the declared bound, with cold storage (py-evm, and
+"""The gas report (infomarket.evm.gasreport) and the declared bound, with cold storage (py-evm, and
 revm, which charges the same gas)."""
 from __future__ import annotations
 
 from dataclasses import replace
 
-from infomarket.chain.gasreport import (CROSS_CHECK_TOLERANCE, GasRow, WorstCall, cross_check, gas_backend, measure,
+from infomarket.evm.gasreport import (CROSS_CHECK_TOLERANCE, GasRow, WorstCall, cross_check, gas_backend, measure,
                                         render, worst_call)
-from infomarket.chain.market import DECLARED_MAX_TX_GAS, connect
+from infomarket.evm.market import DECLARED_MAX_TX_GAS, connect
 
 
 def test_a_deposit_with_cold_storage_splits_into_calls_under_the_declared_bound():

@@ -248,7 +248,7 @@ def _report_text(report, rows) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Stand-alone entry (``python -m infomarket.chain.cli chain demo ...``), same as the main CLI's."""
+    """Stand-alone entry (``python -m infomarket.evm.cli chain demo ...``), same as the main CLI's."""
     parser = argparse.ArgumentParser(prog="infomarket")
     add_subcommand(parser.add_subparsers(dest="command", required=True))
     args = parser.parse_args(argv)

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import math
 
-from infomarket.chain.protocol import FOOD, PathInfo
+from infomarket.evm.protocol import FOOD, PathInfo
 
 #: Where every seller stands in its buyer's frame, and how long its vector is.
 POSITION = (0.5, 0.5)

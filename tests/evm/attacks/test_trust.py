@@ -11,9 +11,9 @@ from __future__ import annotations
 import pytest
 from eth_account import Account
 
-from infomarket.chain.errors import ContractRevert
-from infomarket.chain.market import ROLES, ChainMarket, MarketParams, derived_account
-from infomarket.chain.protocol import SECP256K1_N
+from infomarket.evm.errors import ContractRevert
+from infomarket.evm.market import ROLES, ChainMarket, MarketParams, derived_account
+from infomarket.evm.protocol import SECP256K1_N
 
 from .helpers import sell, settle_all
 

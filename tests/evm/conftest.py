@@ -4,7 +4,7 @@ markets.
 Every test that uses ``chain`` runs on both in-process backends: revm (fast) and py-evm (the pure-Python
 reference EVM), through the same client. ``INFOMARKET_CHAIN_BACKENDS`` (comma-separated) narrows that
 list. ``INFOMARKET_CHAIN_ARTIFACT`` points the market fixtures at another compiled artifact: the
-mutation check (tests/chain/mutation.py) uses it to run the attack tests against patched contracts.
+mutation check (tests/evm/mutation.py) uses it to run the attack tests against patched contracts.
 """
 from __future__ import annotations
 
@@ -14,8 +14,8 @@ from pathlib import Path
 
 import pytest
 
-from infomarket.chain.market import ChainMarket, MarketParams, connect, derived_account
-from infomarket.chain.units import to_units
+from infomarket.evm.market import ChainMarket, MarketParams, connect, derived_account
+from infomarket.evm.units import to_units
 
 ROBOTS = 8
 BACKENDS = os.environ.get("INFOMARKET_CHAIN_BACKENDS", "revm,py-evm").split(",")

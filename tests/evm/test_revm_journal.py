@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import pytest
 
-from infomarket.chain.backends import RevmBackend, journal_accounts
-from infomarket.chain.errors import ChainError
-from infomarket.chain.market import derived_account
+from infomarket.evm.backends import RevmBackend, journal_accounts
+from infomarket.evm.errors import ChainError
+from infomarket.evm.market import derived_account
 
 #: Runtime code PUSH1 7, PUSH1 1, SSTORE, STOP (slot 1 := 7), and init code that returns it.
 RUNTIME = bytes.fromhex("600760015500")

@@ -1,4 +1,4 @@
-"""The contract's payment rules through infomarket.chain.market: reveals, buys, and the 32 conformance
+"""The contract's payment rules through infomarket.evm.market: reveals, buys, and the 32 conformance
 cases computed by the original simulator (tests/fixtures/payment_vectors.json)."""
 from __future__ import annotations
 
@@ -9,10 +9,10 @@ from fractions import Fraction
 from pathlib import Path
 
 import pytest
-from infomarket.chain.errors import ContractRevert
-from infomarket.chain.protocol import FOOD, NEST, PathInfo
-from infomarket.chain.evm_replay import FLOAT_SLACK_UNITS
-from infomarket.chain.units import TOKEN_UNIT, to_units
+from infomarket.evm.errors import ContractRevert
+from infomarket.evm.protocol import FOOD, NEST, PathInfo
+from infomarket.evm.evm_replay import FLOAT_SLACK_UNITS
+from infomarket.evm.units import TOKEN_UNIT, to_units
 
 from .exact_ledger import SELLER_POSITION, ExactLedger, vector_for
 

@@ -1,4 +1,4 @@
-"""The off-chain light contract and the fixed-point encodings (infomarket.chain.protocol, .units)."""
+"""The off-chain light contract and the fixed-point encodings (infomarket.evm.protocol, .units)."""
 from __future__ import annotations
 
 import pytest
@@ -6,7 +6,7 @@ from eth_account import Account
 from eth_account.messages import encode_typed_data
 from eth_utils import keccak
 
-from infomarket.chain.protocol import (
+from infomarket.evm.protocol import (
     Domain,
     Offer,
     PathInfo,
@@ -19,7 +19,7 @@ from infomarket.chain.protocol import (
     path_in_buyer_frame,
     sign_offer,
 )
-from infomarket.chain.units import (
+from infomarket.evm.units import (
     FULL_TURN,
     from_units,
     share_to_wad,

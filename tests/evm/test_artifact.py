@@ -1,4 +1,4 @@
-"""The committed ABI + bytecode (src/infomarket/chain/artifacts) is what the pinned compiler makes of
+"""The committed ABI + bytecode (src/infomarket/evm/artifacts) is what the pinned compiler makes of
 the committed contract, so the Python side can run without Node and still never run stale code."""
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from infomarket.chain.market import load_artifact
+from infomarket.evm.market import load_artifact
 
 ROOT = Path(__file__).resolve().parents[2]
 SOURCE = ROOT / "contracts" / "InformationMarket.sol"
@@ -40,4 +40,4 @@ def test_recompiling_reproduces_the_committed_artifact(tmp_path, procs):
     fresh = tmp_path / "InformationMarket.json"
     procs.run([node, str(TOOLS / "compile.js"), "--out", str(fresh)], check=True)
     assert json.loads(fresh.read_text()) == load_artifact(), (
-        "the committed artifact is stale: run `make contracts` and commit src/infomarket/chain/artifacts")
+        "the committed artifact is stale: run `make contracts` and commit src/infomarket/evm/artifacts")

@@ -8,7 +8,7 @@ solc-js into a temporary artifact, against which the tests guarding it run (thro
 ``INFOMARKET_CHAIN_ARTIFACT``, see conftest.py; on revm only). It needs Node and takes a few minutes,
 so it is a script, not part of the test suite:
 
-    .venv/bin/python tests/chain/mutation.py [WORD ...]
+    .venv/bin/python tests/evm/mutation.py [WORD ...]
 
 With words, only the mutants whose label contains one of them run (the unpatched copy always does).
 Exit status 0 when every mutant is caught (a test guarding it fails) and the unpatched copy passes them.
@@ -26,7 +26,7 @@ from tests.procs import Procs  # noqa: E402
 
 SOURCE = ROOT / "contracts" / "InformationMarket.sol"
 COMPILER = ROOT / "tools" / "solc" / "compile.js"
-TESTS = ROOT / "tests" / "chain"
+TESTS = ROOT / "tests" / "evm"
 
 #: (the check removed, the condition's text in the source, names of the tests that must then fail)
 MUTANTS = [

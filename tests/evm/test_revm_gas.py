@@ -17,10 +17,10 @@ import pytest
 from eth_abi import encode as abi_encode
 from eth_utils.abi import get_abi_input_types
 
-from infomarket.chain.errors import ContractRevert
-from infomarket.chain.market import ChainMarket, MarketParams, connect, derived_account, load_artifact
-from infomarket.chain.protocol import FOOD, NEST, PathInfo
-from infomarket.chain.units import to_units
+from infomarket.evm.errors import ContractRevert
+from infomarket.evm.market import ChainMarket, MarketParams, connect, derived_account, load_artifact
+from infomarket.evm.protocol import FOOD, NEST, PathInfo
+from infomarket.evm.units import to_units
 
 SELLERS = 6
 

@@ -10,9 +10,9 @@ from __future__ import annotations
 
 import pytest
 
-from infomarket.chain.errors import ContractRevert
-from infomarket.chain.market import DEFAULT_MAX_RECORDS_PER_SELLER, DEFAULT_MAX_RECORDS_PER_TRIP
-from infomarket.chain.protocol import PathInfo, ProtocolError
+from infomarket.evm.errors import ContractRevert
+from infomarket.evm.market import DEFAULT_MAX_RECORDS_PER_SELLER, DEFAULT_MAX_RECORDS_PER_TRIP
+from infomarket.evm.protocol import PathInfo, ProtocolError
 
 from .helpers import sell
 

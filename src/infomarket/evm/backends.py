@@ -28,7 +28,7 @@ changes; then the changes are written into the database (``insert_account_info``
 the next transaction loads them cold, with these values as originals. A reverted transaction keeps
 nothing and warms nothing. Views and dry runs run in a checkpoint that is reverted too. The
 database writes are logged once ``snapshot`` is first called, so that ``revert`` can undo them.
-``tests/chain/test_revm_gas.py`` sends the same transactions to both backends and finds the same gas
+``tests/evm/test_revm_gas.py`` sends the same transactions to both backends and finds the same gas
 for each. The block's coinbase stays in the journal, as it is warm for every transaction (EIP-3651).
 
 Both raise ``RevertedCall`` with the raw revert bytes (the market decodes them into ``ContractRevert``,

@@ -1,1 +1,0 @@
-"""Tests of infomarket.chain (a package, so its module names cannot clash with tests elsewhere)."""
