@@ -140,6 +140,7 @@ def test_an_untouched_store_verifies(store, capsys):
 def test_a_caching_store_reads_each_part_once_and_still_sees_damage(store, tiny, monkeypatch):
     """``Store(root, cache=True)`` (the attack search's store, read after every generation) reads and
     verifies each part once; a part changed on disk afterwards is read again and refused."""
+    import infomarket.store.integrity as integrity
     import infomarket.store.results as results
 
     def on_disk():  # (commit records, data parts): what one full check and read must open, counted by glob
@@ -149,7 +150,7 @@ def test_a_caching_store_reads_each_part_once_and_still_sees_damage(store, tiny,
 
     cached = Store(store.root, cache=True)
     calls = {"files": 0, "sha256": 0}  # files read (commit records and robots parts), data parts hashed
-    read_table, sha = results.pq.read_table, results.sha256_file
+    read_table, sha = results.pq.read_table, integrity.sha256_file
 
     def counting_read(*a, **kw):
         calls["files"] += counting
@@ -160,7 +161,7 @@ def test_a_caching_store_reads_each_part_once_and_still_sees_damage(store, tiny,
         return sha(path)
 
     monkeypatch.setattr(results.pq, "read_table", counting_read)
-    monkeypatch.setattr(results, "sha256_file", counting_sha)
+    monkeypatch.setattr(integrity, "sha256_file", counting_sha)
 
     def read_all():
         cached.check()

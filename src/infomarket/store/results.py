@@ -1,51 +1,11 @@
-"""The results store: a folder of Parquet datasets that sweeps append to and analyses read.
-
-Layout (each part file written atomically, see ``files``)::
-
-    STORE/store.json               format version, package version, creation time, master seed per experiment,
-                                   hashes of the question and decision-rule files (analysis.declared)
-    STORE/store.lock               held (an OS lock) by the one sweep writing the store
-    STORE/robots/part-ID.parquet   one row per robot per run
-    STORE/history/part-ID.parquet  wealth of every robot every K steps (when asked)
-    STORE/events/part-ID.parquet   the ledger's event log: purchases, refusals, deposits (``--events``)
-    STORE/payments/part-ID.parquet what each seller received at each deposit (``--events``)
-    STORE/sites/part-ID.parquet    items per site per run (setups with terrain, docs/terrain.md)
-    STORE/chain/part-ID.parquet    the chain model's measures per run (runs with [chain], docs/chain-model.md)
-    STORE/configs/part-ID.parquet  the configuration each condition ran (JSON text), see ``config``
-    STORE/runs/part-ID.parquet     one row per run: the commit record of its part
-    STORE/damaged/...              parts that ``repair`` moved aside
-
-Columns common to the tables: ``experiment`` (e.g. ``fig2A``), ``condition`` (a stable id such as
-``byzantines=3,market=staking,rotation_angle=40``; ``base`` without a sweep), ``run``, ``seed``, and one
-column per condition key (e.g. ``rotation_angle``).  A part counts only once its ``runs`` part exists:
-the runs part is written last, so a crash leaves at most an orphan data part (robots, history, ...), which
-readers ignore and the next sweep deletes.
-
-**Integrity.**  The runs part records, for each other table, the SHA-256 and the row count of the part
-it commits (columns ``robots_sha256``, ``robots_rows``, ...); the runs part itself is written with
-Parquet page checksums and a SHA-256 of its own content (its values, not its bytes) in its Parquet
-metadata (key ``infomarket_record_sha256``), so a commit record rewritten with one value changed is
-caught too (stores made before that have ``record_checksums`` absent from ``store.json`` and are read as
-before).  Every read checks them and raises ``StoreDamaged`` naming the part and the
-repair command; ``verify`` lists every damaged and orphan part, ``repair`` moves damaged parts aside
-(into ``damaged/``) so that their runs count as not done and the next sweep reruns exactly those.
-
-Every column, with its unit, is described in ``store.dictionary`` (docs/data.md) and in each file's Parquet
-field metadata.  Query with pandas (``Store(path).robots()``), ``Store(path).sql(query)`` (DuckDB, over the
-verified parts only) or DuckDB directly::
-
-    SELECT r.* FROM 'STORE/robots/*.parquet' r JOIN 'STORE/runs/*.parquet' USING (experiment, condition, run)
-"""
+"""The results store: a folder of Parquet datasets that sweeps append to and analyses read (its layout,
+columns and integrity checks: the package docstring, ``infomarket.store``)."""
 from __future__ import annotations
 
-import fcntl
 from collections.abc import Iterable
 import json
-import os
-import shutil
 import time
 from contextlib import contextmanager
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import hashlib
@@ -55,18 +15,17 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from .. import __version__, interrupts
-from ..errors import InfomarketError
+from .errors import Inspection, Problem, RecordAltered, SqlError, StoreDamaged, StoreError  # noqa: F401
+from . import integrity
+from .tables import DATA_TABLES, OPTIONAL_TABLES, TABLES
+from .lock import StoreLock
+from .query import run_sql
 from .dictionary import TABLES as TABLES_DICT
 from .dictionary import annotate
 from .files import sha256_file, write_atomic, write_text_atomic
 from ..config.load import validate
 
 FORMAT = 1
-DATA_TABLES = ("robots", "history", "events", "payments", "sites", "configs", "chain")
-#: Tables whose checksum and row count a commit record holds only when its part has rows: parts without
-#: them keep the commit records (and digests) they had before the table existed.
-OPTIONAL_TABLES = ("chain",)
-TABLES = DATA_TABLES + ("runs",)
 KEY = ["experiment", "condition", "run"]
 OK, FAILED = "ok", "failed"
 
@@ -84,82 +43,6 @@ def write_table(table: str, df: pd.DataFrame, path: Path, keys: Iterable[str] = 
     """Write ``df`` as the store's ``table`` to ``path``, each column's unit and description in its field
     metadata (``store.dictionary.annotate``; a column it does not describe is an InternalError)."""
     pq.write_table(annotate(table, pa.Table.from_pandas(df, preserve_index=False), keys), path, **options)
-
-
-class RecordAltered(InfomarketError):
-    """A commit record's content does not match the checksum it was written with (internal signal)."""
-
-
-class StoreError(InfomarketError, ValueError):
-    """The folder is not a usable results store (wrong format, incompatible contents, locked)."""
-
-
-class SqlError(StoreError):
-    """A query given to ``Store.sql`` is not valid SQL or names what the store does not hold."""
-
-
-class StoreDamaged(StoreError):
-    """A committed part does not match its commit record (truncated, altered, missing, unreadable)."""
-
-
-@dataclass(frozen=True)
-class Problem:
-    """One damaged part: ``path`` (relative to the store), and why."""
-
-    part: str
-    path: str
-    why: str
-
-
-@dataclass
-class Inspection:
-    """What ``Store.verify`` found."""
-
-    parts: int = 0
-    damaged: list[Problem] = field(default_factory=list)
-    orphans: list[str] = field(default_factory=list)
-
-    @property
-    def ok(self) -> bool:
-        return not self.damaged
-
-
-_HELD: set[Path] = set()  # stores locked by this process (POSIX locks do not conflict within one)
-
-
-class StoreLock:
-    """An exclusive OS lock (``fcntl.lockf``) on ``STORE/store.lock``, refused at once if held.
-
-    POSIX record locks belong to the process: the kernel drops them when it dies, even by SIGKILL (no
-    stale lock), and forked workers do not inherit them."""
-
-    def __init__(self, root: Path):
-        self.path = root / "store.lock"
-        self.fd: int | None = None
-
-    def __enter__(self) -> "StoreLock":
-        key = self.path.resolve()
-        if key in _HELD:
-            raise StoreError(f"{self.path.parent}: this process is already writing this store")
-        try:
-            fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o666)
-        except OSError as exc:
-            raise StoreError(f"{self.path.parent}: cannot write there ({exc.strerror or exc})") from None
-        try:
-            fcntl.lockf(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            os.close(fd)
-            raise StoreError(f"{self.path.parent}: another infomarket process is writing this store (it holds "
-                             f"{self.path.name}); wait for it to finish, or use another --out") from None
-        self.fd = fd
-        _HELD.add(key)
-        return self
-
-    def __exit__(self, *exc) -> None:
-        _HELD.discard(self.path.resolve())
-        if self.fd is not None:
-            os.close(self.fd)  # closing drops the lock
-            self.fd = None
 
 
 def _declarations() -> dict:
@@ -409,52 +292,11 @@ class Store:
         return hit[1]
 
     def _check_data_part_now(self, table: str, path: Path, record: pd.DataFrame) -> str | None:
-        sha_col, rows_col = f"{table}_sha256", f"{table}_rows"
-        if sha_col not in record.columns:  # a store written before checksums: readable is all we know
-            if not path.exists():
-                return None
-            if table in OPTIONAL_TABLES and self._record_checksums():
-                return "exists but its commit record does not list it"
-            try:
-                pq.read_metadata(path)
-            except Exception as exc:  # noqa: BLE001 - any reader error means damage
-                return f"unreadable ({type(exc).__name__}: {exc})"
-            return None
-        sha, rows = str(record[sha_col].iloc[0]), int(record[rows_col].iloc[0])
-        if not sha:
-            return "exists but its commit record says it has no rows" if path.exists() else None
-        if not path.exists():
-            return f"missing (the commit record says {rows} rows)"
-        if self._cached("sha256", path, lambda: sha256_file(path)) != sha:
-            return f"checksum mismatch: truncated or altered (the commit record says {rows} rows)"
-        return None
+        return integrity.data_part_problem(self, table, path, record)
 
     def verify(self) -> Inspection:
         """Check every committed part against its commit record; list damaged and orphan parts."""
-        found = Inspection()
-        if self.exists():
-            self.meta()  # an unreadable store.json is a StoreError, not a store of no parts
-        runs_parts = self._parts("runs")
-        for pid, path in sorted(runs_parts.items()):
-            found.parts += 1
-            try:
-                record = self._read_runs_part(path)
-            except RecordAltered as exc:
-                found.damaged.append(Problem(pid, _rel(self.root, path), f"commit record {exc}"))
-                continue
-            except Exception as exc:  # noqa: BLE001 - any reader error means damage
-                found.damaged.append(Problem(pid, _rel(self.root, path),
-                                             f"unreadable commit record ({type(exc).__name__}: {exc})"))
-                continue
-            for t in DATA_TABLES:
-                why = self._check_data_part(t, pid, record)
-                if why:
-                    found.damaged.append(Problem(pid, _rel(self.root, self.part_path(t, pid)), why))
-        for t in DATA_TABLES:
-            found.orphans += [_rel(self.root, p) for pid, p in sorted(self._parts(t).items())
-                              if pid not in runs_parts]
-        found.orphans += sorted(_rel(self.root, p) for p in self.root.glob("*/.part-*.tmp"))
-        return found
+        return integrity.inspect(self)
 
     def check(self) -> None:
         """Raise StoreDamaged naming the first damaged part (and how many more) and the repair command."""
@@ -469,26 +311,7 @@ class Store:
         """Move every damaged part (all its files, the commit record included) and every orphan into
         ``damaged/``; returns the inspection and the paths moved (relative to the store).  Call with the
         lock held.  Nothing is deleted."""
-        found = self.verify()
-        moved = []
-        stamp = time.strftime("%Y%m%dT%H%M%S")
-        aside = self.root / "damaged" / stamp
-
-        def move(path: Path) -> None:
-            dest = aside / _rel(self.root, path)
-            dest.parent.mkdir(parents=True, exist_ok=True)
-            shutil.move(path, dest)
-            moved.append(_rel(self.root, path))
-
-        for pid in sorted({p.part for p in found.damaged}):
-            for t in ("runs",) + DATA_TABLES:  # the commit record first: its runs are then not done
-                path = self.part_path(t, pid)
-                if path.exists():
-                    move(path)
-        for rel in found.orphans:
-            if (self.root / rel).exists():
-                move(self.root / rel)
-        return found, moved
+        return integrity.move_aside(self)
 
     # ------------------------------------------------------------------ reading
     def _require(self) -> None:
@@ -567,35 +390,9 @@ class Store:
             self.check()
         bad = {p.part for p in found.damaged}
         good = [pid for pid in self.committed() if pid not in bad]
-        con = duckdb.connect()
-        try:
-            allowed = []
-            for t in TABLES:
-                files = [str(self.part_path(t, pid).resolve()) for pid in good if self.part_path(t, pid).exists()]
-                if files:
-                    con.read_parquet(files, union_by_name=True).create_view(t)
-                    allowed += files
-            # the query reads the verified parts and nothing else, and writes nothing (no COPY TO, no
-            # ATTACH, no other file): the views' files are the only ones allowed, and that is locked
-            con.execute("SET temp_directory = ''")  # no spill files (DuckDB's default is ./.tmp)
-            con.execute("SET allowed_paths = ?", [allowed])
-            con.execute("SET enable_external_access = false")
-            con.execute("SET lock_configuration = true")
-            try:
-                # in a thread: DuckDB does not look at signals, so Ctrl-C interrupts the query (interrupts.wait_for)
-                result = interrupts.wait_for(lambda: con.execute(query), con.interrupt)
-                if result is None or result.description is None:  # only ';' or comments: no statement
-                    raise SqlError(f"the query {query.strip()[:60]!r} holds no SQL statement that returns rows; "
-                                   f"e.g. \"SELECT count(*) FROM robots\"")
-                return result.df()
-            except duckdb.Error as exc:
-                raise SqlError(f"{self.root}: the query failed: {exc} (tables: "
-                               f"{', '.join(r[0] for r in con.execute('SHOW TABLES').fetchall())})") from None
-        finally:
-            try:
-                con.close()
-            except duckdb.Error:  # still busy with a query that Ctrl-C interrupted (interrupts.wait_for)
-                pass
+        files = {t: [str(self.part_path(t, pid).resolve()) for pid in good if self.part_path(t, pid).exists()]
+                 for t in TABLES}
+        return run_sql(duckdb, self.root, {t: f for t, f in files.items() if f}, query)
 
     def runs(self) -> pd.DataFrame:
         """One row per committed run, ``status`` ``ok`` or ``failed`` (then ``error`` says why)."""
