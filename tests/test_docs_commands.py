@@ -197,6 +197,7 @@ SMALL_NOT_RUN = {
     "infomarket attack-search attack_search --defence staking,theta20 --byzantines 3 --dask tcp://head:8786 "
     "--out results/as-dask": "needs a Dask scheduler at that address; tests/search runs one on a LocalCluster",
     "infomarket view": "a web server that runs until stopped; tests/viewer",
+    "infomarket replay --movie": "the command's name in the text (rl.md's rendering); tests/viewer/test_movie.py runs it",
     "infomarket attack-search": "the command's name in the text; its commands are the ones above",
     "infomarket sweep attack_search": "sweep has no --steps: 24 runs of 30 000 steps at the least; `check "
                                       "attack_search` (run above) builds and validates each of its conditions",
@@ -270,7 +271,8 @@ def test_documented_command_runs_at_a_small_size(documented, tmp_path, monkeypat
 
 
 #: The Python examples of these pages, run with their sizes made small (each pattern must match).
-PY_SMALL = {"num_envs=64": "num_envs=2", "steps=10000": "steps=60", "transitory=5000": "transitory=20"}
+PY_SMALL = {"num_envs=64": "num_envs=2", "steps=10000": "steps=60", "transitory=5000": "transitory=20",
+            "steps=4000": "steps=60", "transitory=1000": "transitory=20"}
 
 
 def test_the_python_examples_of_the_small_run_pages_run_at_a_small_size(tmp_path, monkeypatch):
@@ -284,5 +286,6 @@ def test_the_python_examples_of_the_small_run_pages_run_at_a_small_size(tmp_path
             code = code.replace(big, small)
         names: dict = {}
         exec(compile(code, "<docs example>", "exec"), names)  # noqa: S102 - the docs' own example
-        if "env" in names:
-            assert names["env"].num_envs == 2 and names["env"].runs.steps == 60
+        for name in ("env", "venv"):  # whatever vector env an example built runs at the small size
+            if hasattr(names.get(name), "num_envs") and hasattr(names[name], "runs"):
+                assert names[name].num_envs == 2 and names[name].runs.steps == 60

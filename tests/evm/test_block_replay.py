@@ -114,27 +114,27 @@ def test_a_reveal_the_branch_cannot_pay_fails_on_the_evm_too():
 
 
 def test_gas_is_billed_by_the_models_rule():
-    # gas price 1e-7: a reveal 1e-7 x 126 228 = 0.0126228 (docs/gas.md, reveal with staking; its sender's view
-    # set it aside), a deposit settling one record 1e-7 x 150 754 (outlier with staking, n = 1) = 0.0150754
+    # gas price 1e-7: a reveal 1e-7 x 128 652 = 0.0128652 (docs/gas.md, reveal with staking; its sender's view
+    # set it aside), a deposit settling one record 1e-7 x 165 760 (outlier with staking, n = 1) = 0.016576
     config = _tiny(gas_price=1e-7)
-    assert table_gas(np.array([1.0, 4.0]), np.array([150_754.0, 199_569.0]), 1.0) == 150_754
+    assert table_gas(np.array([1.0, 4.0]), np.array([165_760.0, 215_575.0]), 1.0) == 165_760
     blocks = [_block(0, [], [1.0, 1.0]),
-              _block(1, [_reveal(0, 1, gas=0.0126228)], [1.0 - 0.04 - 0.0126228, 1.0]),
+              _block(1, [_reveal(0, 1, gas=0.0128652)], [1.0 - 0.04 - 0.0128652, 1.0]),
               # buyer: +1 reward +0.04 pot -(0.5 + 0.04) to the seller, then the deposit's gas
-              _block(2, [_deposit(1, 2)], [0.9473772 + 0.54, 1.5 - 0.0150754])]
+              _block(2, [_deposit(1, 2)], [0.9471348 + 0.54, 1.5 - 0.016576])]
     report = replay_blocks(blocks, {0: _event(0, 1)}, config)
     assert report.ok, report.first_mismatch
-    assert report.model_deposit_gas == [150_754] and report.model_reveal_gas == [pytest.approx(126_228)]
+    assert report.model_deposit_gas == [165_760] and report.model_reveal_gas == [pytest.approx(128_652)]
     # without the deposit's gas in the modelled ledger the buyer differs at block 2
-    free = [*blocks[:2], _block(2, blocks[2].txs, [0.9473772 + 0.54, 1.5])]
+    free = [*blocks[:2], _block(2, blocks[2].txs, [0.9471348 + 0.54, 1.5])]
     m = replay_blocks(free, {0: _event(0, 1)}, config).first_mismatch
-    assert (m.height, m.robot) == (2, 1) and m.diff_units == pytest.approx(-15_075_400, abs=1)
+    assert (m.height, m.robot) == (2, 1) and m.diff_units == pytest.approx(-16_576_000, abs=1)
 
 
 def test_a_reveal_the_models_gas_check_refuses_is_not_sent():
-    # wealth 0.045 covers the stake (0.04) but not stake + gas (0.0526228): the model fails the reveal
+    # wealth 0.045 covers the stake (0.04) but not stake + gas (0.0528652): the model fails the reveal
     config = _tiny(gas_price=1e-7, wealth=0.045)
-    blocks = [_block(0, [], [0.045, 0.045]), _block(1, [_reveal(0, 1, gas=0.0126228)], [0.045, 0.045])]
+    blocks = [_block(0, [], [0.045, 0.045]), _block(1, [_reveal(0, 1, gas=0.0128652)], [0.045, 0.045])]
     report = replay_blocks(blocks, {0: _event(0, 1)}, config)
     assert report.ok and report.gas_refused == 1 and report.reveals == 0
 

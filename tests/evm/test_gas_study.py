@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import math
 
+import pytest
+
 from infomarket.analysis import chain_study as cs
 from infomarket.analysis.declared import DECLARED, check, status_of
 from infomarket.config.load import load_experiment
@@ -21,14 +23,19 @@ def _three_digits(x: float) -> float:
     return float(f"{x:.3g}")
 
 
-def test_the_amended_prices_keep_the_declared_ratios_with_the_models_reveal_gas():
-    """gas_price = ratio x 0.04 / the model's reveal gas with staking, to 3 digits: e.g. 0.3 x 0.04 /
-    126 228 = 9.5066e-8 -> 9.51e-8 (the stale table's 94 038 gave 1.28e-7)."""
+def test_the_amended_prices_keep_the_declared_ratios_with_the_reveal_gas_they_were_run_with():
+    """gas_price = ratio x 0.04 / the reveal gas with staking the study ran with (126 228, recorded in
+    [amendment_gas]), to 3 digits: e.g. 0.3 x 0.04 / 126 228 = 9.5066e-8 -> 9.51e-8 (the stale table's
+    94 038 gave 1.28e-7).  The audited contract's reveal costs more since (128 652 with staking: roles and
+    the pause flag), so the same prices now stand for ratios 128 652 / 126 228 = 1.0192 times the declared
+    ones; the questions file records that deviation."""
     assert AMENDED["gas_ratio"] == DECL["study"]["gas_ratio"]  # the declared ratios are kept
-    assert AMENDED["reveal_gas"] == GAS_REVEAL["outlier + staking"]
+    assert AMENDED["reveal_gas"] == 126_228
     assert AMENDED["gas_price"][3] == 9.51e-8
     for ratio, price in zip(AMENDED["gas_ratio"], AMENDED["gas_price"]):
-        assert price == _three_digits(ratio * STAKE / GAS_REVEAL["outlier + staking"]), ratio
+        assert price == _three_digits(ratio * STAKE / AMENDED["reveal_gas"]), ratio
+    assert GAS_REVEAL["outlier + staking"] / AMENDED["reveal_gas"] == pytest.approx(1.0192, abs=1e-4)
+    assert any("128 652" in d["what"] and "breaks_gas" in d["questions"] for d in DECL["deviations"])
 
 
 def test_the_shipped_sweeps_run_the_amended_gas_conditions():

@@ -76,15 +76,8 @@ def figure(a: Answers, path: Path, decl: dict | None = None) -> None:
     settings = ("instant", "toychain", "geth_argos")
     conds = [(p, k) for p in ("outlier", "staking") for k in (1, 3, 5)]
     width = 0.26
-    for i, s in enumerate(settings):
-        data = [_sel(runs, PAPER, chain=s, payment=p, byzantines=k) for p, k in conds]
-        pos = np.arange(len(conds)) + (i - 1) * width
-        ok = [d if len(d) else np.array([np.nan]) for d in data]
-        bp = ax.boxplot(ok, positions=pos, widths=width * 0.9, patch_artist=True, showfliers=False)
-        for b in bp["boxes"]:
-            b.set_facecolor(("lightgrey", "tab:green", "tab:purple")[i])
-        ax.plot([], [], "s", color=("lightgrey", "tab:green", "tab:purple")[i],
-                label=f"{s} (n={max(len(d) for d in data)})")
+    _boxes_by_setting(ax, settings, width,
+                      lambda s: [_sel(runs, PAPER, chain=s, payment=p, byzantines=k) for p, k in conds])
     ax.set_xticks(np.arange(len(conds)), [f"{'3' if p == 'outlier' else '4'}{'ABC'[(k - 1) // 2]}" for p, k in conds])
     ax.set_xlabel("paper condition (Fig. 3: no stake, Fig. 4: staking; A/B/C: 1/3/5 Byzantines)")
     ax.set_ylabel("Byzantines' wealth share, %")
@@ -93,15 +86,8 @@ def figure(a: Answers, path: Path, decl: dict | None = None) -> None:
     ax.legend(fontsize=7)
     ax = axes[2, 1]
     conds7 = [(m, ang) for ang in (45.0, 90.0) for m in ("staking", "no_staking")]
-    for i, s in enumerate(settings):
-        data = [_sel(runs, FIG7, "items", chain=s, market=m, rotation_angle=ang) for m, ang in conds7]
-        pos = np.arange(len(conds7)) + (i - 1) * width
-        ok = [d if len(d) else np.array([np.nan]) for d in data]
-        bp = ax.boxplot(ok, positions=pos, widths=width * 0.9, patch_artist=True, showfliers=False)
-        for b in bp["boxes"]:
-            b.set_facecolor(("lightgrey", "tab:green", "tab:purple")[i])
-        ax.plot([], [], "s", color=("lightgrey", "tab:green", "tab:purple")[i],
-                label=f"{s} (n={max(len(d) for d in data)})")
+    _boxes_by_setting(ax, settings, width,
+                      lambda s: [_sel(runs, FIG7, "items", chain=s, market=m, rotation_angle=ang) for m, ang in conds7])
     ax.set_xticks(np.arange(len(conds7)), [f"{m.replace('_', ' ')}\n{ang:g} deg" for m, ang in conds7])
     ax.set_ylabel("swarm items, last 10 000 steps")
     ax.set_title(f"Fig. 7: toychain {a.verdicts['fig7_toychain'].answer}, geth-argos "
@@ -117,3 +103,17 @@ def figure(a: Answers, path: Path, decl: dict | None = None) -> None:
     fig.suptitle("The paper's result on the robots' own chain (chain_questions.toml)", fontsize=12)
     fig.savefig(path, dpi=110)
     plt.close(fig)
+
+
+def _boxes_by_setting(ax, settings, width: float, data_of) -> None:
+    """One box per condition for each chain setting, the settings side by side around each condition's
+    tick (``data_of(setting)``: the conditions' values, in tick order), each setting in its colour."""
+    for i, s in enumerate(settings):
+        data = data_of(s)
+        pos = np.arange(len(data)) + (i - 1) * width
+        ok = [d if len(d) else np.array([np.nan]) for d in data]
+        bp = ax.boxplot(ok, positions=pos, widths=width * 0.9, patch_artist=True, showfliers=False)
+        for b in bp["boxes"]:
+            b.set_facecolor(("lightgrey", "tab:green", "tab:purple")[i])
+        ax.plot([], [], "s", color=("lightgrey", "tab:green", "tab:purple")[i],
+                label=f"{s} (n={max(len(d) for d in data)})")

@@ -23,6 +23,7 @@ from typing import Callable, NamedTuple
 
 from numba import njit
 
+from ..errors import InternalError
 from . import instant
 from .poa.arena import room_fits
 from .poa.blocks import end_of_step
@@ -63,4 +64,4 @@ def operations(ledger: str, settle) -> Operations:
         return Operations(instant.has_room, _nothing, settle, _nothing_yet)
     if ledger == "poa":
         return Operations(room_fits, gossip, _send_deposit, end_of_step(settle))
-    raise ValueError(f"unknown ledger {ledger!r}: one of {', '.join(LEDGERS)}")
+    raise InternalError(f"unknown ledger {ledger!r}: one of {', '.join(LEDGERS)}")
