@@ -116,23 +116,3 @@ def test_ctrl_c_stops_store_sql_in_the_middle_of_a_query(tmp_path, procs):
     assert proc.returncode == 130, err
     assert err == "infomarket: error: interrupted\n" and out == ""
     assert session_members(proc.pid) == []
-
-
-def test_a_stop_the_fork_hook_lets_through_is_raised_after_the_hook():
-    """A signal held across a fork arrives when ``_after_fork_in_parent`` unblocks it; raised inside that
-    at-fork hook, Python would drop the KeyboardInterrupt ("Exception ignored in ..."), so it must come
-    at the first call after the hook returns.  (Called directly here, an exception raised inside the hook
-    propagates, so the test sees where it was raised.)"""
-    raised_inside = []
-    with interrupts.handling():
-        interrupts._state.held = True
-        signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
-        os.kill(os.getpid(), signal.SIGINT)  # pending until the hook lets it through
-        with pytest.raises(KeyboardInterrupt):
-            try:
-                interrupts._after_fork_in_parent()
-            except KeyboardInterrupt:
-                raised_inside.append(True)
-                raise
-            len(raised_inside)  # the first call after the hook: the stop is raised here
-    assert raised_inside == []

@@ -63,10 +63,8 @@ _state = _State()
 
 # ------------------------------------------------------------------------------------------ handler
 def _in_llvmlite(frame) -> bool:
-    """A frame where a KeyboardInterrupt would be dropped (printed as "Exception ignored"), not raised to
-    the command: llvmlite's callbacks, and the at-fork hook that lets a held signal through."""
     while frame is not None:
-        if _LLVMLITE in frame.f_code.co_filename or frame.f_code is _after_fork_in_parent.__code__:
+        if _LLVMLITE in frame.f_code.co_filename:
             return True
         frame = frame.f_back
     return False
