@@ -8,7 +8,7 @@ import copy
 import pandas as pd
 import pytest
 
-from infomarket.analysis import chain_study, sensitivity_report, study, terrain
+from infomarket.analysis import chain_study, future, sensitivity_report, study, terrain
 from infomarket.analysis.declared import ADDED, DECLARED, EDITED
 from infomarket.analysis.report import TOLERANCES
 from infomarket.errors import ConfigError
@@ -118,3 +118,18 @@ def test_out_must_be_a_folder(tmp_path):
         study.out_dir(tmp_path / "f")
     files = study.write(tmp_path / "o", "s", "# md\n", table=pd.DataFrame({"a": [1]}), extra=[("s.json", "{}")])
     assert [f.name for f in files] == ["s.md", "s.csv", "s.json"] and (tmp_path / "o" / "s.csv").read_text() == "a\n1\n"
+
+
+# ------------------------------------------------------------------------------------------ verdicts
+def test_a_one_sided_rule_answers_no_only_with_the_power_to_have_said_yes():
+    assert study.by_power(True, 0.0) == "yes"          # met: yes whatever the power
+    assert study.by_power(False, 0.80) == "no"         # not met at the target power: a finding
+    assert study.by_power(False, 0.79) == "inconclusive"
+    assert study.by_power(False, 0.5, target=0.5) == "no"
+
+
+def test_every_study_answers_with_the_one_verdict():
+    v = study.Verdict("inconclusive", note="n too small")
+    assert v.shown == "inconclusive (n too small)" and study.Verdict("yes").shown == "yes"
+    assert chain_study.Verdict is future.Verdict is study.Verdict
+    assert chain_study.NOT_RUN == terrain.NOT_RUN == study.NOT_RUN == "not run"

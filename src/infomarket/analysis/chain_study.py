@@ -14,18 +14,17 @@ Cliff's delta with bootstrap intervals, simulated power); a rule its runs cannot
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
 from . import stats as st
-from .study import packaged
+from .study import NOT_RUN, PENDING, Verdict, packaged
 
 DECLARATION = packaged("chain_questions.toml")
 QUESTIONS = DECLARATION.path
 YES, NO, INCONCLUSIVE = st.YES, st.NO, st.INCONCLUSIVE
-NOT_RUN, PENDING = "not run", "pending"
 PAPER, FIG7, SWEEP, FIG7_SWEEP, PARTITION = ("chain_paper", "chain_fig7", "chain_sweep", "chain_fig7_sweep",
                                              "chain_partition")
 #: the sweeps' setting label of each axis value; the axis's toychain value is toychain's own runs
@@ -66,18 +65,6 @@ def _sel(runs: pd.DataFrame, experiment: str, col: str = "byz_share", **keys) ->
 
 
 # ------------------------------------------------------------------------------------------ verdicts
-@dataclass
-class Verdict:
-    """One question's (or one axis value's) answer, with what it rests on."""
-
-    answer: str
-    n: str = ""
-    effect: str = ""
-    details: list[str] = field(default_factory=list)
-    note: str = ""
-    value: object = None  # the breaking value of a "where does it break" question
-
-
 def _ci(c: st.Comparison, unit: str) -> str:
     e = c.effect
     return f"HL {e.hl:+.3g}{unit} [{e.hl_low:.3g}, {e.hl_high:.3g}], Cliff's delta {e.delta:+.2f} [{e.delta_low:.2f}, {e.delta_high:.2f}]"
@@ -120,7 +107,8 @@ def wealth_verdict(pairs: list[tuple[str, np.ndarray, np.ndarray, float]], alpha
     note = st.N_TOO_SMALL if ans == INCONCLUSIVE and weak else ""
     if k < declared:
         note = ", ".join(x for x in (note, f"{k} of {declared} conditions run") if x)
-    return Verdict(ans, n, f"largest shift ({pairs[worst][0]}): {_ci(ni[worst], ' pp')}", details, note)
+    return Verdict(ans, n=n, effect=f"largest shift ({pairs[worst][0]}): {_ci(ni[worst], ' pp')}", details=details,
+                   note=note)
 
 
 def fig7_verdict(angles: list[tuple[str, np.ndarray, np.ndarray, float]], alpha: float = st.ALPHA,
@@ -150,7 +138,8 @@ def fig7_verdict(angles: list[tuple[str, np.ndarray, np.ndarray, float]], alpha:
     least = min(range(k), key=lambda i: helps[i].effect.hl)
     n = ", ".join(sorted({f"{c.n_x} vs {c.n_y}" for c in helps}))
     note = st.N_TOO_SMALL if ans == INCONCLUSIVE and weak else ""
-    return Verdict(ans, n, f"smallest gain ({angles[least][0]}): {_ci(helps[least], ' items')}", details, note)
+    return Verdict(ans, n=n, effect=f"smallest gain ({angles[least][0]}): {_ci(helps[least], ' items')}",
+                   details=details, note=note)
 
 
 # ------------------------------------------------------------------------------------------ questions
@@ -249,8 +238,8 @@ def breaks_question(runs: pd.DataFrame, decl: dict, axis: str) -> Verdict:
     for v, label in axis_values(decl, axis):
         state, w, f = axis_point(runs, decl, label)
         states.append((v, state, w, f))
-        details.append(f"{axis} {v:g} ({label}): {state} (wealth: {st.shown(w.answer, w.note)}; Fig. 7 at 90 deg: "
-                       f"{st.shown(f.answer, f.note)})")
+        details.append(f"{axis} {v:g} ({label}): {state} (wealth: {w.shown}; Fig. 7 at 90 deg: "
+                       f"{f.shown})")
         details.extend(f"  {axis} {v:g}, {d}" for d in w.details + f.details)
     ran = [s for s in states if s[1] != NOT_RUN]
     if not ran:
@@ -265,12 +254,12 @@ def breaks_question(runs: pd.DataFrame, decl: dict, axis: str) -> Verdict:
         below = [s for s in states if s[0] < v and NOT_RUN in (s[2].answer, s[3].answer)]
         if below:  # the smallest breaking value may lie below, where a half of the rule was not run
             note = "; ".join(x for x in (note, f"breaks at or below {v:g}: a value below it is not fully run") if x)
-        return Verdict(YES, why.n, f"breaks at {axis} {v:g}: {why.effect}", details, note, value=v)
+        return Verdict(YES, n=why.n, effect=f"breaks at {axis} {v:g}: {why.effect}", details=details, note=note, value=v)
     if all(s[1].startswith("holds") for s in ran):
         if any(s[2].answer == NOT_RUN for s in states):  # "no" needs the wealth rule at every value
-            return Verdict(INCONCLUSIVE, "", f"holds at every {axis} value run", details, note)
-        return Verdict(NO, "", f"holds at every {axis} value run", details, note)
-    return Verdict(INCONCLUSIVE, "", "", details, note)
+            return Verdict(INCONCLUSIVE, effect=f"holds at every {axis} value run", details=details, note=note)
+        return Verdict(NO, effect=f"holds at every {axis} value run", details=details, note=note)
+    return Verdict(INCONCLUSIVE, details=details, note=note)
 
 
 def partition_questions(runs: pd.DataFrame, chain: pd.DataFrame | None, decl: dict) -> tuple[Verdict, Verdict]:
@@ -345,7 +334,7 @@ def answer(runs: pd.DataFrame, chain: pd.DataFrame | None = None, decl: dict | N
     for qid, verdict in v.items():
         rule = RULES["wealth" if qid.startswith("wealth") else "fig7" if qid.startswith("fig7") else
                      "breaks" if qid.startswith("breaks") else qid]
-        shown = st.shown(verdict.answer, verdict.note)
+        shown = verdict.shown
         if qid.startswith("breaks") and verdict.answer == YES:
             shown = f"yes, at {qid.split('_')[1]} {verdict.value:g}" + (f" ({verdict.note})" if verdict.note else "")
         rows.append({"question": qid, "text": q[qid]["question"], "rule": rule, "n": verdict.n,
@@ -366,7 +355,7 @@ def markdown(a: Answers, wall: str = "") -> str:
         lines.append(f"| {qid}: {text} | {rule} | {n} | {effect} | **{shown}** |")
     lines += [""]
     for qid, verdict in a.verdicts.items():
-        lines += [f"## {qid}: {st.shown(verdict.answer, verdict.note)}", ""]
+        lines += [f"## {qid}: {verdict.shown}", ""]
         lines += [f"- {d}" for d in verdict.details] + [""]
     lines += DECLARATION.record_markdown()
     return "\n".join(lines)

@@ -28,7 +28,7 @@ from .declared import size_note, status_of
 from .figures import _runs_text, save
 from .frames import Frames, MissingDataError
 from .headline import DECLARATION
-from .study import Declaration, html_table, md_table
+from .study import NO_DATA, Declaration, Verdict, html_table, md_table
 from ..errors import ConfigError
 
 TOLERANCES = DECLARATION.path
@@ -45,7 +45,7 @@ STYLES = {"paper": (0, (6, 2)), "reputation_sceptic": (0, (2, 1.5)), "adaptive_t
           "both": (0, (1, 1))}
 BELOW = (5.0, 10.0, 20.0, 25.0)
 ABOVE = (40.0, 90.0)
-YES, NO, INCONCLUSIVE, NO_DATA = st.YES, st.NO, st.INCONCLUSIVE, "no data"
+YES, NO, INCONCLUSIVE = st.YES, st.NO, st.INCONCLUSIVE
 
 
 def swarm_items(robots: pd.DataFrame) -> pd.DataFrame:
@@ -92,13 +92,6 @@ class Question:
     params: dict
 
 
-@dataclass(frozen=True)
-class Answer:
-    answer: str      # yes / no / inconclusive / no data
-    statistics: str  # the numbers the answer rests on
-    comparisons: tuple = ()  # the stats.Comparison objects, for tests and JSON
-
-
 STATISTICS = {"alpha": st.ALPHA, "power": st.POWER, "margin_fraction": 0.10, "confidence": st.CONFIDENCE,
               "runs": None}
 
@@ -123,7 +116,7 @@ def load_questions(path: str | Path = TOLERANCES) -> dict[str, Question]:
     return out
 
 
-ANSWERS: dict[str, Callable[[pd.DataFrame, dict], Answer]] = {}
+ANSWERS: dict[str, Callable[[pd.DataFrame, dict], Verdict]] = {}
 
 
 def answers(qid: str):
@@ -164,7 +157,7 @@ def _power_line(comps: list[st.Comparison], p: dict) -> str:
 
 
 @answers("liar_recovered")
-def _liar_recovered(runs: pd.DataFrame, p: dict) -> Answer:
+def _liar_recovered(runs: pd.DataFrame, p: dict) -> Verdict:
     ref, m = _reference(runs, p)
     keys = [(d, a) for d in NEW for a in BELOW]
     xs = {k: _need(values(runs, "future_liar", k[0], 3, k[1]), f"future_liar {k[0]} at {k[1]:g} deg") for k in keys}
@@ -174,7 +167,7 @@ def _liar_recovered(runs: pd.DataFrame, p: dict) -> Answer:
                        for k in keys])
     yes = [d for d in NEW if all(c.significant for c, k in zip(ni, keys) if k[0] == d)]
     no = all(any(c.significant for c, k in zip(below, keys) if k[0] == d) for d in NEW)
-    return Answer(st.answer(bool(yes), no),
+    return Verdict(st.answer(bool(yes), no),
                   f"{_size(p, ni)}reference (paper, 0 Byzantines) median {_med(ref):g} items, n = {len(ref)}; "
                   f"margin {m:.3g} items; shown within the margin at every angle: {', '.join(yes) or 'no defence'}; "
                   f"shown below at some angle: {', '.join(d for d in NEW if any(c.significant for c, k in zip(below, keys) if k[0] == d)) or 'no defence'}; "
@@ -182,7 +175,7 @@ def _liar_recovered(runs: pd.DataFrame, p: dict) -> Answer:
 
 
 def _improves(defence: str):
-    def measure(runs: pd.DataFrame, p: dict) -> Answer:
+    def measure(runs: pd.DataFrame, p: dict) -> Verdict:
         _, m = _reference(runs, p)
         comps = []
         for a in BELOW:
@@ -191,7 +184,7 @@ def _improves(defence: str):
             comps.append(_cmp(x, y, f"{a:g} deg", p, declared=m, family=len(BELOW)))
         comps = st.adjust(comps)
         hits = sum(c.significant for c in comps)
-        return Answer(st.answer_superiority(comps, p["min_angles"], p["power"]),
+        return Verdict(st.answer_superiority(comps, p["min_angles"], p["power"]),
                       f"{_size(p, comps)}{hits} of {len(BELOW)} angles with Holm-adjusted p < {p['alpha']:g} "
                       f"(needed {p['min_angles']}); {_power_line(comps, p)} for a gain of the margin "
                       f"({m:.3g} items). {defence} vs paper: {_lines(comps)}", tuple(comps))
@@ -203,7 +196,7 @@ for _d in NEW:
 
 
 def _beats(experiment: str, defence: str):
-    def measure(runs: pd.DataFrame, p: dict) -> Answer:
+    def measure(runs: pd.DataFrame, p: dict) -> Verdict:
         own = _need(values(runs, HONEST, defence, 0), f"future_honest, {defence}")
         m = p.get("fraction", p["margin_fraction"]) * _med(own)
         angles = (*BELOW, *ABOVE)
@@ -220,7 +213,7 @@ def _beats(experiment: str, defence: str):
 
         yes = any(c.significant for c in dropped) and all(c.significant for c in not_better)
         no = any(c.significant for c in helped) or all(c.significant for c in kept)
-        return Answer(st.answer(yes, no),
+        return Verdict(st.answer(yes, no),
                       f"{_size(p, helped)}{defence} without Byzantines: median {_med(own):g}, margin {m:.3g}; "
                       f"shown below {_med(own):g} - margin at {at(dropped)}; shown above it at {at(kept)}; "
                       f"shown no better than the paper + margin at {at(not_better)}; significantly better than "
@@ -234,13 +227,13 @@ answers("surfer_beats_adaptive_theta")(_beats("future_surfer", "adaptive_theta")
 
 
 def _honest_cost(defence: str):
-    def measure(runs: pd.DataFrame, p: dict) -> Answer:
+    def measure(runs: pd.DataFrame, p: dict) -> Verdict:
         x, m = _reference(runs, p)
         y = _need(values(runs, HONEST, defence, 0), f"future_honest, {defence}")
         cost = _cmp(y, x, f"{defence} below paper", p, alternative="less", declared=-m)
         ni = _cmp(y, x, f"{defence} within the margin of paper", p, shift=m, declared=0.0)
         rel = 100.0 * (_med(y) - _med(x)) / _med(x) if _med(x) else math.nan
-        return Answer(st.answer(cost.significant, ni.significant),
+        return Verdict(st.answer(cost.significant, ni.significant),
                       f"{_size(p, [cost])}medians {_med(y):g} ({defence}) vs {_med(x):g} (paper), {rel:+.1f} %; "
                       f"margin {m:.3g} items. {cost.describe(' items')}; {ni.describe(' items')}", (cost, ni))
     return measure
@@ -251,7 +244,7 @@ for _d in NEW:
 
 
 @answers("above_theta_kept")
-def _above_kept(runs: pd.DataFrame, p: dict) -> Answer:
+def _above_kept(runs: pd.DataFrame, p: dict) -> Verdict:
     _, m = _reference(runs, p)
     keys = [(d, a) for d in NEW for a in ABOVE]
     x = {k: _need(values(runs, "future_liar", k[0], 3, k[1]), f"future_liar {k[0]} at {k[1]:g} deg") for k in keys}
@@ -260,7 +253,7 @@ def _above_kept(runs: pd.DataFrame, p: dict) -> Answer:
                     for k in keys])
     worse = st.adjust([_cmp(x[k], y[k[1]], f"{k[0]} {k[1]:g} deg", p, alternative="less") for k in keys])
     shown = [c.label for c in worse if c.significant]
-    return Answer(st.answer(all(c.significant for c in ni), bool(shown)),
+    return Verdict(st.answer(all(c.significant for c in ni), bool(shown)),
                   f"{_size(p, ni)}margin {m:.3g} items; significantly worse than the paper: "
                   f"{', '.join(shown) or 'none'}; non-inferiority shown at {sum(c.significant for c in ni)} of "
                   f"{len(ni)}; {_power_line(ni, p)}. Non-inferiority (Holm over {len(keys)}): {_lines(ni)}",
@@ -283,12 +276,12 @@ def question_table(source, questions: dict[str, Question] | None = None) -> pd.D
         if qid not in ANSWERS:
             raise ConfigError(f"tolerances questions.{qid} has no answer function in future.py")
         if runs is None:
-            a = Answer(NO_DATA, missing)
+            a = Verdict(NO_DATA, missing)
         else:
             try:
                 a = ANSWERS[qid](runs, q.params)
             except MissingDataError as exc:
-                a = Answer(NO_DATA, str(exc))
+                a = Verdict(NO_DATA, str(exc))
         note = st.N_TOO_SMALL if a.answer == INCONCLUSIVE and st.too_few_runs(a.comparisons) else ""
         rows.append([qid, q.question, q.rule, a.answer, a.statistics,
                      status_of(locks, "tolerances.toml", f"questions.{qid}"), note])

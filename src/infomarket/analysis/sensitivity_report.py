@@ -15,8 +15,7 @@ from .figures import save
 from .frames import MissingDataError
 from . import sensitivity as sens  # module-level knobs (PAWN_PERMUTATIONS) read when drawing
 from .sensitivity import TITLES, Sensitivity, drivers, floor_of, from_store, morris_noise, noise_floor
-from .stats import INCONCLUSIVE, NO, YES
-from .study import Declaration, html_table, md_table, packaged
+from .study import INCONCLUSIVE, NO, YES, Declaration, html_table, md_table, packaged
 
 DECLARATION = packaged("sensitivity_questions.toml")
 QUESTIONS = DECLARATION.path

@@ -5,7 +5,8 @@ terrain, sensitivity and chain studies) goes the same way: read its declaration 
 question from a store's runs, and write the verdicts as markdown (and CSV/JSON) with a figure.  What is
 common lives here: reading the file, how its declarations relate to a store's record (``declared``), the
 study's record of amendments and deviations (printed in every report it writes), tables in markdown and
-HTML, and the command-line plumbing (``--out`` checked before anything runs; files written at the end).
+HTML, the ``Verdict`` every question is answered with (its answer, the numbers and comparisons it rests
+on, what qualifies it), and the command-line plumbing (``--out`` checked before anything runs; files written at the end).
 The studies keep only what is theirs: the per-run values, the rule of each question, the figure.
 
 A declaration file records its history in two arrays of tables, beside its questions:
@@ -22,7 +23,7 @@ from __future__ import annotations
 import html
 import tomllib
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import pandas as pd
@@ -30,9 +31,13 @@ import pandas as pd
 from ..cliargs import UsageError, writable_dir
 from ..errors import ConfigError
 from . import declared
+from . import stats as st
 from .declared import NOTES, Lock, check, status_of, summary
 
 HERE = Path(__file__).parent
+#: a declared question's answers: decided by its rule, or why the store cannot decide it yet
+YES, NO, INCONCLUSIVE = st.YES, st.NO, st.INCONCLUSIVE
+NO_DATA, NOT_RUN, PENDING = "no data", "not run", "pending"
 #: the arrays of a declaration file that record its history (see the module's docstring)
 RECORDS = NOTES
 _FIELDS = ("date", "seen", "what", "why")
@@ -125,6 +130,36 @@ class Declaration:
 def packaged(name: str) -> Declaration:
     """One of the analysis package's declaration files, by file name (``chain_questions.toml``)."""
     return Declaration.read(HERE / name)
+
+
+# ------------------------------------------------------------------------------------------ verdicts
+@dataclass
+class Verdict:
+    """One declared question's answer with what it rests on: every study answers with these, so a
+    report, a table or a test reads the answer, its numbers and its qualifying note the same way
+    whatever the study.  ``details`` grows while a study adds descriptive lines to an answer."""
+
+    answer: str                 # YES / NO / INCONCLUSIVE, or NO_DATA / NOT_RUN / PENDING, or a study's own
+    statistics: str = ""        # the numbers the answer rests on, as the report prints them
+    comparisons: tuple = ()     # the ``stats.Comparison`` objects it was decided from
+    note: str = ""              # what qualifies it (``stats.N_TOO_SMALL``, conditions not run, ...)
+    details: list[str] = field(default_factory=list)  # one line per condition or descriptive result
+    n: str = ""                 # runs per group, as printed
+    effect: str = ""            # the effect it rests on, with its interval, as printed
+    value: object = None        # the answer's value where the question asks for one (a breaking point)
+
+    @property
+    def shown(self) -> str:
+        """The answer as printed: ``inconclusive (n too small)`` when a note qualifies it."""
+        return st.shown(self.answer, self.note)
+
+
+def by_power(met: bool, power: float, target: float = st.POWER) -> str:
+    """A one-sided rule's answer: yes when it is met; no when it is not and its test had the power to
+    meet it; inconclusive otherwise (the runs could not have decided it)."""
+    if met:
+        return YES
+    return NO if power >= target else INCONCLUSIVE
 
 
 # ------------------------------------------------------------------------------------------ tables

@@ -26,6 +26,7 @@ from ..cliargs import UsageError
 from ..store.results import Store
 from . import stats as st
 from . import study
+from .study import INCONCLUSIVE, NO, NOT_RUN, YES, by_power
 from .declared import size_note
 from .stats import mann_whitney
 
@@ -66,14 +67,6 @@ def _ratio(a: float, b: float) -> float:
     return float("inf") if b == 0 else a / b
 
 
-def _verdict(test: st.Comparison, met: bool, target: float = st.POWER) -> str:
-    """yes when the rule is met; no when it is not and the test had the power to meet it; otherwise
-    inconclusive (the run count cannot reach the declared p, or power below ``target``)."""
-    if met:
-        return "yes"
-    return "no" if test.power >= target else "inconclusive"
-
-
 def _comparison_json(c: st.Comparison) -> dict:
     e = c.effect
     return {"test": c.test, "n": [c.n_x, c.n_y], "p": c.p, "min_p": c.min_p, "alpha": c.alpha,
@@ -92,7 +85,7 @@ def chain_blocked(robots: pd.DataFrame, rule: dict) -> dict:
                       label="corridor: market on vs off")
     ratio = _ratio(med["corridor", "on"], med["corridor", "off"])
     yes = test.p < rule["p_below"] and ratio >= rule["min_ratio"]
-    return {"answer": _verdict(test, yes), "runs": len(on),
+    return {"answer": by_power(yes, test.power), "runs": len(on),
             "median_items": {f"{w}/{m}": med[w, m] for w, m in med},
             "iqr_items": {f"{w}/{m}": [float(np.percentile(v, 25)), float(np.percentile(v, 75))]
                           for (w, m), v in runs.items()},
@@ -126,7 +119,7 @@ def waypoints_restore(naive: pd.DataFrame, waypoint: pd.DataFrame, rule: dict) -
     a = test.p < rule["p_below"] and ratio >= rule["min_ratio"]
     b = share.value >= rule["min_share_of_plane"]
     two = lambda x, y: float(sps.mannwhitneyu(x, y, alternative="two-sided").pvalue)  # noqa: E731
-    answer = ("yes" if b else "partly") if a else _verdict(test, False)
+    answer = (YES if b else "partly") if a else by_power(False, test.power)
     return {"answer": answer, "beats_vector_market": bool(a),
             "keeps_half_of_plane": bool(b), "runs": len(way),
             "median_items": med,
@@ -166,7 +159,7 @@ def outlier_two_food(robots: pd.DataFrame, rule: dict, sites: pd.DataFrame | Non
            and two["runs_separated"] >= rule["min_runs_separated"])
     reachable = two["min_p_run_level"] < rule["p_below"]
     gaps = sps.mannwhitneyu(two["gaps"], one["gaps"], alternative="two-sided").pvalue
-    out = {"answer": "yes" if yes else ("no" if reachable else "inconclusive"),
+    out = {"answer": YES if yes else (NO if reachable else INCONCLUSIVE),
            "two_sites": {k: v for k, v in two.items() if k != "gaps"},
            "one_site": {k: v for k, v in one.items() if k != "gaps"}, "p_gaps_differ": float(gaps),
            "gaps_pct": {"two": (100 * two["gaps"]).tolist(), "one": (100 * one["gaps"]).tolist()}}
@@ -224,7 +217,7 @@ def terrain_figure(a: dict):
     data = [q1[k] for k in keys]
     labels = ["plane\nmarket", "plane\nno market", "corridor\nmarket", "corridor\nno market"]
     w = a["waypoints_restore"]
-    if w["answer"] != "not run":
+    if w["answer"] != NOT_RUN:
         data += [w["per_run"]["waypoint/plane"], w["per_run"]["waypoint/corridor"]]
         labels += ["plane\nwaypoints", "corridor\nwaypoints"]
     _boxes(ax[0], data, labels)
@@ -235,7 +228,7 @@ def terrain_figure(a: dict):
     ax[0].set_ylim(0, upper)
     ax[0].set_yticks(ticks, [f"{t:g}" for t in ticks])
     ax[0].set_ylabel("items per run (whole swarm)")
-    robots = "25 naive" + (" / 25 waypoint" if w["answer"] != "not run" else "")
+    robots = "25 naive" + (" / 25 waypoint" if w["answer"] != NOT_RUN else "")
     ax[0].set_title(f"corridor: {robots} robots\n(symlog axis: linear below 10)", loc="left", fontsize=9)
     q3 = a["outlier_two_food"]["gaps_pct"]
     _boxes(ax[1], [q3["one"], q3["two"]], ["one food site", "two food sites"])
@@ -281,7 +274,7 @@ def answer(root: Path) -> dict:
             "waypoints_restore": (waypoints_restore(_robots(root, "corridor"), _robots(root, "corridor_waypoints"),
                                                     q["waypoints_restore"])
                                   if (root / "corridor_waypoints").exists() else
-                                  {"answer": "not run", "why": "no corridor_waypoints store"}),
+                                  {"answer": NOT_RUN, "why": "no corridor_waypoints store"}),
             "outlier_two_food": outlier_two_food(_robots(root, "two_food"), q["outlier_two_food"], sites),
             "crowd_collisions": crowd_collisions(_robots(root, "crowd"), q["crowd_collisions"]),
             **({"crowd_sensing": exploratory(crowd_collisions(_robots(root, "crowd_sensing"), q["crowd_collisions"]))}
@@ -298,7 +291,7 @@ def exploratory(a: dict) -> dict:
 
 def _waypoint_line(q: dict, w: dict) -> str:
     head = f"2. **{q['waypoints_restore']['question']}** — "
-    if w["answer"] == "not run":
+    if w["answer"] == NOT_RUN:
         return head + "**not run**: no `corridor_waypoints` store (`infomarket sweep corridor_waypoints`)."
     m, r = w["median_items"], q["waypoints_restore"]
     return (head + f"**{w['answer']}**.  Median items per run ({w['runs']} runs each, market on): waypoint robots "
@@ -368,7 +361,7 @@ def markdown(a: dict) -> str:
                      ("crowd_collisions", None)):
         ans = a[qid]
         runs = (ans.get(key) if key else (ans["two_sites"]["runs"] if qid == "outlier_two_food" else ans[100]["runs"])) \
-            if ans.get("answer") != "not run" else None
+            if ans.get("answer") != NOT_RUN else None
         note = size_note(q[qid].get("runs"), [runs] if runs else [])
         if note:
             notes.append(f"{qid}: {note}")
