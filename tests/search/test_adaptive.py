@@ -149,6 +149,16 @@ def test_training_is_deterministic_for_a_seed(staking):
     assert not np.array_equal(a.weights, c.weights)
 
 
+def test_workers_and_batches_change_no_result(staking):
+    one = train(staking, 10, seed=4, **TINY)
+    pooled = train(staking, 10, seed=4, workers=2, batch=2, **TINY)
+    np.testing.assert_array_equal(pooled.weights, one.weights)
+    assert pooled.info == one.info
+    seeds = [3, 4, 5]
+    pd.testing.assert_frame_equal(confirm(staking, one, seeds, workers=2, batch=1, **SHORT),
+                                  confirm(staking, one, seeds, **SHORT), check_exact=True)
+
+
 def test_a_resumed_training_gives_the_same_policy_and_repeats_no_run(staking, tmp_path):
     whole = train(staking, 15, seed=4, **TINY)
 
