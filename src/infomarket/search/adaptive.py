@@ -267,6 +267,8 @@ def train(cell: Cell, budget: int, *, pairs: int = 8, runs: int = 4, sigma: floa
         if not (isinstance(v, (int, float)) and np.isfinite(v) and v > 0):
             raise ArgumentError(f"{name} must be a finite number above 0, got {v!r}")
     fitness(np.zeros(1), np.zeros(1), objective)  # an unknown objective is refused before any run
+    if set(start or {}) - set(actions):
+        raise ArgumentError(f"start {start}: sets only the actions {actions}; the other parameters go in base")
     cfg = cell.with_attack(dict(base or {}), steps=steps, transitory=transitory)
     first = start_values(cell, actions, start, base)
     training = Training(cell.experiment, hashlib.sha256(cfg.model_dump_json().encode()).hexdigest(), int(budget),
@@ -302,7 +304,8 @@ def train(cell: Cell, budget: int, *, pairs: int = 8, runs: int = 4, sigma: floa
             if on_generation is not None:
                 on_generation(g, record)
     info = {"training": training.as_dict(), "generations": training.generations, "curve": curve,
-            "runs_played": training.generations * pop * runs, "start_policy": first}
+            "runs_played": training.generations * pop * runs,
+            "env_steps": training.generations * pop * runs * cfg.steps, "start_policy": first}
     return Policy(theta, actions, interval, dict(base or {}), info)
 
 

@@ -24,15 +24,16 @@ from .objective import per_run
 #: Runs stepped together in one compiled call (their worlds are alive at once).
 BATCH = 32
 
-_runs: dict[tuple, Runs] = {}  # per process: built once per (configuration, batch size, actions)
+_runs: dict[tuple, Runs] = {}  # per process: built once per (configuration, actions, batch size)
 
 
 def _runs_for(cfg, size: int, actions: tuple[str, ...]) -> Runs:
-    key = (cfg.model_dump_json(), size, actions)
-    if key not in _runs:
-        _runs.clear()  # one configuration at a time: worlds are large
-        _runs[key] = Runs(cfg, size, actions=actions)
-    return _runs[key]
+    key = (cfg.model_dump_json(), actions)
+    if any(k[:2] != key for k in _runs):
+        _runs.clear()  # one configuration at a time (worlds are large); ``chunks`` makes at most two sizes
+    if key + (size,) not in _runs:
+        _runs[key + (size,)] = Runs(cfg, size, actions=actions)
+    return _runs[key + (size,)]
 
 
 def check_memory(cfg, batch: int, what: str) -> None:
@@ -107,6 +108,8 @@ class Player:
         self._pool = None
 
     def __enter__(self) -> "Player":
+        if self.workers > 1:  # load the kernels here: forked workers inherit them instead of each loading them
+            _runs_for(self.cfg, 1, self.actions)
         self._executor = local_executor(self.workers)
         self._pool = self._executor.__enter__()
         return self
