@@ -166,6 +166,12 @@ def generation_seeds(master: int, seed: int, g: int, runs: int) -> list[int]:
     return [run_seed(master, j, stream) for j in range(runs)]
 
 
+def evaluation_seeds(master: int, seed: int, runs: int) -> list[int]:
+    """Fresh run seeds for comparing a trained policy with its start (a stream training never plays)."""
+    stream = _stream("adaptive", "evaluation", seed)
+    return [run_seed(master, k, stream) for k in range(runs)]
+
+
 def _noise(seed: int, g: int, shape) -> np.ndarray:
     rng = np.random.default_rng(np.random.SeedSequence(int(seed), spawn_key=(_stream("adaptive", "noise"), g)))
     return rng.standard_normal(shape)

@@ -59,14 +59,11 @@ def add_subcommand(sub) -> None:
 
 def _evaluate(cell, policy, start, runs: int, seed: int, steps, transitory, workers: int) -> dict:
     """The learned policy and the constant attack it started from on the same fresh seeds (paired)."""
-    import numpy as np  # with the command: `infomarket --help` stays light
+    import numpy as np
 
-    from ..seeds import run_seed
-    from .adaptive import Policy, _stream, confirm
+    from .adaptive import Policy, confirm, evaluation_seeds  # with the command: `--help` stays light
 
-    cfg_seed = cell.with_attack(policy.base, steps=steps, transitory=transitory).seed
-    stream = _stream("adaptive", "evaluation", seed)
-    seeds = [run_seed(cfg_seed, k, stream) for k in range(runs)]
+    seeds = evaluation_seeds(cell.with_attack(policy.base, steps=steps, transitory=transitory).seed, seed, runs)
     first = Policy.constant(start, policy.actions, policy.interval, policy.base)
     learned = confirm(cell, policy, seeds, steps=steps, transitory=transitory, workers=workers)["items"].to_numpy()
     before = confirm(cell, first, seeds, steps=steps, transitory=transitory, workers=workers)["items"].to_numpy()
