@@ -51,6 +51,8 @@ def refused(capsys, argv, *words) -> str:
     (["--defence", "staking", "--byzantines", "3", "--budget", "5", "--transitory", "40000"], ["--transitory 40000"]),
     (["--defence", "staking", "--byzantines", "3", "--budget", "5", "--objective", "gold"], ["--objective"]),
     (["--defence", "staking", "--byzantines", "3", "--budget", "5", "--seed", "-1"], ["--seed"]),
+    (["--defence", "staking", "--byzantines", "3", "--budget", "5", "--pairs", "100000000", "--runs", "1000"],
+     ["200000001 candidates x 1000 runs", "memory"]),
 ])
 def test_bad_input_is_one_error_and_nothing_written(extra, words, tmp_path, capsys):
     out = tmp_path / "out"

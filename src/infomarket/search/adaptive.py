@@ -281,7 +281,8 @@ def train(cell: Cell, budget: int, *, pairs: int = 8, runs: int = 4, sigma: floa
                         int(pairs), int(runs), float(sigma), float(lr), int(seed), actions, int(interval), first,
                         dict(base or {}), objective)
     pop = training.population
-    check_memory(cfg, min(batch, pop * runs), f"batch {min(batch, pop * runs)}")
+    check_memory(cfg, min(batch, pop * runs), f"{pop} candidates x {runs} runs", pop * runs,
+                 (len(OBSERVATION) + 1) * len(actions))
     theta = Policy.constant(first, actions, interval, base).weights
     opt, curve = Adam(lr), []
     path = _checkpoint(checkpoint)
@@ -324,7 +325,7 @@ def confirm(cell: Cell, policy: Policy, seeds, *, steps: int | None = None, tran
     if not len(seeds):
         raise ArgumentError("confirm: at least one run seed")
     cfg = cell.with_attack(policy.base, steps=steps, transitory=transitory)
-    check_memory(cfg, min(batch, len(seeds)), f"batch {min(batch, len(seeds))}")
+    check_memory(cfg, min(batch, len(seeds)), f"{len(seeds)} seeds", len(seeds), policy.weights.size)
     weights = np.repeat(policy.weights[None], len(seeds), axis=0)
     with Player(cfg, policy.actions, policy.interval, batch=batch, workers=workers) as player:
         per = player.per_run(weights, seeds)

@@ -103,7 +103,10 @@ def cmd_adaptive_attack(args) -> int:
     from ..errors import report
     from ..runner.progress import progress
     from . import study as study_mod
+    from ..rl.observe import OBSERVATION
+    from ..rl.runs import ACTIONS
     from .adaptive import resumed_generations, train
+    from .adaptive_play import BATCH, check_memory
 
     if not args.out.strip():  # Path("") is the current folder: a blank variable must not write there
         raise UsageError(f"--out {args.out!r}: give a folder for the checkpoint, the policy and the summary")
@@ -118,9 +121,11 @@ def cmd_adaptive_attack(args) -> int:
     transitory = args.transitory if args.transitory is not None else exp.transitory
     if transitory >= steps:
         raise UsageError(f"--transitory {transitory}: must be below --steps {steps} (items count after it)")
-    cell.with_attack({}, steps=args.steps, transitory=args.transitory)  # the configuration is valid
+    cfg = cell.with_attack({}, steps=args.steps, transitory=args.transitory)  # the configuration is valid
     pop = 1 + 2 * args.pairs
     generations = max(1, args.budget // pop)
+    check_memory(cfg, min(BATCH, pop * args.runs), f"{pop} candidates x {args.runs} runs", pop * args.runs,
+                 (len(OBSERVATION) + 1) * len(ACTIONS))
     writable_dir(out)
     done = resumed_generations(out)
     t0 = time.perf_counter()
@@ -148,7 +153,7 @@ def cmd_adaptive_attack(args) -> int:
                "steps": steps, "transitory": transitory, "training": policy.info["training"],
                "generations": policy.info["generations"], "runs_played": policy.info["runs_played"],
                "curve": policy.info["curve"], "policy_at_rest": policy.at_rest(),
-               "weights": {a: dict(zip((*_observation(), "constant"), policy.weights[:, k].tolist()))
+               "weights": {a: dict(zip((*OBSERVATION, "constant"), policy.weights[:, k].tolist()))
                            for k, a in enumerate(policy.actions)},
                "evaluation": evaluation, "wall_seconds": time.perf_counter() - t0}
     for name, text in ((SUMMARY_JSON, json.dumps(summary, indent=2)), (SUMMARY_MD, _markdown(summary))):
@@ -161,7 +166,3 @@ def cmd_adaptive_attack(args) -> int:
     return 0
 
 
-def _observation() -> tuple[str, ...]:
-    from ..rl.observe import OBSERVATION  # compiled code: imported with the command only
-
-    return OBSERVATION

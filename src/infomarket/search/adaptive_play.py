@@ -36,9 +36,10 @@ def _runs_for(cfg, size: int, actions: tuple[str, ...]) -> Runs:
     return _runs[key + (size,)]
 
 
-def check_memory(cfg, batch: int, what: str) -> None:
-    """Refuse, before any world is built, a batch whose worlds would not fit in memory."""
-    too_big = sizes.batch_too_big(cfg, batch, what)
+def check_memory(cfg, batch: int, what: str, episodes: int = 0, weights: int = 0) -> None:
+    """Refuse, before any world is built, a batch whose worlds would not fit in memory, with a policy of
+    ``weights`` numbers for each of ``episodes`` episodes (a generation's candidates, each run's copy)."""
+    too_big = sizes.batch_too_big(cfg, batch, what, extra={"policies per episode": 8 * episodes * weights})
     if too_big:
         raise UsageError(too_big)
 
