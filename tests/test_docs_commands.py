@@ -109,6 +109,8 @@ NOT_RUN = {
     "infomarket adaptive-attack attack_search --defence staking --byzantines 3 --budget 180 --pairs 4 --runs 8 "
     "--lr 0.01 --seed 0 --eval-runs 0 --out results/adaptive-staking3-b": "1 440 runs of 30 000 steps; run below "
                                                                          "at a small size",
+    "infomarket adaptive-attack attack_search --defence staking --byzantines 3 --budget 170 --seed 0 --eval-runs 0 "
+    "--out results/adaptive-staking3-c": "680 runs of 30 000 steps; run below at a small size",
 }
 
 
@@ -204,6 +206,10 @@ SMALL = {
     "--lr 0.01 --seed 0 --eval-runs 0 --out results/adaptive-staking3-b":
         "infomarket adaptive-attack attack_search --defence staking --byzantines 3 --budget 3 --pairs 1 --runs 1 "
         "--steps 60 --transitory 20 --lr 0.01 --seed 0 --eval-runs 0 --out adaptive",
+    "infomarket adaptive-attack attack_search --defence staking --byzantines 3 --budget 170 --seed 0 --eval-runs 0 "
+    "--out results/adaptive-staking3-c":
+        "infomarket adaptive-attack attack_search --defence staking --byzantines 3 --budget 3 --pairs 1 --runs 1 "
+        "--steps 60 --transitory 20 --seed 0 --eval-runs 0 --out adaptive",
 }
 #: Shown in these pages but not run here, with the reason.
 SMALL_NOT_RUN = {

@@ -160,6 +160,16 @@ def es_gradient(fitness: np.ndarray, eps: np.ndarray, sigma: float) -> np.ndarra
     return np.tensordot(u[0::2] - u[1::2], eps, axes=1) / (len(eps) * sigma)
 
 
+def step_scale(actions) -> np.ndarray:
+    """Per weight, the scale of its noise and steps relative to the constant's: 1 / sqrt(observation
+    columns) for the observation rows, so that a perturbation or a step moves an action by about as much
+    whatever the robot observes (observations are in [0, 1]), instead of sqrt(19) times more through the
+    19 weights together than through the constant."""
+    r = np.full((len(OBSERVATION) + 1, len(actions)), 1.0 / np.sqrt(len(OBSERVATION)))
+    r[-1] = 1.0
+    return r
+
+
 def generation_seeds(master: int, seed: int, g: int, runs: int) -> list[int]:
     """The run seeds every candidate of generation ``g`` plays (common random numbers)."""
     stream = _stream("adaptive", "search", seed, g)
@@ -253,7 +263,7 @@ def start_values(cell: Cell, actions, start: dict | None, base: dict | None = No
     return {a: float((start or {}).get(a, own.get(a, _DEFAULTS[a]))) for a in actions}
 
 
-def train(cell: Cell, budget: int, *, pairs: int = 8, runs: int = 4, sigma: float = 0.1, lr: float = 0.03,
+def train(cell: Cell, budget: int, *, pairs: int = 8, runs: int = 4, sigma: float = 0.05, lr: float = 0.02,
           seed: int = 0, steps: int | None = None, transitory: int | None = None, interval: int = 10,
           actions=ACTIONS, start: dict | None = None, base: dict | None = None, objective: str = "items",
           checkpoint=None, workers: int = 1, batch: int = BATCH,
@@ -284,6 +294,7 @@ def train(cell: Cell, budget: int, *, pairs: int = 8, runs: int = 4, sigma: floa
     check_memory(cfg, min(batch, pop * runs), f"{pop} candidates x {runs} runs", pop * runs,
                  (len(OBSERVATION) + 1) * len(actions))
     theta = Policy.constant(first, actions, interval, base).weights
+    scale = step_scale(actions)
     opt, curve = Adam(lr), []
     path = _checkpoint(checkpoint)
     if path is not None:
@@ -294,13 +305,13 @@ def train(cell: Cell, budget: int, *, pairs: int = 8, runs: int = 4, sigma: floa
         for g in range(len(curve), training.generations):
             eps = _noise(seed, g, (pairs,) + theta.shape)
             cands = np.repeat(theta[None], pop, axis=0)
-            cands[1::2] += sigma * eps
-            cands[2::2] -= sigma * eps
+            cands[1::2] += sigma * scale * eps
+            cands[2::2] -= sigma * scale * eps
             seeds = generation_seeds(cfg.seed, seed, g, runs)
             weights = np.repeat(cands, runs, axis=0)  # candidate c plays seeds[0..runs-1]
             items, liar = player.play(weights, np.array(seeds * pop, dtype=np.int64), on_done=on_runs)
             f = fitness(items, liar, objective).reshape(pop, runs).mean(axis=1)
-            theta = theta + opt.step(es_gradient(f[1:], eps, sigma))
+            theta = theta + scale * opt.step(es_gradient(f[1:], eps, sigma))
             per = items.reshape(pop, runs).mean(axis=1)
             best = 1 + int(np.argmax(f[1:]))
             record = {"generation": g, "centre": float(f[0]), "mean": float(f[1:].mean()), "best": float(f[best]),

@@ -42,8 +42,9 @@ def add_subcommand(sub) -> None:
     p.add_argument("--pairs", type=at_least(1), default=8, help="antithetic pairs per generation (default 8)")
     p.add_argument("--runs", type=at_least(1), default=4,
                    help="runs per candidate, the same seeds for the whole generation (default 4)")
-    p.add_argument("--sigma", type=_positive, default=0.1, help="perturbation scale, in action ranges (default 0.1)")
-    p.add_argument("--lr", type=_positive, default=0.03, help="Adam's step size (default 0.03)")
+    p.add_argument("--sigma", type=_positive, default=0.05,
+                   help="perturbation scale, in action ranges (default 0.05)")
+    p.add_argument("--lr", type=_positive, default=0.02, help="Adam's step size, in action ranges (default 0.02)")
     p.add_argument("--interval", type=at_least(1), default=10, help="engine steps per decision, K (default 10)")
     p.add_argument("--objective", choices=["items", "liar_wealth"], default="items",
                    help="what the attack optimises (default items: the honest robots' items, minimised)")
