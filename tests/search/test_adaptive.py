@@ -204,3 +204,19 @@ def test_bad_training_arguments_are_refused_before_any_run(staking, monkeypatch)
                           ({"objective": "gold"}, "objective"), ({"actions": ("theta_x",)}, "one of")):
         with pytest.raises(ArgumentError, match=words):
             train(staking, 10, **kwargs)
+
+
+def test_the_declared_comparison_picks_on_selection_seeds_and_scores_on_fresh_ones(staking):
+    from infomarket.search import adaptive_compare
+
+    hand = {"liar10": {"rot_base": 10.0}, "liar90": {"rot_base": 90.0}}
+    p = Policy.constant({"rot_base": 40.0})
+    r = adaptive_compare.compare(staking, p, hand, {"lie_from_rep": 1.0}, selection=3, confirmation=4, **SHORT)
+    sel = adaptive_compare.seeds_of(staking, "selection", 3)
+    conf = adaptive_compare.seeds_of(staking, "confirmation", 4)
+    assert not set(sel) & set(conf)
+    means = {n: reference(staking, q, sel, **SHORT)["items"].mean() for n, q in hand.items()}
+    assert r["selection_means"] == pytest.approx(means, abs=1e-12) and r["best_hand_written"] == min(means, key=means.get)
+    np.testing.assert_array_equal(r["learned"], reference(staking, p.at_rest(), conf, **SHORT)["items"])
+    np.testing.assert_array_equal(r["hand_written"], reference(staking, hand[r["best_hand_written"]], conf, **SHORT)["items"])
+    assert r["answer"] in ("yes", "no", "inconclusive")
