@@ -104,6 +104,13 @@ NOT_RUN = {
     "infomarket bench --env --json": "5 timed episodes of 64 runs; tests/bench/test_bench_env.py runs it with --steps 60",
     "infomarket rl-train --steps 4000 --transitory 1000 --iterations 60 --pairs 32 --eval-runs 32 --seed 0 "
     "--out rl-train.json": "minutes of training; tests/rl/test_cli.py runs a tiny one",
+    "infomarket adaptive-attack attack_search --defence staking --byzantines 3 --budget 170 --seed 0 "
+    "--out results/adaptive-staking3": "680 runs of 30 000 steps; run below at a small size",
+    "infomarket adaptive-attack attack_search --defence staking --byzantines 3 --budget 180 --pairs 4 --runs 8 "
+    "--lr 0.01 --seed 0 --eval-runs 0 --out results/adaptive-staking3-b": "1 440 runs of 30 000 steps; run below "
+                                                                         "at a small size",
+    "infomarket adaptive-attack attack_search --defence staking --byzantines 3 --budget 170 --seed 0 --eval-runs 0 "
+    "--out results/adaptive-staking3-c": "680 runs of 30 000 steps; run below at a small size",
 }
 
 
@@ -191,6 +198,18 @@ SMALL = {
     "infomarket store verify DIR/store": "infomarket store verify chainstore",
     "infomarket bench --env": "infomarket bench --env --steps 60 --repeats 1 --batch 2",
     "infomarket rl-train": "infomarket rl-train --steps 60 --transitory 20 --iterations 1 --pairs 1 --eval-runs 2",
+    "infomarket adaptive-attack attack_search --defence staking --byzantines 3 --budget 170 --seed 0 "
+    "--out results/adaptive-staking3": "infomarket adaptive-attack attack_search --defence staking --byzantines 3 "
+                                      "--budget 3 --pairs 1 --runs 1 --steps 60 --transitory 20 --eval-runs 2 "
+                                      "--seed 0 --out adaptive",
+    "infomarket adaptive-attack attack_search --defence staking --byzantines 3 --budget 180 --pairs 4 --runs 8 "
+    "--lr 0.01 --seed 0 --eval-runs 0 --out results/adaptive-staking3-b":
+        "infomarket adaptive-attack attack_search --defence staking --byzantines 3 --budget 3 --pairs 1 --runs 1 "
+        "--steps 60 --transitory 20 --lr 0.01 --seed 0 --eval-runs 0 --out adaptive",
+    "infomarket adaptive-attack attack_search --defence staking --byzantines 3 --budget 170 --seed 0 --eval-runs 0 "
+    "--out results/adaptive-staking3-c":
+        "infomarket adaptive-attack attack_search --defence staking --byzantines 3 --budget 3 --pairs 1 --runs 1 "
+        "--steps 60 --transitory 20 --seed 0 --eval-runs 0 --out adaptive",
 }
 #: Shown in these pages but not run here, with the reason.
 SMALL_NOT_RUN = {
@@ -199,6 +218,7 @@ SMALL_NOT_RUN = {
     "infomarket view": "a web server that runs until stopped; tests/viewer",
     "infomarket replay --movie": "the command's name in the text (rl.md's rendering); tests/viewer/test_movie.py runs it",
     "infomarket attack-search": "the command's name in the text; its commands are the ones above",
+    "infomarket adaptive-attack": "the command's name in the text (rl.md); its command is the one above",
     "infomarket sweep attack_search": "sweep has no --steps: 24 runs of 30 000 steps at the least; `check "
                                       "attack_search` (run above) builds and validates each of its conditions",
     "infomarket chain demo --chain-period P":

@@ -22,6 +22,7 @@ SUBCOMMAND_MODULES = ("infomarket.runner.cli", "infomarket.analysis.cli", "infom
 SUBCOMMAND_MODULES += ("infomarket.analysis.terrain",)  # terrain-report (docs/terrain.md)
 SUBCOMMAND_MODULES += ("infomarket.search.cli",)  # attack-search (docs/attack-search.md)
 SUBCOMMAND_MODULES += ("infomarket.rl.cli",)  # rl-train (docs/rl.md)
+SUBCOMMAND_MODULES += ("infomarket.search.adaptive_cli",)  # adaptive-attack (docs/rl.md)
 
 
 def _print_summary(robots, title: str) -> None:
