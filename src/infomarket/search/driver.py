@@ -45,8 +45,8 @@ from ..seeds import run_seed
 from ..store import Store
 from . import space
 from .objective import loss, per_run
-from .racing import race
-from .restarts import Restarts, design, random_batches, stream
+from .racing import race, survivors
+from .restarts import Restarts, design, evaluations, random_batches, stream
 from .study import QUESTIONS, Cell, Settings, Study
 
 PHASES = ("start", "search", "random", "selection", "confirmation")
@@ -294,6 +294,25 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
                       confirmation_seeds(study, cell))
 
 
+def planned_runs(study: Study) -> int:
+    """The runs of one cell's search (at most: fewer when two roles choose the same attack, or a searcher
+    found fewer distinct points than ``finalists``)."""
+    s = study.settings
+    hand = len([n for n in study.baselines if n != study.reference])
+    n_eval = evaluations(s)
+    sizes = [min(s.finalists, s.restarts + n_eval), min(s.finalists, n_eval), hand, int(bool(study.reference))]
+    selection = 0
+    for n in sizes:
+        before = 0
+        for i, runs in enumerate(s.race):
+            selection += n * (runs - before)
+            before = runs
+            if i < len(s.race) - 1:
+                n = survivors(n, s.keep)
+    roles = len([n for n in sizes[:3] if n]) + int(bool(study.reference))
+    return (hand + s.restarts + 2 * n_eval) * s.runs + selection + roles * s.confirmation_runs
+
+
 def _raced(ev: _Evaluator, params: dict, label: str, group: str, row, runs: int, crn: int) -> CRNCondition:
     """The selection condition of one raced attack (the same condition at every stage, its runs grown)."""
     where = (int(row.restart), int(row.gen), int(row.cand)) if row is not None else (-1, -1, -1)
@@ -316,6 +335,7 @@ def store_runner(store: Store, *, workers: int = 1, executor=None,
                  on_done: Callable[[int], None] | None = None,
                  on_skip: Callable[[int], None] | None = None) -> Callable[[list[Condition]], tuple[int, int]]:
     """``run(conds)`` for ``search_cell``: their missing runs into ``store`` on the sweep machinery.
+    A condition run again with more runs (a race's next stage) counts only its new runs as made or found.
     ``run.robots(conds)``: the robots rows of ``conds``, kept from the parts just written when every run of
     theirs was made by this runner (the store is read back only for a search that resumes): reading the
     whole store after every generation cost the parent more the larger the store grew, while the
@@ -339,8 +359,11 @@ def store_runner(store: Store, *, workers: int = 1, executor=None,
         r = store.robots()
         return r[r.experiment.isin({c.experiment for c in conds})]
 
+    seen: dict[tuple[str, str], int] = {}  # runs of a condition already counted (a race grows its runs)
+
     def run(conds: list[Condition]) -> tuple[int, int]:
-        planned = sum(c.runs for c in conds)
+        before = sum(seen.get((c.experiment, c.id), 0) for c in conds)
+        planned = sum(c.runs for c in conds) - before
         rep = run_sweep(conds, store, workers=workers, executor=executor, on_done=on_done,
                         on_plan=(lambda todo: on_skip(planned - todo)) if on_skip else None, on_part=keep)
         if rep.failed:
@@ -348,7 +371,9 @@ def store_runner(store: Store, *, workers: int = 1, executor=None,
 
             raise SimulationError(f"{rep.failed} of {rep.done} runs failed (the first: {rep.first_error}); "
                                   f"`infomarket store failed {store.root}` lists them")
-        return rep.done, rep.skipped
+        for c in conds:
+            seen[(c.experiment, c.id)] = max(c.runs, seen.get((c.experiment, c.id), 0))
+        return rep.done, rep.skipped - before
 
     run.robots = robots
     return run

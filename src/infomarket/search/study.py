@@ -57,7 +57,8 @@ class Settings:
 RENAMED = {"heldout_runs": "confirmation_runs", "best": "finalists"}
 
 
-def settings(table: dict, overrides: dict | None = None, source: str = "questions.toml [search]") -> Settings:
+def settings(table: dict, overrides: dict | None = None,
+             source: str = "search settings (questions.toml [search] or an option)") -> Settings:
     """The ``Settings`` of a ``[search]`` table with ``overrides`` (None values ignored) over it; an unknown
     key or a value out of range is a UsageError naming it."""
     known = Settings.__dataclass_fields__
