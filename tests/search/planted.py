@@ -1,11 +1,12 @@
 """A defence whose weakness is known by construction, for the search's tests.
 
-``planted_oracle`` robots buy every fresher offer and use it only when it points within ``theta`` degrees
-of the true direction to the site (they know the truth: the defence is planted, not realistic).  A lie
-rotated by less than ``theta`` is used, and does the more damage the larger its rotation; a lie rotated by
-more is always refused and does none.  So the most damaging attack is a rotation just below ``theta`` (30°),
-and every rotation above it is as harmless as the truth: a plateau that gives a searcher started there no
-slope to follow.
+``planted_oracle`` robots know the true direction to each site (the defence is planted, not realistic).
+An offer that points within ``theta`` degrees of the truth is used as it is, so a lie rotated by less than
+``theta`` does the more damage the larger its rotation; an offer further off is penalised: turned back
+towards the truth, its error halved at once (just beyond ``theta``) and shrunk further to none at 180°.
+The most damaging attack is therefore a rotation just below ``theta`` (30°): a smaller one does less harm
+the smaller it is, a larger one at most half as much, the less the larger it is; so a searcher far away
+has a slope to follow, and a random point rarely lands in the narrow band below ``theta``.
 """
 import math
 
@@ -30,9 +31,12 @@ def oracle_buy(w, me, nbrs, theta=30.0):
             nb, nt = math.hypot(x, y), math.hypot(tx, ty)
             if nb == 0.0 or nt == 0.0:
                 continue
-            cos = (x * tx + y * ty) / (nb * nt)
-            if math.degrees(math.acos(max(-1.0, min(1.0, cos)))) < theta:
-                combine(w, me, site, x, y, age)
+            off = math.degrees(math.atan2(tx * y - ty * x, tx * x + ty * y))  # signed, from the truth
+            if abs(off) > theta:  # penalised: the error halved, and shrunk linearly to 0 at 180 degrees
+                err = math.copysign(0.5 * theta * (180.0 - abs(off)) / (180.0 - theta), off)
+                a = math.atan2(ty, tx) + math.radians(err)
+                x, y = nb * math.cos(a), nb * math.sin(a)
+            combine(w, me, site, x, y, age)
 
 
 im.register_behaviour("planted_oracle", buy=oracle_buy, sell="naive", honest=True, replace=True,

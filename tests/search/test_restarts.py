@@ -4,16 +4,22 @@ import pytest
 
 from infomarket.search import space
 from infomarket.search.baselines import rotation_grid
-from infomarket.search.restarts import Restarts, design, evaluations, plan, random_batches
+from infomarket.search.restarts import Restarts, design, evaluations, plan, random_batches, spread_points
 from infomarket.search.study import Settings
 
 
 def test_the_plan_shares_the_budget_and_doubles_the_population():
-    # by hand: budget 256 in 4 shares of 64; populations 8, 16, then 32 and 64 capped at 64 // 3 = 21
-    legs = plan(Settings(budget=256, popsize=8, restarts=4))
-    assert [(leg.popsize, leg.generations) for leg in legs] == [(8, 8), (16, 4), (21, 3), (21, 3)]
-    # what a restart cannot use goes to the next: 64 - 63 = 1 carried to the last (65 // 21 = 3)
-    assert evaluations(Settings(budget=256, popsize=8, restarts=4)) == 64 + 64 + 63 + 63
+    # by hand: a quarter of 256 (64) on spread start points; the other 192 in 4 shares of 48: populations
+    # 8, then 16, 32 and 64 capped at 48 // 3 = 16
+    s = Settings(budget=256, popsize=8, restarts=4, spread=0.25)
+    assert spread_points(s) == 64
+    assert [(leg.popsize, leg.generations) for leg in plan(s)] == [(8, 6), (16, 3), (16, 3), (16, 3)]
+    assert evaluations(s) == 256
+    # what a restart cannot use goes to the next: 75 after the 25 start points, shares 18, then 37 - 16 = 21,
+    # 56 - 32 = 24, 75 - 56 = 19; populations 8 each (doubled, then capped at share // 3, never below 8)
+    s = Settings(budget=100, popsize=8, restarts=4, spread=0.25)
+    assert [(leg.popsize, leg.generations) for leg in plan(s)] == [(8, 2), (8, 2), (8, 3), (8, 2)]
+    assert evaluations(s) == 25 + 72
 
 
 def test_the_random_search_gets_the_same_budget_in_batches_of_a_population():
@@ -32,7 +38,7 @@ def test_start_points_spread_over_the_cube():
 
 
 def test_each_restart_starts_where_it_is_told_and_replays_exactly():
-    s = Settings(budget=12, popsize=2, restarts=3, sigma0=0.01)
+    s = Settings(budget=15, popsize=2, restarts=3, sigma0=0.01, spread=0.2)
     starts = [np.full(space.dimension(), v) for v in (0.2, 0.5, 0.8)]
 
     def points(seed):

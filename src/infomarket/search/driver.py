@@ -6,12 +6,13 @@ phases, each on its own seed set (``phase`` and ``seed_set`` are condition keys,
 which set every run belongs to):
 
 1. **start** (search seeds): every baseline (the declared hand-written attacks and the rotation grid,
-   ``search.baselines``) and the restarts' start points, spread over the cube (``restarts.design``), all
-   on one seed set;
+   ``search.baselines``) and the global search's start points, spread over the cube (``restarts.design``,
+   a share of its budget), all on one seed set;
 2. **search** and **random** (search seeds): CMA-ES restarted from the start points (``restarts``;
-   restart 0 from the best point of the start phase, the others from the spread points), and beside it
-   a random search with as many evaluations; all candidates of one generation share seeds (common random
-   numbers), stream ("search", searcher, restart, generation);
+   restart 0 from the best point of the start phase, the others from the next best spread points), and
+   beside it a random search with as many evaluations as the global search (start points included); all
+   candidates of one generation share seeds (common random numbers), stream ("search", searcher,
+   restart, generation);
 3. **selection** (one shared seed set): the best distinct points of each searcher (the best point it ever
    evaluated first) and every baseline race by successive halving (``racing``); each role of
    ``CellSearch.chosen`` is decided here, on these seeds only;
@@ -46,7 +47,7 @@ from ..store import Store
 from . import space
 from .objective import loss, per_run
 from .racing import race, survivors
-from .restarts import Restarts, design, evaluations, random_batches, stream
+from .restarts import Restarts, design, evaluations, random_batches, spread_points, stream
 from .study import QUESTIONS, Cell, Settings, Study
 
 PHASES = ("start", "search", "random", "selection", "confirmation")
@@ -191,7 +192,7 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
     ev = _Evaluator(study, cell, store, run, steps, transitory)
     record_provenance(store)
     dim, seed = space.dimension(), stream(s.seed, cell.experiment)
-    points = design(s.restarts, dim, stream(seed, "design")) if starts is None else np.asarray(starts, float)
+    points = design(spread_points(s), dim, stream(seed, "design")) if starts is None else np.asarray(starts, float)
     rows: list[dict] = []
 
     def add(searcher, restart, gen, frames, conds, points):
@@ -211,13 +212,12 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
     add("start", -1, -1, frames[len(base):], spread, list(points))
     scores = [ev.fitness(f) for f in frames]
     firsts = [space.to_unit(p) for p in hand.values()] + list(points)
-    best = int(np.argmin(scores)) if scores else None  # ties: the first (baselines before start points)
-    rest = [x for k, x in enumerate(points) if k + len(base) != best]
+    order = sorted(range(len(scores)), key=lambda k: (scores[k], k))  # ties: baselines first, then in order
+    # restart 0 at the best point of the start phase, the others at the next best spread points
+    origins = order[:1] + [k for k in order[1:] if k >= len(base)]
 
     def start(r: int) -> np.ndarray:
-        if r == 0 and best is not None:
-            return firsts[best]
-        return rest[(r - (best is not None)) % len(rest)] if rest else np.full(dim, 0.5)
+        return firsts[origins[r % len(origins)]] if origins else np.full(dim, 0.5)
 
     # 2. the global search and the random search, one generation of each per call (one batch of runs)
     cma = Restarts(s, dim, seed, start) if "cma" in searchers else None
@@ -300,7 +300,7 @@ def planned_runs(study: Study) -> int:
     s = study.settings
     hand = len([n for n in study.baselines if n != study.reference])
     n_eval = evaluations(s)
-    sizes = [min(s.finalists, s.restarts + n_eval), min(s.finalists, n_eval), hand, int(bool(study.reference))]
+    sizes = [min(s.finalists, n_eval), min(s.finalists, n_eval), hand, int(bool(study.reference))]
     selection = 0
     for n in sizes:
         before = 0
@@ -310,7 +310,7 @@ def planned_runs(study: Study) -> int:
             if i < len(s.race) - 1:
                 n = survivors(n, s.keep)
     roles = len([n for n in sizes[:3] if n]) + int(bool(study.reference))
-    return (hand + s.restarts + 2 * n_eval) * s.runs + selection + roles * s.confirmation_runs
+    return (hand + 2 * n_eval) * s.runs + selection + roles * s.confirmation_runs
 
 
 def _raced(ev: _Evaluator, params: dict, label: str, group: str, row, runs: int, crn: int) -> CRNCondition:

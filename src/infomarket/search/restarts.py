@@ -1,12 +1,14 @@
 """The searchers' points: start points spread over the cube, CMA-ES restarted from them, and random search.
 
-``design`` spreads the restarts' start points over the whole cube (a scrambled Sobol sequence seeded
-from the study's seed and the cell), so the search does not only refine the strongest known attack.
-``Restarts`` runs CMA-ES (``cma``) restart after restart, the population doubled at each (IPOP): a
-small population refines, a large one explores; each restart gets an equal share of the budget, and its
+The global search spends a share of its budget (``spread``) on start points spread over the whole cube
+(``design``: a scrambled Sobol sequence seeded from the study's seed and the cell), so it does not only
+refine the strongest known attack: a weakness far from every hand-written attack is sampled as densely
+as a random search would, and the restarts then refine the best of what was sampled.  ``Restarts`` runs
+CMA-ES (``cma``) restart after restart, the population doubled at each (IPOP): a small population
+refines, a large one explores; each restart gets an equal share of the rest of the budget, and its
 population is capped so it still makes at least ``MIN_GENERATIONS`` generations.  ``random_batches`` is
-the baseline every search must beat: uniform points, in batches of one population, as many as CMA-ES
-evaluates.
+the baseline every search must beat: uniform points, in batches of one population, as many as the
+global search evaluates (start points included).
 
 Everything here is a pure function of the settings and seeds: ``cma`` samples from NumPy's global
 generator, which is reseeded before every ``ask`` from (study seed, cell, restart, generation), so a
@@ -52,12 +54,19 @@ class Leg:
         return self.popsize * self.generations
 
 
+def spread_points(s: Settings) -> int:
+    """How many start points the design spreads over the cube: ``spread`` of the budget, one per restart at least."""
+    return min(s.budget, max(s.restarts, round(s.spread * s.budget)))
+
+
 def plan(s: Settings) -> list[Leg]:
-    """The restarts' populations and generations: equal shares of ``budget`` (what a restart cannot use
-    goes to the next), the population doubled per restart and capped at share / ``MIN_GENERATIONS``."""
+    """The restarts' populations and generations: equal shares of the budget left after the start points
+    (what a restart cannot use goes to the next), the population doubled per restart and capped at
+    share / ``MIN_GENERATIONS``."""
     legs, spent = [], 0
+    budget = s.budget - spread_points(s)
     for r in range(s.restarts):
-        share = s.budget * (r + 1) // s.restarts - spent
+        share = budget * (r + 1) // s.restarts - spent
         pop = max(2, min(s.popsize * 2 ** r, max(s.popsize, share // MIN_GENERATIONS)))
         gens = share // pop
         if gens == 0:
@@ -68,8 +77,8 @@ def plan(s: Settings) -> list[Leg]:
 
 
 def evaluations(s: Settings) -> int:
-    """Candidate evaluations of the global search (and of the random search beside it)."""
-    return sum(leg.evaluations for leg in plan(s))
+    """Candidate evaluations of the global search, start points included (and of the random search)."""
+    return spread_points(s) + sum(leg.evaluations for leg in plan(s))
 
 
 class Restarts:

@@ -38,6 +38,7 @@ class Settings:
     popsize: int = 8               # CMA-ES population of the first restart (IPOP doubles it per restart)
     sigma0: float = 0.3            # CMA-ES step size, in the unit cube
     restarts: int = 4              # CMA-ES restarts, each from its own start point
+    spread: float = 0.25           # share of the budget spent on start points spread over the cube (Sobol)
     runs: int = 8                  # runs per evaluation; the candidates of one generation share seeds
     finalists: int = 8             # best distinct points per searcher entering the race
     race: tuple[int, ...] = (8, 16, 32)  # cumulative runs per raced attack at each stage (selection seeds)
@@ -88,6 +89,8 @@ def settings(table: dict, overrides: dict | None = None,
             or race[0] < 2 or any(b <= a for a, b in zip(race, race[1:]))):
         raise UsageError(f"{source}: race = {list(race) if isinstance(race, tuple) else race!r}: cumulative runs per "
                          f"stage, whole numbers from 2 up, each above the one before (e.g. [8, 16, 32])")
+    if isinstance(s.spread, bool) or not isinstance(s.spread, (int, float)) or not 0.0 <= s.spread < 1.0:
+        raise UsageError(f"{source}: spread = {s.spread!r}: a share of the budget in [0, 1) is expected")
     for k, lo, hi in (("keep", 0.0, 1.0), ("sigma0", 0.0, 1.0), ("grid_step", 0.0, 180.0)):
         v = getattr(s, k)
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not lo < v <= hi:
