@@ -11,7 +11,7 @@ import pytest
 
 import infomarket as im
 from infomarket.search import driver, space, study
-from infomarket.search.restarts import design, spread_points
+from infomarket.search.restarts import design, spread_points, stream
 from infomarket.store import Store
 
 HERE = Path(__file__).parent
@@ -36,10 +36,11 @@ SETTINGS = {"budget": 96, "popsize": 8, "restarts": 2, "runs": 2, "finalists": 3
             "confirmation_runs": 8, "sigma0": 0.3, "seed": 1}
 
 
-def far_starts(s: study.Settings) -> np.ndarray:
-    """The spread start points, every one moved to a rotation above 120° (rot_base is coordinate 0)."""
-    pts = design(spread_points(s), space.dimension(), 99)
-    pts[:, space.NAMES.index("rot_base")] = (120.0 + 60.0 * pts[:, 0]) / 180.0
+def far_starts(s: study.Settings, cell: study.Cell) -> np.ndarray:
+    """The search's own spread start points, every one moved to a rotation above 120°."""
+    pts = design(spread_points(s), space.dimension(), stream(stream(s.seed, cell.experiment), "design"))
+    k = space.NAMES.index("rot_base")
+    pts[:, k] = 0.7 + 0.3 * pts[:, k]  # 126° to 180°
     return pts
 
 
@@ -47,7 +48,7 @@ def run_planted(tmp_path, **overrides) -> driver.CellSearch:
     st = planted_study(**{**SETTINGS, **overrides})
     cell = study.cells(st)[0]
     store = Store(tmp_path / "store")
-    starts = far_starts(st.settings)
+    starts = far_starts(st.settings, cell)
     assert min(space.to_params(x)["rot_base"] for x in starts) > 120.0
     return driver.search_cell(st, cell, store, run=driver.store_runner(store), steps=3000, transitory=1000,
                               starts=starts)

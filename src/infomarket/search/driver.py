@@ -183,11 +183,11 @@ class _Evaluator:
 
 
 def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[Condition]], tuple[int, int]],
-                steps: int | None = None, transitory: int | None = None, starts: np.ndarray | None = None,
-                searchers: tuple[str, ...] = ("cma", "random")) -> CellSearch:
+                steps: int | None = None, transitory: int | None = None, starts: np.ndarray | None = None
+                ) -> CellSearch:
     """Search one cell (the module's docstring gives the phases).  ``run(conds)`` runs the missing runs of
-    ``conds`` into ``store`` and returns (runs made, runs skipped).  ``starts``: the restarts' start points
-    (default: spread over the cube); ``searchers``: which of the global and the random search run."""
+    ``conds`` into ``store`` and returns (runs made, runs skipped).  ``starts``: the global search's start
+    points (default: ``restarts.design``, spread over the cube)."""
     s: Settings = study.settings
     ev = _Evaluator(study, cell, store, run, steps, transitory)
     record_provenance(store)
@@ -220,11 +220,11 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
         return firsts[origins[r % len(origins)]] if origins else np.full(dim, 0.5)
 
     # 2. the global search and the random search, one generation of each per call (one batch of runs)
-    cma = Restarts(s, dim, seed, start) if "cma" in searchers else None
-    batches = random_batches(s, dim, seed) if "random" in searchers else []
+    cma = Restarts(s, dim, seed, start)
+    batches = random_batches(s, dim, seed)
     j = 0
     while True:
-        asked = cma.ask() if cma is not None else None
+        asked = cma.ask()
         conds, parts = [], []
         if asked is not None:
             r, g, X = asked
