@@ -23,9 +23,11 @@ def test_the_plan_shares_the_budget_and_doubles_the_population():
 
 
 def test_the_random_search_gets_the_same_budget_in_batches_of_a_population():
-    s = Settings(budget=20, popsize=4, restarts=2)
+    # by hand: 5 start points (a quarter of 20), then 15 in shares of 7 (1 generation of 4) and 11 (2 of 4):
+    # 17 evaluations, which the random search makes in batches of 4, 4, 4, 4 and 1
+    s = Settings(budget=20, popsize=4, restarts=2, spread=0.25)
     batches = random_batches(s, space.dimension(), 3)
-    assert [len(b) for b in batches] == [4] * (evaluations(s) // 4) and sum(map(len, batches)) == evaluations(s)
+    assert evaluations(s) == 17 and [len(b) for b in batches] == [4, 4, 4, 4, 1]
     assert all(((0 <= b) & (b < 1)).all() for b in batches)
 
 
