@@ -14,6 +14,8 @@ from infomarket.search import driver, space, study
 from infomarket.search.restarts import design, spread_points, stream
 from infomarket.store import Store
 
+pytestmark = pytest.mark.slow  # a search of some hundred short runs, twice the budget of one searcher
+
 HERE = Path(__file__).parent
 SCEPTIC = 2.0 * math.degrees(math.asin(0.25 / 2.0))  # the angle a sceptic of threshold 0.25 accepts (attacks.py)
 
