@@ -160,7 +160,7 @@ def test_rl_train_takes_every_defence_the_search_takes():
     (["--defence", ""], ["--defence ''", "at least one defence"]),
     (["--defence", " , "], ["--defence ' , '", "at least one defence"]),
     (["--byzantines", ""], ["--byzantines ''", "at least one count"]),
-    (["--best", "10", "--budget", "4"], ["--best 10", "4 candidates"]),
+    (["--race", "8,8"], ["race = [8, 8]", "each above the one before"]),
 ])
 def test_attack_search_refuses_before_writing(extra, words, tmp_path, monkeypatch, capsys):
     import infomarket.search.driver

@@ -1,38 +1,54 @@
-"""``infomarket attack-search`` at tiny size: it completes, resumes after SIGKILL with no evaluation lost
-or repeated, gives the same results inline and on Dask, uses common random numbers, refuses bad input."""
+"""``infomarket attack-search`` at tiny size: it completes with every run once, uses the three seed sets as
+declared, reruns bit for bit, resumes after SIGKILL with no evaluation lost or repeated, gives the same
+results on Dask, records its provenance, refuses bad input."""
+import datetime
+import hashlib
 import json
 import signal
 import subprocess
 import time
 from pathlib import Path
 
+import pandas as pd
 import pytest
 
 from infomarket.cli import main
-from infomarket.search import space
-from infomarket.search.study import load as load_study
+from infomarket.config import load_experiment
+from infomarket.search import study
+from infomarket.search.driver import planned_runs
 from infomarket.store import Store
 
 from ..procs import HANG
 
 TINY = ["attack-search", "attack_search", "--defence", "staking", "--byzantines", "3", "--budget", "4",
-        "--popsize", "2", "--runs", "2", "--heldout-runs", "2", "--best", "1", "--steps", "2500",
-        "--transitory", "0", "--seed", "7"]
-BASELINES = len(load_study.__globals__["load_declarations"]()["baselines"])  # the hand-written + truthful
-# the start (every hand-written attack) and 2 generations x 2 candidates, 2 runs each; then (1 searched +
-# every declared baseline) x 2 held-out runs
-PLANNED = (BASELINES - 1) * 2 + 2 * 2 * 2 + (1 + BASELINES) * 2
+        "--popsize", "2", "--restarts", "2", "--runs", "2", "--finalists", "2", "--race", "2,3",
+        "--confirmation-runs", "3", "--grid-step", "90", "--steps", "400", "--transitory", "100", "--seed", "7"]
+CELL = "attack_search.staking.b3"
+DECLARED = len(study.load_declarations()["baselines"])  # hand-written + truthful
+# by hand: start = (the hand-written + 18 grid (0, 90, 180 degrees x 2 x 3) + 2 start points) x 2 runs;
+# search: budget 4 = 2 start points (one per restart) + 2 CMA-ES evaluations (restart 0's share of 1 is
+# carried to restart 1: 1 generation of 2), random: 4 evaluations, each x 2 runs; race: search
+# 2 x 3 runs, random 2 x 3, the n baselines n x 2 then the better half (rounded up) x 1 more, truthful 3;
+# confirmation: 4 attacks (search, random, baseline, truthful) x 3
+HAND = DECLARED - 1
+N = HAND + 18
+PLANNED = (N + 2) * 2 + (2 + 4) * 2 + (2 * 3 + 2 * 3 + N * 2 + (N + 1) // 2 + 3) + 4 * 3
 
 
-def _report(out: Path) -> dict:
-    data = json.loads((out / "report.json").read_text())
-    data.pop("wall_seconds")
-    return data
+def _frames(out: Path) -> dict:
+    return {n: pd.read_parquet(out / "cells" / CELL / f"{n}.parquet") for n in ("candidates", "selection", "confirmation")}
 
 
-def _runs_table(out: Path):
-    runs = Store(out / "store").runs()
-    return runs.sort_values(["condition", "run"]).reset_index(drop=True)
+def _same_frames(a: Path, b: Path) -> None:
+    fa, fb = _frames(a), _frames(b)
+    for name in fa:
+        pd.testing.assert_frame_equal(fa[name], fb[name], check_exact=True)
+    ja, jb = json.loads((a / "search.json").read_text()), json.loads((b / "search.json").read_text())
+    assert [c["chosen"] for c in ja["cells"]] == [c["chosen"] for c in jb["cells"]]
+
+
+def _runs_table(out: Path) -> pd.DataFrame:
+    return Store(out / "store").runs().sort_values(["condition", "run"]).reset_index(drop=True)
 
 
 @pytest.fixture(scope="module")
@@ -43,25 +59,56 @@ def inline(tmp_path_factory):
 
 
 def test_a_tiny_search_completes_with_every_run_once(inline):
+    st = study.load(load_experiment("attack_search"), budget=4, popsize=2, restarts=2, runs=2, finalists=2,
+                    race=[2, 3], confirmation_runs=3, grid_step=90.0)
+    assert planned_runs(st) == PLANNED
     runs = _runs_table(inline)
     assert len(runs) == PLANNED and not runs.duplicated(["experiment", "condition", "run"]).any()
-    rep = _report(inline)
-    assert [(c["defence"], c["byzantines"], c["evaluations"]) for c in rep["cells"]] == [("staking", 3, 4)]
-    assert set(rep["cells"][0]["params"]) == set(space.NAMES)
-    assert rep["cells"][0]["start_from"] in load_study.__globals__["load_declarations"]()["baselines"]
+    f = _frames(inline)
+    assert f["candidates"].searcher.value_counts().to_dict() == {"baseline": N, "cma": 2, "random": 4,
+                                                                 "start": 2}
+    chosen = json.loads((inline / "search.json").read_text())["cells"][0]["chosen"]
+    assert set(chosen) == {"search", "random", "baseline", "worst", "reference"}
+    assert chosen["worst"] in {chosen["search"], chosen["random"], chosen["baseline"]}
+    conf = f["confirmation"]
+    assert set(conf.attack) == set(chosen.values())
+    assert all(sorted(g.run) == [0, 1, 2] for _, g in conf.groupby("attack"))  # every attack on every run
 
 
-def test_candidates_of_a_generation_share_seeds_and_held_out_seeds_are_new(inline):
+def test_each_run_belongs_to_its_seed_set_and_confirmation_seeds_are_fresh(inline):
     runs = _runs_table(inline)
+    want = {"start": "search", "search": "search", "random": "search", "selection": "selection",
+            "confirmation": "confirmation"}
+    assert set(runs.phase) == set(want)
+    assert (runs.seed_set == runs.phase.map(want)).all()
     seeds = {cond: tuple(g.sort_values("run").seed) for cond, g in runs.groupby("condition")}
-    gen = {c: s for c, s in seeds.items() if "phase=search" in c}
-    g0 = {s for c, s in gen.items() if "gen=0" in c}
-    g1 = {s for c, s in gen.items() if "gen=1" in c}
-    held = {s for c, s in seeds.items() if "phase=heldout" in c}
-    start = {s for c, s in seeds.items() if "phase=start" in c}
-    assert len(g0) == len(g1) == len(held) == len(start) == 1  # one seed set per generation, start, held-out
-    assert len(g0 | g1 | held | start) == 4
-    assert not set(next(iter(held))) & (set(next(iter(g0))) | set(next(iter(g1))))
+    phase = runs.groupby("condition").phase.first()
+    # candidates of one generation share seeds; generations, searchers and phases do not
+    gen = runs[runs.phase.isin(["search", "random"])].groupby(["searcher", "restart", "gen"]).condition.unique()
+    sets = [{seeds[c] for c in conds} for conds in gen]
+    assert all(len(s) == 1 for s in sets) and len({next(iter(s)) for s in sets}) == len(sets)
+    assert len({seeds[c] for c in phase.index if phase[c] == "start"}) == 1
+    sel = [seeds[c] for c in phase.index if phase[c] == "selection"]
+    longest = max(sel, key=len)
+    assert len(longest) == 3 and all(s == longest[:len(s)] for s in sel)  # one shared set, run k alike
+    confirm = {s for c in phase.index if phase[c] == "confirmation" for s in seeds[c]}
+    others = {s for c in phase.index if phase[c] != "confirmation" for s in seeds[c]}
+    assert len(confirm) == 3 and not confirm & others
+
+
+def test_the_store_records_the_questions_file_and_the_first_run_time(inline):
+    meta = Store(inline / "store").meta()["attack_search"]
+    assert meta["questions_sha256"] == hashlib.sha256(study.QUESTIONS.read_bytes()).hexdigest()
+    assert meta["questions_commit"] is None or len(meta["questions_commit"]) == 40
+    first = datetime.datetime.strptime(meta["first_run_utc"], "%Y-%m-%dT%H:%M:%SZ")
+    assert first <= datetime.datetime.now(datetime.timezone.utc).replace(tzinfo=None)
+    assert first >= datetime.datetime.now(datetime.timezone.utc).replace(tzinfo=None) - datetime.timedelta(hours=2)
+
+
+def test_a_second_search_into_another_store_is_the_same_bit_for_bit(inline, tmp_path):
+    out = tmp_path / "again"
+    assert main(TINY + ["--workers", "1", "--quiet", "--out", str(out)]) == 0
+    _same_frames(inline, out)
 
 
 def test_a_killed_search_resumes_without_losing_or_repeating_an_evaluation(inline, tmp_path, capsys, procs):
@@ -70,13 +117,14 @@ def test_a_killed_search_resumes_without_losing_or_repeating_an_evaluation(inlin
                      stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     runs_dir = out / "store" / "runs"
     deadline = time.monotonic() + HANG
-    while time.monotonic() < deadline and proc.poll() is None:
+    while time.monotonic() < deadline and proc.poll() is None:  # killed in the search phase
         if runs_dir.exists() and len(list(runs_dir.glob("part-*.parquet"))) >= 3:
             break
         time.sleep(0.02)
     proc.send_signal(signal.SIGKILL)
     proc.wait()
     assert proc.returncode == -signal.SIGKILL, proc.stderr.read().decode()[-2000:]  # killed mid-search
+    first = Store(out / "store").meta()["attack_search"]["first_run_utc"]
     kept = len(Store(out / "store").completed_runs())
     assert 0 < kept < PLANNED
     capsys.readouterr()
@@ -85,7 +133,8 @@ def test_a_killed_search_resumes_without_losing_or_repeating_an_evaluation(inlin
     assert made.startswith(f"attack-search: {PLANNED - kept} runs made now, {kept} found in the store")
     runs = _runs_table(out)
     assert len(runs) == PLANNED and not runs.duplicated(["experiment", "condition", "run"]).any()
-    assert _report(out) == _report(inline)  # the optimiser's state was rebuilt exactly
+    _same_frames(inline, out)  # the optimisers' state and the race were rebuilt exactly
+    assert Store(out / "store").meta()["attack_search"]["first_run_utc"] == first
 
 
 def test_the_same_search_on_dask_gives_identical_results(inline, tmp_path):
@@ -94,32 +143,49 @@ def test_the_same_search_on_dask_gives_identical_results(inline, tmp_path):
                                   dashboard_address=None) as cluster:
         out = tmp_path / "dask"
         assert main(TINY + ["--dask", cluster.scheduler_address, "--quiet", "--out", str(out)]) == 0
-    assert _report(out) == _report(inline)
-    a, b = Store(inline / "store").robots(), Store(out / "store").robots()
-    key = ["condition", "run", "robot"]
-    cols = ["condition", "run", "robot", "items_collected", "wealth"]
-    assert a.sort_values(key)[cols].reset_index(drop=True).equals(b.sort_values(key)[cols].reset_index(drop=True))
+    _same_frames(inline, out)
 
 
 @pytest.mark.parametrize("option, words", [
     (["--defence", "nope"], ["--defence nope", "allowed: outlier, staking"]),
     (["--byzantines", "5"], ["--byzantines 5", "allowed: 1, 3, 8"]),
+    (["--race", "8,4"], ["race = [8, 4]", "each above the one before"]),
+    (["--race", "8,x"], ["--race '8,x'"]),
+    (["--keep", "0"], ["keep = 0"]),
+    (["--grid-step", "-5"], ["grid_step = -5"]),
 ])
-def test_bad_cells_are_refused_before_anything_is_written(tmp_path, capsys, option, words):
+def test_bad_input_is_refused_before_anything_is_written(tmp_path, capsys, option, words):
     out = tmp_path / "never"
     args = ["attack-search", "attack_search", *option, "--out", str(out)]
     assert main(args) == 2
     err = capsys.readouterr().err
-    assert all(w in err for w in words) and "Traceback" not in err
+    assert all(w in err for w in words) and "Traceback" not in err, err
     assert not out.exists()
+
+
+def test_an_unknown_search_setting_is_refused(tmp_path, capsys, monkeypatch):
+    declared = study.load_declarations()
+    monkeypatch.setattr(study, "load_declarations", lambda: {**declared, "search": {"budegt": 3}})
+    out = tmp_path / "never"
+    assert main(["attack-search", "attack_search", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "unknown key 'budegt'" in err and "budget" in err and "Traceback" not in err
+    assert not out.exists()
+
+
+def test_the_baselines_are_listed(capsys):
+    assert main(["attack-search", "attack_search", "--list-baselines", "--grid-step", "90"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    kinds = [line.split("\t")[1] for line in lines]
+    assert kinds.count("grid") == 3 * 2 * 3 and kinds.count("declared") == HAND and kinds.count("reference") == 1
+    assert any(line.startswith("rot_090_collude_nest\tgrid\t") and "collude=1" in line and "lie_site=1" in line
+               for line in lines)
 
 
 def test_a_pending_defence_waits_for_its_scheme(tmp_path, capsys, monkeypatch):
     """A defence declared in `[pending_defences]` joins the cells only once its scheme is registered:
-    unregistered it is refused, saying which scheme it waits for; registered, it is a cell.  (`distinct`
-    waited so for `outlier_distinct`; now registered, it is on the experiment's own axis.)"""
+    unregistered it is refused, saying which scheme it waits for; registered, it is a cell."""
     import infomarket as im
-    from infomarket.search import study
 
     declared = study.load_declarations()
     pending = {"later": {"requires": "outlier_distinct", "set": {"payment.scheme": "outlier_distinct"}}}
@@ -138,7 +204,6 @@ def test_a_pending_defence_waits_for_its_scheme(tmp_path, capsys, monkeypatch):
 
 def test_with_outlier_distinct_registered_the_distinct_cell_is_searched():
     import infomarket as im
-    from infomarket.search import study
 
     s = study.load(im.load_experiment("attack_search"))
     got = {(c.defence, c.byzantines) for c in study.cells(s, ["distinct"], [3])}

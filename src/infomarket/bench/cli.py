@@ -182,12 +182,12 @@ def _many(repeats: int) -> dict:
 def _print_many(m: dict) -> None:
     e = m["engine"]["env_steps_per_second"]
     print(f"many runs of {m['setup']}, {m['steps']} steps a run, per CPU second of this process:")
-    print(f"  engine      {e:>12,.0f} env-steps/s")
+    print(f"  engine      {e:>12,.0f} env-steps/s  {m['engine']['runs_per_second']:>8,.2f} runs/s")
     for k in ("sweep", "search", "search_pool"):
         r = m.get(k)
         if r:
-            print(f"  {k:11s} {r['env_steps_per_second']:>12,.0f} env-steps/s  {r['ratio_to_engine']:.2f} of the "
-                  f"engine's (goal >= {r['goal']}; {r['runs']} runs)")
+            print(f"  {k:11s} {r['env_steps_per_second']:>12,.0f} env-steps/s  {r['runs_per_second']:>8,.2f} runs/s  "
+                  f"{r['ratio_to_engine']:.2f} of the engine's (goal >= {r['goal']}; {r['runs']} runs)")
     p = m.get("search_pool")
     if p:
         print(f"  {p['workers']} workers: {p['wall_env_steps_per_second']:,.0f} env-steps per wall second, "

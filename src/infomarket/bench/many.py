@@ -9,13 +9,15 @@ between generations.  Kernels are loaded and the optimiser's libraries imported 
 
 - engine: ``Simulation.run`` alone, world building excluded (the median of ``repeats`` runs);
 - sweep: ``run_sweep`` of ``runs`` runs of the same configuration into a fresh store;
-- search: ``search.driver.search_cell`` of one cell (the start runs of every hand-written attack, the
-  CMA-ES generations, the held-out runs), reduced to ``budget`` evaluations of ``popsize``; and again
-  on a pool of ``workers`` processes (``search_pool``), where the CPU time is the parent's and the
-  workers' together, and the wall time shows what CPU time cannot: workers idle while the parent writes,
-  reads the store between generations and asks CMA-ES for the next points.
+- search: ``search.driver.search_cell`` of one cell (the start runs of every baseline, the CMA-ES and
+  random-search generations, the race, the confirmation), reduced to ``budget`` evaluations of
+  ``popsize``, one restart, the coarsest rotation grid; and again on a pool of ``workers`` processes
+  (``search_pool``), where the CPU time is the parent's and the workers' together, and the wall time
+  shows what CPU time cannot: workers idle while the parent writes, reads the store between generations
+  and asks CMA-ES for the next points.
 
-Each ratio is the rate over the engine's.
+Each path reports runs per second beside env-steps per second (the same runs: every run has ``steps``
+steps), and each ratio is the rate over the engine's, whose runs per second are those of ``Simulation.run``.
 """
 from __future__ import annotations
 
@@ -53,7 +55,8 @@ def engine_rate(cfg, repeats: int) -> dict:
         sim.run()
         seconds.append(time.process_time() - t0)
     med = statistics.median(seconds)
-    return {"env_steps_per_second": cfg.steps / med, "cpu_seconds_per_run": med, "repeats": repeats}
+    return {"env_steps_per_second": cfg.steps / med, "runs_per_second": 1.0 / med, "cpu_seconds_per_run": med,
+            "repeats": repeats}
 
 
 def sweep_rate(cfg, runs: int, folder: Path) -> dict:
@@ -63,7 +66,7 @@ def sweep_rate(cfg, runs: int, folder: Path) -> dict:
     report = run_sweep([cond], store)
     cpu = time.process_time() - t0
     return {"runs": report.done, "env_steps": report.env_steps, "cpu_seconds": cpu,
-            "env_steps_per_second": report.env_steps / cpu}
+            "env_steps_per_second": report.env_steps / cpu, "runs_per_second": report.done / cpu}
 
 
 def search_rate(steps: int, transitory: int, folder: Path, *, budget: int, popsize: int, runs: int,
@@ -73,8 +76,8 @@ def search_rate(steps: int, transitory: int, folder: Path, *, budget: int, popsi
     CPU time of this process and its workers together (``cpu_seconds``)."""
     import cma  # noqa: F401 - imported before the clock starts (a fixed cost, not a run's)
 
-    st = study_mod.load(load_experiment(SETUP), budget=budget, popsize=popsize, runs=runs, heldout_runs=max(runs, 2),
-                        best=1, objective=None, seed=None)
+    st = study_mod.load(load_experiment(SETUP), budget=budget, popsize=popsize, runs=runs, restarts=1, finalists=1,
+                        race=[max(runs, 2)], confirmation_runs=max(runs, 2), grid_step=180.0)
     cell = study_mod.cells(st, [CELL[0]], [CELL[1]])[0]
     store = Store(folder / f"search{workers}", cache=True)
     t0, w0, c0 = time.process_time(), time.perf_counter(), _children_cpu()
@@ -89,9 +92,10 @@ def search_rate(steps: int, transitory: int, folder: Path, *, budget: int, popsi
     wall = time.perf_counter() - w0
     env_steps = int(store.runs().steps.sum())
     out = {"runs": result.done, "env_steps": env_steps, "cpu_seconds": cpu, "env_steps_per_second": env_steps / cpu,
-           "budget": budget, "popsize": popsize, "runs_per_candidate": runs, "workers": workers}
+           "runs_per_second": result.done / cpu, "budget": budget, "popsize": popsize, "runs_per_candidate": runs,
+           "workers": workers, "phases": {k: v["runs"] for k, v in result.cost.items()}}
     if workers > 1:
-        out.update(wall_seconds=wall, wall_env_steps_per_second=env_steps / wall)
+        out.update(wall_seconds=wall, wall_env_steps_per_second=env_steps / wall, wall_runs_per_second=result.done / wall)
     return out
 
 
@@ -123,6 +127,7 @@ def run_many_bench(*, steps: int = 30000, repeats: int = 5, sweep_runs: int = 32
     for k in ("sweep", "search", "search_pool"):
         if k in out:
             out[k]["ratio_to_engine"] = out[k]["env_steps_per_second"] / e
+            out[k]["engine_runs_per_second"] = out["engine"]["runs_per_second"]
             out[k]["goal"] = GOALS["search" if k == "search_pool" else k]
     if "search_pool" in out:  # wall time on a quiet machine: against the engine on every worker at once
         p = out["search_pool"]

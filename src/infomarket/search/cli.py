@@ -5,6 +5,7 @@ import time
 from pathlib import Path
 
 from ..cliargs import UsageError, at_least
+from .baselines import rotation_grid
 
 
 def _ints(text: str) -> list[int]:
@@ -26,6 +27,16 @@ def _names(text: str) -> list[str]:
     return out
 
 
+def _race(text: str) -> list[int]:
+    try:
+        return [int(t) for t in text.split(",") if t.strip()]
+    except ValueError:
+        raise UsageError(f"--race {text!r}: expected cumulative run counts separated by commas, e.g. 8,16,32") from None
+
+
+SIZES = ("budget", "popsize", "restarts", "runs", "finalists", "confirmation_runs")
+
+
 def _reductions(st, declared, exp, chosen, all_cells, args) -> list[str]:
     """What makes this search smaller than the declared study (the report is marked reduced by it)."""
     out = []
@@ -35,11 +46,23 @@ def _reductions(st, declared, exp, chosen, all_cells, args) -> list[str]:
         out.append(f"--steps {args.steps} (declared {exp.steps})")
     if args.transitory is not None and args.transitory != exp.transitory:
         out.append(f"--transitory {args.transitory} (declared {exp.transitory})")
-    for key in ("budget", "popsize", "runs", "heldout_runs", "best"):
+    for key in SIZES:
         have, want = getattr(st.settings, key), getattr(declared.settings, key)
         if have < want:
             out.append(f"--{key.replace('_', '-')} {have} (declared {want})")
+    if st.settings.race != declared.settings.race:
+        out.append(f"--race {','.join(map(str, st.settings.race))} (declared {','.join(map(str, declared.settings.race))})")
+    if st.settings.grid_step > declared.settings.grid_step:
+        out.append(f"--grid-step {st.settings.grid_step:g} (declared {declared.settings.grid_step:g})")
     return out
+
+
+def _list_baselines(st) -> int:
+    grid = rotation_grid(st.settings.grid_step)
+    for name, params in st.baselines.items():
+        what = "reference" if name == st.reference else ("grid" if name in grid else "declared")
+        print(f"{name}\t{what}\t" + ", ".join(f"{k}={v:g}" for k, v in params.items()))
+    return 0
 
 
 def cmd_attack_search(args) -> int:
@@ -48,23 +71,24 @@ def cmd_attack_search(args) -> int:
     from ..runner.execute import default_workers, local_executor, warm
     from ..runner.progress import progress
     from ..store import Store
-    from . import report, study as study_mod
-    from .driver import search_cell, store_runner
+    from . import study as study_mod
+    from .driver import planned_runs, search_cell, store_runner
     from .study import cells
+    from .summary import write
 
+    exp = load_experiment(args.experiment)
+    st = study_mod.load(exp, budget=args.budget, popsize=args.popsize, restarts=args.restarts, runs=args.runs,
+                        finalists=args.finalists, race=_race(args.race) if args.race is not None else None,
+                        keep=args.keep, confirmation_runs=args.confirmation_runs, grid_step=args.grid_step,
+                        objective=args.objective, seed=args.seed)
+    if args.list_baselines:
+        return _list_baselines(st)
+    if args.out is None:
+        raise UsageError("attack-search needs --out FOLDER (the store and the report go there)")
     if not args.out.strip():  # Path("") is the current folder: a blank variable must not write there
         raise UsageError(f"--out {args.out!r}: give a folder for the store and the report")
-    exp = load_experiment(args.experiment)
-    st = study_mod.load(exp, budget=args.budget, popsize=args.popsize, runs=args.runs,
-                        heldout_runs=args.heldout_runs, best=args.best, objective=args.objective, seed=args.seed)
     defences = _names(args.defence) if args.defence is not None else None
     chosen = cells(st, defences, _ints(args.byzantines) if args.byzantines is not None else None)
-    s = st.settings
-    evaluated = s.generations * s.popsize
-    if args.best is not None and s.best > evaluated:
-        raise UsageError(f"--best {s.best}: more than the {evaluated} candidates a cell evaluates "
-                         f"(--budget {s.budget}, population {s.popsize}); give --best {evaluated} or less, "
-                         f"or a larger --budget")
     if args.steps is not None and args.transitory is not None and args.transitory >= args.steps:
         raise UsageError(f"--transitory {args.transitory}: must be below --steps {args.steps}")
     for c in chosen:  # every configuration is checked before anything runs
@@ -77,10 +101,7 @@ def cmd_attack_search(args) -> int:
         raise UsageError(f"--out {out}: exists and is not a directory")
     store = Store(out / "store", cache=True)  # read after every generation: each part read once
     store.refuse_foreign()
-    per_cell = (s.generations * s.popsize + len(st.baselines) - bool(st.reference)) * s.runs + (
-        min(s.best, s.generations * s.popsize)
-                                                     + len(st.baselines)) * s.heldout_runs
-    total = per_cell * len(chosen)
+    total = planned_runs(st) * len(chosen)
     client = None
     if args.dask:
         try:
@@ -107,11 +128,10 @@ def cmd_attack_search(args) -> int:
         if client is not None:
             client.close()
     wall = time.perf_counter() - t0
-    analysis = report.analyse(st, results)
-    length = {"steps": first.steps, "transitory": first.transitory}
-    written = report.write(out, analysis, reduced=reduced, wall_seconds=wall, **length)
+    written, text = write(out, st, results, reduced=reduced, wall_seconds=wall, steps=first.steps,
+                          transitory=first.transitory)
     if not args.quiet:
-        print(report.markdown(analysis, reduced=reduced, wall_seconds=wall, **length))
+        print(text)
         made = sum(r.done for r in results)
         kept = sum(r.skipped for r in results)
         print(f"attack-search: {made} runs made now, {kept} found in the store; {wall:.1f} s wall; "
@@ -120,21 +140,29 @@ def cmd_attack_search(args) -> int:
 
 
 def add_subcommand(sub) -> None:
-    p = sub.add_parser("attack-search", help="optimise the parameterised attacker (CMA-ES) against each defence; "
-                                             "resumable, compared with the hand-written attacks on held-out seeds")
+    p = sub.add_parser("attack-search", help="the worst attack found against each defence: CMA-ES "
+                                             "restarts and a random search, raced, confirmed on fresh seeds; resumable")
     p.add_argument("experiment", help="a study experiment (the shipped attack_search, or a file like it)")
     p.add_argument("--defence", help="defence(s) to search, comma-separated (default: every one of the study)")
     p.add_argument("--byzantines", metavar="K", help="Byzantine count(s), comma-separated (default: the study's)")
-    p.add_argument("--budget", type=at_least(1), metavar="N", help="candidate evaluations per cell (default: declared)")
-    p.add_argument("--popsize", type=at_least(2), help="CMA-ES population (default: declared)")
-    p.add_argument("--runs", type=at_least(1), help="runs per candidate (default: declared)")
-    p.add_argument("--heldout-runs", type=at_least(2), help="held-out runs per attack (default: declared)")
-    p.add_argument("--best", type=at_least(1), help="best candidates re-evaluated on held-out seeds (default: declared)")
+    p.add_argument("--budget", type=at_least(1), metavar="N",
+                   help="evaluations per cell of the global search, and of the random search (default: declared)")
+    p.add_argument("--popsize", type=at_least(2), help="CMA-ES population of the first restart (default: declared)")
+    p.add_argument("--restarts", type=at_least(1), help="CMA-ES restarts (default: declared)")
+    p.add_argument("--runs", type=at_least(1), help="runs per candidate evaluation (default: declared)")
+    p.add_argument("--finalists", type=at_least(1), help="best distinct points per searcher raced (default: declared)")
+    p.add_argument("--race", metavar="N,N,...", help="cumulative runs per raced attack at each stage (default: declared)")
+    p.add_argument("--keep", type=float, help="fraction of raced attacks kept after each stage (default: declared)")
+    p.add_argument("--confirmation-runs", type=at_least(2), help="runs per chosen attack on the confirmation seeds "
+                                                                 "(default: declared)")
+    p.add_argument("--grid-step", type=float, metavar="DEGREES", help="rotation grid's step (default: declared)")
     p.add_argument("--objective", choices=["items", "liar_wealth"], help="what the attack optimises (default: items)")
-    p.add_argument("--seed", type=at_least(0), help="the optimiser's seed (default: declared)")
+    p.add_argument("--seed", type=at_least(0), help="the search's seed: optimisers and seed sets (default: declared)")
+    p.add_argument("--list-baselines", action="store_true", help="list the baselines (declared and rotation grid) "
+                                                                 "and exit")
     p.add_argument("--steps", type=at_least(1), help="steps per run (default: the experiment's), for a reduced search")
     p.add_argument("--transitory", type=at_least(0), help="steps not counted (default: the experiment's)")
-    p.add_argument("--out", required=True, help="folder: the results store (OUT/store) and the report")
+    p.add_argument("--out", help="folder: the results store (OUT/store) and the report")
     p.add_argument("--workers", type=at_least(1), help="local processes (default: one per core)")
     p.add_argument("--dask", metavar="ADDRESS", help="run on a Dask scheduler, e.g. tcp://host:8786")
     p.add_argument("--reduced", metavar="TEXT", help="label the report as a reduced run (what was reduced)")

@@ -1,45 +1,68 @@
-"""The resumable CMA-ES loop: candidates are conditions of a results store, evaluated on the sweep machinery.
+"""One cell's attack search: start points, a global search beside a random one, a race, a confirmation.
 
-Generation g of a cell asks CMA-ES (``cma``) for ``popsize`` points; each becomes the condition
-``phase=search,gen=g,cand=i`` of the cell's experiment in the store, whose runs all use the seeds of
-generation g (**common random numbers**: candidates of one generation differ only by their parameters;
-each generation draws a new set).  The runs go to ``runner.sweep.run_sweep`` (inline, a local process
-pool, or Dask), which skips runs already committed.  The optimiser keeps no state of its own: a search
-that starts again (after a crash or a SIGKILL) replays the generations from the optimiser's seed, asks
-the same points (NumPy's global generator, which ``cma`` samples from, is reseeded per generation from the
-study's seed, the cell and g), finds their runs committed and tells CMA-ES the same values, so no
-evaluation is lost or repeated.  A replay that asked another point would need another configuration, and
-the store refuses that (``runner.sweep.check_compatible``), so a divergence cannot pass unnoticed.
+Every evaluation is a condition of the cell's experiment in a results store, run on the sweep machinery
+(``runner.sweep.run_sweep``: inline, a local pool or Dask), which skips runs already committed.  The
+phases, each on its own seed set (``phase`` and ``seed_set`` are condition keys, so the store records
+which set every run belongs to):
 
-Before the first generation, every hand-written attack runs on a seed set of its own (``phase=start``);
-CMA-ES starts at the point of the best of them (the search space contains every hand-written attack), so
-the search refines the strongest known attack instead of starting from the middle of the cube.
+1. **start** (search seeds): every baseline (the declared hand-written attacks and the rotation grid,
+   ``search.baselines``) and the global search's start points, spread over the cube (``restarts.design``,
+   a share of its budget), all on one seed set;
+2. **search** and **random** (search seeds): CMA-ES restarted from the start points (``restarts``;
+   restart 0 from the best point of the start phase, the others from the next best spread points), and
+   beside it a random search with as many evaluations as the global search (start points included); all
+   candidates of one generation share seeds (common random numbers), stream ("search", searcher,
+   restart, generation);
+3. **selection** (one shared seed set): the best distinct points of each searcher (the best point it ever
+   evaluated first) and every baseline race by successive halving (``racing``); each role of
+   ``CellSearch.chosen`` is decided here, on these seeds only;
+4. **confirmation** (one shared seed set no other phase uses): the chosen attacks and the truthful
+   reference, every one on every run, paired by run.  The worst case is reported from these runs only.
 
-After the search, the ``best`` candidates and every hand-written attack run on **held-out seeds** (one
-set shared by all of them, never used by the search): conditions ``phase=heldout,attack=NAME``.
+The streams are keyed by the study's seed, so a study declared with a new seed gets confirmation seeds no
+earlier run (pilot or reduced) touched.  Nothing of the optimisers' state is kept: a search that starts
+again (after a crash or SIGKILL) replays every phase from the seeds, finds the runs committed and makes
+the same decisions; a replay that asked another point would need another configuration under the same
+condition, which the store refuses (``runner.sweep.check_compatible``).  The store's metadata records the
+questions file's commit and the time of the study's first run (``record_provenance``).
 """
 from __future__ import annotations
 
+import datetime
 import hashlib
+import subprocess
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 
+from ..behaviours.attacks import POLICY
+from ..errors import InternalError
 from ..runner.plan import Condition, condition_number
 from ..runner.sweep import run_sweep
 from ..seeds import run_seed
 from ..store import Store
 from . import space
 from .objective import loss, per_run
-from .study import Cell, Settings, Study
+from .racing import race, survivors
+from .restarts import Restarts, design, evaluations, random_batches, spread_points, stream
+from .study import QUESTIONS, Cell, Settings, Study
+
+PHASES = ("start", "search", "random", "selection", "confirmation")
+SEED_SET = {"start": "search", "search": "search", "random": "search", "selection": "selection",
+            "confirmation": "confirmation"}
+#: the race's groups: the searcher whose points each holds (the start points belong to the global search)
+GROUPS = {"search": ("start", "cma"), "random": ("random",)}
+ROLES = ("search", "random", "baseline")
+DEFAULTS = {p[0]: float(p[1]) for p in POLICY}
 
 
 @dataclass(frozen=True)
 class CRNCondition(Condition):
     """A condition whose runs use a seed stream of their own choosing (``crn``), shared with other
-    conditions: the common random numbers of one generation, or the held-out set."""
+    conditions: the common random numbers of one generation, of the race or of the confirmation."""
 
     crn: int = 0
 
@@ -49,89 +72,258 @@ class CRNCondition(Condition):
 
 @dataclass
 class CellSearch:
-    """What the search of one cell found: every evaluated candidate, and the held-out runs."""
+    """What the search of one cell found (docs/attack-search.md describes each frame)."""
 
     cell: Cell
-    candidates: pd.DataFrame   # gen, cand, label, fitness, the parameters
-    heldout: pd.DataFrame      # attack, run, items, liar_wealth
-    searched: list[str] = field(default_factory=list)  # labels of the re-evaluated candidates, best first
-    done: int = 0              # runs made now
-    skipped: int = 0           # runs found in the store
-    start_from: str = ""       # the hand-written attack CMA-ES started at (the best on the start seeds)
+    candidates: pd.DataFrame    # searcher, restart, gen, cand, label, fitness, then the parameters
+    selection: pd.DataFrame     # attack, run, items, liar_wealth: the race on the selection seeds
+    confirmation: pd.DataFrame  # attack, run, items, liar_wealth: the chosen attacks, every confirmation run
+    chosen: dict[str, str]      # role (search, random, baseline, worst, reference) -> attack label
+    params: dict[str, dict]     # attack label -> its attacker parameters
+    cost: dict                  # phase -> {"runs", "env_steps", "seconds"}
+    done: int = 0               # runs made now
+    skipped: int = 0            # runs found in the store
+    confirmation_seeds: list[int] = field(default_factory=list)  # the run seeds of confirmation runs 0, 1, ...
+    extra: dict[str, pd.DataFrame] = field(default_factory=dict)  # other searchers' confirmation runs
 
 
-def _stream(*parts) -> int:
-    text = "/".join(map(str, parts))
-    return int(hashlib.sha256(text.encode()).hexdigest()[:15], 16)
+def seed_stream(s: Settings, *parts) -> int:
+    """The seed stream of a seed set: ("search", searcher, restart, gen), ("selection",), ("confirmation",)."""
+    return stream(s.seed, *parts)
 
 
-def _keys(phase: str, gen: int, cand: int, attack: str) -> dict:
-    return {"phase": phase, "gen": gen, "cand": cand, "attack": attack}
+def confirmation_seeds(study: Study, cell: Cell, runs: int | None = None) -> list[int]:
+    """The run seeds of the cell's confirmation runs 0..runs-1 (default: the declared count)."""
+    s = study.settings
+    crn = seed_stream(s, "confirmation")
+    return [run_seed(cell.config.seed, k, crn) for k in range(s.confirmation_runs if runs is None else runs)]
 
 
-def _condition(cell: Cell, params: dict, keys: dict, runs: int, crn: int, steps, transitory) -> CRNCondition:
-    cid = ",".join(f"{k}={keys[k]}" for k in sorted(keys))
-    cfg = cell.with_attack(params, steps=steps, transitory=transitory)
-    return CRNCondition(cell.experiment, cid, keys, cfg, runs, cfg.seed, condition_number(cid), crn=crn)
+def _git(folder, *args) -> str | None:
+    try:
+        out = subprocess.run(["git", "-C", str(folder), *args], capture_output=True, text=True, timeout=30)
+    except (OSError, subprocess.SubprocessError):
+        return None
+    return out.stdout.strip() if out.returncode == 0 else None
+
+
+def provenance(questions=QUESTIONS) -> dict:
+    """The questions file's identity: its last commit (when the package is a git checkout; ``modified``
+    says whether the file differs from it) and its SHA-256."""
+    folder = questions.parent
+    commit = _git(folder, "log", "-1", "--format=%H", "--", questions.name) or None
+    modified = bool(_git(folder, "status", "--porcelain", "--", questions.name)) if commit else None
+    return {"questions_file": questions.name, "questions_commit": commit, "questions_modified": modified,
+            "questions_sha256": hashlib.sha256(questions.read_bytes()).hexdigest()}
+
+
+def record_provenance(store: Store, questions=QUESTIONS) -> dict:
+    """Record in the store's metadata (``store.json``, key ``attack_search``), once, before the study's
+    first run: the questions file's commit and hash, and the UTC time of the first run."""
+    with store.writing():
+        meta = store.meta()
+        if "attack_search" not in meta:
+            first = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+            meta["attack_search"] = {**provenance(questions), "first_run_utc": first}
+            store._write_meta(meta)  # under the store's lock, as Store writes it
+        return meta["attack_search"]
+
+
+class _Evaluator:
+    """Runs conditions of one cell and remembers each run's values; counts each phase's cost."""
+
+    def __init__(self, study: Study, cell: Cell, store: Store, run, steps, transitory):
+        self.s, self.cell, self.store, self.run = study.settings, cell, store, run
+        self.steps, self.transitory = steps, transitory
+        self.robots = getattr(run, "robots", None) or (lambda conds: _robots(store, cell))
+        self.values: dict[str, dict[int, tuple[float, float]]] = {}
+        self.counted: dict[str, int] = {}
+        self.cost = {p: {"runs": 0, "env_steps": 0, "seconds": 0.0} for p in PHASES}
+        self.done = self.skipped = 0
+        self.length = cell.with_attack({}, steps=steps, transitory=transitory).steps
+
+    def condition(self, params: dict, phase: str, searcher: str, restart: int, gen: int, cand: int, attack: str,
+                  runs: int, crn: int) -> CRNCondition:
+        keys = {"phase": phase, "seed_set": SEED_SET[phase], "searcher": searcher, "restart": restart, "gen": gen,
+                "cand": cand, "attack": attack}
+        cid = ",".join(f"{k}={keys[k]}" for k in sorted(keys))
+        cfg = self.cell.with_attack(params, steps=self.steps, transitory=self.transitory)
+        return CRNCondition(self.cell.experiment, cid, keys, cfg, runs, cfg.seed, condition_number(cid), crn=crn)
+
+    def evaluate(self, conds: list[CRNCondition]) -> list[pd.DataFrame]:
+        """Each condition's runs 0..runs-1 (made where missing): frames of run, items, liar_wealth."""
+        t0 = time.perf_counter()
+        made, found = self.run(conds)
+        self.done, self.skipped = self.done + made, self.skipped + found
+        if any(k not in self.values.get(c.id, {}) for c in conds for k in range(c.runs)):
+            per = per_run(self.robots(conds))
+            per = per[per.condition.isin({c.id for c in conds})]
+            for cid, r, items, lw in zip(per.condition, per.run, per["items"], per.liar_wealth):
+                self.values.setdefault(cid, {})[int(r)] = (float(items), float(lw))
+        seconds = time.perf_counter() - t0
+        new = {c.id: c.runs - self.counted.get(c.id, 0) for c in conds}
+        total = max(1, sum(new.values()))
+        out = []
+        for c in conds:
+            have = self.values.get(c.id, {})
+            missing = [k for k in range(c.runs) if k not in have]
+            if missing:
+                raise InternalError(f"{c.experiment} [{c.id}]: runs {missing[:5]} were run but not found")
+            cost = self.cost[c.keys["phase"]]
+            cost["runs"] += new[c.id]
+            cost["env_steps"] += new[c.id] * self.length
+            cost["seconds"] += seconds * new[c.id] / total
+            self.counted[c.id] = max(self.counted.get(c.id, 0), c.runs)
+            out.append(pd.DataFrame({"run": np.arange(c.runs), "items": [have[k][0] for k in range(c.runs)],
+                                     "liar_wealth": [have[k][1] for k in range(c.runs)]}))
+        return out
+
+    def fitness(self, frame: pd.DataFrame) -> float:
+        return float(np.mean(loss(frame[self.s.objective].to_numpy(float), self.s.objective)))
 
 
 def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[Condition]], tuple[int, int]],
-                steps: int | None = None, transitory: int | None = None) -> CellSearch:
-    """Search one cell: CMA-ES generations, then the held-out re-evaluation.  ``run(conds)`` runs the
-    missing runs of ``conds`` into ``store`` and returns (runs made, runs skipped)."""
-    import cma
-
+                steps: int | None = None, transitory: int | None = None, starts: np.ndarray | None = None
+                ) -> CellSearch:
+    """Search one cell (the module's docstring gives the phases).  ``run(conds)`` runs the missing runs of
+    ``conds`` into ``store`` and returns (runs made, runs skipped).  ``starts``: the global search's start
+    points (default: ``restarts.design``, spread over the cube)."""
     s: Settings = study.settings
-    dim = space.dimension()
-    opts = {"bounds": [0.0, 1.0], "popsize": s.popsize, "seed": _stream(s.seed, cell.experiment) % (2**31 - 2) + 1,
-            "verbose": -9, "verb_log": 0, "verb_disp": 0, "verb_filenameprefix": "", "tolfun": 0.0,
-            "tolx": 0.0, "tolfunhist": 0.0, "tolstagnation": 10**9, "tolflatfitness": 10**9}
-    # the start: every hand-written attack on one shared seed set of its own; CMA-ES starts at the best
-    hand = [(n, p) for n, p in study.baselines.items() if n != study.reference]
-    start = [_condition(cell, p, _keys("start", -1, k, n), s.runs, _stream("start"), steps, transitory)
-             for k, (n, p) in enumerate(hand)]
-    done, skipped = run(start) if start else (0, 0)
-    x0, start_from = np.full(dim, 0.5), ""
-    robots = getattr(run, "robots", None) or (lambda conds: _robots(store, cell))
-    if start:
-        values = _values(robots(start), start, s.objective)
-        scores = [float(loss(values.loc[c.id].mean(), s.objective)) for c in start]
-        k = int(np.argmin(scores))  # ties: the first declared
-        x0, start_from = np.clip(space.to_unit(hand[k][1]), 0.0, 1.0), hand[k][0]
-    es = cma.CMAEvolutionStrategy(x0, s.sigma0, opts)
-    rows = []
-    for g in range(s.generations):
-        np.random.seed(_stream(s.seed, cell.experiment, "gen", g) % (2**32))  # what cma samples from
-        X = es.ask()
-        crn = _stream("search", g)
-        conds = [_condition(cell, space.to_params(x), _keys("search", g, i, f"g{g}c{i}"), s.runs, crn, steps,
-                            transitory) for i, x in enumerate(X)]
-        made, found = run(conds)
-        done, skipped = done + made, skipped + found
-        values = _values(robots(conds), conds, s.objective)
-        fitness = [float(loss(values.loc[c.id].mean(), s.objective)) for c in conds]
-        es.tell(X, fitness)
-        for i, (c, f) in enumerate(zip(conds, fitness)):
-            rows.append({"gen": g, "cand": i, "label": c.keys["attack"], "fitness": f,
-                         **space.to_params(X[i])})
+    ev = _Evaluator(study, cell, store, run, steps, transitory)
+    record_provenance(store)
+    dim, seed = space.dimension(), stream(s.seed, cell.experiment)
+    points = design(spread_points(s), dim, stream(seed, "design")) if starts is None else np.asarray(starts, float)
+    rows: list[dict] = []
+
+    def add(searcher, restart, gen, frames, conds, points):
+        for i, (c, f) in enumerate(zip(conds, frames)):
+            p = space.to_params(points[i]) if isinstance(points[i], np.ndarray) else {**DEFAULTS, **points[i]}
+            rows.append({"searcher": searcher, "restart": restart, "gen": gen, "cand": i, "label": c.keys["attack"],
+                         "fitness": ev.fitness(f), **{n: float(p[n]) for n in space.NAMES}})
+
+    # 1. start: every baseline and every start point, on one seed set
+    hand = {n: p for n, p in study.baselines.items() if n != study.reference}
+    crn = seed_stream(s, "search", "start", 0, 0)
+    base = [ev.condition(p, "start", "baseline", -1, -1, k, n, s.runs, crn) for k, (n, p) in enumerate(hand.items())]
+    spread = [ev.condition(space.to_params(x), "start", "start", -1, -1, k, f"start{k}", s.runs, crn)
+              for k, x in enumerate(points)]
+    frames = ev.evaluate(base + spread)
+    add("baseline", -1, -1, frames[:len(base)], base, list(hand.values()))
+    add("start", -1, -1, frames[len(base):], spread, list(points))
+    scores = [ev.fitness(f) for f in frames]
+    firsts = [space.to_unit(p) for p in hand.values()] + list(points)
+    order = sorted(range(len(scores)), key=lambda k: (scores[k], k))  # ties: baselines first, then in order
+    # restart 0 at the best point of the start phase, the others at the next best spread points
+    origins = order[:1] + [k for k in order[1:] if k >= len(base)]
+
+    def start(r: int) -> np.ndarray:
+        return firsts[origins[r % len(origins)]] if origins else np.full(dim, 0.5)
+
+    # 2. the global search and the random search, one generation of each per call (one batch of runs)
+    cma = Restarts(s, dim, seed, start)
+    batches = random_batches(s, dim, seed)
+    j = 0
+    while True:
+        asked = cma.ask()
+        conds, parts = [], []
+        if asked is not None:
+            r, g, X = asked
+            crn = seed_stream(s, "search", "cma", r, g)
+            conds += [ev.condition(space.to_params(x), "search", "cma", r, g, i, f"cma_r{r}g{g}c{i}", s.runs, crn)
+                      for i, x in enumerate(X)]
+            parts.append(("cma", r, g, len(X), list(X)))
+        if j < len(batches):
+            crn = seed_stream(s, "search", "random", 0, j)
+            conds += [ev.condition(space.to_params(x), "random", "random", 0, j, i, f"random_g{j}c{i}", s.runs, crn)
+                      for i, x in enumerate(batches[j])]
+            parts.append(("random", 0, j, len(batches[j]), list(batches[j])))
+            j += 1
+        if not conds:
+            break
+        frames, k = ev.evaluate(conds), 0
+        for searcher, r, g, n, X in parts:
+            add(searcher, r, g, frames[k:k + n], conds[k:k + n], X)
+            if searcher == "cma":
+                cma.tell([ev.fitness(f) for f in frames[k:k + n]])
+            k += n
     candidates = pd.DataFrame(rows)
-    best = candidates.sort_values(["fitness", "gen", "cand"], kind="stable").head(s.best)
-    crn = _stream("heldout")
-    held = []
-    for rank, row in enumerate(best.itertuples(index=False)):
-        params = {n: getattr(row, n) for n in space.NAMES}
-        held.append(_condition(cell, params, _keys("heldout", row.gen, row.cand, f"search{rank + 1}"),
-                               s.heldout_runs, crn, steps, transitory))
-    for name, params in study.baselines.items():
-        held.append(_condition(cell, params, _keys("heldout", -1, -1, name), s.heldout_runs, crn, steps,
-                               transitory))
-    made, found = run(held)
-    per = per_run(_robots(store, cell))
-    per = per[per.condition.isin({c.id for c in held})]
-    label = {c.id: c.keys["attack"] for c in held}
-    heldout = per.assign(attack=per.condition.map(label))[["attack", "run", "items", "liar_wealth"]]
-    return CellSearch(cell, candidates, heldout.reset_index(drop=True), [f"search{k + 1}" for k in range(len(best))],
-                      done + made, skipped + found, start_from)
+
+    # 3. the race on the selection seeds: each searcher's best distinct points, every baseline
+    ranked = candidates.assign(order=np.arange(len(candidates))).sort_values(["fitness", "order"], kind="stable")
+    groups = {}
+    for role, members in GROUPS.items():
+        mine = ranked[ranked.searcher.isin(members)].drop_duplicates(list(space.NAMES))
+        if len(mine):
+            groups[role] = list(mine.label.head(s.finalists))
+    if hand:
+        groups["baseline"] = list(ranked[ranked.searcher == "baseline"].label)
+    if study.reference:
+        groups["reference"] = [study.reference]
+    row = {r.label: r for r in candidates.itertuples(index=False)}
+    params = {lab: {n: float(getattr(row[lab], n)) for n in space.NAMES} for g in groups.values() for lab in g
+              if lab in row}
+    if study.reference:
+        params[study.reference] = {**DEFAULTS, **study.baselines[study.reference]}
+    searcher = {lab: g for g, labs in groups.items() for lab in labs}
+    crn = seed_stream(s, "selection")
+    selected: dict[str, pd.DataFrame] = {}
+
+    def on_selection(labels: list[str], runs: int) -> dict[str, np.ndarray]:
+        conds = [_raced(ev, params[a], a, searcher[a], row.get(a), runs, crn) for a in labels]
+        for a, f in zip(labels, ev.evaluate(conds)):
+            selected[a] = f
+        return {a: loss(selected[a][s.objective].to_numpy(float), s.objective) for a in labels}
+
+    result = race(groups, tuple(s.race), s.keep, on_selection)
+    chosen = {role: result.ranking[role][0] for role in ROLES if result.ranking.get(role)}
+    median = {a: float(np.median(loss(selected[a][s.objective].to_numpy(float), s.objective))) for a in chosen.values()}
+    if chosen:
+        chosen["worst"] = min((chosen[r] for r in ROLES if r in chosen), key=lambda a: median[a])
+    if study.reference:
+        chosen["reference"] = study.reference
+    selection = _frame(selected)
+
+    # 4. the confirmation: the chosen attacks, every one on every confirmation run
+    crn = seed_stream(s, "confirmation")
+    labels = list(dict.fromkeys(chosen.values()))
+    conds = [ev.condition(params[a], "confirmation", searcher[a], -1, -1, -1, a, s.confirmation_runs, crn)
+             for a in labels]
+    confirmation = _frame(dict(zip(labels, ev.evaluate(conds))))
+    return CellSearch(cell, candidates, selection, confirmation, chosen,
+                      {a: params[a] for a in dict.fromkeys([*selected, *labels])}, ev.cost, ev.done, ev.skipped,
+                      confirmation_seeds(study, cell))
+
+
+def planned_runs(study: Study) -> int:
+    """The runs of one cell's search (at most: fewer when two roles choose the same attack, or a searcher
+    found fewer distinct points than ``finalists``)."""
+    s = study.settings
+    hand = len([n for n in study.baselines if n != study.reference])
+    n_eval = evaluations(s)
+    sizes = [min(s.finalists, n_eval), min(s.finalists, n_eval), hand, int(bool(study.reference))]
+    selection = 0
+    for n in sizes:
+        before = 0
+        for i, runs in enumerate(s.race):
+            selection += n * (runs - before)
+            before = runs
+            if i < len(s.race) - 1:
+                n = survivors(n, s.keep)
+    roles = len([n for n in sizes[:3] if n]) + int(bool(study.reference))
+    return (hand + 2 * n_eval) * s.runs + selection + roles * s.confirmation_runs
+
+
+def _raced(ev: _Evaluator, params: dict, label: str, group: str, row, runs: int, crn: int) -> CRNCondition:
+    """The selection condition of one raced attack (the same condition at every stage, its runs grown)."""
+    where = (int(row.restart), int(row.gen), int(row.cand)) if row is not None else (-1, -1, -1)
+    return ev.condition(params, "selection", group, *where, label, runs, crn)
+
+
+def _frame(per: dict[str, pd.DataFrame]) -> pd.DataFrame:
+    cols = ["attack", "run", "items", "liar_wealth"]
+    if not per:
+        return pd.DataFrame(columns=cols)
+    return pd.concat([f.assign(attack=a) for a, f in per.items()], ignore_index=True)[cols]
 
 
 def _robots(store: Store, cell: Cell) -> pd.DataFrame:
@@ -139,18 +331,11 @@ def _robots(store: Store, cell: Cell) -> pd.DataFrame:
     return r[r.experiment == cell.experiment]
 
 
-def _values(robots: pd.DataFrame, conds: list[Condition], objective: str) -> pd.Series:
-    """The objective's per-run values of ``conds`` (from ``robots``, which holds their rows), indexed by
-    condition id."""
-    per = per_run(robots)
-    per = per[per.condition.isin({c.id for c in conds})]
-    return per.set_index("condition")[objective]
-
-
 def store_runner(store: Store, *, workers: int = 1, executor=None,
                  on_done: Callable[[int], None] | None = None,
                  on_skip: Callable[[int], None] | None = None) -> Callable[[list[Condition]], tuple[int, int]]:
     """``run(conds)`` for ``search_cell``: their missing runs into ``store`` on the sweep machinery.
+    A condition run again with more runs (a race's next stage) counts only its new runs as made or found.
     ``run.robots(conds)``: the robots rows of ``conds``, kept from the parts just written when every run of
     theirs was made by this runner (the store is read back only for a search that resumes): reading the
     whole store after every generation cost the parent more the larger the store grew, while the
@@ -174,8 +359,11 @@ def store_runner(store: Store, *, workers: int = 1, executor=None,
         r = store.robots()
         return r[r.experiment.isin({c.experiment for c in conds})]
 
+    seen: dict[tuple[str, str], int] = {}  # runs of a condition already counted (a race grows its runs)
+
     def run(conds: list[Condition]) -> tuple[int, int]:
-        planned = sum(c.runs for c in conds)
+        before = sum(seen.get((c.experiment, c.id), 0) for c in conds)
+        planned = sum(c.runs for c in conds) - before
         rep = run_sweep(conds, store, workers=workers, executor=executor, on_done=on_done,
                         on_plan=(lambda todo: on_skip(planned - todo)) if on_skip else None, on_part=keep)
         if rep.failed:
@@ -183,7 +371,9 @@ def store_runner(store: Store, *, workers: int = 1, executor=None,
 
             raise SimulationError(f"{rep.failed} of {rep.done} runs failed (the first: {rep.first_error}); "
                                   f"`infomarket store failed {store.root}` lists them")
-        return rep.done, rep.skipped
+        for c in conds:
+            seen[(c.experiment, c.id)] = max(c.runs, seen.get((c.experiment, c.id), 0))
+        return rep.done, rep.skipped - before
 
     run.robots = robots
     return run

@@ -20,6 +20,7 @@ from ..analysis.study import Declaration
 from ..errors import ConfigError, UsageError
 from ..registry import payments
 from ..runner.plan import conditions
+from .baselines import rotation_grid
 from .objective import OBJECTIVES
 from .space import NAMES
 
@@ -31,18 +32,72 @@ ATTACKER = "attacker"
 
 @dataclass(frozen=True)
 class Settings:
-    budget: int = 128
-    popsize: int = 8
-    sigma0: float = 0.3
-    runs: int = 8
-    heldout_runs: int = 32
-    best: int = 3
+    """The declared search settings (``questions.toml`` ``[search]``); every key has a default here."""
+
+    budget: int = 256              # evaluations per cell for the global search; the random search gets as many
+    popsize: int = 8               # CMA-ES population of the first restart (IPOP doubles it per restart)
+    sigma0: float = 0.3            # CMA-ES step size, in the unit cube
+    restarts: int = 4              # CMA-ES restarts, each from its own start point
+    spread: float = 0.25           # share of the budget spent on start points spread over the cube (Sobol)
+    runs: int = 8                  # runs per evaluation; the candidates of one generation share seeds
+    finalists: int = 8             # best distinct points per searcher entering the race
+    race: tuple[int, ...] = (8, 16, 32)  # cumulative runs per raced attack at each stage (selection seeds)
+    keep: float = 0.5              # fraction of a race's attacks kept after each stage (at least 2)
+    confirmation_runs: int = 64    # runs per chosen attack on the confirmation seeds
+    grid_step: float = 15.0        # degrees between the rotation grid's baselines (search.baselines)
     objective: str = "items"
     seed: int = 23023
 
     @property
     def generations(self) -> int:
-        return max(1, self.budget // self.popsize)
+        """Batches of the random search (``popsize`` points each, ``budget`` in all)."""
+        return -(-self.budget // self.popsize)
+
+
+#: Keys of an earlier ``[search]`` table, read as the settings that replaced them.
+RENAMED = {"heldout_runs": "confirmation_runs", "best": "finalists"}
+
+
+def settings(table: dict, overrides: dict | None = None,
+             source: str = "search settings (questions.toml [search] or an option)") -> Settings:
+    """The ``Settings`` of a ``[search]`` table with ``overrides`` (None values ignored) over it; an unknown
+    key or a value out of range is a UsageError naming it."""
+    known = Settings.__dataclass_fields__
+    base = {}
+    for k, v in table.items():
+        k = RENAMED.get(k, k)
+        if k not in known:
+            raise UsageError(f"{source}: unknown key {k!r}; allowed: {', '.join(known)}")
+        base[k] = v
+    base.update({k: v for k, v in (overrides or {}).items() if v is not None})
+    if isinstance(base.get("budget"), int) and base["budget"] < base.get("popsize", Settings.popsize):
+        base["popsize"] = max(2, base["budget"])  # a budget below one population: one smaller generation
+    if "race" in base:
+        base["race"] = tuple(base["race"]) if isinstance(base["race"], (list, tuple)) else base["race"]
+    s = Settings(**base)
+    ints = ("budget", "popsize", "restarts", "runs", "finalists", "confirmation_runs", "seed")
+    for k in ints:
+        v = getattr(s, k)
+        if isinstance(v, bool) or not isinstance(v, int):
+            raise UsageError(f"{source}: {k} = {v!r}: a whole number is expected")
+    for k, v in (("budget", 1), ("popsize", 2), ("restarts", 1), ("runs", 1), ("finalists", 1),
+                 ("confirmation_runs", 2), ("seed", 0)):
+        if getattr(s, k) < v:
+            raise UsageError(f"{source}: {k} = {getattr(s, k)}: must be at least {v}")
+    race = s.race
+    if (not isinstance(race, tuple) or not race or any(isinstance(r, bool) or not isinstance(r, int) for r in race)
+            or race[0] < 2 or any(b <= a for a, b in zip(race, race[1:]))):
+        raise UsageError(f"{source}: race = {list(race) if isinstance(race, tuple) else race!r}: cumulative runs per "
+                         f"stage, whole numbers from 2 up, each above the one before (e.g. [8, 16, 32])")
+    if isinstance(s.spread, bool) or not isinstance(s.spread, (int, float)) or not 0.0 <= s.spread < 1.0:
+        raise UsageError(f"{source}: spread = {s.spread!r}: a share of the budget in [0, 1) is expected")
+    for k, lo, hi in (("keep", 0.0, 1.0), ("sigma0", 0.0, 1.0), ("grid_step", 0.0, 180.0)):
+        v = getattr(s, k)
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not lo < v <= hi:
+            raise UsageError(f"{source}: {k} = {v!r}: a number in ({lo:g}, {hi:g}] is expected")
+    if s.objective not in OBJECTIVES:
+        raise UsageError(f"--objective {s.objective}: unknown; allowed: {', '.join(OBJECTIVES)}")
+    return s
 
 
 @dataclass(frozen=True)
@@ -73,6 +128,9 @@ class Cell:
 
 @dataclass(frozen=True)
 class Study:
+    """A study: its experiment, settings, and baselines (the declared hand-written attacks, the truthful
+    ``reference`` among them, then the rotation grid), each a point of the attacker's parameters."""
+
     experiment: Experiment
     settings: Settings
     baselines: dict[str, dict[str, float]]
@@ -88,17 +146,7 @@ def load_declarations(path: Path = QUESTIONS) -> dict:
 def load(experiment: Experiment, declarations: dict | None = None, **overrides) -> Study:
     """The study of ``experiment`` with the declared settings, ``overrides`` (None values ignored) applied."""
     d = load_declarations() if declarations is None else declarations
-    known = Settings.__dataclass_fields__
-    base = {k: v for k, v in d.get("search", {}).items() if k in known}
-    base.update({k: v for k, v in overrides.items() if v is not None})
-    if "budget" in base and base["budget"] < base.get("popsize", Settings.popsize):
-        base["popsize"] = max(2, base["budget"])  # a budget below one population: one smaller generation
-    settings = Settings(**base)
-    if settings.objective not in OBJECTIVES:
-        raise UsageError(f"--objective {settings.objective}: unknown; allowed: {', '.join(OBJECTIVES)}")
-    if settings.best < 1 or settings.popsize < 2 or settings.runs < 1 or settings.heldout_runs < 2:
-        raise UsageError("attack-search needs --best >= 1, a population of at least 2, --runs >= 1 and "
-                         "--heldout-runs >= 2")
+    settings_ = settings(d.get("search", {}), overrides)
     baselines, reference = {}, None
     for name, b in d.get("baselines", {}).items():
         unknown = set(b.get("params", {})) - set(NAMES)
@@ -107,7 +155,12 @@ def load(experiment: Experiment, declarations: dict | None = None, **overrides) 
         baselines[name] = dict(b.get("params", {}))
         if b.get("reference"):
             reference = name
-    return Study(experiment, settings, baselines, reference, d.get("questions", {}), d.get("pending_defences", {}))
+    for name, params in rotation_grid(settings_.grid_step).items():
+        if name in baselines:
+            raise ConfigError(f"{QUESTIONS.name}: baseline {name}: the name of a rotation-grid baseline "
+                              f"(search.baselines); give the declared one another name")
+        baselines[name] = params
+    return Study(experiment, settings_, baselines, reference, d.get("questions", {}), d.get("pending_defences", {}))
 
 
 def _with_pending(exp: Experiment, pending: dict) -> Experiment:
