@@ -77,6 +77,17 @@ def test_wilcoxon_p_by_hand_and_with_a_margin():
     assert pr.wilcoxon_p([0.0, 0.0]) == 1.0
 
 
+def test_exact_only_for_few_untied_differences():
+    assert pr.method([1.0, -2.0, 3.0]) == "exact"
+    assert pr.method([1.0, -1.0, 3.0]) == "asymptotic"      # |d| tied
+    assert pr.method([0.0, 1.0, 2.0]) == "asymptotic"
+    assert pr.method(np.arange(1.0, 52.0)) == "asymptotic"  # 51 differences
+    assert pr.method([[1.0, 2.0], [1.0, 1.0]]) == "asymptotic"  # any row tied
+    # eight equal negative differences: all ranks 4.5, T+ = 0; mean 8 x 9 / 4 = 18, variance
+    # 8 x 9 x 17 / 24 - (8^3 - 8) / 48 = 40.5 (tie-corrected): p = Phi(-18 / sqrt(40.5))
+    assert pr.wilcoxon_p([-1.0] * 8, alternative="less") == pytest.approx(sps.norm.cdf(-18 / math.sqrt(40.5)))
+
+
 def test_power_matches_its_closed_form():
     """n = 5 at alpha 0.05: only "all five positive" (p = 1/32) rejects, so with normal differences of
     centre 1 and sd 1 the power is Phi(1)^5 = 0.4214; 4 000 simulations: standard error 0.008."""

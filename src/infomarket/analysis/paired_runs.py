@@ -82,13 +82,28 @@ def hl_interval(d, confidence: float = CONFIDENCE) -> tuple[float, float, float]
     return float(w[k - 1]), float(w[len(w) - k]), cover
 
 
+#: up to this many differences, untied and non-zero, the signed-rank p-value is exact
+EXACT = 50
+
+
+def method(d) -> str:
+    """"exact" for at most ``EXACT`` untied, non-zero differences (in every row), else "asymptotic" (the
+    normal approximation with scipy's tie correction), never scipy's "auto", which with ties in few
+    differences runs a permutation test: unseeded beyond 13 differences, and slow over many rows."""
+    a = np.abs(np.atleast_2d(np.asarray(d, float)))
+    if a.shape[-1] > EXACT or np.any(a == 0):
+        return "asymptotic"
+    s = np.sort(a, axis=-1)
+    return "asymptotic" if np.any(s[..., 1:] == s[..., :-1]) else "exact"
+
+
 def wilcoxon_p(d, alternative: str = "greater", shift: float = 0.0) -> float:
-    """Signed-rank p-value of ``d + shift`` (scipy: exact for small untied samples): "greater" tests
-    H1 "the differences' centre is above -shift"."""
+    """Signed-rank p-value of ``d + shift`` (``method``): "greater" tests H1 "the differences' centre
+    is above -shift"."""
     d = np.asarray(d, float) + shift
     if not np.any(d != 0):
         return 1.0
-    return float(sps.wilcoxon(d, alternative=alternative).pvalue)
+    return float(sps.wilcoxon(d, alternative=alternative, method=method(d[d != 0])).pvalue)
 
 
 def min_pvalue(n: int, alternative: str = "greater") -> float:
@@ -120,7 +135,7 @@ def power(model, n: int, effect: float, *, shift: float = 0.0, alternative: str 
     if n < 1 or min_pvalue(n, alternative) >= alpha:
         return 0.0
     d = model(np.random.default_rng(seed), (sims, n)) + effect + shift
-    p = sps.wilcoxon(d, alternative=alternative, axis=1).pvalue
+    p = sps.wilcoxon(d, alternative=alternative, axis=1, method=method(d)).pvalue
     return float(np.mean(p < alpha))
 
 
