@@ -74,8 +74,9 @@ def search(defence, byz, *, worst, base, rand, extra=None, wealth=None):
     cost = {"search": {"runs": 2048, "env_steps": 2048 * 30000, "seconds": 300.0},
             "confirmation": {"runs": 4 * N, "env_steps": 4 * N * 30000, "seconds": 5.0}}
     ext = {"adaptive": frame({"policy1": extra})} if extra is not None else {}
+    cands = pd.DataFrame({"searcher": ["cma", "cma", "random", "cma", "random"], "fitness": np.arange(5.0)})
     return Search(Cell(defence, byz), frame(values, wealth), chosen, {"cma_best": {"rot_base": 170.0}}, cost,
-                  extra=ext)
+                  candidates=cands, extra=ext)
 
 
 # cell A: per-seed loss 0.01 i (within 10 %); the search beats the best baseline by 1.0 + 0.1 i items on
@@ -138,6 +139,7 @@ def test_an_extra_searcher_is_compared_with_the_search(analysis):
     assert ad["answer"] == "yes" and ad["family"] == 1     # the one cell it ran in
     assert "adaptive_beats_parametric" not in b
     assert a["extra_attacks"] == {"adaptive": "policy1"}
+    assert a["evaluations"] == {"cma": 3, "random": 2}
 
 
 def test_the_figure_draws_what_the_table_prints(analysis):
@@ -218,6 +220,7 @@ def test_write_gives_strict_json_markdown_and_the_figure(analysis, tmp_path):
     assert "REDUCED RUN (one cell)" in md and "questions commit: abc123" in md
     assert "All cells: 4160 runs" in md   # (2048 + 32) x 2
     assert "| staking | 1 | 8 | 10.00 | cma_best (9.55) | 4.5% [2.0%, 7.0%] | yes |" in md
+    assert "(evaluations: cma 3, random 2)" in md
     few = search("outlier", 1, worst=W_A[:5], base=W_A[:5], rand=W_A[:5])
     few.confirmation = few.confirmation[few.confirmation.run < 5]
     one = report.analyse(study(), [few])["cells"][0]

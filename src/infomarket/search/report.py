@@ -132,12 +132,16 @@ def analyse(study: Study, results: list) -> dict:
         extra = {name: loss(_per_run(df, _only(df, name), obj, runs), obj)
                  for name, df in (getattr(r, "extra", None) or {}).items()}
         cost = {ph: dict(v) for ph, v in (r.cost or {}).items()}
+        cand = getattr(r, "candidates", None)
+        evaluations = ({str(k): int(v) for k, v in cand.searcher.value_counts(sort=False).items()}
+                       if cand is not None and "searcher" in getattr(cand, "columns", ()) else {})
         cells.append({"defence": r.cell.defence, "byzantines": r.cell.byzantines, "experiment": r.cell.experiment,
                       "share": r.cell.byzantines / study.experiment.swarm.robots, "runs": len(runs),
                       "chosen": chosen, "params": {a: dict(r.params.get(a, {})) for a in dict.fromkeys(chosen.values())},
                       "medians": {role: float(np.median(v)) for role, v in items.items()},
                       "extra_attacks": {n: _only(df, n) for n, df in (getattr(r, "extra", None) or {}).items()},
-                      "cost": cost, "cost_total": _total(cost), "done": r.done, "skipped": r.skipped})
+                      "evaluations": evaluations, "cost": cost, "cost_total": _total(cost), "done": r.done,
+                      "skipped": r.skipped})
         frames.append((damage, items, extra))
     out = {"objective": obj, "settings": _settings(s), "cells": cells}
     if not cells:
@@ -349,7 +353,8 @@ def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, s
     lines += ["", "## Chosen attacks (on the selection seeds)", ""]
     for c in a["cells"]:
         roles = ", ".join(f"{r} = {lab}" for r, lab in c["chosen"].items())
-        lines.append(f"- {c['defence']}, {c['byzantines']}: {roles}")
+        ev = ", ".join(f"{k} {v}" for k, v in c.get("evaluations", {}).items())
+        lines.append(f"- {c['defence']}, {c['byzantines']}: {roles}" + (f" (evaluations: {ev})" if ev else ""))
         for lab, p in c["params"].items():
             if p:
                 lines.append(f"  - {lab}: " + ", ".join(f"{k}={v:g}" for k, v in p.items()))
