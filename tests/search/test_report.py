@@ -159,6 +159,7 @@ def test_the_figure_draws_what_the_table_prints(analysis):
         highs = [seg[1][1] for seg in bars.get_segments()]
         np.testing.assert_allclose(lows, data[lo], rtol=0, atol=1e-12)
         np.testing.assert_allclose(highs, data[hi], rtol=0, atol=1e-12)
+    assert [ln.get_ydata()[0] for ln in loss_ax.lines if ln.get_linestyle() == "--"] == [0.10]  # the margin
     md = report.markdown(analysis)
     rows = [line for line in md.splitlines() if line.startswith("| staking |")]
     for row, c in zip(rows, cells):

@@ -234,6 +234,9 @@ def figure(analysis: dict):
             v, a, b = (np.asarray(d[k], float) for k in (y, lo, hi))
             err = np.vstack([v - np.where(np.isfinite(a), a, v), np.where(np.isfinite(b), b, v) - v])
             ax.errorbar(d["share"], v, yerr=err, marker="o", capsize=3, label=name)
+    margins = {c["worst_case_bounded"]["max_loss"] for c in analysis["cells"] if "worst_case_bounded" in c}
+    for m in margins:  # the declared bound the loss is judged against
+        axes[0].axhline(m, color="grey", lw=0.8, ls="--")
     axes[0].set_ylabel("worst-case loss (1 - items / truthful, per seed)")
     axes[1].set_ylabel("search beyond best baseline (share of its items)")
     axes[1].axhline(0.0, color="grey", lw=0.8)
