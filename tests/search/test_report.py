@@ -197,6 +197,22 @@ def test_the_loss_is_the_worst_roles_attack():
     assert c["medians"]["worst"] == 9.0 and c["chosen"]["worst"] == "base_best"
 
 
+def test_a_reference_with_no_items_leaves_the_loss_undefined():
+    """Runs too short to count items: the per-seed loss 1 - x / 0 is undefined; that cell is answered
+    "inconclusive" with a note and left out of the Holm family, the other cell keeps its answer."""
+    empty = search("outlier", 1, worst=np.zeros(N), base=np.zeros(N), rand=np.zeros(N))
+    empty.confirmation.loc[empty.confirmation.attack == "truthful", "items"] = [0.0, 1.0] * (N // 2)
+    a = report.analyse(study(), [empty, A])
+    undefined, fine = a["cells"]
+    assert undefined["worst_case_bounded"]["answer"] == "inconclusive"
+    assert "no items on 4 of 8 seeds" in undefined["worst_case_bounded"]["note"]
+    assert fine["worst_case_bounded"]["within"]["family"] == 1 and fine["worst_case_bounded"]["answer"] == "yes"
+    md = report.markdown(a)
+    assert "| outlier | 1 | 8 | 0.50 | cma_best (0.00) | undefined | inconclusive |" in md
+    assert "- outlier, 1: the truthful reference collected no items on 4 of 8 seeds" in md
+    assert report.figure(a) is not None
+
+
 def test_confirmation_runs_must_pair(analysis):
     bad = search("outlier", 1, worst=W_A, base=W_A, rand=W_A)
     bad.confirmation = bad.confirmation.drop(index=3)     # cma_best's run 3

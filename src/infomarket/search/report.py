@@ -150,9 +150,19 @@ def analyse(study: Study, results: list) -> dict:
     if all("reference" in c["chosen"] and "worst" in c["chosen"] for c in cells):
         rule = _rule(study, "worst_case_bounded")
         rule.setdefault("max_loss", 0.10)
-        losses = [1.0 - it["worst"] / it["reference"] for _, it, _ in frames]
-        for c, b in zip(cells, _bounded(losses, cells, rule)):
-            c["worst_case_bounded"] = b
+        # the per-seed loss is undefined on a seed where the reference collected nothing (a run too short
+        # to count items): such a cell is left unanswered, and out of the Holm family
+        zero = [int(np.sum(it["reference"] <= 0)) for _, it, _ in frames]
+        ok = [i for i, z in enumerate(zero) if z == 0]
+        losses = [1.0 - frames[i][1]["worst"] / frames[i][1]["reference"] for i in ok]
+        for i, b in zip(ok, _bounded(losses, [cells[i] for i in ok], rule)):
+            cells[i]["worst_case_bounded"] = b
+        for i, z in enumerate(zero):
+            if z:
+                cells[i]["worst_case_bounded"] = {
+                    "answer": stats.INCONCLUSIVE, "max_loss": rule["max_loss"], "loss": math.nan, "low": math.nan,
+                    "high": math.nan, "note": f"the truthful reference collected no items on {z} of "
+                                              f"{cells[i]['runs']} seeds: the per-seed loss is undefined"}
         out["bounded_by_defence"] = _by_defence(cells)
     for q, xr, yr in DUELS:
         if all(xr in c["chosen"] and yr in c["chosen"] for c in cells):
@@ -286,6 +296,8 @@ def _clean(v):
 
 
 def _ci(lo: float, hi: float, fmt: str) -> str:
+    if math.isnan(lo) or math.isnan(hi):
+        return "undefined"
     return "unbounded" if not (math.isfinite(lo) and math.isfinite(hi)) else f"[{lo:{fmt}}, {hi:{fmt}}]"
 
 
@@ -331,7 +343,8 @@ def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, s
               "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for c in a["cells"]:
         b = c.get("worst_case_bounded")
-        loss_txt = f"{b['loss']:.1%} {_ci(b['low'], b['high'], '.1%')}" if b else "–"
+        loss_txt = "–" if not b else ("undefined" if math.isnan(b["loss"]) else
+                                      f"{b['loss']:.1%} {_ci(b['low'], b['high'], '.1%')}")
         m, ch = c["medians"], c["chosen"]
         worst = f"{ch.get('worst', '–')} ({m['worst']:.2f})" if "worst" in m else "–"
         ref = f"{m['reference']:.2f}" if "reference" in m else "–"
@@ -340,6 +353,10 @@ def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, s
                      f"{_answer(b)} | {_duel_cell(c.get('search_beats_baseline'))} | "
                      f"{_answer(c.get('search_beats_baseline'))} | {_duel_cell(c.get('search_beats_random'))} | "
                      f"{_answer(c.get('search_beats_random'))} | {t['runs']:.0f} / {t['seconds']:.0f} |")
+    notes = [f"- {c['defence']}, {c['byzantines']}: {c['worst_case_bounded']['note']}" for c in a["cells"]
+             if c.get("worst_case_bounded", {}).get("note")]
+    if notes:
+        lines += ["", *notes]
     extra = sorted({n for c in a["cells"] for n in c.get(EXTRA_QUESTION, {})})
     for n in extra:
         lines += ["", f"**{n} vs the parametric search** (per-seed {n} − search; negative: {n} does more damage):",
