@@ -210,6 +210,7 @@ def test_a_reference_with_no_items_leaves_the_loss_undefined():
     md = report.markdown(a)
     assert "| outlier | 1 | 8 | 0.50 | cma_best (0.00) | undefined | inconclusive |" in md
     assert "- outlier, 1: the truthful reference collected no items on 4 of 8 seeds" in md
+    assert "| +0.00 unbounded (share undefined) | inconclusive (power 0.00) |" in md  # d = 0, medians 0
     assert report.figure(a) is not None
 
 

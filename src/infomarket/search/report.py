@@ -311,8 +311,9 @@ def _answer(a: dict | None) -> str:
 def _duel_cell(a: dict | None) -> str:
     if not a:
         return "–"
-    return (f"{a['hl']:+.2f} {_ci(a['low'], a['high'], '.2f')} ({a['percent']:+.1%} "
-            f"{_ci(a['percent_low'], a['percent_high'], '+.1%')})")
+    share = ("share undefined" if math.isnan(a["percent"]) else
+             f"{a['percent']:+.1%} {_ci(a['percent_low'], a['percent_high'], '+.1%')}")
+    return f"{a['hl']:+.2f} {_ci(a['low'], a['high'], '.2f')} ({share})"
 
 
 def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, steps: int | None = None,
