@@ -195,7 +195,7 @@ def test_the_search_says_what_is_reduced(tmp_path):
     small = study.load(exp, budget=4, runs=1)
     got = _reductions(small, declared, exp, every[:1], every, Namespace(steps=60, transitory=20))
     assert got == [f"1 of {len(every)} cells", f"--steps 60 (declared {exp.steps})",
-                   f"--transitory 20 (declared {exp.transitory})", "--budget 4 (declared 128)",
+                   f"--transitory 20 (declared {exp.transitory})", "--budget 4 (declared 256)",
                    "--popsize 4 (declared 8)", "--runs 1 (declared 8)"]
 
 

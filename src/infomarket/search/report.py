@@ -1,185 +1,390 @@
-"""The attack search's answers: held-out comparisons with intervals, the declared rules applied.
+"""The attack search's answers: the chosen attacks on the confirmation seeds, paired, the declared rules
+applied.
 
-Per cell, x is the searched attack (of the re-evaluated candidates, the one with the lowest held-out
-median of the objective's loss) and y the best hand-written attack (chosen the same way), both on the
-same held-out seeds; the questions are those of ``questions.toml`` (``search_no_worse``,
-``search_more_damaging``, ``worst_case_growth``, ``bounded_defence``).  Every statistic comes from
-``infomarket.analysis.stats``.
+Every attack a cell chose (on its selection seeds: the search's best, the random search's best, the best
+baseline, the worst of those three, and the truthful reference) ran on one shared set of confirmation
+seeds that no other phase touched, so run *i* of each is paired with run *i* of every other, and every
+comparison is of per-seed differences (``analysis.paired_runs``): the signed-rank test, the
+Hodges-Lehmann estimate with its distribution-free interval, Holm over the question's family, and, for a
+"no" that rests on a test not rejecting, its simulated power at the declared smallest effect.
+
+The report reads only the fields a cell's search returns (``cell``, ``confirmation``, ``chosen``,
+``params``, ``cost``, ``extra``), so any searcher that fills them is reported the same way.  The loss is
+per seed: 1 - items under the worst attack / items of the truthful reference on the same seed, and the
+figure draws exactly the estimates and intervals the table prints (``figure_data``).
 """
 from __future__ import annotations
 
 import json
 import math
-from dataclasses import asdict
+from dataclasses import asdict, is_dataclass
 from pathlib import Path
 
 import numpy as np
 
+from ..analysis import paired_runs as pr
 from ..analysis import stats
-from ..errors import InputTypeError
-from .driver import CellSearch
+from ..analysis.declared import size_note
+from ..errors import ArgumentError
 from .objective import loss
 from .study import DECLARATION, Study
 
-
-def _pick(held, labels, objective):
-    """Of ``labels``, the attack whose held-out median loss is lowest (ties: the first)."""
-    med = {a: float(np.median(loss(held[held.attack == a][objective].to_numpy(), objective))) for a in labels}
-    return min(labels, key=lambda a: med[a])
+#: the comparisons of the "does one searcher beat another" questions: (question, x role, y role)
+DUELS = (("search_beats_baseline", "search", "baseline"), ("search_beats_random", "search", "random"))
+EXTRA_QUESTION = "adaptive_beats_parametric"
 
 
-def _runs(held, attack, objective):
-    return held[held.attack == attack].sort_values("run")[objective].to_numpy(float)
+def _rule(study: Study, name: str) -> dict:
+    q = dict(study.questions.get(name, {}))
+    q.setdefault("alpha", stats.ALPHA)
+    q.setdefault("power", stats.POWER)
+    q.setdefault("confidence", stats.CONFIDENCE)
+    q.setdefault("family", "cells")
+    return q
 
 
-def _comparison_dict(c: stats.Comparison) -> dict:
-    d = asdict(c)
-    d["effect"] = asdict(c.effect)
-    d["text"] = c.describe()
-    return d
+def _per_run(frame, attack: str, column: str, runs) -> np.ndarray:
+    """``column`` of ``attack`` at each of ``runs`` (one value per run, or a clear error)."""
+    rows = frame[frame.attack == attack].drop_duplicates("run").set_index("run")
+    missing = sorted(set(runs) - set(rows.index))
+    if missing or len(frame[frame.attack == attack]) != len(rows):
+        raise ArgumentError(f"confirmation runs of {attack!r}: need exactly one row for each run "
+                            f"{min(runs)}..{max(runs)}" + (f" (missing {missing[:5]})" if missing else " (duplicates)"))
+    return rows.loc[list(runs), column].to_numpy(float)
 
 
-def analyse(study: Study, results: list[CellSearch]) -> dict:
-    """Every cell's comparisons and every declared question's answer (a JSON-ready dict)."""
-    s, q = study.settings, study.questions
+def _groups(cells: list[dict], family: str) -> list[list[int]]:
+    """Indices of ``cells`` in each Holm family: all cells, or per defence, or per Byzantine count."""
+    key = {"cells": lambda c: 0, "defence": lambda c: c["defence"], "byzantines": lambda c: c["byzantines"]}
+    if family not in key:
+        raise ArgumentError(f"family {family!r}: allowed: {', '.join(key)}")
+    out: dict = {}
+    for i, c in enumerate(cells):
+        out.setdefault(key[family](c), []).append(i)
+    return list(out.values())
+
+
+def _holm(comparisons: list, cells: list[dict], family: str) -> list:
+    out = list(comparisons)
+    for idx in _groups(cells, family):
+        for i, c in zip(idx, pr.adjust([comparisons[i] for i in idx])):
+            out[i] = c
+    return out
+
+
+def _row(c: pr.PairedComparison) -> dict:
+    return {**asdict(c), "significant": c.significant, "text": c.describe()}
+
+
+def _duel(xs, ys, cells, rule: dict, label: str) -> list[dict]:
+    """x beats y (lower damage value) per cell: yes when shown (Holm), no when not shown although the
+    test had the power ``rule["power"]`` at the declared effect, else inconclusive."""
+    sizes = {i: len(g) for g in _groups(cells, rule["family"]) for i in g}
+    comps = [pr.compare(x, y, alternative="less", declared=-rule["min_effect"] * abs(float(np.median(y))),
+                        alpha=rule["alpha"], family=sizes[i], confidence=rule["confidence"],
+                        label=f"{c['experiment']}: {label}")
+             for i, (x, y, c) in enumerate(zip(xs, ys, cells))]
+    out = []
+    for c, y in zip(_holm(comps, cells, rule["family"]), ys):
+        no = (not c.significant) and c.power >= rule["power"]
+        med = float(np.median(y))
+        out.append({"answer": stats.answer(c.significant, no), **_row(c),
+                    "percent": _pct(c.hl, med), "percent_low": _pct(c.high, med), "percent_high": _pct(c.low, med)})
+    return out
+
+
+def _pct(v: float, ref: float) -> float:
+    """A difference ``v`` of damage values as a share of ``|ref|``, signed so that more damage (a
+    negative difference) is positive."""
+    return -v / abs(ref) if ref else math.nan
+
+
+def _bounded(losses, cells, rule: dict) -> list[dict]:
+    """The per-seed loss within ``max_loss``: yes when shown below it, no when shown above it (Holm over
+    the family, each direction), else inconclusive."""
+    m = rule["max_loss"]
+    sizes = {i: len(g) for g in _groups(cells, rule["family"]) for i in g}
+    kw = {"alpha": rule["alpha"], "confidence": rule["confidence"]}
+    within = _holm([pr.compare(ls, np.zeros_like(ls), alternative="less", shift=-m, family=sizes[i],
+                               label=f"{c['experiment']}: loss < {m:.0%}", **kw)
+                    for i, (ls, c) in enumerate(zip(losses, cells))], cells, rule["family"])
+    beyond = _holm([pr.compare(ls, np.zeros_like(ls), alternative="greater", shift=-m, family=sizes[i],
+                               label=f"{c['experiment']}: loss > {m:.0%}", **kw)
+                    for i, (ls, c) in enumerate(zip(losses, cells))], cells, rule["family"])
+    return [{"answer": stats.answer(w.significant, b.significant), "max_loss": m, "loss": w.hl, "low": w.low,
+             "high": w.high, "coverage": w.coverage, "within": _row(w), "beyond": _row(b)}
+            for w, b in zip(within, beyond)]
+
+
+def analyse(study: Study, results: list) -> dict:
+    """Every cell's paired comparisons on its confirmation seeds and every declared question's answer (a
+    JSON-ready dict).  ``results``: one search result per cell (``driver.CellSearch``)."""
+    s = study.settings
     obj = s.objective
-    sign = 1.0 if obj == "items" else -1.0  # compare in "lower is more damaging" terms
-    cells = []
+    cells, frames = [], []
     for r in results:
-        held = r.heldout
-        hand = [a for a in study.baselines if a != study.reference]
-        x_label, y_label = _pick(held, r.searched, obj), _pick(held, hand, obj)
-        x, y = sign * _runs(held, x_label, obj), sign * _runs(held, y_label, obj)
-        ref = sign * _runs(held, study.reference, obj) if study.reference else None
-        best = r.candidates.sort_values(["fitness", "gen", "cand"], kind="stable")
-        chosen = best.iloc[int(x_label.removeprefix("search")) - 1]
+        conf, chosen = r.confirmation, dict(r.chosen)
+        runs = sorted(int(v) for v in conf.run.unique())
+        if len(runs) < 2:
+            raise ArgumentError(f"{r.cell.experiment}: {len(runs)} confirmation run(s); a paired comparison needs 2")
+        damage = {role: loss(_per_run(conf, a, obj, runs), obj) for role, a in chosen.items()}
+        items = {role: _per_run(conf, a, "items", runs) for role, a in chosen.items()}
+        extra = {name: loss(_per_run(df, _only(df, name), obj, runs), obj)
+                 for name, df in (getattr(r, "extra", None) or {}).items()}
+        cost = {ph: dict(v) for ph, v in (r.cost or {}).items()}
+        cand = getattr(r, "candidates", None)
+        evaluations = ({str(k): int(v) for k, v in cand.searcher.value_counts(sort=False).items()}
+                       if cand is not None and "searcher" in getattr(cand, "columns", ()) else {})
         cells.append({"defence": r.cell.defence, "byzantines": r.cell.byzantines, "experiment": r.cell.experiment,
-                      "evaluations": len(r.candidates), "search": x_label, "hand": y_label,
-                      "start_from": r.start_from,
-                      "params": {k: float(chosen[k]) for k in chosen.index if k not in ("gen", "cand", "label", "fitness")},
-                      "found_at": {"gen": int(chosen.gen), "cand": int(chosen.cand)},
-                      "medians": {a: float(np.median(_runs(held, a, obj))) for a in held.attack.unique()},
-                      "x": x, "y": y, "ref": ref})
-    n = len(cells)
-    margin = q.get("search_no_worse", {}).get("margin", 0.05)
-    min_effect = q.get("search_more_damaging", {}).get("min_effect", 0.10)
-    max_loss = q.get("bounded_defence", {}).get("max_loss", 0.10)
-    no_worse = stats.adjust([stats.compare(c["x"], c["y"], alternative="less", shift=-margin * abs(np.median(c["y"])),
-                                           label=f"{c['experiment']}: searched < hand-written + margin")
-                             for c in cells])
-    hand_better = stats.adjust([stats.compare(c["y"], c["x"], alternative="less",
-                                              label=f"{c['experiment']}: hand-written < searched") for c in cells])
-    more = stats.adjust([stats.compare(c["x"], c["y"], alternative="less", family=n,
-                                       declared=-min_effect * abs(np.median(c["y"])),
-                                       label=f"{c['experiment']}: searched < hand-written") for c in cells])
-    out_cells = []
-    for c, a, b, m in zip(cells, no_worse, hand_better, more):
-        answer_nw = stats.answer(a.significant, b.significant)
-        no_more = (not m.significant) and m.power >= stats.POWER
-        row = {k: v for k, v in c.items() if k not in ("x", "y", "ref")}
-        row["search_no_worse"] = {"answer": answer_nw, "test": _comparison_dict(a), "reverse": _comparison_dict(b)}
-        row["search_more_damaging"] = {"answer": stats.answer(m.significant, no_more), "test": _comparison_dict(m)}
-        if c["ref"] is not None:
-            e = stats.effect(c["x"], c["ref"])
-            med_ref = float(np.median(c["ref"]))
-            row["worst_case_growth"] = {"loss": 1.0 - float(np.median(c["x"])) / med_ref if med_ref else math.nan,
-                                        "share": c["byzantines"] / study.experiment.swarm.robots,
-                                        "effect_vs_truthful": asdict(e)}
-        out_cells.append(row)
-    bounded = {}
-    if study.reference:
-        for d in dict.fromkeys(c["defence"] for c in cells):
-            mine = [c for c in cells if c["defence"] == d]
-            within = stats.adjust([stats.compare(c["x"], c["ref"], alternative="greater",
-                                                 shift=max_loss * abs(np.median(c["ref"])),
-                                                 label=f"{c['experiment']}: loss < {max_loss:.0%}") for c in mine])
-            beyond = stats.adjust([stats.compare(c["x"], c["ref"], alternative="less",
-                                                 shift=max_loss * abs(np.median(c["ref"])),
-                                                 label=f"{c['experiment']}: loss > {max_loss:.0%}") for c in mine])
-            yes = all(w.significant for w in within)
-            no = any(b.significant for b in beyond)
-            bounded[d] = {"answer": stats.answer(yes, no), "byzantines": [c["byzantines"] for c in mine],
-                          "within": [_comparison_dict(w) for w in within],
-                          "beyond": [_comparison_dict(b) for b in beyond]}
-    return {"objective": obj, "settings": asdict(s), "cells": out_cells, "bounded_defence": bounded}
+                      "share": r.cell.byzantines / study.experiment.swarm.robots, "runs": len(runs),
+                      "chosen": chosen, "params": {a: dict(r.params.get(a, {})) for a in dict.fromkeys(chosen.values())},
+                      "medians": {role: float(np.median(v)) for role, v in items.items()},
+                      "extra_attacks": {n: _only(df, n) for n, df in (getattr(r, "extra", None) or {}).items()},
+                      "evaluations": evaluations, "cost": cost, "cost_total": _total(cost), "done": r.done,
+                      "skipped": r.skipped})
+        frames.append((damage, items, extra))
+    out = {"objective": obj, "settings": _settings(s), "cells": cells}
+    if not cells:
+        return {**out, "bounded_by_defence": {}}
+    out["size_note"] = size_note(getattr(s, "confirmation_runs", None), [c["runs"] for c in cells])
+    if all("reference" in c["chosen"] and "worst" in c["chosen"] for c in cells):
+        rule = _rule(study, "worst_case_bounded")
+        rule.setdefault("max_loss", 0.10)
+        # the per-seed loss is undefined on a seed where the reference collected nothing (a run too short
+        # to count items): such a cell is left unanswered, and out of the Holm family
+        zero = [int(np.sum(it["reference"] <= 0)) for _, it, _ in frames]
+        ok = [i for i, z in enumerate(zero) if z == 0]
+        losses = [1.0 - frames[i][1]["worst"] / frames[i][1]["reference"] for i in ok]
+        for i, b in zip(ok, _bounded(losses, [cells[i] for i in ok], rule)):
+            cells[i]["worst_case_bounded"] = b
+        for i, z in enumerate(zero):
+            if z:
+                cells[i]["worst_case_bounded"] = {
+                    "answer": stats.INCONCLUSIVE, "max_loss": rule["max_loss"], "loss": math.nan, "low": math.nan,
+                    "high": math.nan, "note": f"the truthful reference collected no items on {z} of "
+                                              f"{cells[i]['runs']} seeds: the per-seed loss is undefined"}
+        out["bounded_by_defence"] = _by_defence(cells)
+    for q, xr, yr in DUELS:
+        if all(xr in c["chosen"] and yr in c["chosen"] for c in cells):
+            rule = _rule(study, q)
+            rule.setdefault("min_effect", 0.05)
+            for c, a in zip(cells, _duel([d[xr] for d, _, _ in frames], [d[yr] for d, _, _ in frames], cells,
+                                         rule, f"{xr} - {yr}")):
+                c[q] = a
+    names = sorted({n for _, _, e in frames for n in e})
+    for n in names:
+        have = [i for i, (_, _, e) in enumerate(frames) if n in e and "search" in cells[i]["chosen"]]
+        rule = _rule(study, EXTRA_QUESTION)
+        rule.setdefault("min_effect", 0.05)
+        sub = [cells[i] for i in have]
+        for i, a in zip(have, _duel([frames[i][2][n] for i in have], [frames[i][0]["search"] for i in have], sub,
+                                    rule, f"{n} - search")):
+            cells[i].setdefault(EXTRA_QUESTION, {})[n] = a
+    return out
+
+
+def _only(df, name: str) -> str:
+    labels = list(dict.fromkeys(df.attack))
+    if len(labels) != 1:
+        raise ArgumentError(f"extra searcher {name!r}: its confirmation runs must hold one attack, not {labels}")
+    return labels[0]
+
+
+def _total(cost: dict) -> dict:
+    keys = ("runs", "env_steps", "seconds")
+    return {k: sum(float(v.get(k, 0)) for v in cost.values()) for k in keys}
+
+
+def _settings(s) -> dict:
+    return asdict(s) if is_dataclass(s) else dict(s)
+
+
+def _by_defence(cells: list[dict]) -> dict:
+    """Per defence: within the margin at every count (yes: every cell yes; no: some cell no)."""
+    out = {}
+    for d in dict.fromkeys(c["defence"] for c in cells):
+        mine = [c for c in cells if c["defence"] == d]
+        ans = [c["worst_case_bounded"]["answer"] for c in mine]
+        out[d] = {"answer": stats.answer(all(a == stats.YES for a in ans), any(a == stats.NO for a in ans)),
+                  "byzantines": [c["byzantines"] for c in mine], "answers": ans}
+    return out
+
+
+# ------------------------------------------------------------------------------------------ output
+def figure_data(analysis: dict) -> dict[str, dict[str, list[float]]]:
+    """What the figure draws, per defence: Byzantine share, the worst case's loss (Hodges-Lehmann of the
+    per-seed loss) and its interval, and the search's damage beyond the best baseline (as a share of the
+    baseline's median) with its interval: the very numbers the table prints."""
+    out: dict = {}
+    for c in sorted(analysis["cells"], key=lambda c: c["share"]):
+        d = out.setdefault(c["defence"], {k: [] for k in ("share", "loss", "low", "high", "beyond", "beyond_low",
+                                                          "beyond_high")})
+        b = c.get("worst_case_bounded", {})
+        s = c.get("search_beats_baseline", {})
+        d["share"].append(c["share"])
+        for k, v in (("loss", b.get("loss")), ("low", b.get("low")), ("high", b.get("high")),
+                     ("beyond", s.get("percent")), ("beyond_low", s.get("percent_low")),
+                     ("beyond_high", s.get("percent_high"))):
+            d[k].append(math.nan if v is None else float(v))
+    return out
+
+
+def figure(analysis: dict):
+    """Two panels from ``figure_data``: the worst case's loss vs Byzantine share (intervals as error
+    bars), and how far the search's attack got beyond the best baseline."""
+    import matplotlib  # only when a figure is drawn: matplotlib is slow to import
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    data = figure_data(analysis)
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    for name, d in data.items():
+        for ax, (y, lo, hi) in zip(axes, (("loss", "low", "high"), ("beyond", "beyond_low", "beyond_high"))):
+            v, a, b = (np.asarray(d[k], float) for k in (y, lo, hi))
+            err = np.vstack([v - np.where(np.isfinite(a), a, v), np.where(np.isfinite(b), b, v) - v])
+            ax.errorbar(d["share"], v, yerr=err, marker="o", capsize=3, label=name)
+    margins = {c["worst_case_bounded"]["max_loss"] for c in analysis["cells"] if "worst_case_bounded" in c}
+    for m in margins:  # the declared bound the loss is judged against
+        axes[0].axhline(m, color="grey", lw=0.8, ls="--")
+    axes[0].set_ylabel("worst-case loss (1 - items / truthful, per seed)")
+    axes[1].set_ylabel("search beyond best baseline (share of its items)")
+    axes[1].axhline(0.0, color="grey", lw=0.8)
+    for ax in axes:
+        ax.set_xlabel("Byzantine share")
+        ax.yaxis.set_major_formatter(matplotlib.ticker.PercentFormatter(1.0))
+    axes[0].legend(fontsize=8)
+    fig.tight_layout()
+    return fig
 
 
 def write(out: Path, analysis: dict, *, reduced: str = "", wall_seconds: float | None = None,
-          steps: int | None = None, transitory: int | None = None) -> list[Path]:
-    """``report.json``, ``report.md`` and ``loss.png`` (worst-case loss vs Byzantine share) into ``out``;
-    ``steps`` and ``transitory``: the runs' length, recorded so a shortened search reads as one."""
+          steps: int | None = None, transitory: int | None = None, provenance: dict | None = None) -> list[Path]:
+    """``report.json``, ``report.md`` and ``loss.png`` into ``out``; ``steps`` and ``transitory``: the runs'
+    length, recorded so a shortened search reads as one; ``provenance``: e.g. the questions file's commit
+    and the first run's time, printed as they are."""
     out = Path(out)
     paths = [out / "report.json", out / "report.md"]
-    meta = {"reduced": reduced, "wall_seconds": wall_seconds, "steps": steps, "transitory": transitory}
-    paths[0].write_text(json.dumps({**meta, **analysis}, indent=2, default=_json) + "\n")
+    meta = {"reduced": reduced, "wall_seconds": wall_seconds, "steps": steps, "transitory": transitory,
+            "provenance": provenance or {}}
+    paths[0].write_text(json.dumps(_clean({**meta, **analysis}), indent=2) + "\n")
     paths[1].write_text(markdown(analysis, reduced=reduced, wall_seconds=wall_seconds, steps=steps,
-                                 transitory=transitory))
-    fig = _figure(analysis, out / "loss.png")
-    return paths + ([fig] if fig else [])
+                                 transitory=transitory, provenance=provenance))
+    if analysis["cells"]:
+        import matplotlib.pyplot as plt  # only when a figure is drawn: matplotlib is slow to import
+
+        fig = figure(analysis)
+        fig.savefig(out / "loss.png", dpi=120)
+        plt.close(fig)
+        paths.append(out / "loss.png")
+    return paths
 
 
-def _json(v):
-    if isinstance(v, (np.integer,)):
-        return int(v)
-    if isinstance(v, (np.floating,)):
-        return float(v)
+def _clean(v):
+    """JSON-ready: numpy scalars as Python numbers, NaN and infinities as null."""
+    if isinstance(v, dict):
+        return {str(k): _clean(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [_clean(x) for x in v]
     if isinstance(v, np.ndarray):
-        return v.tolist()
-    raise InputTypeError(f"not JSON: {type(v).__name__}")
+        return _clean(v.tolist())
+    if isinstance(v, (np.integer, np.bool_)):
+        return v.item()
+    if isinstance(v, (float, np.floating)):
+        return float(v) if math.isfinite(v) else None
+    return v
+
+
+def _ci(lo: float, hi: float, fmt: str) -> str:
+    if math.isnan(lo) or math.isnan(hi):
+        return "undefined"
+    return "unbounded" if not (math.isfinite(lo) and math.isfinite(hi)) else f"[{lo:{fmt}}, {hi:{fmt}}]"
+
+
+def _answer(a: dict | None) -> str:
+    if not a:
+        return "–"
+    return a["answer"] + (f" (power {a['power']:.2f})" if a["answer"] != stats.YES and "power" in a
+                          and a["power"] == a["power"] else "")
+
+
+def _duel_cell(a: dict | None) -> str:
+    if not a:
+        return "–"
+    share = ("share undefined" if math.isnan(a["percent"]) else
+             f"{a['percent']:+.1%} {_ci(a['percent_low'], a['percent_high'], '+.1%')}")
+    return f"{a['hl']:+.2f} {_ci(a['low'], a['high'], '.2f')} ({share})"
 
 
 def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, steps: int | None = None,
-             transitory: int | None = None) -> str:
+             transitory: int | None = None, provenance: dict | None = None) -> str:
     s = a["settings"]
     lines = ["# Attack search", ""]
     if reduced:
         lines += [f"**REDUCED RUN ({reduced}): not the declared study; no answer here is the study's.**", ""]
     length = "" if steps is None else (f"Runs of {steps} steps, items counted after step {transitory}. "
                                        if transitory is not None else f"Runs of {steps} steps. ")
-    lines += [f"{length}Objective: {a['objective']}; CMA-ES popsize {s['popsize']}, {s['budget']} evaluations per cell, "
-              f"{s['runs']} runs per candidate (common random numbers per generation), {s['heldout_runs']} held-out "
-              f"runs per attack, best {s['best']} re-evaluated."
-              + (f" Wall time {wall_seconds:.0f} s." if wall_seconds else ""), "",
-              "| defence | Byzantines | best hand-written (median) | searched (median) | HL shift [95 % CI] | "
-              "Cliff's δ [95 % CI] | no worse? | more damaging? | loss vs truthful |",
-              "|---|---|---|---|---|---|---|---|---|"]
+    lines += [f"{length}Objective: {a['objective']}. Settings: "
+              + ", ".join(f"{k} {v}" for k, v in s.items() if k != "objective") + "."
+              + (f" Wall time {wall_seconds:.0f} s." if wall_seconds else ""), ""]
+    for k, v in (provenance or {}).items():
+        lines.append(f"- {k}: {v}")
+    if provenance:
+        lines.append("")
+    if a.get("size_note"):
+        lines += [f"Confirmation: {a['size_note']}.", ""]
+    lines += ["Every number below is from the CONFIRMATION seeds (never used to choose an attack), paired by "
+              "seed. Loss: Hodges-Lehmann estimate of the per-seed loss 1 − items(worst) / items(truthful), "
+              "with its distribution-free 95 % interval. Search − baseline, search − random: Hodges-Lehmann "
+              "of the per-seed differences of the objective's damage value (negative: the search's attack "
+              "does more damage), with the interval, and as a share of the other's median (positive: more "
+              "damage). A \"no\" to a \"beats\" question needs the power shown.", "",
+              "| defence | Byz. | runs | truthful | worst (median) | loss [95 % CI] | within 10 %? | "
+              "search − best baseline | beats baseline? | search − random | beats random? | runs / CPU s |",
+              "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for c in a["cells"]:
-        t = c["search_more_damaging"]["test"]
-        e = t["effect"]
-        loss_txt = f"{c['worst_case_growth']['loss']:.1%}" if "worst_case_growth" in c else "–"
-        lines.append(f"| {c['defence']} | {c['byzantines']} | {c['hand']} ({t['median_y']:.3g}) | {c['search']} "
-                     f"({t['median_x']:.3g}) | {e['hl']:+.3g} [{e['hl_low']:.3g}, {e['hl_high']:.3g}] | "
-                     f"{e['delta']:+.2f} [{e['delta_low']:.2f}, {e['delta_high']:.2f}] | "
-                     f"{c['search_no_worse']['answer']} | {c['search_more_damaging']['answer']} | {loss_txt} |")
-    if a["bounded_defence"]:
-        lines += ["", "Loss within 10 % at every Byzantine count (bounded_defence): "
-                  + "; ".join(f"{d}: {v['answer']}" for d, v in a["bounded_defence"].items())]
-    lines += ["", "Searched parameters per cell (CMA-ES started at the best hand-written attack on the start seeds):", ""]
+        b = c.get("worst_case_bounded")
+        loss_txt = "–" if not b else ("undefined" if math.isnan(b["loss"]) else
+                                      f"{b['loss']:.1%} {_ci(b['low'], b['high'], '.1%')}")
+        m, ch = c["medians"], c["chosen"]
+        worst = f"{ch.get('worst', '–')} ({m['worst']:.2f})" if "worst" in m else "–"
+        ref = f"{m['reference']:.2f}" if "reference" in m else "–"
+        t = c["cost_total"]
+        lines.append(f"| {c['defence']} | {c['byzantines']} | {c['runs']} | {ref} | {worst} | {loss_txt} | "
+                     f"{_answer(b)} | {_duel_cell(c.get('search_beats_baseline'))} | "
+                     f"{_answer(c.get('search_beats_baseline'))} | {_duel_cell(c.get('search_beats_random'))} | "
+                     f"{_answer(c.get('search_beats_random'))} | {t['runs']:.0f} / {t['seconds']:.0f} |")
+    notes = [f"- {c['defence']}, {c['byzantines']}: {c['worst_case_bounded']['note']}" for c in a["cells"]
+             if c.get("worst_case_bounded", {}).get("note")]
+    if notes:
+        lines += ["", *notes]
+    extra = sorted({n for c in a["cells"] for n in c.get(EXTRA_QUESTION, {})})
+    for n in extra:
+        lines += ["", f"**{n} vs the parametric search** (per-seed {n} − search; negative: {n} does more damage):",
+                  "", "| defence | Byz. | attack | difference [95 % CI] | beats the parametric search? |",
+                  "|---|---|---|---|---|"]
+        for c in a["cells"]:
+            e = c.get(EXTRA_QUESTION, {}).get(n)
+            if e:
+                lines.append(f"| {c['defence']} | {c['byzantines']} | {c['extra_attacks'][n]} | {_duel_cell(e)} | "
+                             f"{_answer(e)} |")
+    if a.get("bounded_by_defence"):
+        lines += ["", "Loss within 10 % at every Byzantine count, per defence: "
+                  + "; ".join(f"{d}: {v['answer']}" for d, v in a["bounded_by_defence"].items())]
+    lines += ["", "## Chosen attacks (on the selection seeds)", ""]
     for c in a["cells"]:
-        p = ", ".join(f"{k}={v:g}" for k, v in c["params"].items())
-        lines.append(f"- {c['defence']}, {c['byzantines']} (started at {c.get('start_from') or 'the centre'}): {p}")
-    lines += ["", *DECLARATION.record_markdown()]
+        roles = ", ".join(f"{r} = {lab}" for r, lab in c["chosen"].items())
+        ev = ", ".join(f"{k} {v}" for k, v in c.get("evaluations", {}).items())
+        lines.append(f"- {c['defence']}, {c['byzantines']}: {roles}" + (f" (evaluations: {ev})" if ev else ""))
+        for lab, p in c["params"].items():
+            if p:
+                lines.append(f"  - {lab}: " + ", ".join(f"{k}={v:g}" for k, v in p.items()))
+    lines += ["", "## Cost", "", "| defence | Byz. | phase | runs | env-steps | CPU s |", "|---|---|---|---|---|---|"]
+    for c in a["cells"]:
+        for ph, v in c["cost"].items():
+            lines.append(f"| {c['defence']} | {c['byzantines']} | {ph} | {v.get('runs', 0)} | "
+                         f"{v.get('env_steps', 0):.3g} | {v.get('seconds', 0):.0f} |")
+    total = {k: sum(c["cost_total"][k] for c in a["cells"]) for k in ("runs", "env_steps", "seconds")}
+    lines += ["", f"All cells: {total['runs']:.0f} runs, {total['env_steps']:.3g} env-steps, "
+                  f"{total['seconds']:.0f} s of run time.", "", *DECLARATION.record_markdown()]
     return "\n".join(lines) + "\n"
-
-
-def _figure(a: dict, path: Path) -> Path | None:
-    cells = [c for c in a["cells"] if "worst_case_growth" in c]
-    if not cells:
-        return None
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(figsize=(6, 4))
-    for d in dict.fromkeys(c["defence"] for c in cells):
-        pts = sorted((c["worst_case_growth"]["share"], c["worst_case_growth"]["loss"]) for c in cells
-                     if c["defence"] == d)
-        ax.plot([p[0] for p in pts], [p[1] for p in pts], marker="o", label=d)
-    ax.set_xlabel("Byzantine share")
-    ax.set_ylabel("worst-case loss (1 - items / truthful)")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
