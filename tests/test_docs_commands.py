@@ -93,11 +93,9 @@ NOT_RUN = {
     "results/chain/chain_fig7_sweep results/chain/chain_partition --out results/chain/report":
         "needs the study's stores; tests/analysis/test_chain_study.py runs it on a synthetic one",
     # docs/attack-search.md
-    "infomarket attack-search attack_search --workers 2 --out results/attack_search":
-        "the declared study, 38 208 full runs (17 276 s of run time); tests/search runs a tiny search",
-    "infomarket attack-search attack_search --out results/attack_search": "the full study, 38 208 runs",
+    "infomarket attack-search attack_search --out results/attack_search": "the full study, about 169 000 runs",
     "infomarket attack-search attack_search --defence staking --byzantines 3 --budget 48 --runs 4 "
-    "--heldout-runs 16 --best 2 --out /tmp/attack-reduced": "~460 full runs; tests/search runs a tiny search",
+    "--confirmation-runs 16 --seed 7 --out /tmp/attack-reduced": "~2 500 full runs; tests/search runs a tiny search",
     "infomarket attack-search attack_search --defence staking,theta20 --byzantines 3 --dask tcp://head:8786 "
     "--out results/as-dask": "needs a Dask scheduler at that address; tests/search runs one on a LocalCluster",
     # docs/rl.md
@@ -170,20 +168,19 @@ def test_cheap_documented_command_runs(cmd, tmp_path, monkeypatch, capsys):
 #: (and placeholders filled), run in a scratch folder.  A new or edited command there needs an entry.
 SMALL_DOCS = ("attack-search.md", "rl.md", "chain-model.md")
 #: Options that change how much is run, not what: a small run may set these, and nothing else.
-SIZE_OPTIONS = frozenset({"steps", "transitory", "budget", "popsize", "runs", "heldout_runs", "best", "iterations",
+SIZE_OPTIONS = frozenset({"steps", "transitory", "budget", "popsize", "runs", "restarts", "finalists", "race",
+                          "keep", "confirmation_runs", "grid_step", "adaptive_budget", "iterations",
                           "pairs", "eval_runs", "repeats", "batch", "robots", "out", "workers", "defence",
                           "byzantines", "store", "chain_period"})
-TINY_SEARCH = ("--defence staking --byzantines 3 --budget 2 --popsize 2 --runs 1 --heldout-runs 2 --best 1 "
-               "--steps 60 --transitory 20 --workers 1")
+TINY_SEARCH = ("--defence staking --byzantines 3 --budget 2 --popsize 2 --restarts 1 --runs 1 --finalists 1 "
+               "--race 2 --confirmation-runs 2 --grid-step 90 --adaptive-budget 0 --steps 60 --transitory 20 --workers 1")
 SMALL = {
     "infomarket check attack_search": "infomarket check attack_search",
     "infomarket check chain_partition": "infomarket check chain_partition",
     "infomarket attack-search attack_search --out results/attack_search":
         f"infomarket attack-search attack_search {TINY_SEARCH} --out as",
-    "infomarket attack-search attack_search --workers 2 --out results/attack_search":
-        f"infomarket attack-search attack_search {TINY_SEARCH} --out as",
-    "infomarket attack-search attack_search --defence staking --byzantines 3 --budget 48 --runs 4 --heldout-runs 16 "
-    "--best 2 --out /tmp/attack-reduced": f"infomarket attack-search attack_search {TINY_SEARCH} --out as",
+    "infomarket attack-search attack_search --defence staking --byzantines 3 --budget 48 --runs 4 --confirmation-runs 16 "
+    "--seed 7 --out /tmp/attack-reduced": f"infomarket attack-search attack_search {TINY_SEARCH} --seed 7 --out as",
     "infomarket bench --env --json": "infomarket bench --env --json --steps 60 --repeats 1 --batch 2",
     "infomarket rl-train --steps 4000 --transitory 1000 --iterations 60 --pairs 32 --eval-runs 32 --seed 0 "
     "--out rl-train.json": "infomarket rl-train --steps 60 --transitory 20 --iterations 1 --pairs 1 --eval-runs 2 "

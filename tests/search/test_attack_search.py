@@ -9,20 +9,23 @@ import subprocess
 import time
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 
 from infomarket.cli import main
 from infomarket.config import load_experiment
-from infomarket.search import study
-from infomarket.search.driver import planned_runs
+from infomarket.search import adaptive, study
+from infomarket.search.driver import confirmation_seeds, planned_runs
+from infomarket.search.report import EXTRA_QUESTION
 from infomarket.store import Store
 
 from ..procs import HANG
 
 TINY = ["attack-search", "attack_search", "--defence", "staking", "--byzantines", "3", "--budget", "4",
         "--popsize", "2", "--restarts", "2", "--runs", "2", "--finalists", "2", "--race", "2,3",
-        "--confirmation-runs", "3", "--grid-step", "90", "--steps", "400", "--transitory", "100", "--seed", "7"]
+        "--confirmation-runs", "3", "--grid-step", "90", "--steps", "400", "--transitory", "100", "--seed", "7",
+        "--adaptive-budget", "0"]
 CELL = "attack_search.staking.b3"
 DECLARED = len(study.load_declarations()["baselines"])  # hand-written + truthful
 # by hand: start = (the hand-written + 18 grid (0, 90, 180 degrees x 2 x 3) + 2 start points) x 2 runs;
@@ -208,3 +211,26 @@ def test_with_outlier_distinct_registered_the_distinct_cell_is_searched():
     s = study.load(im.load_experiment("attack_search"))
     got = {(c.defence, c.byzantines) for c in study.cells(s, ["distinct"], [3])}
     assert got == {("distinct", 3)}
+
+
+def test_the_adaptive_attacker_is_the_second_searcher_on_the_same_confirmation_seeds(tmp_path):
+    """With an adaptive budget the search trains the adaptive attacker (one generation of 2 x 8 + 1), plays it
+    on the cell's confirmation seeds and the report compares it with the parametric search's attack; its
+    runs are those ``adaptive.confirm`` gives for the policy saved beside the store, seed for seed."""
+    out = tmp_path / "search"
+    tiny = TINY[:TINY.index("--adaptive-budget")] + ["--adaptive-budget", "17", "--seed", "11"]
+    assert main(tiny + ["--workers", "1", "--quiet", "--out", str(out)]) == 0
+    report = json.loads((out / "report.json").read_text())
+    cell_report = next(c for c in report["cells"] if c["experiment"] == CELL)
+    assert cell_report["extra_attacks"] == {"adaptive": "adaptive"}
+    assert "adaptive" in cell_report[EXTRA_QUESTION]
+    st = study.load(load_experiment("attack_search"), seed=11, confirmation_runs=3)
+    cell = study.cells(st, ["staking"], [3])[0]
+    policy = adaptive.Policy.load(out / "adaptive" / CELL / "policy.npz")
+    expected = adaptive.confirm(cell, policy, confirmation_seeds(st, cell), steps=400, transitory=100)
+    assert len(expected) == 3
+    conf = _frames(out)["confirmation"]
+    search = conf[conf.attack == cell_report["chosen"]["search"]].sort_values("run")["items"].to_numpy()
+    d = expected.sort_values("run")["items"].to_numpy() - search  # adaptive - search, seed by seed
+    walsh = [(d[i] + d[j]) / 2 for i in range(3) for j in range(i, 3)]  # Hodges-Lehmann by hand
+    assert cell_report[EXTRA_QUESTION]["adaptive"]["hl"] == pytest.approx(float(np.median(walsh)))

@@ -75,6 +75,7 @@ def cmd_attack_search(args) -> int:
     from .driver import planned_runs, search_cell, store_runner
     from .study import cells
     from .summary import write
+    from . import adaptive, report
 
     exp = load_experiment(args.experiment)
     st = study_mod.load(exp, budget=args.budget, popsize=args.popsize, restarts=args.restarts, runs=args.runs,
@@ -113,6 +114,10 @@ def cmd_attack_search(args) -> int:
         except (OSError, TimeoutError) as exc:
             raise UsageError(f"--dask {args.dask}: no Dask scheduler answers there ({exc})") from None
     workers = args.workers or default_workers()
+    learner = {**ADAPTIVE, **study_mod.DECLARATION.data.get("adaptive", {})}
+    if args.adaptive_budget is not None:
+        learner["budget"] = args.adaptive_budget
+    _check_learner(learner)  # before any run: a bad value must not surface after a cell's search
     t0 = time.perf_counter()
     results = []
     try:
@@ -123,13 +128,22 @@ def cmd_attack_search(args) -> int:
             executor = client.get_executor(pure=False) if client is not None else pool
             run = store_runner(store, executor=executor, on_done=bar.advance, on_skip=lambda k: k and bar.skip(k))
             for c in chosen:
-                results.append(search_cell(st, c, store, run=run, steps=args.steps, transitory=args.transitory))
+                r = search_cell(st, c, store, run=run, steps=args.steps, transitory=args.transitory)
+                if learner["budget"]:
+                    r.extra["adaptive"] = _adaptive(adaptive, st, c, r, learner, out, args,
+                                                    1 if client is not None else workers)
+                results.append(r)
     finally:
         if client is not None:
             client.close()
     wall = time.perf_counter() - t0
     written, text = write(out, st, results, reduced=reduced, wall_seconds=wall, steps=first.steps,
                           transitory=first.transitory)
+    analysis = report.analyse(st, results)
+    length = {"steps": first.steps, "transitory": first.transitory}
+    written += report.write(out, analysis, reduced=reduced, wall_seconds=wall,
+                            provenance=store.meta().get("attack_search"), **length)
+    text = report.markdown(analysis, reduced=reduced, wall_seconds=wall, **length)
     if not args.quiet:
         print(text)
         made = sum(r.done for r in results)
@@ -137,6 +151,36 @@ def cmd_attack_search(args) -> int:
         print(f"attack-search: {made} runs made now, {kept} found in the store; {wall:.1f} s wall; "
               f"wrote {', '.join(str(p) for p in written)}")
     return 0
+
+
+#: the adaptive attacker's training when questions.toml declares no ``[adaptive]`` table (budget 0: not run)
+ADAPTIVE = {"budget": 0, "pairs": 8, "runs": 4, "sigma": 0.05, "lr": 0.02}
+
+
+def _check_learner(learner: dict) -> None:
+    unknown = sorted(set(learner) - set(ADAPTIVE))
+    if unknown:
+        raise UsageError(f"questions.toml [adaptive]: unknown key {unknown[0]!r}; allowed: {', '.join(ADAPTIVE)}")
+    for k, v in learner.items():
+        whole = k in ("budget", "pairs", "runs")
+        ok = (isinstance(v, int) and not isinstance(v, bool) and v >= (0 if k == "budget" else 1)) if whole else \
+            (isinstance(v, (int, float)) and not isinstance(v, bool) and 0 < v < float("inf"))
+        if not ok:
+            raise UsageError(f"questions.toml [adaptive] {k} = {v!r}: must be "
+                             + ("a whole number >= " + ("0" if k == "budget" else "1") if whole else "a finite number > 0"))
+
+
+def _adaptive(adaptive, st, cell, r, learner: dict, out: Path, args, workers: int):
+    """The second searcher of a cell: the adaptive attacker trained on search seeds of its own (checkpointed
+    under OUT/adaptive/EXPERIMENT, so a search started again resumes it), then played on the cell's
+    confirmation seeds, where the report compares it with the parametric search's attack."""
+    folder = out / "adaptive" / cell.experiment
+    length = {"steps": args.steps, "transitory": args.transitory}
+    policy = adaptive.train(cell, int(learner["budget"]), pairs=int(learner["pairs"]), runs=int(learner["runs"]),
+                            sigma=float(learner["sigma"]), lr=float(learner["lr"]), seed=st.settings.seed,
+                            objective=st.settings.objective, checkpoint=folder, workers=workers, **length)
+    policy.save(folder / "policy.npz")
+    return adaptive.confirm(cell, policy, r.confirmation_seeds, workers=workers, **length)
 
 
 def add_subcommand(sub) -> None:
@@ -158,6 +202,8 @@ def add_subcommand(sub) -> None:
     p.add_argument("--grid-step", type=float, metavar="DEGREES", help="rotation grid's step (default: declared)")
     p.add_argument("--objective", choices=["items", "liar_wealth"], help="what the attack optimises (default: items)")
     p.add_argument("--seed", type=at_least(0), help="the search's seed: optimisers and seed sets (default: declared)")
+    p.add_argument("--adaptive-budget", type=at_least(0), metavar="N",
+                   help="evaluations per cell of the adaptive attacker, the second searcher (0: none; default: declared)")
     p.add_argument("--list-baselines", action="store_true", help="list the baselines (declared and rotation grid) "
                                                                  "and exit")
     p.add_argument("--steps", type=at_least(1), help="steps per run (default: the experiment's), for a reduced search")

@@ -54,10 +54,6 @@ class Settings:
         return -(-self.budget // self.popsize)
 
 
-#: Keys of an earlier ``[search]`` table, read as the settings that replaced them.
-RENAMED = {"heldout_runs": "confirmation_runs", "best": "finalists"}
-
-
 def settings(table: dict, overrides: dict | None = None,
              source: str = "search settings (questions.toml [search] or an option)") -> Settings:
     """The ``Settings`` of a ``[search]`` table with ``overrides`` (None values ignored) over it; an unknown
@@ -65,7 +61,6 @@ def settings(table: dict, overrides: dict | None = None,
     known = Settings.__dataclass_fields__
     base = {}
     for k, v in table.items():
-        k = RENAMED.get(k, k)
         if k not in known:
             raise UsageError(f"{source}: unknown key {k!r}; allowed: {', '.join(known)}")
         base[k] = v
