@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import signal
 import subprocess
+import sys
 import threading
 import time
 from pathlib import Path
@@ -116,3 +117,52 @@ def test_ctrl_c_stops_store_sql_in_the_middle_of_a_query(tmp_path, procs):
     assert proc.returncode == 130, err
     assert err == "infomarket: error: interrupted\n" and out == ""
     assert session_members(proc.pid) == []
+
+
+# A command that holds a stop signal across a fork: the signal is sent (to this thread, so that it stays
+# pending under the block whatever other threads exist) before the fork, as a Ctrl-C landing inside
+# ``os.fork`` would be.  Another library's at-fork hook, registered after infomarket's, runs after it
+# inside the same fork (``logging`` has one, for instance): the stop must not be let through there either.
+_FORK_SCRIPT = """
+import os, signal, sys, threading
+from infomarket import interrupts
+
+def other_hook():
+    len(())  # a call: an event the profile function sees, inside the fork
+
+os.register_at_fork(after_in_parent=other_hook)
+
+def profile(frame, event, arg):
+    pass
+
+def fork():
+    pid = os.fork()
+    if pid == 0:
+        os._exit(0)
+    return pid
+
+with interrupts.handling():
+    sys.setprofile(profile)
+    os.waitpid(fork(), 0)  # nothing pending: signals let through again, the profile function put back
+    print(sorted(signal.pthread_sigmask(signal.SIG_BLOCK, set())), sys.getprofile() is profile)
+    sys.setprofile(None)
+    try:
+        signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIG%s})
+        signal.pthread_kill(threading.main_thread().ident, signal.SIG%s)
+        fork()
+        print("not stopped")
+    except KeyboardInterrupt:
+        print("stopped", interrupts.requested())
+    print(sorted(signal.pthread_sigmask(signal.SIG_BLOCK, set())))
+"""
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_a_stop_held_across_a_fork_is_raised_after_the_fork_not_dropped_in_its_hook(procs, sig):
+    """Let through inside the at-fork hook that ends a held fork, the stop's ``KeyboardInterrupt`` would
+    be raised there, where Python drops it ("Exception ignored in ...") and the command runs on; it must
+    reach the code that called ``os.fork``.  In a process of its own: a real fork, one thread."""
+    name = signal.Signals(sig).name[3:]
+    done = procs.run([sys.executable, "-c", _FORK_SCRIPT % (name, name)])
+    assert done.returncode == 0 and done.stderr == "", done.stderr
+    assert done.stdout == f"[] True\nstopped {int(sig)}\n[]\n"

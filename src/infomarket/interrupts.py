@@ -16,6 +16,8 @@ fails, and each has its own remedy here, none of which waits for or guesses at a
 * **Pool workers and children**: ``detach`` puts each in its own process group with the default
   dispositions (a signal ends it at once, even inside a kernel), and makes it die with its parent
   (Linux ``PR_SET_PDEATHSIG``); the parent ends them with SIGKILL to their group (``kill_group``).
+  The stop signals are blocked across each fork, so one cannot land in a child before it is detached,
+  and let through again only once the fork has returned to its caller: at-fork hooks drop exceptions.
 
 A stretch that an exception must not land in (DuckDB's import aborts when one does) runs in ``held()``,
 whose end raises a stop that came meanwhile.  The request to stop is sticky: ``check`` raises again at the safe points (after each kernel call, after
@@ -176,9 +178,39 @@ def _before_fork() -> None:
 
 
 def _after_fork_in_parent() -> None:
-    if _state.held:
-        _state.held = False
+    """The signals held for the fork stay blocked until the fork's caller runs again: let through here, a
+    pending stop's ``KeyboardInterrupt`` would be raised inside this at-fork hook (or a later one), where
+    Python drops it ("Exception ignored in ...") and the command runs on.  A profile function lets them
+    through at the first call or return made outside the at-fork hooks (``_release_after``)."""
+    if not _state.held:
+        return
+    _state.held = False
+    try:
+        caller = sys._getframe(1)  # the frame that called os.fork: the hooks run inside that call
+    except ValueError:  # no Python caller: nowhere better to raise a stop
         signal.pthread_sigmask(signal.SIG_UNBLOCK, set(SIGNALS))
+        return
+    sys.setprofile(_release_after(caller, sys.getprofile()))
+
+
+def _release_after(caller, previous):
+    """A profile function that unblocks the stop signals at the first event of this thread outside the
+    at-fork hooks running in ``caller``'s fork call, i.e. once the fork has returned to ``caller``; the
+    profile function ``previous`` is put back first.  A pending stop's handler raises there, in
+    ``caller`` (or wherever the thread has gone), as a signal arriving just after the fork would."""
+    at = caller.f_lasti  # the call of os.fork: unchanged while the hooks run, past it once fork returned
+
+    def release(frame, event, arg) -> None:
+        if frame is not caller and caller.f_lasti == at:
+            f = frame.f_back
+            while f is not None and f is not caller:
+                f = f.f_back
+            if f is caller:  # a frame of an at-fork hook, called from inside the fork
+                return
+        sys.setprofile(previous)
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, set(SIGNALS))
+
+    return release
 
 
 def _after_fork_in_child() -> None:
