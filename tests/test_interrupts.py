@@ -166,3 +166,48 @@ def test_a_stop_held_across_a_fork_is_raised_after_the_fork_not_dropped_in_its_h
     done = procs.run([sys.executable, "-c", _FORK_SCRIPT % (name, name)])
     assert done.returncode == 0 and done.stderr == "", done.stderr
     assert done.stdout == f"[] True\nstopped {int(sig)}\n[]\n"
+
+
+# The console script's own two lines (pyproject's [project.scripts]), after a finder that stops the start-up
+# in the middle of the imports, just before the module named on its command line is imported, and says so.
+_START_SCRIPT = """
+import os, sys, time
+
+MODULE = sys.argv[1]
+
+class Pause:
+    def find_spec(self, name, path=None, target=None):
+        if name == MODULE:
+            sys.meta_path.remove(self)
+            os.write(1, b"importing " + name.encode() + b"\\n")
+            time.sleep(%r)  # the signal comes meanwhile
+        return None
+
+sys.meta_path.insert(0, Pause())
+sys.argv[1:] = ["list"]
+from infomarket_entry import main
+sys.exit(main())
+""" % HANG
+
+
+def test_the_console_script_is_the_light_entry():
+    import tomllib
+
+    scripts = tomllib.loads((Path(__file__).parents[1] / "pyproject.toml").read_text())["project"]["scripts"]
+    assert scripts == {"infomarket": "infomarket_entry:main"}
+
+
+@pytest.mark.parametrize(("module", "sig"), [
+    ("numpy", signal.SIGINT),  # among the first of the package's imports
+    ("numba", signal.SIGINT),
+    ("infomarket.engine", signal.SIGTERM),
+    ("infomarket.cli", signal.SIGINT),  # the last module of the entry's import
+    ("infomarket.runner.cli", signal.SIGINT),  # imported by the parser, before the command's handling
+])
+def test_a_stop_during_the_start_up_imports_ends_the_command_with_one_line(procs, module, sig):
+    proc = procs.start([sys.executable, "-c", _START_SCRIPT, module], stdout=subprocess.PIPE,
+                       stderr=subprocess.PIPE, text=True)
+    assert proc.stdout.readline() == f"importing {module}\n", proc.communicate()
+    os.killpg(proc.pid, sig)  # a terminal's Ctrl-C reaches the whole process group
+    out, err = proc.communicate(timeout=HANG)
+    assert (proc.returncode, err, out) == (128 + sig, "infomarket: error: interrupted\n", "")
