@@ -112,3 +112,24 @@ def test_a_batch_is_stepped_in_calls_of_bounded_work_that_do_not_change_its_runs
         pd.testing.assert_frame_equal(a.robots, b.robots, check_exact=True)
         pd.testing.assert_frame_equal(a.history, b.history, check_exact=True)
 
+
+def test_the_worlds_of_a_batch_share_the_sampling_tables_and_own_the_rest(cfg):
+    sims = Simulations(cfg, SEEDS)
+    a, b = sims.sims[0].world, sims.sims[1].world
+    for name in build.SHARED_TABLES:
+        assert getattr(a, name) is getattr(b, name)  # 16 bytes per step of the run, held once
+    assert not np.shares_memory(a.bparams, b.bparams) and not np.shares_memory(a.balance, b.balance)
+
+
+@pytest.mark.parametrize("alpha", [0.0, 1.0, 1.4, 2.0])  # exponents -1 and -2 take numpy's fast paths
+@pytest.mark.parametrize("steps", [1, 15000, 3_000_000])  # the last: the guide table in several chunks
+def test_the_step_length_tables_are_the_plain_formula_bit_for_bit(alpha, steps):
+    from infomarket.engine import params
+
+    k = np.arange(1, steps + 2, dtype=np.float64)
+    p = k ** -(alpha + 1.0)
+    cdf = np.cumsum(p / p.sum())
+    cdf[-1] = 1.0
+    guide = np.searchsorted(cdf, np.arange(len(cdf)) / len(cdf), side="right").astype(np.int64)
+    assert params.levy_cdf(alpha, steps).tobytes() == cdf.tobytes()
+    assert params.guide_table(cdf).tobytes() == guide.tobytes()
