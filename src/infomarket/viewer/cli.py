@@ -107,7 +107,8 @@ class _Ticker:
 
 def _refuse_too_big(cfg, every: int | None) -> None:
     """A replay whose event log and frames would not fit in memory is refused before it runs."""
-    from ..config import sizes  # with the command, as the recording's own imports
+    # with the command, as cmd_replay's own imports: `infomarket --help` stays light
+    from ..config import sizes
     from .frames import frame_size
     from .recording import default_every
 
