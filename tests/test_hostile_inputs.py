@@ -371,3 +371,13 @@ def test_the_worlds_of_one_process_share_the_tables_the_estimate_counts_once():
     held = sizes.held_bytes(cfg, worlds=16, processes=3)
     assert held["Lévy step-length table"] == 3 * 16 * 1001  # once per process
     assert held["robot state"] == 3 * 16 * one["robot state"]  # once per world
+
+
+def test_chain_demo_refuses_an_event_log_beyond_memory_before_simulating(monkeypatch, capsys):
+    """The demo keeps the run's whole event log: 25 x 10**8 x 0.5 x 192 bytes = 223.5 GiB (by hand)."""
+    pytest.importorskip("web3")
+    import infomarket
+
+    monkeypatch.setattr(infomarket, "simulate", never)
+    refused(capsys, ["chain", "demo", "--steps", "100000000", "--robots", "25"],
+            "--steps 100000000 --robots 25", "event log 223.5 GiB")
