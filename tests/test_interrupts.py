@@ -211,3 +211,31 @@ def test_a_stop_during_the_start_up_imports_ends_the_command_with_one_line(procs
     os.killpg(proc.pid, sig)  # a terminal's Ctrl-C reaches the whole process group
     out, err = proc.communicate(timeout=HANG)
     assert (proc.returncode, err, out) == (128 + sig, "infomarket: error: interrupted\n", "")
+
+
+_STRAY_SCRIPT = """
+import os, subprocess, sys, time
+from infomarket import interrupts
+
+with interrupts.handling():
+    started = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(%r)"], stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)  # a program the command started: not its to end
+    pid = os.fork()
+    if pid == 0:  # a fork that nothing registered (a pool worker whose start a stop cut short)
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, 1)
+        os.dup2(null, 2)
+        time.sleep(%r)
+        os._exit(0)
+    print(pid, started.pid, flush=True)
+    interrupts.exit_now(130)
+""" % (HANG, HANG)
+
+
+def test_a_stopped_command_leaves_no_fork_of_itself_behind(procs):
+    proc = procs.start([sys.executable, "-c", _STRAY_SCRIPT], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                       text=True)
+    out, err = proc.communicate(timeout=HANG)
+    assert proc.returncode == 130 and err == "", err
+    fork, started = map(int, out.split())
+    assert session_members(proc.pid) == [started]  # the fork is gone (reaped), the started program is not

@@ -161,11 +161,40 @@ def exit_code() -> int:
 def exit_now(code: int) -> None:
     """End the program now, after a stop: what it keeps is committed, its children are ended and its
     files closed, so the interpreter's own teardown (finalizers of numba's and LLVM's objects, seconds
-    on a loaded machine) would only delay the exit.  Only for the program itself, never a library call."""
+    on a loaded machine) would only delay the exit.  Any fork of the program still alive (a pool worker
+    whose start a stop cut short, so the pool never knew it) is killed and reaped first, so none outlives
+    it even for the moment its death signal takes.  Only for the program itself, never a library call."""
     for stream in (sys.stdout, sys.stderr):
         with contextlib.suppress(Exception):
             stream.flush()
+    for pid in forks():
+        kill_group(pid)
+        with contextlib.suppress(ChildProcessError):
+            os.waitpid(pid, 0)
     os._exit(code)
+
+
+def forks() -> list[int]:
+    """This process's children that are forks of it, not programs it started: the same executable and
+    command line (Linux ``/proc``; elsewhere none)."""
+    me = os.getpid()
+    try:
+        mine = Path("/proc/self/cmdline").read_bytes(), os.readlink("/proc/self/exe")
+    except OSError:
+        return []
+    found = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            stat = (entry / "stat").read_text()
+            if int(stat[stat.rindex(")") + 2:].split()[1]) != me:  # state ppid ...
+                continue
+            if ((entry / "cmdline").read_bytes(), os.readlink(entry / "exe")) == mine:
+                found.append(int(entry.name))
+        except (OSError, ValueError):  # gone meanwhile, or not readable
+            continue
+    return found
 
 
 def _before_fork() -> None:
