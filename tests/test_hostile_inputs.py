@@ -326,3 +326,58 @@ def test_the_figures_page_says_when_runs_are_shorter_than_the_paper_s():
     runs = pd.DataFrame({"experiment": ["fig2B", "fig2B", "fig2A", "mine"], "steps": [4000, 4000, 15000, 10]})
     notes = length_notes(runs)
     assert len(notes) == 1 and notes[0].startswith("fig2B: runs of 4,000 steps") and "15,000 steps" in notes[0]
+
+
+# ------------------------------------------------------------------ sizes that grow with the run's length
+def test_run_refuses_steps_whose_tables_do_not_fit_in_its_worker_processes(monkeypatch, tmp_path, capsys):
+    """One run of a billion steps fits in 16 GiB (its Lévy tables: 16 bytes x (10**9 + 1) = 14.9 GiB), but
+    two worker processes each hold their own: 2 x 16 x (10**9 + 1) bytes = 29.8 GiB (by hand), refused."""
+    import infomarket.runner.run
+
+    monkeypatch.setattr(infomarket.runner.run, "sweep_locked", never)
+    monkeypatch.setattr(infomarket.runner.run, "preflight", never)
+    out = tmp_path / "D"
+    refused(capsys, ["run", "fig2B", "--steps", "1000000000", "--workers", "2", "--out", str(out), "--quiet"],
+            "2 worker processes", "1,000,000,000 steps", "would need about 29.8 GiB",
+            "Lévy step-length table 29.8 GiB", "fewer --steps or --workers", sizes.ENV)
+    assert not out.exists()
+
+
+def test_run_names_steps_when_they_make_the_results_too_big(tmp_path, capsys):
+    # fig5 keeps the wealth history every 100 steps: 32 runs x 25 robots x 10**6 samples x 32 bytes
+    # = 23.8 GiB (by hand) of results
+    out = tmp_path / "D"
+    refused(capsys, ["run", "fig5", "--steps", "100000000", "--out", str(out), "--quiet"],
+            "--runs 32 --steps 100000000:", "would need about 23.8 GiB")
+    assert not out.exists()
+
+
+def test_replay_refuses_an_event_log_beyond_memory_before_running(monkeypatch, tmp_path, capsys):
+    """A replay records the event log: 25 robots x 10**8 steps x 0.5 events x 192 bytes = 223.5 GiB (by hand)."""
+    import infomarket.viewer.recording
+
+    monkeypatch.setattr(infomarket.viewer.recording, "record", never)
+    out = tmp_path / "r.html"
+    refused(capsys, ["replay", "fig2B", "--steps", "100000000", "--out", str(out), "--quiet"],
+            "--steps 100000000", "event log 223.5 GiB", "fewer --steps or a larger --every")
+    assert not out.exists()
+
+
+def test_the_worlds_of_one_process_share_the_tables_the_estimate_counts_once():
+    from infomarket.config import load_experiment
+
+    cfg = load_experiment("fig2B").with_overrides(steps=1000)
+    one = sizes.run_bytes(cfg)
+    held = sizes.held_bytes(cfg, worlds=16, processes=3)
+    assert held["Lévy step-length table"] == 3 * 16 * 1001  # once per process
+    assert held["robot state"] == 3 * 16 * one["robot state"]  # once per world
+
+
+def test_chain_demo_refuses_an_event_log_beyond_memory_before_simulating(monkeypatch, capsys):
+    """The demo keeps the run's whole event log: 25 x 10**8 x 0.5 x 192 bytes = 223.5 GiB (by hand)."""
+    pytest.importorskip("web3")
+    import infomarket
+
+    monkeypatch.setattr(infomarket, "simulate", never)
+    refused(capsys, ["chain", "demo", "--steps", "100000000", "--robots", "25"],
+            "--steps 100000000 --robots 25", "event log 223.5 GiB")

@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 import signal
 import subprocess
+import sys
 import threading
 import time
 from pathlib import Path
@@ -116,3 +117,125 @@ def test_ctrl_c_stops_store_sql_in_the_middle_of_a_query(tmp_path, procs):
     assert proc.returncode == 130, err
     assert err == "infomarket: error: interrupted\n" and out == ""
     assert session_members(proc.pid) == []
+
+
+# A command that holds a stop signal across a fork: the signal is sent (to this thread, so that it stays
+# pending under the block whatever other threads exist) before the fork, as a Ctrl-C landing inside
+# ``os.fork`` would be.  Another library's at-fork hook, registered after infomarket's, runs after it
+# inside the same fork (``logging`` has one, for instance): the stop must not be let through there either.
+_FORK_SCRIPT = """
+import os, signal, sys, threading
+from infomarket import interrupts
+
+def other_hook():
+    len(())  # a call: an event the profile function sees, inside the fork
+
+os.register_at_fork(after_in_parent=other_hook)
+
+def profile(frame, event, arg):
+    pass
+
+def fork():
+    pid = os.fork()
+    if pid == 0:
+        os._exit(0)
+    return pid
+
+with interrupts.handling():
+    sys.setprofile(profile)
+    os.waitpid(fork(), 0)  # nothing pending: signals let through again, the profile function put back
+    print(sorted(signal.pthread_sigmask(signal.SIG_BLOCK, set())), sys.getprofile() is profile)
+    sys.setprofile(None)
+    try:
+        signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIG%s})
+        signal.pthread_kill(threading.main_thread().ident, signal.SIG%s)
+        fork()
+        print("not stopped")
+    except KeyboardInterrupt:
+        print("stopped", interrupts.requested())
+    print(sorted(signal.pthread_sigmask(signal.SIG_BLOCK, set())))
+"""
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_a_stop_held_across_a_fork_is_raised_after_the_fork_not_dropped_in_its_hook(procs, sig):
+    """Let through inside the at-fork hook that ends a held fork, the stop's ``KeyboardInterrupt`` would
+    be raised there, where Python drops it ("Exception ignored in ...") and the command runs on; it must
+    reach the code that called ``os.fork``.  In a process of its own: a real fork, one thread."""
+    name = signal.Signals(sig).name[3:]
+    done = procs.run([sys.executable, "-c", _FORK_SCRIPT % (name, name)])
+    assert done.returncode == 0 and done.stderr == "", done.stderr
+    assert done.stdout == f"[] True\nstopped {int(sig)}\n[]\n"
+
+
+# The console script's own two lines (pyproject's [project.scripts]), after a finder that stops the start-up
+# in the middle of the imports, just before the module named on its command line is imported, and says so.
+_START_SCRIPT = """
+import os, sys, time
+
+MODULE = sys.argv[1]
+
+class Pause:
+    def find_spec(self, name, path=None, target=None):
+        if name == MODULE:
+            sys.meta_path.remove(self)
+            os.write(1, b"importing " + name.encode() + b"\\n")
+            time.sleep(%r)  # the signal comes meanwhile
+        return None
+
+sys.meta_path.insert(0, Pause())
+sys.argv[1:] = ["list"]
+from infomarket_entry import main
+sys.exit(main())
+""" % HANG
+
+
+def test_the_console_script_is_the_light_entry():
+    import tomllib
+
+    scripts = tomllib.loads((Path(__file__).parents[1] / "pyproject.toml").read_text())["project"]["scripts"]
+    assert scripts == {"infomarket": "infomarket_entry:main"}
+
+
+@pytest.mark.parametrize(("module", "sig"), [
+    ("numpy", signal.SIGINT),  # among the first of the package's imports
+    ("numba", signal.SIGINT),
+    ("infomarket.engine", signal.SIGTERM),
+    ("infomarket.cli", signal.SIGINT),  # the last module of the entry's import
+    ("infomarket.runner.cli", signal.SIGINT),  # imported by the parser, before the command's handling
+])
+def test_a_stop_during_the_start_up_imports_ends_the_command_with_one_line(procs, module, sig):
+    proc = procs.start([sys.executable, "-c", _START_SCRIPT, module], stdout=subprocess.PIPE,
+                       stderr=subprocess.PIPE, text=True)
+    assert proc.stdout.readline() == f"importing {module}\n", proc.communicate()
+    os.killpg(proc.pid, sig)  # a terminal's Ctrl-C reaches the whole process group
+    out, err = proc.communicate(timeout=HANG)
+    assert (proc.returncode, err, out) == (128 + sig, "infomarket: error: interrupted\n", "")
+
+
+_STRAY_SCRIPT = """
+import os, subprocess, sys, time
+from infomarket import interrupts
+
+with interrupts.handling():
+    started = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(%r)"], stdout=subprocess.DEVNULL,
+                               stderr=subprocess.DEVNULL)  # a program the command started: not its to end
+    pid = os.fork()
+    if pid == 0:  # a fork that nothing registered (a pool worker whose start a stop cut short)
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, 1)
+        os.dup2(null, 2)
+        time.sleep(%r)
+        os._exit(0)
+    print(pid, started.pid, flush=True)
+    interrupts.exit_now(130)
+""" % (HANG, HANG)
+
+
+def test_a_stopped_command_leaves_no_fork_of_itself_behind(procs):
+    proc = procs.start([sys.executable, "-c", _STRAY_SCRIPT], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                       text=True)
+    out, err = proc.communicate(timeout=HANG)
+    assert proc.returncode == 130 and err == "", err
+    fork, started = map(int, out.split())
+    assert session_members(proc.pid) == [started]  # the fork is gone (reaped), the started program is not

@@ -1,6 +1,7 @@
 """How long `infomarket run` takes to stop after Ctrl-C, at random moments, on a busy machine.
 
-Each trial starts `infomarket run` (default: fig2B, 200 runs, one worker per core) in a session of its
+Each trial starts `infomarket run` (default: fig2B, 200 runs, one worker per core; through the console
+script's entry, `python -m infomarket_entry`, so a stop during its imports counts too) in a session of its
 own with a fresh, empty kernel cache (INFOMARKET_CACHE_DIR; --warm: one cache shared by the trials),
 sends SIGINT to its process group (as a terminal's Ctrl-C does) at a random moment between --earliest
 and --latest seconds after the start, and measures the time until the command has exited; then it
@@ -90,7 +91,7 @@ def main() -> int:
               f"{'shared warm' if args.warm else 'fresh cold'} kernel cache; load {os.getloadavg()[0]:.1f}",
               flush=True)
         if args.warm:  # fill the shared cache first: the trials then load the kernel and run
-            subprocess.run([sys.executable, "-m", "infomarket.cli", *args.words, "--runs", "1", "--steps", "10",
+            subprocess.run([sys.executable, "-m", "infomarket_entry", *args.words, "--runs", "1", "--steps", "10",
                             "--quiet", "--out", str(work / "warm")], env={**env, "INFOMARKET_CACHE_DIR": str(work / "cache")},
                            check=True)
         for k in range(args.trials):
@@ -98,7 +99,7 @@ def main() -> int:
             out = work / f"out{k}"
             err = open(work / f"err{k}.txt", "w+")
             delay = rng.uniform(args.earliest, args.latest)
-            cmd = [sys.executable, "-m", "infomarket.cli", *args.words, "--out", str(out)]
+            cmd = [sys.executable, "-m", "infomarket_entry", *args.words, "--out", str(out)]
             t_start = time.monotonic()
             proc = start(cmd, {**env, "INFOMARKET_CACHE_DIR": str(cache)}, stdout=subprocess.DEVNULL, stderr=err)
             while time.monotonic() - t_start < delay and proc.poll() is None:

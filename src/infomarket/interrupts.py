@@ -16,6 +16,8 @@ fails, and each has its own remedy here, none of which waits for or guesses at a
 * **Pool workers and children**: ``detach`` puts each in its own process group with the default
   dispositions (a signal ends it at once, even inside a kernel), and makes it die with its parent
   (Linux ``PR_SET_PDEATHSIG``); the parent ends them with SIGKILL to their group (``kill_group``).
+  The stop signals are blocked across each fork, so one cannot land in a child before it is detached,
+  and let through again only once the fork has returned to its caller: at-fork hooks drop exceptions.
 
 A stretch that an exception must not land in (DuckDB's import aborts when one does) runs in ``held()``,
 whose end raises a stop that came meanwhile.  The request to stop is sticky: ``check`` raises again at the safe points (after each kernel call, after
@@ -159,11 +161,40 @@ def exit_code() -> int:
 def exit_now(code: int) -> None:
     """End the program now, after a stop: what it keeps is committed, its children are ended and its
     files closed, so the interpreter's own teardown (finalizers of numba's and LLVM's objects, seconds
-    on a loaded machine) would only delay the exit.  Only for the program itself, never a library call."""
+    on a loaded machine) would only delay the exit.  Any fork of the program still alive (a pool worker
+    whose start a stop cut short, so the pool never knew it) is killed and reaped first, so none outlives
+    it even for the moment its death signal takes.  Only for the program itself, never a library call."""
     for stream in (sys.stdout, sys.stderr):
         with contextlib.suppress(Exception):
             stream.flush()
+    for pid in forks():
+        kill_group(pid)
+        with contextlib.suppress(ChildProcessError):
+            os.waitpid(pid, 0)
     os._exit(code)
+
+
+def forks() -> list[int]:
+    """This process's children that are forks of it, not programs it started: the same executable and
+    command line (Linux ``/proc``; elsewhere none)."""
+    me = os.getpid()
+    try:
+        mine = Path("/proc/self/cmdline").read_bytes(), os.readlink("/proc/self/exe")
+    except OSError:
+        return []
+    found = []
+    for entry in Path("/proc").iterdir():
+        if not entry.name.isdigit():
+            continue
+        try:
+            stat = (entry / "stat").read_text()
+            if int(stat[stat.rindex(")") + 2:].split()[1]) != me:  # state ppid ...
+                continue
+            if ((entry / "cmdline").read_bytes(), os.readlink(entry / "exe")) == mine:
+                found.append(int(entry.name))
+        except (OSError, ValueError):  # gone meanwhile, or not readable
+            continue
+    return found
 
 
 def _before_fork() -> None:
@@ -176,9 +207,39 @@ def _before_fork() -> None:
 
 
 def _after_fork_in_parent() -> None:
-    if _state.held:
-        _state.held = False
+    """The signals held for the fork stay blocked until the fork's caller runs again: let through here, a
+    pending stop's ``KeyboardInterrupt`` would be raised inside this at-fork hook (or a later one), where
+    Python drops it ("Exception ignored in ...") and the command runs on.  A profile function lets them
+    through at the first call or return made outside the at-fork hooks (``_release_after``)."""
+    if not _state.held:
+        return
+    _state.held = False
+    try:
+        caller = sys._getframe(1)  # the frame that called os.fork: the hooks run inside that call
+    except ValueError:  # no Python caller: nowhere better to raise a stop
         signal.pthread_sigmask(signal.SIG_UNBLOCK, set(SIGNALS))
+        return
+    sys.setprofile(_release_after(caller, sys.getprofile()))
+
+
+def _release_after(caller, previous):
+    """A profile function that unblocks the stop signals at the first event of this thread outside the
+    at-fork hooks running in ``caller``'s fork call, i.e. once the fork has returned to ``caller``; the
+    profile function ``previous`` is put back first.  A pending stop's handler raises there, in
+    ``caller`` (or wherever the thread has gone), as a signal arriving just after the fork would."""
+    at = caller.f_lasti  # the call of os.fork: unchanged while the hooks run, past it once fork returned
+
+    def release(frame, event, arg) -> None:
+        if frame is not caller and caller.f_lasti == at:
+            f = frame.f_back
+            while f is not None and f is not caller:
+                f = f.f_back
+            if f is caller:  # a frame of an at-fork hook, called from inside the fork
+                return
+        sys.setprofile(previous)
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, set(SIGNALS))
+
+    return release
 
 
 def _after_fork_in_child() -> None:

@@ -75,3 +75,61 @@ def test_room_of_keeps_the_largest_capacities():
     assert wide.nbr.shape == (w.nbr.shape[0], small["nbr"] + 5) and not wide.nbr.any()
     # a block of 16 asked for 36: grow_ledger gives max(2 x 16, 36) = 36, blocks laid end to end, empty
     assert (wide.tx_cap == 36).all() and (wide.tx_off == 36 * np.arange(25)).all() and wide.tx_count.sum() == 0
+
+
+class _Counted:
+    """A batch module whose ``step_all`` records each call's robot-steps."""
+
+    def __init__(self, module, robots: int):
+        self.module, self.robots, self.work = module, robots, []
+
+    def step_all(self, views, rngs, t_end, status, clocks, extra):
+        before = clocks.copy()
+        short = self.module.step_all(views, rngs, t_end, status, clocks, extra)
+        self.work.append(int((clocks - before).sum()) * self.robots)
+        return short
+
+
+@pytest.mark.parametrize("world_steps", [2, 150])  # per call: one step of two of the four worlds; 37 of each
+def test_a_batch_is_stepped_in_calls_of_bounded_work_that_do_not_change_its_runs(cfg, monkeypatch, world_steps):
+    from infomarket.engine import batch
+
+    seeds = SEEDS + [7]
+    monkeypatch.setattr(batch, "CALL_ROBOT_STEPS", 1 << 62)  # no bound: the reference, one call per advance
+    whole = Simulations(cfg, seeds)
+    whole.advance([100, 700, 1500, 20])
+    whole.advance(cfg.steps)
+    robots = whole.sims[0].world.pos.shape[0]
+    cap = world_steps * robots
+    monkeypatch.setattr(batch, "CALL_ROBOT_STEPS", cap)
+    parts = Simulations(cfg, seeds)
+    parts._batch = counted = _Counted(parts._batch, robots)
+    parts.advance([100, 700, 1500, 20])
+    parts.advance(cfg.steps)
+    assert max(counted.work) <= cap and sum(counted.work) == len(seeds) * cfg.steps * robots
+    assert parts.clocks.tolist() == [cfg.steps] * len(seeds)
+    for a, b in zip(parts.run(), whole.run()):
+        pd.testing.assert_frame_equal(a.robots, b.robots, check_exact=True)
+        pd.testing.assert_frame_equal(a.history, b.history, check_exact=True)
+
+
+def test_the_worlds_of_a_batch_share_the_sampling_tables_and_own_the_rest(cfg):
+    sims = Simulations(cfg, SEEDS)
+    a, b = sims.sims[0].world, sims.sims[1].world
+    for name in build.SHARED_TABLES:
+        assert getattr(a, name) is getattr(b, name)  # 16 bytes per step of the run, held once
+    assert not np.shares_memory(a.bparams, b.bparams) and not np.shares_memory(a.balance, b.balance)
+
+
+@pytest.mark.parametrize("alpha", [0.0, 1.0, 1.4, 2.0])  # exponents -1 and -2 take numpy's fast paths
+@pytest.mark.parametrize("steps", [1, 15000, 3_000_000])  # the last: the guide table in several chunks
+def test_the_step_length_tables_are_the_plain_formula_bit_for_bit(alpha, steps):
+    from infomarket.engine import params
+
+    k = np.arange(1, steps + 2, dtype=np.float64)
+    p = k ** -(alpha + 1.0)
+    cdf = np.cumsum(p / p.sum())
+    cdf[-1] = 1.0
+    guide = np.searchsorted(cdf, np.arange(len(cdf)) / len(cdf), side="right").astype(np.int64)
+    assert params.levy_cdf(alpha, steps).tobytes() == cdf.tobytes()
+    assert params.guide_table(cdf).tobytes() == guide.tobytes()

@@ -2,9 +2,11 @@
 
 The estimate follows the engine's O(n) layout (``engine.world``): per robot, a few hundred bytes of O(1) state
 and O(k) buffers (neighbours, pending transactions, offers), with k bounded by how many robots fit in
-communication range; a neighbour grid; the Lévy step-length table, 16 bytes × (steps + 1); the wealth
-history, 8 bytes × robots × steps / history_every (and its long table); the event log when recorded.
-Results kept in memory (``run``'s tables, a store read whole) cost per robot per run.
+communication range; a neighbour grid; the Lévy step-length table, 16 bytes × (steps + 1), once per
+process (the worlds it steps share it); the wealth history, 8 bytes × robots × steps / history_every (and
+its long table); the event log when recorded.  A sweep's process steps several worlds at once, and a pool
+has several processes (``held_bytes``).  Results kept in memory (``run``'s tables, a store read whole)
+cost per robot per run.
 
 The limit is ``INFOMARKET_MEMORY_LIMIT`` (e.g. ``64GiB``, ``500MB``, or a number of bytes) when set, else
 80 % of this machine's physical memory.  Estimates are deliberately a little generous: a refusal names
@@ -28,6 +30,8 @@ EVENT_BYTES = 96 + 96        # 12 int64/float64 columns, in the engine's log and
 PAYMENT_BYTES = 48 + 48      # 6 columns, at most one row per purchase (bounded by the events' rate)
 ROBOT_ROW_BYTES = 96         # one row of the robots table (9 columns, categorical behaviour)
 RUN_ROW_BYTES = 256          # one row of the runs table (strings included) and its seed bookkeeping
+#: parts held once per process, however many worlds it steps (``held_bytes``)
+SHARED_PARTS = frozenset({"Lévy step-length table"})
 _UNITS = {"": 1, "b": 1, "k": 10**3, "kb": 10**3, "m": 10**6, "mb": 10**6, "g": 10**9, "gb": 10**9,
           "t": 10**12, "tb": 10**12, "kib": 2**10, "mib": 2**20, "gib": 2**30, "tib": 2**40}
 
@@ -125,10 +129,41 @@ def runs_too_big(cfg, runs: int, *, history_every: int | None = None) -> str | N
     return _refusal(f"the results of {runs:,} runs", need, None, "ask for fewer runs")
 
 
+def held_bytes(cfg, worlds: int, processes: int = 1, *, record_events: bool = False) -> dict[str, int]:
+    """Estimated bytes, by part, of ``processes`` processes each stepping ``worlds`` runs of ``cfg`` at once:
+    the worlds of one process share the random walk's sampling tables (``engine.build.SHARED_TABLES``)."""
+    return {k: v * processes * (1 if k in SHARED_PARTS else worlds)
+            for k, v in run_bytes(cfg, record_events=record_events).items()}
+
+
+def held_too_big(cfg, worlds: int, processes: int = 1, *, record_events: bool = False) -> str | None:
+    """Why ``processes`` processes (pool workers, or the command's own), each stepping ``worlds`` runs of
+    ``cfg`` at once, would not fit in memory, or None."""
+    parts = held_bytes(cfg, worlds, processes, record_events=record_events)
+    need = sum(parts.values())
+    if need <= limit()[0]:
+        return None
+    who = f"{processes} worker processes, each" if processes > 1 else "one process"
+    return _refusal(f"{who} stepping {worlds} run(s) of {cfg.steps:,} steps at once", need, parts,
+                    "use fewer --steps or --workers (or a larger history_every)")
+
+
+def recording_too_big(cfg, frames: int, frame_bytes: int) -> str | None:
+    """Why a replay of ``cfg`` (one run with its event log, and ``frames`` frames of ``frame_bytes`` each,
+    held twice while the page is written) would not fit in memory, or None."""
+    parts = run_bytes(cfg, record_events=True)
+    parts["frames"] = 2 * frames * frame_bytes
+    need = sum(parts.values())
+    if need <= limit()[0]:
+        return None
+    return _refusal(f"a replay of {cfg.steps:,} steps in {frames:,} frames", need, parts,
+                    "use fewer --steps or a larger --every")
+
+
 def batch_too_big(cfg, runs: int, what: str, *, extra: dict[str, int] | None = None) -> str | None:
     """Why ``runs`` runs of ``cfg`` held at once (the RL vector env's worlds: ``what`` names the option
     that asked for them), plus ``extra`` bytes by part, would not fit in memory, or None."""
-    parts = {k: v * runs for k, v in run_bytes(cfg).items()}
+    parts = held_bytes(cfg, runs)
     parts.update(extra or {})
     need = sum(parts.values())
     if need <= limit()[0]:

@@ -12,9 +12,10 @@ from pathlib import Path
 import numpy as np
 from numba import typed
 
+from .. import interrupts
 from ..errors import ArgumentError, SimulationError
 from ..generated import generated_digest, load_generated
-from .simulation import Result, Simulation, _explained
+from .simulation import CALL_ROBOT_STEPS, Result, Simulation, _explained
 
 
 _BATCH_SOURCE = '''\
@@ -114,19 +115,27 @@ class Simulations:
         self._seconds[b] = 0.0
 
     def advance(self, t_end, extra=0) -> None:
-        """Run world b up to step ``t_end[b]`` (an array, or one step for all); seconds are shared among
-        the runs by the steps each made."""
+        """Run world b up to step ``t_end[b]`` (an array, or one step for all), in calls of at most
+        ``CALL_ROBOT_STEPS`` robot-steps in all, as ``Simulation.advance_to`` does: Python, and so Ctrl-C
+        (``interrupts``), gets control between calls however many and long the runs (each world resumes
+        exactly where it stopped, so the calls do not change the runs).  ``finish`` runs after each call
+        that leaves every world at its call's step, the last one included.  Seconds are shared among the
+        runs by the steps each made."""
         t_end = np.ascontiguousarray(np.broadcast_to(np.asarray(t_end, np.int64), (len(self.sims),)))
         before = self._clocks.copy()
         t0 = time.perf_counter()
         while True:
+            target = self._call_targets(t_end)
             try:
-                short = self._batch.step_all(self._views, self._rngs, t_end, self._status, self._clocks, extra)
+                short = self._batch.step_all(self._views, self._rngs, target, self._status, self._clocks, extra)
             except Exception as exc:  # a rule raised in the step of the run left at -1
                 sim = self.sims[int(np.argmax(self._status == -1))]
                 raise _explained(sim.config, sim.seed, exc, sim) from exc
+            interrupts.check()  # between kernel calls: a stop asked for while the kernel ran
             if not short:
-                break
+                if (self._clocks >= t_end).all():
+                    break
+                continue
             for b in np.flatnonzero(self._status):
                 sim = self.sims[b]
                 if self._status[b] == FLAGGED:  # an error bit a rule (or the engine) set: named
@@ -142,6 +151,22 @@ class Simulations:
         total = int(made.sum())
         if total:
             self._seconds += (time.perf_counter() - t0) / total * made
+
+    def _call_targets(self, t_end: np.ndarray) -> np.ndarray:
+        """Each world's step for the next call: the worlds short of ``t_end`` advance by the same number
+        of steps, as many as fit in ``CALL_ROBOT_STEPS`` robot-steps; when even one step each does not
+        fit, one step for as many of them as fit, in order (one world at the least)."""
+        short = np.flatnonzero(self._clocks < t_end)
+        target = t_end.copy()
+        if not len(short):
+            return target
+        robots = max(1, self.sims[0].world.pos.shape[0])
+        budget = max(1, CALL_ROBOT_STEPS // robots)  # world-steps per call
+        each = max(1, budget // len(short))
+        target[short] = self._clocks[short]  # the worlds left out of this call stay where they are
+        moving = short[:max(1, budget // each)]
+        target[moving] = np.minimum(t_end[moving], self._clocks[moving] + each)
+        return target
 
     def run(self) -> list[Result]:
         """Every run to the configuration's ``steps``; their results, in order (each run's ``run_seconds``

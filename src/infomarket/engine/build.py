@@ -19,19 +19,25 @@ from .terrain import place_clear
 from .world import ChainWorld, World, kernel_view
 
 
+#: Parameter arrays no run writes (the random walk's sampling tables), shared by the worlds built from one
+#: ``build_params`` instead of copied: the Lévy tables are 16 bytes per step of the run, for each world.
+SHARED_TABLES = frozenset({"levy_cdf", "levy_guide", "cauchy_cdf", "cauchy_guide", "turn_cos", "turn_sin"})
+
+
 def build_world(cfg: Experiment, rng: np.random.Generator, *, record_events: bool = False,
                 history_every: int = 0, kinds: tuple[str, ...] | None = None,
                 params: dict | None = None) -> tuple[World, list[str]]:
     """A fresh world: robots in group order (ids follow the groups), uniform integer positions,
     uniform headings, bimodal odometry biases, empty tables, initial wealth; and each robot's behaviour
     (its ``kind`` an index into ``kinds``, the kernel's behaviours; by default the experiment's own).
-    ``params``: ``build_params`` of ``cfg`` (with the same ``kinds``) made earlier (its arrays are copied),
+    ``params``: ``build_params`` of ``cfg`` (with the same ``kinds``) made earlier (its arrays are copied,
+    but for the ``SHARED_TABLES``),
     for many runs of one configuration; they draw nothing from ``rng``."""
     kind, bparams, names = behaviour_table(cfg, kinds)
     if params is None:
         params = build_params(cfg, bparams)
     else:
-        params = {k: v.copy() if isinstance(v, np.ndarray) else v for k, v in params.items()}
+        params = {k: v.copy() if isinstance(v, np.ndarray) and k not in SHARED_TABLES else v for k, v in params.items()}
     swarm = build_swarm(cfg, rng, kind, params["grid_nx"] * params["grid_ny"])
     log = build_log(cfg.swarm.robots, record_events=record_events, history_every=history_every,
                     history_rows=cfg.steps // history_every if history_every else 0,

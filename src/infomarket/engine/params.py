@@ -66,20 +66,30 @@ def cauchy_cdf(rho: float) -> np.ndarray:
     return cdf
 
 
+#: Entries of the guide table computed at once: its construction holds no second table-sized array.
+GUIDE_CHUNK = 1 << 20
+
+
 def levy_cdf(alpha: float, steps: int) -> np.ndarray:
-    """CDF of Lévy step lengths (eq. 3), P(k) ∝ k^-(alpha+1) for k = 1..steps+1 (index k-1)."""
-    k = np.arange(1, steps + 2, dtype=np.float64)
-    p = k ** -(alpha + 1.0)
-    cdf = np.cumsum(p / p.sum())
+    """CDF of Lévy step lengths (eq. 3), P(k) ∝ k^-(alpha+1) for k = 1..steps+1 (index k-1).  Computed in
+    place (the same values as ``cumsum(k ** -(alpha+1) / sum)``): the table is 8 bytes per step of the run."""
+    p = np.arange(1, steps + 2, dtype=np.float64)
+    p **= -(alpha + 1.0)
+    p /= p.sum()
+    cdf = np.cumsum(p, out=p)
     cdf[-1] = 1.0
     return cdf
 
 
 def guide_table(cdf: np.ndarray) -> np.ndarray:
     """For u in [j/M, (j+1)/M): the answer of inverse-CDF sampling is at least ``guide[j]`` (M = len(cdf)),
-    the first index whose cumulative probability exceeds j/M."""
+    the first index whose cumulative probability exceeds j/M (computed in chunks of ``GUIDE_CHUNK``)."""
     m = len(cdf)
-    return np.searchsorted(cdf, np.arange(m) / m, side="right").astype(np.int64)
+    guide = np.empty(m, np.int64)
+    for a in range(0, m, GUIDE_CHUNK):
+        b = min(m, a + GUIDE_CHUNK)
+        guide[a:b] = np.searchsorted(cdf, np.arange(a, b, dtype=np.float64) / m, side="right")
+    return guide
 
 
 def turn_tables() -> tuple[np.ndarray, np.ndarray]:

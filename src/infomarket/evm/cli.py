@@ -116,6 +116,7 @@ def run_demo(args: argparse.Namespace) -> int:
     try:
         # the chain extra (web3, py-evm, pyrevm) is optional: refused with a message if it is missing
         from .. import load_experiment, simulate
+        from ..config import sizes
         from ..errors import ConfigError
         from .errors import ChainError
         from .market import connect
@@ -135,6 +136,9 @@ def run_demo(args: argparse.Namespace) -> int:
             connect(args.rpc)  # fail before simulating if the node is not there
         if config.payment.scheme == "outlier" and config.payment_params()["theta"] > 180:
             raise ConfigError("the contract needs theta in [0, 180] degrees")
+        too_big = sizes.run_too_big(config, record_events=True)  # the demo keeps the whole event log
+        if too_big:
+            raise ConfigError(f"--steps {args.steps} --robots {args.robots}: {too_big}")
     except (ConfigError, ValueError, ChainError) as exc:
         return report_error(exc, 2)
     composition = ", ".join(f"{g.count} {g.behaviour}" for g in config.swarm.groups if g.count)

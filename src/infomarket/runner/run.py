@@ -26,7 +26,7 @@ from ..config.load import validate
 from ..errors import ConfigError, UsageError
 from ..store import Store
 from .plan import BASE, Condition
-from .sweep import SweepReport, sweep_locked
+from .sweep import SweepReport, refuse_too_big, sweep_locked
 from .execute import preflight
 
 #: What ``infomarket run`` wrote before it wrote a results store (``--force`` replaces these).
@@ -73,8 +73,8 @@ def prepare(experiment: str, *, runs: int | None = None, seed: int | None = None
     except ConfigError as exc:  # e.g. --steps below the file's transitory or history_every
         raise UsageError(str(exc).replace(" invalid experiment\n  ", " ").replace("\n  ", "; ")) from None
     too_big = sizes.runs_too_big(cfg, runs)
-    if too_big:
-        raise UsageError(f"--runs {runs}: {too_big}")
+    if too_big:  # named with the options that make the results this big
+        raise UsageError(f"{' '.join(filter(None, (f'--runs {runs}', options)))}: {too_big}")
     return Condition(cfg.name, BASE, {}, cfg, runs, seed, 0)
 
 
@@ -85,6 +85,7 @@ def run_experiment(cond: Condition, out: str | Path, *, workers: int = 1, force:
     existing folder may hold).  Ctrl-C raises ``RunInterrupted``: the runs already finished are kept in
     the store, and the same call again runs only the others."""
     out = Path(out)
+    refuse_too_big([cond], workers, None, False)
     store = Store(out)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {out}: exists and is not a directory")

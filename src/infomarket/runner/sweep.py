@@ -22,10 +22,12 @@ import numpy as np
 import pandas as pd
 
 from .. import __version__
+from ..config import sizes
 from ..config.schema import Experiment
+from ..errors import UsageError
 from ..store import Store, StoreError
 from ..store.results import FAILED, OK
-from .execute import RunOutput, Task, execute, local_executor, make_tasks, preflight
+from .execute import TOGETHER, RunOutput, Task, execute, local_executor, make_tasks, preflight
 from .plan import Condition, conditions
 
 __all__ = ["SweepReport", "Task", "check_compatible", "make_tasks", "plan", "run_sweep", "sweep_locked"]
@@ -154,10 +156,23 @@ def run_sweep(conds: list[Condition], store: Store, *, workers: int = 1, executo
     A kernel that a user's rule keeps from compiling is refused first (RuleRunError), nothing written.
     ``on_part(tables)``: called with each part's tables once it is committed (what a caller that reads the
     runs back at once would otherwise read from the store)."""
+    refuse_too_big(conds, workers, executor, record_events)
     preflight(c.config for c in conds)
     with store.writing():
         return sweep_locked(conds, store, workers=workers, executor=executor, on_done=on_done, on_plan=on_plan,
                             record_events=record_events, retry_failed=retry_failed, on_part=on_part)
+
+
+def refuse_too_big(conds: list[Condition], workers: int, executor: Executor | None, record_events: bool) -> None:
+    """Refuse (UsageError, before anything is written) runs whose worlds would not fit in memory at once:
+    each local worker process (one: an executor's own processes are counted one by one) steps up to
+    ``TOGETHER`` runs of a condition at once (one at a time when events are recorded)."""
+    processes = 1 if executor is not None else max(1, min(workers, sum(c.runs for c in conds)))
+    for c in conds:
+        worlds = 1 if record_events else min(TOGETHER, c.runs)
+        why = sizes.held_too_big(c.config, worlds, processes, record_events=record_events)
+        if why:
+            raise UsageError(f"{c.experiment} [{c.id}]: {why}")
 
 
 def sweep_locked(conds: list[Condition], store: Store, *, workers: int = 1, executor: Executor | None = None,

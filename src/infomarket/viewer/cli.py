@@ -105,6 +105,20 @@ class _Ticker:
             self.last = now
 
 
+def _refuse_too_big(cfg, every: int | None) -> None:
+    """A replay whose event log and frames would not fit in memory is refused before it runs."""
+    # with the command, as cmd_replay's own imports: `infomarket --help` stays light
+    from ..config import sizes
+    from .frames import frame_size
+    from .recording import default_every
+
+    every = every or default_every(cfg.steps, cfg.swarm.robots)
+    frames = cfg.steps // every + 2  # the first, one every ``every`` steps, and the last
+    why = sizes.recording_too_big(cfg, frames, frame_size(cfg.swarm.robots, cfg.chain.enabled))
+    if why:
+        raise UsageError(f"--steps {cfg.steps} --every {every}: {why}")
+
+
 def cmd_replay(args) -> int:
     from .recording import record, write_html  # with the command: `infomarket --help` stays light
 
@@ -123,6 +137,7 @@ def cmd_replay(args) -> int:
         writable_file(args.movie, "--movie")
     cfg = _load(args.experiment, args.steps)
     steps = cfg.steps
+    _refuse_too_big(cfg, args.every)
     rec = record(cfg, args.seed, steps=steps, every=args.every, on_progress=_Ticker("steps"))
     _say(f"recorded {steps} steps of {cfg.name} (seed {rec.scene['seed']}): {len(rec.frames)} frames, "
          f"one every {rec.every} steps")
