@@ -106,3 +106,17 @@ register_behaviour("reputation_weighted", buy=weighted.reputation_weighted_buy, 
                    description="buys like the naive robot but averages a purchase in with its age weight times the "
                                "seller's reputation ** power (continuous trust)",
                    limits={"power": (">= 0", lambda v: v >= 0)})
+
+# Robust buyers: a robust combination of the last purchases from distinct sellers (docs/defences.md).
+from .behaviours import robust  # noqa: E402
+
+_ROBUST = {"vectors": (">= 1", lambda v: v >= 1), "power": (">= 0", lambda v: v >= 0)}
+register_behaviour("robust_median", buy=robust.robust_median_buy, sell="naive", honest=True,
+                   description="holds its last `vectors` purchases per site from distinct sellers and steers by "
+                               "their coordinate-wise median with its own entry", limits=_ROBUST)
+register_behaviour("robust_trimmed", buy=robust.robust_trimmed_buy, sell="naive", honest=True,
+                   description="as robust_median, with the coordinate-wise mean trimmed by `trim` at each end",
+                   limits={**_ROBUST, "trim": (">= 0", lambda v: v >= 0)})
+register_behaviour("robust_geometric", buy=robust.robust_geometric_buy, sell="naive", honest=True,
+                   description="as robust_median, with the geometric median (`iterations` Weiszfeld steps)",
+                   limits={**_ROBUST, "iterations": (">= 0", lambda v: v >= 0)})
