@@ -120,3 +120,15 @@ register_behaviour("robust_trimmed", buy=robust.robust_trimmed_buy, sell="naive"
 register_behaviour("robust_geometric", buy=robust.robust_geometric_buy, sell="naive", honest=True,
                    description="as robust_median, with the geometric median (`iterations` Weiszfeld steps)",
                    limits={**_ROBUST, "iterations": (">= 0", lambda v: v >= 0)})
+
+# Market-side rules that give back or keep each seller's stake at settlement (docs/defences.md).
+from .payments import consensus  # noqa: E402
+
+register_payment("consensus_slash", consensus.consensus_slash_weights,
+                 description="a record d degrees from its site's settled consensus (medoid) loses min(1, d / "
+                             "slash_angle) of its stake and earns that much less of the share",
+                 limits={"slash_angle": ("in (0, 180]", lambda v: 0 < v <= 180)})
+register_payment("capped_outlier", consensus.capped_outlier_weights,
+                 description="outlier penalisation counting at most `cap` records per seller per round trip; "
+                             "later ones are void: stake back, no pay",
+                 limits={"theta": ("in (0, 180]", lambda v: 0 < v <= 180), "cap": (">= 1", lambda v: v >= 1)})
