@@ -3,10 +3,13 @@
 Buyer and sellers stand on one spot facing the same way, so a bought vector is the offered one (no
 rotation, no offset) and every expected entry is computed by hand from the offers.
 """
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 import infomarket as im
+from infomarket import registry
 from infomarket.behaviours import robust
 from infomarket.engine.world import FOOD, open_transactions
 from infomarket.registry import get_behaviour
@@ -120,3 +123,15 @@ def test_robust_buyers_run_among_naive_robots_and_saboteurs():
             assert all((i, site, s) in bought for s in held)
     assert result.robots.items_collected[13:].sum() > 0
     assert max(w.pend_count[i, s] for i in robust_ids for s in (0, 1)) >= 2  # they do gather opinions
+
+
+def test_the_defences_page_example_steers_by_the_median_of_its_memory(monkeypatch):
+    text = (Path(__file__).parents[2] / "docs" / "defences.md").read_text()
+    code = text.split("## Writing a new defence")[1].split("```python\n")[1].split("```")[0]
+    check = 'checks.check_behaviour("median_of_memory")'
+    assert check in code
+    monkeypatch.setattr(registry, "_BEHAVIOURS", dict(registry._BEHAVIOURS))  # registered for this test only
+    exec(compile(code.replace(check, ""), "docs/defences.md", "exec"), {})  # the full check compiles two kernels
+    h = _market(4, offers=[(1, 100.0, 0.0, 5), (2, 90.0, 10.0, 6), (3, 0.0, 100.0, 7)])
+    vec, age, held = _buy(h, "median_of_memory", 3.0)
+    assert vec == (90.0, 10.0) and age == 7 and held == [1, 2, 3]  # the last purchase's age
