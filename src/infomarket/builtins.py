@@ -110,7 +110,8 @@ register_behaviour("reputation_weighted", buy=weighted.reputation_weighted_buy, 
 # Robust buyers: a robust combination of the last purchases from distinct sellers (docs/defences.md).
 from .behaviours import robust  # noqa: E402
 
-_ROBUST = {"vectors": (">= 1", lambda v: v >= 1), "power": (">= 0", lambda v: v >= 0)}
+_ROBUST = {"vectors": (">= 1", lambda v: v >= 1), "power": (">= 0", lambda v: v >= 0),
+           "horizon": (">= 0", lambda v: v >= 0)}
 register_behaviour("robust_median", buy=robust.robust_median_buy, sell="naive", honest=True,
                    description="holds its last `vectors` purchases per site from distinct sellers and steers by "
                                "their coordinate-wise median with its own entry", limits=_ROBUST)

@@ -101,6 +101,14 @@ def test_an_entry_fresher_than_every_purchase_held_forgets_them(own_age, kept):
     assert h.world.pend_count[0, FOOD] == kept
 
 
+def test_a_purchase_older_than_the_horizon_is_forgotten():
+    h = _market(3, own=(1.0, 1.0, 20))
+    for s, age in ((1, 10), (2, 300)):
+        robust.remember(h.view, 0, FOOD, s, 1.0, 1.0, age, 3)
+    assert _buy(h, "robust_median", 3.0, 0.0, 300.0)[2] == [1, 2]  # 300 is not older than 300
+    assert _buy(h, "robust_median", 3.0, 0.0, 299.0)[2] == [1]
+
+
 def test_robust_buyers_run_among_naive_robots_and_saboteurs():
     """A run on the shared kernel: the memories hold at most `vectors` distinct sellers, each of whom the
     robot really bought from for that site, and the robust buyers forage."""

@@ -183,9 +183,10 @@ def install_combination(w, me, site, method, trim, iterations, power):
 
 
 @njit(inline="always")
-def robust_site(w, me, nbrs, site, method, vectors, trim, iterations, power):
+def robust_site(w, me, nbrs, site, method, vectors, trim, iterations, power, horizon):
     """One site of a robust buy rule.  A robot whose entry is invalid (never known, or it failed it), or
-    fresher than every purchase held (it has sensed the site since), forgets its purchases.  Then every
+    fresher than every purchase held (it has sensed the site since), forgets its purchases, and it
+    forgets any purchase older than ``horizon`` steps (dead reckoning has drifted it).  Then every
     candidate whose offer is younger than the robot's start-of-step entry is bought, in (offered age, id)
     order, except a seller whose held purchase is no older than its offer (nothing new from it); after
     each purchase the combination is installed.  Comparing with the start-of-step entry, not the current
@@ -200,6 +201,9 @@ def robust_site(w, me, nbrs, site, method, vectors, trim, iterations, power):
             freshest = min(freshest, w.pend_age[me, site, j])
         if oage < freshest:
             pending_clear(w, me, site)
+    for j in range(pending_count(w, me, site) - 1, -1, -1):
+        if w.pend_age[me, site, j] > horizon:
+            pending_remove(w, me, site, j)
     s = -1
     while True:
         s = next_candidate(w, nbrs, site, -1 if s < 0 else w.off_age[s, site], s)
@@ -215,20 +219,21 @@ def robust_site(w, me, nbrs, site, method, vectors, trim, iterations, power):
         install_combination(w, me, site, method, trim, iterations, power)
 
 
-def robust_median_buy(w, me, nbrs, vectors=5.0, power=0.0):
-    """Hold the last ``vectors`` purchases per site from distinct sellers; steer by their coordinate-wise
-    median with the own entry (weighted by the sellers' reputation ** ``power``; 0: unweighted)."""
+def robust_median_buy(w, me, nbrs, vectors=5.0, power=0.0, horizon=1e9):
+    """Hold the last ``vectors`` purchases per site from distinct sellers, none older than ``horizon``
+    steps; steer by their coordinate-wise median with the own entry (weighted by the sellers'
+    reputation ** ``power``; 0: unweighted)."""
     for site in range(2):
-        robust_site(w, me, nbrs, site, MEDIAN, int(vectors), 0, 0, power)
+        robust_site(w, me, nbrs, site, MEDIAN, int(vectors), 0, 0, power, horizon)
 
 
-def robust_trimmed_buy(w, me, nbrs, vectors=5.0, trim=1.0, power=0.0):
+def robust_trimmed_buy(w, me, nbrs, vectors=5.0, trim=1.0, power=0.0, horizon=1e9):
     """As ``robust_median_buy`` with the coordinate-wise mean after dropping ``trim`` values at each end."""
     for site in range(2):
-        robust_site(w, me, nbrs, site, TRIMMED, int(vectors), int(trim), 0, power)
+        robust_site(w, me, nbrs, site, TRIMMED, int(vectors), int(trim), 0, power, horizon)
 
 
-def robust_geometric_buy(w, me, nbrs, vectors=5.0, iterations=30.0, power=0.0):
+def robust_geometric_buy(w, me, nbrs, vectors=5.0, iterations=30.0, power=0.0, horizon=1e9):
     """As ``robust_median_buy`` with the geometric median (``iterations`` Weiszfeld steps)."""
     for site in range(2):
-        robust_site(w, me, nbrs, site, GEOMETRIC, int(vectors), 0, int(iterations), power)
+        robust_site(w, me, nbrs, site, GEOMETRIC, int(vectors), 0, int(iterations), power, horizon)
