@@ -70,6 +70,19 @@ def test_geometric_buyer_takes_the_centre_of_a_symmetric_cross():
     assert vec == pytest.approx((0.0, 0.0), abs=1e-12) and age == 5 and held == [1, 2, 3, 4]
 
 
+@pytest.mark.parametrize("power, expected", [(0.0, (50.0, 50.0)), (1.0, (100.0, 0.0))])
+def test_reputation_weights_the_voices(power, expected):
+    # seller 1 (100, 0): 8 settled sales, none an outlier: reputation 9/10; seller 2 (0, 100): 8 of 8
+    # outliers: 1/10.  Unweighted, the median of two voices is their mean; with power 1 the weights are
+    # 0.9 and 0.1, so in each coordinate seller 1's value alone passes half the weight: (100, 0).
+    h = _market(3, offers=[(1, 100.0, 0.0, 5), (2, 0.0, 100.0, 6)])
+    w = h.world
+    w.rep_settled[1:3] = 8
+    w.rep_reduced[2] = 8
+    vec, _, held = _buy(h, "robust_median", 3.0, power)
+    assert vec == pytest.approx(expected, abs=1e-12) and held == [1, 2]
+
+
 def test_the_memory_holds_one_purchase_per_seller_and_the_last_ones():
     h = _market(4)
     v = h.view
