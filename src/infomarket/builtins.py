@@ -106,3 +106,30 @@ register_behaviour("reputation_weighted", buy=weighted.reputation_weighted_buy, 
                    description="buys like the naive robot but averages a purchase in with its age weight times the "
                                "seller's reputation ** power (continuous trust)",
                    limits={"power": (">= 0", lambda v: v >= 0)})
+
+# Robust buyers: a robust combination of the last purchases from distinct sellers (docs/defences.md).
+from .behaviours import robust  # noqa: E402
+
+_ROBUST = {"vectors": (">= 1", lambda v: v >= 1), "power": (">= 0", lambda v: v >= 0),
+           "horizon": (">= 0", lambda v: v >= 0)}
+register_behaviour("robust_median", buy=robust.robust_median_buy, sell="naive", honest=True,
+                   description="holds its last `vectors` purchases per site from distinct sellers and steers by "
+                               "their coordinate-wise median with its own entry", limits=_ROBUST)
+register_behaviour("robust_trimmed", buy=robust.robust_trimmed_buy, sell="naive", honest=True,
+                   description="as robust_median, with the coordinate-wise mean trimmed by `trim` at each end",
+                   limits={**_ROBUST, "trim": (">= 0", lambda v: v >= 0)})
+register_behaviour("robust_geometric", buy=robust.robust_geometric_buy, sell="naive", honest=True,
+                   description="as robust_median, with the geometric median (`iterations` Weiszfeld steps)",
+                   limits={**_ROBUST, "iterations": (">= 0", lambda v: v >= 0)})
+
+# Market-side rules that give back or keep each seller's stake at settlement (docs/defences.md).
+from .payments import consensus  # noqa: E402
+
+register_payment("consensus_slash", consensus.consensus_slash_weights,
+                 description="a record d degrees from its site's settled consensus (medoid) loses min(1, d / "
+                             "slash_angle) of its stake and earns that much less of the share",
+                 limits={"slash_angle": ("in (0, 180]", lambda v: 0 < v <= 180)})
+register_payment("capped_outlier", consensus.capped_outlier_weights,
+                 description="outlier penalisation counting at most `cap` records per seller per round trip; "
+                             "later ones are void: stake back, no pay",
+                 limits={"theta": ("in (0, 180]", lambda v: 0 < v <= 180), "cap": (">= 1", lambda v: v >= 1)})

@@ -53,7 +53,7 @@ def test_expired_sales_are_not_settled_and_money_follows_the_returned_stake():
 
 def test_readers_compute_from_the_record():
     rec = _settlement("outlier", 0.04).record
-    w = type("W", (), {**rec, "balance": np.array([3.0, 1.0]), "money": np.array([4.0])})
+    w = type("W", (), {**rec, "balance": np.array([3.0, 1.0]), "money": np.array([4.0]), "rep_decay": 1.0})
     py = {name: getattr(market, name).py_func for name in ("seller_reputation", "wealth_share", "wealth",
                                                           "sales_settled", "sales_reduced", "deposits")}
     assert py["seller_reputation"](w, 1) == pytest.approx(2 / 3)   # 1 good sale of 1, Laplace: 2/3

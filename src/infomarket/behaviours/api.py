@@ -175,6 +175,28 @@ def pending_clear(w, me, site):
 
 
 @njit(inline="always")
+def pending_find(w, me, site, seller):
+    """Index of the seller's pending entry for ``site``, or -1."""
+    for j in range(w.pend_count[me, site]):
+        if w.pend_seller[me, site, j] == seller:
+            return j
+    return -1
+
+
+@njit(inline="always")
+def pending_remove(w, me, site, j):
+    """Drop the j-th pending entry, keeping the others in insertion order (the list doubles as a memory
+    of recent purchases: the engine dead-reckons and ages its entries like table entries)."""
+    k = w.pend_count[me, site]
+    for i in range(j, k - 1):
+        w.pend_seller[me, site, i] = w.pend_seller[me, site, i + 1]
+        w.pend_vec[me, site, i, 0] = w.pend_vec[me, site, i + 1, 0]
+        w.pend_vec[me, site, i, 1] = w.pend_vec[me, site, i + 1, 1]
+        w.pend_age[me, site, i] = w.pend_age[me, site, i + 1]
+    w.pend_count[me, site] = k - 1
+
+
+@njit(inline="always")
 def confirm_or_wait(w, me, site, seller, x, y, age, threshold):
     """The sceptic's second chance for a purchase that disagrees with its own entry: if a pending
     purchase agrees with it (diff < threshold), install their age-weighted average and clear the

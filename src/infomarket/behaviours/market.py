@@ -44,7 +44,12 @@ def sales_reduced(w, j):
 @njit(inline="always")
 def seller_reputation(w, j):
     """The fraction of j's settled sales that were not outliers, with one good and one bad sale added
-    (Laplace's rule), so a seller nobody has judged yet scores 0.5 and one sale cannot make 0 or 1."""
+    (Laplace's rule), so a seller nobody has judged yet scores 0.5 and one sale cannot make 0 or 1.
+    When the market's reputation decays (``payment.reputation_decay`` < 1) the sales are counted
+    decayed: each earlier sale weighs ``reputation_decay`` times less at every later one, so a record
+    built long ago does not cover lies told now."""
+    if w.rep_decay < 1.0:
+        return (w.rep_good[j] + 1.0) / (w.rep_good[j] + w.rep_bad[j] + 2.0)
     return (w.rep_settled[j] - w.rep_reduced[j] + 1.0) / (w.rep_settled[j] + 2.0)
 
 

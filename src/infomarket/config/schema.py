@@ -151,6 +151,9 @@ class Payment(_Strict):
     stake: NonNegFloat = 0.0
     #: Steps after which an open purchase's stake goes back to its seller (0 = never; docs/chain.md).
     stake_expiry: NonNegInt = 0
+    #: Reputation that decays: each earlier settled sale of a seller counts this many times less at each
+    #: later one in the reputation rules read (1 = never; docs/defences.md).
+    reputation_decay: Annotated[float, Field(gt=0, le=1)] = 1.0
     params: dict[str, Finite] = Field(default_factory=dict)
 
 
@@ -341,9 +344,9 @@ class Experiment(_Strict):
                     raise ConfigError(f"chain.signers: robot {s} does not exist (robots = {self.swarm.robots})")
             if len(set(self.chain.signers)) != len(self.chain.signers):
                 raise ConfigError("chain.signers: a robot is listed twice")
-            if self.robot.fuel_cost > 0 or self.payment.stake_expiry > 0:
-                raise ConfigError("chain.consensus = 'poa' does not model robot.fuel_cost or payment.stake_expiry "
-                                 "yet; set them to 0 or use the instant ledger")
+            if self.robot.fuel_cost > 0 or self.payment.stake_expiry > 0 or self.payment.reputation_decay < 1:
+                raise ConfigError("chain.consensus = 'poa' does not model robot.fuel_cost, payment.stake_expiry or "
+                                  "payment.reputation_decay yet; set them to 0 (decay 1) or use the instant ledger")
         too_big = sizes.run_too_big(self)
         if too_big:
             raise ConfigError(too_big)
@@ -386,6 +389,8 @@ class Experiment(_Strict):
         """Hash of everything that determines results (not name, description, runs or seed)."""
         data = self.model_dump(exclude={"name", "description", "runs", "seed", "sweep"})
         terrain.drop_defaults(data)  # setups on the paper's plane keep the hashes they always had
+        if data["payment"].get("reputation_decay") == 1.0:
+            data["payment"].pop("reputation_decay")  # and so do setups whose reputation does not decay
         if data.get("chain") == Chain().model_dump():
             data.pop("chain")  # and so do setups on the instant ledger
         elif data.get("chain", {}).get("partition", 0) is None:

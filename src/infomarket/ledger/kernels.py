@@ -126,8 +126,13 @@ def purchase_events(w, ok, buyer, seller, site, direction, x, y, age, sx, sy):
 def _record_sale(w, seller, weight, top, pay, stake):
     """The seller's reputation record for one settled transaction (ledger.state, REPUTATION): O(1)."""
     unlock(w.rep_settled)[seller] += 1
-    if weight <= 0.0 or weight < OUTLIER_FRACTION * top:
+    outlier = weight <= 0.0 or weight < OUTLIER_FRACTION * top
+    if outlier:
         unlock(w.rep_reduced)[seller] += 1
+    if w.rep_decay < 1.0:  # the decayed record: older sales count rep_decay times less at each new one
+        good, bad = unlock(w.rep_good), unlock(w.rep_bad)
+        good[seller] = w.rep_decay * good[seller] + (0.0 if outlier else 1.0)
+        bad[seller] = w.rep_decay * bad[seller] + (1.0 if outlier else 0.0)
     unlock(w.rep_earned)[seller] += pay
     if stake > pay:
         unlock(w.rep_stake_lost)[seller] += stake - pay

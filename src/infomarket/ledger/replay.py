@@ -50,7 +50,8 @@ class Ledger:
 
     def __init__(self, robots: int, *, scheme: str = "delayed", initial_wealth: float = 1.0,
                  reward: float = 1.0, information_share: float = 0.5, stake: float = 0.0,
-                 params: dict | None = None, stake_expiry: int = 0, record_events: bool = False):
+                 params: dict | None = None, stake_expiry: int = 0, record_events: bool = False,
+                 reputation_decay: float = 1.0):
         spec = get_payment(scheme)
         values = {**spec.defaults, **(params or {})}
         unknown = sorted(set(values) - set(spec.params))
@@ -60,7 +61,8 @@ class Ledger:
         self.scheme = spec
         self.book = new_book(robots, record_events=record_events, initial_wealth=initial_wealth, reward=reward,
                              information_share=information_share, stake=stake, stake_expiry=int(stake_expiry),
-                             pparams=[float(values.get(p, 0.0)) for p in spec.params])
+                             pparams=[float(values.get(p, 0.0)) for p in spec.params],
+                             reputation_decay=float(reputation_decay))
         self.view = make_view("book", self.book)
         self.rng = np.random.default_rng(0)  # only a scheme that asks for one uses it
 
@@ -106,16 +108,18 @@ class Ledger:
 
 def replay_events(events: Iterable, robots: int, *, scheme: str = "delayed", initial_wealth: float = 1.0,
                   reward: float = 1.0, information_share: float = 0.5, stake: float = 0.0,
-                  params: dict | None = None, stake_expiry: int = 0) -> Replayed:
+                  params: dict | None = None, stake_expiry: int = 0, reputation_decay: float = 1.0) -> Replayed:
     """Apply purchases and deposits in order; return the final balances and pots and, per purchase,
     whether it was accepted.  Events are LedgerEvent-like objects or mappings with the same fields
     (a DataFrame's ``itertuples()`` works; 'refused' events are replayed as purchases).
 
     ``stake_expiry`` = T > 0 applies the stake-expiry rule (docs/chain.md): at the start of each step
     s (before its first event), every open transaction opened at a step t with t + T <= s expires:
-    its stake goes back to its seller and it leaves the buyer's round trip."""
+    its stake goes back to its seller and it leaves the buyer's round trip.  ``reputation_decay`` < 1 keeps
+    the decayed reputation record (``payment.reputation_decay``)."""
     ledger = Ledger(robots, scheme=scheme, initial_wealth=initial_wealth, reward=reward,
-                    information_share=information_share, stake=stake, params=params, stake_expiry=stake_expiry)
+                    information_share=information_share, stake=stake, params=params, stake_expiry=stake_expiry,
+                    reputation_decay=reputation_decay)
     accepted: list[bool] = []
     step = None
     for ev in events:

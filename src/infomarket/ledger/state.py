@@ -27,7 +27,8 @@ TX_CAPACITY = 16
 #: The fields of one transaction in the pool (moved together when a block moves or is compacted).
 TX_POOL = ("tx_seller", "tx_site", "tx_dir", "tx_step", "tx_stake")
 #: The reputation record of every robot (rules read it through ``behaviours.market``).
-REPUTATION = ("money", "rep_settled", "rep_reduced", "rep_earned", "rep_stake_lost", "rep_deposits")
+REPUTATION = ("money", "rep_settled", "rep_reduced", "rep_earned", "rep_stake_lost", "rep_deposits", "rep_good",
+              "rep_bad")
 
 SPEC = Spec("ledger", [
     *fields("host", [
@@ -35,6 +36,7 @@ SPEC = Spec("ledger", [
         ("info_share", "float", "", "share of the reward paid to the sellers of the round trip"),
         ("stake", "float", "", "stake a seller locks per sale (0: no staking)"),
         ("stake_expiry", "int", "", "steps after which an unsettled stake returns to its seller (0: never)"),
+        ("rep_decay", "float", "", "factor on a seller's decayed record at each of its settled sales (1: none)"),
         ("pparams", "float64", "Q", "the payment scheme's parameters, in its declared order"),
     ]),
     *fields("ledger", [
@@ -56,24 +58,28 @@ SPEC = Spec("ledger", [
         ("rep_earned", "float64", "n", "money earned by sales"),
         ("rep_stake_lost", "float64", "n", "stake locked in sales and not paid back"),
         ("rep_deposits", "int64", "n", "deposits made as buyer"),
+        ("rep_good", "float64", "n", "decayed count of settled sales that were not outliers (rep_decay < 1)"),
+        ("rep_bad", "float64", "n", "decayed count of settled sales that were outliers (rep_decay < 1)"),
     ]),
 ])
 
 
 def build_ledger(robots: int, *, initial_wealth: float, reward: float, information_share: float,
-                 stake: float, stake_expiry: int, pparams) -> dict:
+                 stake: float, stake_expiry: int, pparams, reputation_decay: float = 1.0) -> dict:
     """A fresh ledger: every robot holds ``initial_wealth``, no transaction is open."""
     n, kt = robots, TX_CAPACITY
     z = np.zeros
     ledger = {
         "reward": float(reward), "info_share": float(information_share), "stake": float(stake),
-        "stake_expiry": int(stake_expiry), "pparams": np.array(list(pparams) or [0.0], dtype=np.float64),
+        "stake_expiry": int(stake_expiry), "rep_decay": float(reputation_decay),
+        "pparams": np.array(list(pparams) or [0.0], dtype=np.float64),
         "balance": np.full(n, float(initial_wealth)), "pot": z(n), "burned": z(1),
         "tx_off": np.arange(n, dtype=np.int64) * kt, "tx_cap": np.full(n, kt, np.int64), "tx_count": z(n, np.int64),
         "tx_seller": z(n * kt, np.int64), "tx_site": z(n * kt, np.int64), "tx_dir": z(n * kt),
         "tx_step": z(n * kt, np.int64), "tx_stake": z(n * kt), "pool_top": np.array([n * kt], np.int64),
         "money": np.array([n * float(initial_wealth)]), "rep_settled": z(n, np.int64),
         "rep_reduced": z(n, np.int64), "rep_earned": z(n), "rep_stake_lost": z(n), "rep_deposits": z(n, np.int64),
+        "rep_good": z(n), "rep_bad": z(n),
     }
     SPEC.check(ledger)
     return ledger
@@ -84,7 +90,7 @@ def ledger_of(cfg) -> dict:
     p = cfg.payment
     return build_ledger(cfg.swarm.robots, initial_wealth=p.initial_wealth, reward=p.reward,
                         information_share=p.information_share, stake=p.stake, stake_expiry=p.stake_expiry,
-                        pparams=cfg.payment_params().values())
+                        pparams=cfg.payment_params().values(), reputation_decay=p.reputation_decay)
 
 
 def grow_ledger(ledger, tx_need: np.ndarray) -> dict:
