@@ -47,8 +47,28 @@ class _Compiles(event.Listener):
                    "cpu": time.process_time() - _STATE["start"]})
 
 
+_USES: dict = {}
+
+
+def _record_uses(module) -> None:
+    """Note every generated module (step kernel, batch kernel, state view) a test loads, compiled or loaded
+    from a cache: its callers look ``load_generated`` up as a global, so it is wrapped in each."""
+    inner = module.load_generated
+
+    def load_generated(prefix, key, *args, **kwargs):
+        _USES.setdefault(_STATE["test"], set()).add(f"infomarket_{prefix}_{key}")
+        return inner(prefix, key, *args, **kwargs)
+
+    module.load_generated = load_generated
+
+
 def pytest_configure(config):
+    from infomarket import generated  # the package only once pytest runs with this plugin
+    from infomarket.engine import batch, specialise
+
     event.register("numba:compile", _Compiles())
+    for module in (generated, specialise, batch):
+        _record_uses(module)
 
 
 @pytest.hookimpl(hookwrapper=True)
@@ -59,7 +79,8 @@ def pytest_runtest_protocol(item, nextitem):
     after = os.times()
     _emit({"test": item.nodeid, "cpu": time.process_time() - start,
            "children_cpu": after.children_user + after.children_system
-           - children.children_user - children.children_system})
+           - children.children_user - children.children_system,
+           "uses": sorted(_USES.pop(item.nodeid, ()))})
     _STATE["test"] = "<between tests>"
 
 
@@ -71,17 +92,31 @@ def summary(path: str, top: int = 40) -> str:
             compiles.append(record)
         else:
             tests[record["test"]] = record
-    kernels = [c for c in compiles if c["module"].startswith("infomarket_kernel")]
+    users = collections.defaultdict(set)  # generated module -> the tests that loaded it
+    for name, t in tests.items():
+        for module in t.get("uses", ()):
+            users[module].add(name)
+    kernels = collections.defaultdict(list)  # step kernel -> its compiles (run_steps, or a dispatch alone)
+    for c in compiles:
+        if c["module"].startswith("infomarket_kernel"):
+            kernels[c["module"]].append(c)
     files = collections.Counter()
     for name, t in tests.items():
         files[name.split("::")[0]] += t["cpu"] + t["children_cpu"]
+    kernel_cpu = sum(c["cpu"] for cs in kernels.values() for c in cs)
     lines = [f"{len(tests)} tests, {sum(t['cpu'] for t in tests.values()):.0f} CPU s in the test process, "
              f"{sum(t['children_cpu'] for t in tests.values()):.0f} in processes they started",
              f"{len(compiles)} compiles, {sum(c['cpu'] for c in compiles):.0f} CPU s; {len(kernels)} step kernels, "
-             f"{sum(c['cpu'] for c in kernels):.0f} CPU s", "", "step kernels (CPU s, the test that compiled it):"]
-    lines += [f"{c['cpu']:7.1f}  {c['module']}  {c['test']}" for c in sorted(kernels, key=lambda c: -c["cpu"])]
+             f"{kernel_cpu:.0f} CPU s", "",
+             "step kernels (CPU s compiling it, tests that loaded it where recorded, the first test that compiled it):"]
+    for module, cs in sorted(kernels.items(), key=lambda kv: -sum(c["cpu"] for c in kv[1])):
+        used = f"{len(users[module]):4d}" if users else "   ?"
+        lines.append(f"{sum(c['cpu'] for c in cs):7.1f} {used}  {module}  {cs[0]['test']}")
     lines += ["", f"the {top} costliest files (CPU s, their processes included):"]
     lines += [f"{cpu:7.1f}  {name}" for name, cpu in files.most_common(top)]
+    lines += ["", f"the {top // 2} costliest tests (CPU s, their processes included; the longest bounds a parallel run):"]
+    costly = sorted(tests.items(), key=lambda kv: -(kv[1]["cpu"] + kv[1]["children_cpu"]))[:top // 2]
+    lines += [f"{t['cpu'] + t['children_cpu']:7.1f}  {name}" for name, t in costly]
     return "\n".join(lines)
 
 

@@ -8,6 +8,7 @@ from infomarket.config.legacy import from_legacy
 from infomarket.registry import get_behaviour
 
 from .config.test_legacy import legacy
+from .shared_kernel import simulate
 
 
 def test_free_rider_maps_to_the_originals_sceptical_free_rider():
@@ -25,7 +26,7 @@ def test_sceptical_free_rider_buys_sceptically_and_never_sells(tmp_path):
         {"class": "NaiveBehavior", "population_size": 20, "parameters": {}},
         {"class": "FreeRiderBehavior", "population_size": 5, "parameters": {"threshold": 0.25}}])))
     cfg = im.load_experiment(p).with_overrides(steps=3000, transitory=0)
-    ev = im.simulate(cfg, seed=2, record_events=True).events
+    ev = simulate(cfg, seed=2, record_events=True).events  # built-in rules: on the shared kernel
     bought = ev[(ev.kind == "purchase") & (ev.buyer >= 20)]
     assert len(bought) > 0 and not (ev.seller >= 20).any()  # they buy, nobody ever buys from them
     # sceptics buy several offers per site and step; naive buyers at most one

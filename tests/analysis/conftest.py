@@ -4,6 +4,7 @@ from __future__ import annotations
 import pytest
 
 from infomarket.analysis.frames import Frames
+from infomarket.analysis.report import build_report
 
 from .synthetic import paper_like, write_store
 
@@ -11,6 +12,14 @@ from .synthetic import paper_like, write_store
 @pytest.fixture(scope="session")
 def paper_store(tmp_path_factory):
     return write_store(tmp_path_factory.mktemp("paper") / "store", paper_like())
+
+
+@pytest.fixture(scope="session")
+def paper_report(paper_store, tmp_path_factory):
+    """``build_report`` of the paper-like store, drawn once (every figure): (the report, its folder, the lines
+    it echoed).  For tests that only read what it wrote."""
+    out, lines = tmp_path_factory.mktemp("paper-report"), []
+    return build_report(paper_store, out, echo=lines.append), out, lines
 
 
 @pytest.fixture(scope="session")

@@ -134,10 +134,10 @@ def test_figures_and_report_section_from_a_store(tmp_path):
     assert "open questions" in (tmp_path / "out" / "report.html").read_text()
 
 
-def test_a_paper_only_store_has_no_open_questions_section(paper_store, tmp_path):
-    report = build_report(paper_store, tmp_path)
+def test_a_paper_only_store_has_no_open_questions_section(paper_report):
+    report, out, _ = paper_report
     assert report.future is None
-    assert "open questions" not in (tmp_path / "report.md").read_text()
+    assert "open questions" not in (out / "report.md").read_text()
 
 
 @pytest.mark.parametrize("items", [hopeless, rescued, costly])

@@ -5,15 +5,14 @@ from infomarket.analysis.figures import save
 from .synthetic import paper_like, write_store
 
 
-def test_report_has_every_figure_the_table_and_provenance(paper_store, tmp_path):
-    lines = []
-    report = build_report(paper_store, tmp_path, echo=lines.append)
+def test_report_has_every_figure_the_table_and_provenance(paper_report):
+    report, out, lines = paper_report
     for name in ("fig2", "fig3", "fig4", "fig5", "fig6", "fig7"):
-        assert (tmp_path / f"{name}.png").stat().st_size > 5_000
-        assert (tmp_path / f"{name}.svg").exists()
+        assert (out / f"{name}.png").stat().st_size > 5_000
+        assert (out / f"{name}.svg").exists()
         assert any(line.startswith(f"{name}: wrote") for line in lines)
-    md = (tmp_path / "report.md").read_text()
-    html = (tmp_path / "report.html").read_text()
+    md = (out / "report.md").read_text()
+    html = (out / "report.html").read_text()
     for name in ("fig2", "fig7"):
         assert f"]({name}.png)" in md and f"src='{name}.png'" in html
     assert "## Paper vs this store" in md

@@ -96,13 +96,11 @@ def test_the_chain_report_prints_every_amendment_and_deviation():
     assert md.count("- **Amendment, ") == 2 and md.count("- **Deviation, ") == 3
 
 
-def test_the_shipped_records_are_printed_by_their_reports(paper_store, tmp_path):
-    from infomarket.analysis.report import build_report
-
-    build_report(paper_store, tmp_path)
-    md = (tmp_path / "report.md").read_text()
+def test_the_shipped_records_are_printed_by_their_reports(paper_report):
+    _, out, _ = paper_report
+    md = (out / "report.md").read_text()
     assert all(r.markdown() in md for r in TOLERANCES.records()) and md.count("- **Amendment, ") == 3
-    assert "Amendments and deviations (tolerances.toml)" in (tmp_path / "report.html").read_text()
+    assert "Amendments and deviations (tolerances.toml)" in (out / "report.html").read_text()
     assert "issue" not in md.lower()
 
 

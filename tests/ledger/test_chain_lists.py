@@ -33,8 +33,10 @@ def _config(scheme: str = "outlier", robots: int = 3, **over):
 def lists():
     """Buyer 0's lists on two branches that share their first two reveals:
     A = [r1, r2, r3] and B = [r1, r2, r4] (seller, direction in degrees, all at site 0):
-    r1 (1, 0), r2 (2, 10), r3 (1, 100), r4 (1, 20)."""
-    sim = im.Simulation(_config(), 1)
+    r1 (1, 0), r2 (2, 10), r3 (1, 100), r4 (1, 20).  Nothing steps and no rule runs, so the robots are
+    sceptics on the kernel of the forking run below (sceptics and scaboteurs): no kernel of their own."""
+    sim = im.Simulation(_config(swarm={"robots": 3, "groups": [{"behaviour": "sceptical", "count": 3}]}), 1,
+                        kernel_kinds=("sceptical", "scaboteur"))
     v = sim._view
     n1 = append_node(v, 0, -1, 1, 1, 0, 0.0, 5, 0.04)
     n2 = append_node(v, 0, n1, 2, 2, 0, 10.0, 6, 0.04)

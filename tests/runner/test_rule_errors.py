@@ -58,15 +58,26 @@ def divided(buyer, sellers, sites, directions, weights, k=0.0):
 '''
 
 
+@pytest.fixture(scope="module")
+def shared(tmp_path_factory):
+    """A folder for the plugins several tests load: one file, one registered rule and so one step kernel
+    per test process for all of them (a kernel's name hashes its rules' file and source)."""
+    return tmp_path_factory.mktemp("plugins")
+
+
 def experiment(tmp_path, name: str, plugin: str, behaviour: str = "naive", scheme: str = "delayed",
-               steps: int = 200, runs: int = 2, robots: int = 6) -> str:
-    (tmp_path / f"{name}.py").write_text(plugin)
+               steps: int = 200, runs: int = 2, robots: int = 6, plugins=None) -> str:
+    """The experiment ``name``, its plugin written as ``name.py`` in ``plugins`` (default ``tmp_path``; kept
+    when it is there already) and its file in ``tmp_path``."""
+    path = (plugins or tmp_path) / f"{name}.py"
+    if not path.exists():
+        path.write_text(plugin)
     (tmp_path / f"{name}.toml").write_text(textwrap.dedent(f'''
         name = "{name}"
         steps = {steps}
         runs = {runs}
         seed = 4
-        plugins = ["{name}.py"]
+        plugins = ["{path}"]
 
         [swarm]
         robots = {robots}
@@ -96,12 +107,12 @@ def line_of(path, text: str) -> int:
     return next(i for i, ln in enumerate(path.read_text().splitlines(), 1) if text in ln)
 
 
-def test_a_rule_raising_in_a_process_pool_sweep_is_named_with_its_line_and_step(tmp_path, capsys):
-    exp = experiment(tmp_path, "late", LATE, "late_divider")
+def test_a_rule_raising_in_a_process_pool_sweep_is_named_with_its_line_and_step(tmp_path, shared, capsys):
+    exp = experiment(tmp_path, "late", LATE, "late_divider", plugins=shared)
     out = tmp_path / "store"
     assert main(["sweep", exp, "--out", str(out), "--workers", "2", "--quiet"]) == 2
     err = one_message(capsys)
-    at = f"{tmp_path / 'late.py'}:{line_of(tmp_path / 'late.py', 'x = x / k')}"
+    at = f"{shared / 'late.py'}:{line_of(shared / 'late.py', 'x = x / k')}"
     assert (f"behaviour 'late_divider': its sell rule late_divider_sell raised ZeroDivisionError "
             f"(division by zero) at step 37 (robot 5, site 0), at {at}") in err
     failed = Store(out).failed()  # committed as failed, with the same one-line message
@@ -109,9 +120,8 @@ def test_a_rule_raising_in_a_process_pool_sweep_is_named_with_its_line_and_step(
                                     for e in failed.error)
 
 
-def test_infomarket_run_names_the_rule_too(tmp_path, capsys):
-    exp = experiment(tmp_path, "late", LATE.replace('"late_divider"', '"late_divider_run"'), "late_divider_run",
-                     runs=1)
+def test_infomarket_run_names_the_rule_too(tmp_path, shared, capsys):
+    exp = experiment(tmp_path, "late", LATE, "late_divider", runs=1, plugins=shared)
     assert main(["run", exp, "--out", str(tmp_path / "store"), "--quiet"]) == 2
     assert "late_divider_sell raised ZeroDivisionError (division by zero) at step 37" in one_message(capsys)
 
@@ -147,12 +157,12 @@ def test_a_weight_rule_raising_at_a_deposit_is_named_with_the_step(tmp_path, cap
     assert f"at step {step} (buyer " in err and at in err
 
 
-def test_a_rule_returning_three_values_is_refused_before_anything_is_written(tmp_path, capsys):
-    exp = experiment(tmp_path, "three", THREE, "three_values")
+def test_a_rule_returning_three_values_is_refused_before_anything_is_written(tmp_path, shared, capsys):
+    exp = experiment(tmp_path, "three", THREE, "three_values", plugins=shared)
     out = tmp_path / "store"
     assert main(["sweep", exp, "--out", str(out), "--quiet"]) == 2
     err = one_message(capsys)
-    assert (f"behaviour 'three_values': its sell rule three_values_sell ({tmp_path / 'three.py'}:{line_of(tmp_path / 'three.py', '@im.behaviour')}) returns "
+    assert (f"behaviour 'three_values': its sell rule three_values_sell ({shared / 'three.py'}:{line_of(shared / 'three.py', '@im.behaviour')}) returns "
             f"3 values") in err
     assert "a sell rule returns 4: (valid, x, y, age)" in err and "Cannot unify" not in err
     assert not out.exists()
@@ -200,9 +210,8 @@ def test_defaults_that_are_not_finite_numbers_are_refused(default):
         register_behaviour(f"bad_default_{abs(hash(default))}", buy="naive", sell=scope["bad_sell"], honest=True)
 
 
-def test_replay_names_the_rule_and_writes_nothing(tmp_path, capsys):
-    exp = experiment(tmp_path, "late", LATE.replace('"late_divider"', '"late_divider_replay"'),
-                     "late_divider_replay")
+def test_replay_names_the_rule_and_writes_nothing(tmp_path, shared, capsys):
+    exp = experiment(tmp_path, "late", LATE, "late_divider", plugins=shared)
     out = tmp_path / "late.html"
     assert main(["replay", exp, "--out", str(out), "--steps", "100", "--quiet"]) == 2
     assert "late_divider_sell raised ZeroDivisionError (division by zero) at step 37" in one_message(capsys)
@@ -234,23 +243,21 @@ def test_a_weight_rule_giving_negative_weights_is_named_with_the_step(tmp_path, 
             f"non-finite weight at step {step}") in err
 
 
-def test_the_python_api_names_the_rule_and_the_step_too(tmp_path):
+def test_the_python_api_names_the_rule_and_the_step_too(tmp_path, shared):
     """``im.simulate`` / ``Simulation.step`` raise the same RuleRunError as the command line (they raised
     numba's bare ZeroDivisionError, or its typing error pointing into the generated kernel)."""
     from infomarket import plugins
     from infomarket.errors import RuleRunError
 
-    late = LATE.replace('"late_divider"', '"late_divider_api"')
-    exp = experiment(tmp_path, "late_api", late, "late_divider_api", runs=1)
-    plugins.load(str(tmp_path / "late_api.py"))
+    exp = experiment(tmp_path, "late", LATE, "late_divider", runs=1, plugins=shared)
+    plugins.load(str(shared / "late.py"))
     with pytest.raises(RuleRunError) as err:
         im.simulate(exp, seed=3)
-    at = f"{tmp_path / 'late_api.py'}:{line_of(tmp_path / 'late_api.py', 'x = x / k')}"
+    at = f"{shared / 'late.py'}:{line_of(shared / 'late.py', 'x = x / k')}"
     assert "its sell rule late_divider_sell raised ZeroDivisionError (division by zero) at step 37" in str(err.value)
     assert at in str(err.value)
 
-    three = THREE.replace('"three_values"', '"three_values_api"')
-    exp = experiment(tmp_path, "three_api", three, "three_values_api", runs=1)
-    plugins.load(str(tmp_path / "three_api.py"))
+    exp = experiment(tmp_path, "three", THREE, "three_values", runs=1, plugins=shared)
+    plugins.load(str(shared / "three.py"))
     with pytest.raises(RuleRunError, match="three_values_sell.*returns 3 values"):
         im.Simulation(exp, seed=3)
