@@ -17,10 +17,11 @@ pragma solidity 0.8.28;
 /// by is that of the vector the seller committed to, minus the seller's position the buyer signed
 /// (docs/model.md §4), and "within theta" is decided on those integer vectors with dot products
 /// against a fixed cos(theta), exactly. A stake never stays locked for ever: records older than
-/// `stakeExpiry` blocks (never 0) give their stake back to their seller (anyone may trigger it), and a
-/// deposit not weighed within `settlementDeadline` blocks is paid by the delayed rule instead (stake
-/// plus an equal part of the share per live record), so a buyer gains nothing by leaving its
-/// settlement unfinished. Every call does a bounded amount of work: a round trip holds at most
+/// `stakeExpiry` blocks (never 0) give their stake back to their seller (anyone may trigger it) and are
+/// paid, at the buyer's next deposit, an equal part of the share (share / records of the round trip),
+/// so a buyer gains nothing by waiting for its records to expire; a deposit not weighed within
+/// `settlementDeadline` blocks is paid by the delayed rule instead (stake plus an equal part of the
+/// share per live record), so a buyer gains nothing by leaving its settlement unfinished either. Every call does a bounded amount of work: a round trip holds at most
 /// `maxRecordsPerTrip` (<= 512) live records, one seller at most `maxRecordsPerSeller` of them, and
 /// `buyItem`, `settle` and `refundExpired` each do at most `settleBatch` (<= 48) units of work, so no
 /// call exceeds the gas bound docs/gas.md declares, measured with cold storage, whatever the number of
@@ -146,17 +147,20 @@ contract InformationMarket {
 
     /// @dev A deposited round trip being settled, records [next, end) still to process in `phase`
     /// (in the weighing phase `next` is the next record to weigh).
-    /// `escrow` holds the reward share and the stakes not yet paid out; `amount` is what the live
-    /// records share (fixed when paying starts); `live` is the first live record.
+    /// `escrow` holds the reward share and the stakes not yet paid out; `amount` is what the records
+    /// share (fixed when paying starts); `first` is the round trip's first record, `live` its first
+    /// live one: the expired records [first, live) are each paid `perExpired`, the live ones the rest.
     struct Settlement {
         uint64 next;
         uint64 end;
         uint64 closedAt;
         uint64 live;
         uint8 phase;
+        uint64 first;
         uint256 escrow;
         uint256 amount;
         uint256 totalWeight;
+        uint256 perExpired;
     }
 
     // ------------------------------------------------------------------------------------------------
@@ -201,9 +205,9 @@ contract InformationMarket {
         bytes32 pathHash
     );
 
-    /// @notice A record expired (its buyer did not deposit within `stakeExpiry` blocks, or its deposit was
-    /// not settled within `settlementDeadline` blocks): its stake went back to its seller and it takes
-    /// no part in the buyer's settlement.
+    /// @notice A record expired (its buyer did not deposit within `stakeExpiry` blocks): its stake went
+    /// back to its seller and it takes no part in the weighing; the buyer's next deposit pays it an
+    /// equal part of the share ({RewardShared} with weight 0).
     /// @param buyer The buyer.
     /// @param seller The seller, refunded.
     /// @param index The record.
@@ -214,7 +218,7 @@ contract InformationMarket {
     /// @param robot Depositing robot.
     /// @param reward Reward minted to it, 1e-9 units.
     /// @param pot Stakes of the round trip (refunds of expired records come out of it).
-    /// @param transactions Number of records in the round trip, expired ones included.
+    /// @param transactions Number of records in the round trip, expired ones included (each is paid).
     event ItemBought(address indexed robot, uint256 reward, uint256 pot, uint256 transactions);
 
     /// @notice One record's seller received its share of a deposit.
@@ -222,7 +226,8 @@ contract InformationMarket {
     /// @param seller Receiving seller.
     /// @param index The record.
     /// @param weight The record's weight (1 under delayed payment, similar-transaction count under
-    /// outlier, distinct-seller count * 1e27 / the seller's records for the site under outlier-distinct).
+    /// outlier, distinct-seller count * 1e27 / the seller's records for the site under outlier-distinct;
+    /// 0 for an expired record, paid the share over the round trip's records).
     /// @param amount Share paid, 1e-9 units.
     event RewardShared(address indexed robot, address indexed seller, uint256 index, uint256 weight, uint256 amount);
 
@@ -257,7 +262,7 @@ contract InformationMarket {
     event PauseSet(address indexed account, bool paused);
 
     /// @notice A round trip's settlement finished: `shared` went to the sellers of its live records and
-    /// `kept` (rounding dust, or the whole share when no record was live) back to `robot`.
+    /// `kept` (rounding dust, or the whole share when the round trip had no record) back to `robot`.
     /// @param robot Depositing robot.
     /// @param shared Sum of the shares paid.
     /// @param kept Returned to the robot.
@@ -655,16 +660,18 @@ contract InformationMarket {
         _totalSupply += _reward;
         _pots[robot] = 0;
         uint64 start = round.start;
+        uint64 first = round.first;
         uint64 end = round.count;
         round.start = end;
         round.first = end;
         round.trip += 1;
-        emit ItemBought(robot, _reward, pot, end - start);
+        emit ItemBought(robot, _reward, pot, end - first);
         s.next = start;
         s.end = end;
         s.closedAt = uint64(block.number);
         s.live = start;
         s.phase = _EXPIRE;
+        s.first = first;
         s.escrow = share + pot;
         done = _settle(robot, _settleBatch);
     }
@@ -1127,9 +1134,11 @@ contract InformationMarket {
     }
 
     /// @dev Runs the pending settlement of `robot` for at most `budget` units of work, phase by phase:
-    /// refund the expired prefix, weigh the live records, pay them; then return the rest. Weighing not
-    /// finished `settlementDeadline` blocks after the deposit stops there, and the live records are paid
-    /// equal parts instead (the delayed rule), so the robot gains nothing by a settlement left pending.
+    /// refund the expired prefix, weigh the live records, pay every record of the round trip (an
+    /// expired one the share over the number of records, the live ones the rest by weight); then return
+    /// the rest. Weighing not finished `settlementDeadline` blocks after the deposit stops there, and
+    /// the live records are paid equal parts instead (the delayed rule), so the robot gains nothing by
+    /// a settlement left pending.
     /// A registered caller earns `settleBounty` per unit: for refunding and weighing from the escrow
     /// before the paid amount is fixed, for paying from each record's share.
     function _settle(address robot, uint256 budget) private returns (bool) {
@@ -1153,7 +1162,6 @@ contract InformationMarket {
         }
         if (phase == _WEIGH && block.number >= uint256(s.closedAt) + _settlementDeadline) {
             phase = _EQUAL;
-            next = s.live;
         }
         if (phase == _WEIGH) {
             // Weighing one record compares it with every live record: it costs ceil(m / pairs per unit)
@@ -1175,25 +1183,36 @@ contract InformationMarket {
                 return _pause(robot, next, escrow, rate * (units - budget));
             }
             phase = _PAY;
-            next = s.live;
         }
         uint256 bounty;
+        uint64 first = s.first;
+        uint64 live = s.live;
         if (phase != s.phase) {
-            // Paying starts: the work so far is paid from the escrow, then what the live records share
-            // is fixed.
+            // Paying starts, from the round trip's first record: the work so far is paid from the
+            // escrow, then what the records share is fixed. Each expired record is paid an equal part
+            // of the share, stake excluded (it went back to its seller), so a robot that waits for its
+            // records to expire before depositing pays the share all the same.
             bounty = rate * (units - budget);
             escrow -= bounty;
             s.amount = escrow;
-            if (phase == _EQUAL || _scheme == Scheme.Delayed) s.totalWeight = end - s.live;
+            if (phase == _EQUAL || _scheme == Scheme.Delayed) s.totalWeight = end - live;
+            if (live > first) s.perExpired = (escrow - (end - live) * _stake) / (end - first);
             s.phase = phase;
+            next = first;
         }
         uint256 amount = s.amount;
         uint256 total = s.totalWeight;
+        uint256 perExpired = live > first ? s.perExpired : 0;
+        uint256 liveAmount = amount - (live - first) * perExpired;
         bool equal = phase == _EQUAL || _scheme == Scheme.Delayed;
         while (next < end && budget > 0) {
             Information storage record = _records[robot][next];
-            uint256 weight = equal ? 1 : record.weight;
-            uint256 share = (amount * weight) / total;
+            uint256 weight;
+            uint256 share = perExpired;
+            if (next >= live) {
+                weight = equal ? 1 : record.weight;
+                share = (liveAmount * weight) / total;
+            }
             uint256 cut = rate < share ? rate : share;
             _balances[record.seller] += share - cut;
             escrow -= share;
@@ -1208,7 +1227,7 @@ contract InformationMarket {
             s.escrow = escrow;
             return false;
         }
-        return _finish(robot, escrow, s.live < end ? amount - escrow : 0, total);
+        return _finish(robot, escrow, first < end ? amount - escrow : 0, total);
     }
 
     /// @dev Stops a settlement call before paying: records where it stands and pays the bounty.
