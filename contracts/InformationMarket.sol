@@ -9,8 +9,8 @@ pragma solidity 0.8.28;
 /// ERC-20: robots never transfer tokens to each other directly, every movement of money is one of the
 /// market's rules (stake, reward, share), and leaving `transfer`/`approve` out keeps the only ways to
 /// move money the ones this contract audits. Invariant: the sum of all balances plus all locked stakes
-/// equals `totalSupply()` (initial wealth granted plus every reward issued); stakes still locked in a
-/// buyer's pot or in a settlement count as locked. Rounding dust of a share stays with the depositing
+/// and bonds equals `totalSupply()` (initial wealth granted plus every reward issued, less the bonds
+/// forfeited); stakes still locked in a buyer's pot or in a settlement count as locked. Rounding dust of a share stays with the depositing
 /// robot, so no token is ever created or destroyed by a division.
 ///
 /// The contract trusts no seller's word about its information: the direction each record is weighed
@@ -31,7 +31,10 @@ pragma solidity 0.8.28;
 /// Trust (docs/chain.md, "Trust model"): roles, as in OpenZeppelin's AccessControl. The admin grants
 /// and revokes roles (key rotation; several accounts may hold a role). A robot is registered when
 /// `registrarThreshold` distinct registrars approved the same (robot, grant), and a registrar approves
-/// at most `registrarQuota` robots per `registrarPeriod` blocks. A depositor submits a deposit only
+/// at most `registrarQuota` robots per `registrarPeriod` blocks. Registering locks `registrationBond` of
+/// the robot's grant as its bond: it comes back to the robot `bondDelay` blocks after the robot leaves
+/// the market (`exit`, then `withdrawBond`), and is forfeited (burned) when `registrarThreshold`
+/// registrars revoke the robot (`revokeRegistration`), before or during that delay. A depositor submits a deposit only
 /// with its evidence: the robot's signature over its round trip and a nest's acknowledgement of it. A
 /// pauser stops registrations, reveals and deposits; settlements and refunds go on while paused, so no
 /// stake is ever held by a pause. Only registered robots may buy, sell or be paid a reward. A light
@@ -244,6 +247,32 @@ contract InformationMarket {
     /// @param approvals Distinct registrars that approved this (robot, amount) so far.
     event RegistrationApproved(address indexed registrar, address indexed robot, uint256 amount, uint256 approvals);
 
+    /// @notice `robot`'s registration locked `amount` of its grant as its bond.
+    /// @param robot The robot.
+    /// @param amount The bond, 1e-9 units.
+    event BondLocked(address indexed robot, uint256 amount);
+
+    /// @notice `robot` left the market; its bond may be withdrawn from block `unlockBlock` on.
+    /// @param robot The robot.
+    /// @param unlockBlock First block of `withdrawBond`.
+    event ExitRequested(address indexed robot, uint256 unlockBlock);
+
+    /// @notice `robot`'s bond went back to its balance after a clean exit.
+    /// @param robot The robot.
+    /// @param amount The bond, 1e-9 units.
+    event BondReturned(address indexed robot, uint256 amount);
+
+    /// @notice `registrar` approved revoking `robot`.
+    /// @param registrar The approving registrar.
+    /// @param robot The robot.
+    /// @param approvals Distinct registrars that approved revoking it so far.
+    event RevocationApproved(address indexed registrar, address indexed robot, uint256 approvals);
+
+    /// @notice `robot` was revoked and its bond burned.
+    /// @param robot The robot.
+    /// @param amount The bond, 1e-9 units.
+    event BondForfeited(address indexed robot, uint256 amount);
+
     /// @notice `account` received `role` from `sender`.
     /// @param role The role.
     /// @param account The account.
@@ -380,6 +409,20 @@ contract InformationMarket {
     /// @param robot The account.
     error InfoMarketAlreadyRegistered(address robot);
 
+    /// @notice The grant does not cover the bond a registration locks.
+    /// @param amount The refused grant.
+    /// @param bond `registrationBond`.
+    error InfoMarketGrantBelowBond(uint256 amount, uint256 bond);
+
+    /// @notice `robot` has no bond waiting to be withdrawn (it did not `exit`, or its bond is gone).
+    /// @param robot The robot.
+    error InfoMarketNotExiting(address robot);
+
+    /// @notice `robot`'s bond is locked until block `unlockBlock`.
+    /// @param robot The robot.
+    /// @param unlockBlock First block of `withdrawBond`.
+    error InfoMarketBondLocked(address robot, uint256 unlockBlock);
+
     /// @notice The grant exceeds `maxGrant`.
     /// @param amount The refused grant.
     /// @param limit `maxGrant`.
@@ -426,6 +469,10 @@ contract InformationMarket {
     uint8 private constant _WEIGH = 1;
     uint8 private constant _PAY = 2;
     uint8 private constant _EQUAL = 3;
+    /// @dev An identity's life after registration: active (`_registered`), exiting (bond locked until
+    /// `_exits[robot].at`), closed (bond returned or forfeited; the robot may not register again).
+    uint8 private constant _EXITING = 1;
+    uint8 private constant _CLOSED = 2;
 
     /// @notice Role that grants and revokes every role (as AccessControl's DEFAULT_ADMIN_ROLE).
     bytes32 public constant ADMIN_ROLE = 0x00;
@@ -468,6 +515,8 @@ contract InformationMarket {
     uint256 private immutable _registrarThreshold;
     uint256 private immutable _registrarQuota;
     uint64 private immutable _registrarPeriod;
+    uint256 private immutable _registrationBond;
+    uint64 private immutable _bondDelay;
     uint256 private immutable _cachedChainId;
     bytes32 private immutable _cachedDomainSeparator;
 
@@ -494,6 +543,12 @@ contract InformationMarket {
     /// @dev (period << 128) | approvals the registrar made in that period.
     mapping(address registrar => uint256) private _quotaUsed;
     bool private _paused;
+    /// @dev Exits: the block from which the bond may be withdrawn, and the identity's state.
+    struct Exit {
+        uint64 at;
+        uint8 state;
+    }
+    mapping(address robot => Exit) private _exits;
 
     /// @notice Deploys a market with a fixed payment scheme and its trust policy.
     /// @param market_ Account of the market node: it receives the admin, depositor and pauser roles.
@@ -518,6 +573,10 @@ contract InformationMarket {
     /// @param nest_ Account that receives the nest role (acknowledges deposits).
     /// @param settleBounty_ Paid to a registered robot per unit of settlement work it does, 1e-9 units;
     /// the bounty of the largest settlement must fit in the reward's share.
+    /// @param registrationBond_ Bond every registration locks out of the grant, 1e-9 units (at most
+    /// `maxGrant_`).
+    /// @param bondDelay_ Blocks between a robot's `exit` and the return of its bond (>= 1): the time the
+    /// registrars have to revoke it.
     constructor(
         address market_,
         Scheme scheme_,
@@ -537,7 +596,9 @@ contract InformationMarket {
         uint256 registrarQuota_,
         uint64 registrarPeriod_,
         address nest_,
-        uint256 settleBounty_
+        uint256 settleBounty_,
+        uint256 registrationBond_,
+        uint64 bondDelay_
     ) {
         if (market_ == address(0)) revert InfoMarketInvalidParameter("market", 0);
         if (nest_ == address(0)) revert InfoMarketInvalidParameter("nest", 0);
@@ -564,6 +625,12 @@ contract InformationMarket {
             revert InfoMarketInvalidParameter("settleBatch", int256(settleBatch_));
         }
         if (settlementDeadline_ == 0) revert InfoMarketInvalidParameter("settlementDeadline", 0);
+        if (registrationBond_ > maxGrant_) {
+            revert InfoMarketInvalidParameter("registrationBond", int256(registrationBond_));
+        }
+        if (bondDelay_ == 0) revert InfoMarketInvalidParameter("bondDelay", 0);
+        _registrationBond = registrationBond_;
+        _bondDelay = bondDelay_;
         _grantRole(ADMIN_ROLE, market_);
         _grantRole(DEPOSITOR_ROLE, market_);
         _grantRole(PAUSER_ROLE, market_);
@@ -599,17 +666,20 @@ contract InformationMarket {
     /// @notice Approves registering `robot` with `amount` tokens of initial wealth (0 allowed); the
     /// `registrarThreshold`-th distinct registrar to approve the same (robot, amount) registers it and
     /// mints the grant. Only registered robots may buy, sell or deposit.
+    /// The registration locks `registrationBond` of the grant as the robot's bond.
     /// @dev Requirements: the caller is a registrar within its quota for the period; not paused;
-    /// `robot` is not registered yet; `amount` is at most `maxGrant`; the caller has not approved this
-    /// (robot, amount) yet. Emits {RegistrationApproved}, and {WealthGranted} when it registers.
+    /// `robot` is not registered and never was; `amount` covers the bond and is at most `maxGrant`; the
+    /// caller has not approved this (robot, amount) yet. Emits {RegistrationApproved}, and
+    /// {WealthGranted} and {BondLocked} when it registers.
     /// @param robot Receiving account.
     /// @param amount Tokens, 1e-9 units.
     /// @return registered Whether this approval registered the robot.
     function grantWealth(address robot, uint256 amount) external returns (bool registered) {
         _requireRole(REGISTRAR_ROLE);
         _requireNotPaused();
-        if (_registered[robot]) revert InfoMarketAlreadyRegistered(robot);
+        if (_registered[robot] || _exits[robot].state != 0) revert InfoMarketAlreadyRegistered(robot);
         if (amount > _maxGrant) revert InfoMarketGrantTooLarge(amount, _maxGrant);
+        if (amount < _registrationBond) revert InfoMarketGrantBelowBond(amount, _registrationBond);
         uint256 period = block.number / _registrarPeriod;
         uint256 used = _quotaUsed[msg.sender];
         used = used >> 128 == period ? used & type(uint128).max : 0;
@@ -624,9 +694,61 @@ contract InformationMarket {
         if (count < _registrarThreshold) return false;
         registered = true;
         _registered[robot] = true;
-        _balances[robot] += amount;
+        _balances[robot] += amount - _registrationBond;
         _totalSupply += amount;
         emit WealthGranted(robot, amount);
+        emit BondLocked(robot, _registrationBond);
+    }
+
+    /// @notice The caller leaves the market: it may no longer buy, sell or deposit, and its bond comes
+    /// back with `withdrawBond` from `bondDelay` blocks on, unless the registrars revoke it meanwhile.
+    /// Its sales still pending are paid as usual.
+    /// @dev Requirements: the caller is registered. Emits {ExitRequested}.
+    function exit() external {
+        if (!_registered[msg.sender]) revert InfoMarketUnregistered(msg.sender);
+        _registered[msg.sender] = false;
+        uint64 at = uint64(block.number) + _bondDelay;
+        _exits[msg.sender] = Exit(at, _EXITING);
+        emit ExitRequested(msg.sender, at);
+    }
+
+    /// @notice Returns `robot`'s bond to its balance after its exit delay; anyone may call it.
+    /// @dev Requirements: `robot` exited and was not revoked; the delay has passed. Emits {BondReturned}.
+    /// @param robot The exited robot.
+    /// @return amount The bond returned, 1e-9 units.
+    function withdrawBond(address robot) external returns (uint256 amount) {
+        Exit storage e = _exits[robot];
+        if (e.state != _EXITING) revert InfoMarketNotExiting(robot);
+        if (block.number < e.at) revert InfoMarketBondLocked(robot, e.at);
+        e.state = _CLOSED;
+        amount = _registrationBond;
+        _balances[robot] += amount;
+        emit BondReturned(robot, amount);
+    }
+
+    /// @notice Approves revoking `robot` (registered, or exited within its bond delay); the
+    /// `registrarThreshold`-th distinct registrar to approve revokes it: it may no longer buy, sell or
+    /// deposit, nor register again, and its bond is burned. Works while paused.
+    /// @dev Requirements: the caller is a registrar that has not approved revoking `robot` yet; `robot`
+    /// holds a bond. Emits {RevocationApproved}, and {BondForfeited} when it revokes.
+    /// @param robot The robot.
+    /// @return revoked Whether this approval revoked it.
+    function revokeRegistration(address robot) external returns (bool revoked) {
+        _requireRole(REGISTRAR_ROLE);
+        Exit storage e = _exits[robot];
+        if (!_registered[robot] && e.state != _EXITING) revert InfoMarketUnregistered(robot);
+        bytes32 request = keccak256(abi.encode("revoke", robot));
+        if (_approvedBy[request][msg.sender]) revert InfoMarketAlreadyApproved(msg.sender, robot);
+        _approvedBy[request][msg.sender] = true;
+        uint256 count = _approvals[request] + 1;
+        _approvals[request] = count;
+        emit RevocationApproved(msg.sender, robot, count);
+        if (count < _registrarThreshold) return false;
+        revoked = true;
+        _registered[robot] = false;
+        e.state = _CLOSED;
+        _totalSupply -= _registrationBond;
+        emit BondForfeited(robot, _registrationBond);
     }
 
     /// @notice Buys the item `robot` deposited: pays it the reward, closes its round trip and settles
@@ -1045,11 +1167,24 @@ contract InformationMarket {
     }
 
     /// @notice The registration policy.
-    /// @return threshold Distinct registrar approvals that register a robot.
+    /// @return threshold Distinct registrar approvals that register (or revoke) a robot.
     /// @return quota Most approvals per registrar per period.
     /// @return period Its length, blocks.
-    function policy() external view returns (uint256 threshold, uint256 quota, uint64 period) {
-        return (_registrarThreshold, _registrarQuota, _registrarPeriod);
+    /// @return bond Bond a registration locks, 1e-9 units.
+    /// @return bondDelay Blocks from a robot's exit to the return of its bond.
+    function policy()
+        external
+        view
+        returns (uint256 threshold, uint256 quota, uint64 period, uint256 bond, uint64 bondDelay)
+    {
+        return (_registrarThreshold, _registrarQuota, _registrarPeriod, _registrationBond, _bondDelay);
+    }
+
+    /// @notice The bond `robot` has locked (registered, or exited and not yet withdrawn; 0 otherwise).
+    /// @param robot The account.
+    /// @return The bond, 1e-9 units.
+    function bondOf(address robot) external view returns (uint256) {
+        return _registered[robot] || _exits[robot].state == _EXITING ? _registrationBond : 0;
     }
 
     // ------------------------------------------------------------------------------------------------

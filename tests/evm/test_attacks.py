@@ -354,9 +354,10 @@ def test_the_market_grants_wealth_once_per_robot_and_within_its_cap(make_market,
     refused(lambda: market.grant_wealth(robots[0].address, 1), "InfoMarketAlreadyRegistered",
             robot=robots[0].address)
     newcomer = derived_account("newcomer", 0)
-    refused(lambda: market.grant_wealth(newcomer.address, 5_000_000_001), "InfoMarketGrantTooLarge",
+    # the client grants the free wealth asked plus the bond (1 token): the grant is what maxGrant caps
+    refused(lambda: market.grant_wealth(newcomer.address, 4_000_000_001), "InfoMarketGrantTooLarge",
             amount=5_000_000_001, limit=5_000_000_000)
-    market.grant_wealth(newcomer.address, 5_000_000_000)
+    market.grant_wealth(newcomer.address, 4_000_000_000)
     assert market.total_supply() == supply + 5_000_000_000
 
 

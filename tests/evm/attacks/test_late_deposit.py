@@ -56,7 +56,8 @@ def test_expired_records_are_paid_equal_parts_and_the_live_ones_the_rest_by_weig
     # one voice per distinct similar seller: 2, 2 and 1 of 5
     expected = [1.1, 1.1, 1 - 0.04 + 0.42 * 2 / 5, 1 - 0.04 + 0.42 * 2 / 5, 1 - 0.04 + 0.42 / 5]
     assert [market.balance_of(r.address) for r in robots[1:6]] == [round(v * TOKEN) for v in expected]
-    supply = sum(market.balance_of(r.address) for r in robots) + market.locked_stake(buyer.address)
+    supply = sum(market.balance_of(r.address) + market.bond_of(r.address) for r in robots)
+    supply += market.locked_stake(buyer.address)
     assert supply == market.total_supply()
 
 
