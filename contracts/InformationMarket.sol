@@ -34,8 +34,9 @@ pragma solidity 0.8.28;
 /// at most `registrarQuota` robots per `registrarPeriod` blocks. Registering locks `registrationBond` of
 /// the robot's grant as its bond: it comes back to the robot `bondDelay` blocks after the robot leaves
 /// the market (`exit`, then `withdrawBond`), and is forfeited (burned) when `registrarThreshold`
-/// registrars revoke the robot (`revokeRegistration`), before or during that delay. A depositor submits a deposit only
-/// with its evidence: the robot's signature over its round trip and a nest's acknowledgement of it. A
+/// registrars revoke the robot (`revokeRegistration`), before or during that delay. A depositor
+/// submits a deposit only with its evidence: the robot's signature over its round trip and a nest's
+/// acknowledgement of it. A
 /// pauser stops registrations, reveals and deposits; settlements and refunds go on while paused, so no
 /// stake is ever held by a pause. Only registered robots may buy, sell or be paid a reward. A light
 /// contract names the buyer's round trip it belongs to, so a reveal after the buyer's deposit is
@@ -737,14 +738,14 @@ contract InformationMarket {
         _requireRole(REGISTRAR_ROLE);
         Exit storage e = _exits[robot];
         if (!_registered[robot] && e.state != _EXITING) revert InfoMarketUnregistered(robot);
-        bytes32 request = keccak256(abi.encode("revoke", robot));
-        if (_approvedBy[request][msg.sender]) revert InfoMarketAlreadyApproved(msg.sender, robot);
-        _approvedBy[request][msg.sender] = true;
-        uint256 count = _approvals[request] + 1;
-        _approvals[request] = count;
+        bytes32 revocation = keccak256(abi.encode("revoke", robot));
+        if (_approvedBy[revocation][msg.sender]) revert InfoMarketAlreadyApproved(msg.sender, robot);
+        _approvedBy[revocation][msg.sender] = true;
+        uint256 count = _approvals[revocation] + 1;
+        _approvals[revocation] = count;
         emit RevocationApproved(msg.sender, robot, count);
-        if (count < _registrarThreshold) return false;
-        revoked = true;
+        revoked = count >= _registrarThreshold;
+        if (!revoked) return false;
         _registered[robot] = false;
         e.state = _CLOSED;
         _totalSupply -= _registrationBond;
