@@ -208,3 +208,16 @@ def test_transient_storage_does_not_outlive_its_transaction(backend):
     address, _ = chain.deploy(deployer, init)
     logged = [chain.transact(deployer, address, b"").logs for _ in range(3)]
     assert [[int.from_bytes(lg.data, "big") for lg in logs] for logs in logged] == [[0], [0], [0]]
+
+
+def test_an_exit_a_bond_withdrawal_and_a_revocation_cost_the_same_gas_on_revm():
+    twin = Twin("bond", "outlier", 0.04, [1.0] * SELLERS + [0.0, 0.0], bond_delay=3)
+    leaving, revoked = twin.sellers[:2]
+    twin.tx("exit", leaving, label="exit")
+    twin.advance(3)
+    twin.tx("withdrawBond", None, leaving.address, label="withdrawBond")
+    twin.tx("revokeRegistration", None, revoked.address, label="revokeRegistration")  # the one registrar
+    twin.assert_same_state()
+    twin.assert_same_gas()
+    assert [what for what, *_ in twin.gas][-3:] == ["exit", "withdrawBond", "revokeRegistration"]
+    assert twin.markets[1].total_supply() == twin.markets[0].total_supply()
