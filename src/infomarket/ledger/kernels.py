@@ -111,12 +111,12 @@ def expire_stakes(w, buyer):
     buyer opened at a step t with t + stake_expiry <= s gives its stake back to its seller.  It stays
     in the round trip, out of the weighing: the deposit pays it an equal part of the share
     (``distribute``), so a buyer gains nothing by waiting for its transactions to expire.  The ones
-    refunded at an earlier step hold no stake and end the scan (a stake locked is never 0)."""
+    refunded at an earlier step hold no stake any more."""
     a = w.tx_off[buyer]
     balance, money, pot, stake = unlock(w.balance), unlock(w.money), unlock(w.pot), unlock(w.tx_stake)
-    for x in range(expired_count(w, buyer) - 1, -1, -1):
+    for x in range(expired_count(w, buyer)):
         if stake[a + x] == 0.0:
-            break
+            continue
         balance[w.tx_seller[a + x]] += stake[a + x]
         money[0] += stake[a + x]
         pot[buyer] -= stake[a + x]
