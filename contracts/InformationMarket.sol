@@ -9,18 +9,19 @@ pragma solidity 0.8.28;
 /// ERC-20: robots never transfer tokens to each other directly, every movement of money is one of the
 /// market's rules (stake, reward, share), and leaving `transfer`/`approve` out keeps the only ways to
 /// move money the ones this contract audits. Invariant: the sum of all balances plus all locked stakes
-/// equals `totalSupply()` (initial wealth granted plus every reward issued); stakes still locked in a
-/// buyer's pot or in a settlement count as locked. Rounding dust of a share stays with the depositing
+/// and bonds equals `totalSupply()` (initial wealth granted plus every reward issued, less the bonds
+/// forfeited); stakes still locked in a buyer's pot or in a settlement count as locked. Rounding dust of a share stays with the depositing
 /// robot, so no token is ever created or destroyed by a division.
 ///
 /// The contract trusts no seller's word about its information: the direction each record is weighed
 /// by is that of the vector the seller committed to, minus the seller's position the buyer signed
 /// (docs/model.md §4), and "within theta" is decided on those integer vectors with dot products
 /// against a fixed cos(theta), exactly. A stake never stays locked for ever: records older than
-/// `stakeExpiry` blocks (never 0) give their stake back to their seller (anyone may trigger it), and a
-/// deposit not weighed within `settlementDeadline` blocks is paid by the delayed rule instead (stake
-/// plus an equal part of the share per live record), so a buyer gains nothing by leaving its
-/// settlement unfinished. Every call does a bounded amount of work: a round trip holds at most
+/// `stakeExpiry` blocks (never 0) give their stake back to their seller (anyone may trigger it) and are
+/// paid, at the buyer's next deposit, an equal part of the share (share / records of the round trip),
+/// so a buyer gains nothing by waiting for its records to expire; a deposit not weighed within
+/// `settlementDeadline` blocks is paid by the delayed rule instead (stake plus an equal part of the
+/// share per live record), so a buyer gains nothing by leaving its settlement unfinished either. Every call does a bounded amount of work: a round trip holds at most
 /// `maxRecordsPerTrip` (<= 512) live records, one seller at most `maxRecordsPerSeller` of them, and
 /// `buyItem`, `settle` and `refundExpired` each do at most `settleBatch` (<= 48) units of work, so no
 /// call exceeds the gas bound docs/gas.md declares, measured with cold storage, whatever the number of
@@ -30,8 +31,12 @@ pragma solidity 0.8.28;
 /// Trust (docs/chain.md, "Trust model"): roles, as in OpenZeppelin's AccessControl. The admin grants
 /// and revokes roles (key rotation; several accounts may hold a role). A robot is registered when
 /// `registrarThreshold` distinct registrars approved the same (robot, grant), and a registrar approves
-/// at most `registrarQuota` robots per `registrarPeriod` blocks. A depositor submits a deposit only
-/// with its evidence: the robot's signature over its round trip and a nest's acknowledgement of it. A
+/// at most `registrarQuota` robots per `registrarPeriod` blocks. Registering locks `registrationBond` of
+/// the robot's grant as its bond: it comes back to the robot `bondDelay` blocks after the robot leaves
+/// the market (`exit`, then `withdrawBond`), and is forfeited (burned) when `registrarThreshold`
+/// registrars revoke the robot (`revokeRegistration`), before or during that delay. A depositor
+/// submits a deposit only with its evidence: the robot's signature over its round trip and a nest's
+/// acknowledgement of it. A
 /// pauser stops registrations, reveals and deposits; settlements and refunds go on while paused, so no
 /// stake is ever held by a pause. Only registered robots may buy, sell or be paid a reward. A light
 /// contract names the buyer's round trip it belongs to, so a reveal after the buyer's deposit is
@@ -146,17 +151,20 @@ contract InformationMarket {
 
     /// @dev A deposited round trip being settled, records [next, end) still to process in `phase`
     /// (in the weighing phase `next` is the next record to weigh).
-    /// `escrow` holds the reward share and the stakes not yet paid out; `amount` is what the live
-    /// records share (fixed when paying starts); `live` is the first live record.
+    /// `escrow` holds the reward share and the stakes not yet paid out; `amount` is what the records
+    /// share (fixed when paying starts); `first` is the round trip's first record, `live` its first
+    /// live one: the expired records [first, live) are each paid `perExpired`, the live ones the rest.
     struct Settlement {
         uint64 next;
         uint64 end;
         uint64 closedAt;
         uint64 live;
         uint8 phase;
+        uint64 first;
         uint256 escrow;
         uint256 amount;
         uint256 totalWeight;
+        uint256 perExpired;
     }
 
     // ------------------------------------------------------------------------------------------------
@@ -201,9 +209,9 @@ contract InformationMarket {
         bytes32 pathHash
     );
 
-    /// @notice A record expired (its buyer did not deposit within `stakeExpiry` blocks, or its deposit was
-    /// not settled within `settlementDeadline` blocks): its stake went back to its seller and it takes
-    /// no part in the buyer's settlement.
+    /// @notice A record expired (its buyer did not deposit within `stakeExpiry` blocks): its stake went
+    /// back to its seller and it takes no part in the weighing; the buyer's next deposit pays it an
+    /// equal part of the share ({RewardShared} with weight 0).
     /// @param buyer The buyer.
     /// @param seller The seller, refunded.
     /// @param index The record.
@@ -214,7 +222,7 @@ contract InformationMarket {
     /// @param robot Depositing robot.
     /// @param reward Reward minted to it, 1e-9 units.
     /// @param pot Stakes of the round trip (refunds of expired records come out of it).
-    /// @param transactions Number of records in the round trip, expired ones included.
+    /// @param transactions Number of records in the round trip, expired ones included (each is paid).
     event ItemBought(address indexed robot, uint256 reward, uint256 pot, uint256 transactions);
 
     /// @notice One record's seller received its share of a deposit.
@@ -222,7 +230,8 @@ contract InformationMarket {
     /// @param seller Receiving seller.
     /// @param index The record.
     /// @param weight The record's weight (1 under delayed payment, similar-transaction count under
-    /// outlier, distinct-seller count * 1e27 / the seller's records for the site under outlier-distinct).
+    /// outlier, distinct-seller count * 1e27 / the seller's records for the site under outlier-distinct;
+    /// 0 for an expired record, paid the share over the round trip's records).
     /// @param amount Share paid, 1e-9 units.
     event RewardShared(address indexed robot, address indexed seller, uint256 index, uint256 weight, uint256 amount);
 
@@ -238,6 +247,32 @@ contract InformationMarket {
     /// @param amount The grant approved, 1e-9 units.
     /// @param approvals Distinct registrars that approved this (robot, amount) so far.
     event RegistrationApproved(address indexed registrar, address indexed robot, uint256 amount, uint256 approvals);
+
+    /// @notice `robot`'s registration locked `amount` of its grant as its bond.
+    /// @param robot The robot.
+    /// @param amount The bond, 1e-9 units.
+    event BondLocked(address indexed robot, uint256 amount);
+
+    /// @notice `robot` left the market; its bond may be withdrawn from block `unlockBlock` on.
+    /// @param robot The robot.
+    /// @param unlockBlock First block of `withdrawBond`.
+    event ExitRequested(address indexed robot, uint256 unlockBlock);
+
+    /// @notice `robot`'s bond went back to its balance after a clean exit.
+    /// @param robot The robot.
+    /// @param amount The bond, 1e-9 units.
+    event BondReturned(address indexed robot, uint256 amount);
+
+    /// @notice `registrar` approved revoking `robot`.
+    /// @param registrar The approving registrar.
+    /// @param robot The robot.
+    /// @param approvals Distinct registrars that approved revoking it so far.
+    event RevocationApproved(address indexed registrar, address indexed robot, uint256 approvals);
+
+    /// @notice `robot` was revoked and its bond burned.
+    /// @param robot The robot.
+    /// @param amount The bond, 1e-9 units.
+    event BondForfeited(address indexed robot, uint256 amount);
 
     /// @notice `account` received `role` from `sender`.
     /// @param role The role.
@@ -257,7 +292,7 @@ contract InformationMarket {
     event PauseSet(address indexed account, bool paused);
 
     /// @notice A round trip's settlement finished: `shared` went to the sellers of its live records and
-    /// `kept` (rounding dust, or the whole share when no record was live) back to `robot`.
+    /// `kept` (rounding dust, or the whole share when the round trip had no record) back to `robot`.
     /// @param robot Depositing robot.
     /// @param shared Sum of the shares paid.
     /// @param kept Returned to the robot.
@@ -375,6 +410,20 @@ contract InformationMarket {
     /// @param robot The account.
     error InfoMarketAlreadyRegistered(address robot);
 
+    /// @notice The grant does not cover the bond a registration locks.
+    /// @param amount The refused grant.
+    /// @param bond `registrationBond`.
+    error InfoMarketGrantBelowBond(uint256 amount, uint256 bond);
+
+    /// @notice `robot` has no bond waiting to be withdrawn (it did not `exit`, or its bond is gone).
+    /// @param robot The robot.
+    error InfoMarketNotExiting(address robot);
+
+    /// @notice `robot`'s bond is locked until block `unlockBlock`.
+    /// @param robot The robot.
+    /// @param unlockBlock First block of `withdrawBond`.
+    error InfoMarketBondLocked(address robot, uint256 unlockBlock);
+
     /// @notice The grant exceeds `maxGrant`.
     /// @param amount The refused grant.
     /// @param limit `maxGrant`.
@@ -421,6 +470,10 @@ contract InformationMarket {
     uint8 private constant _WEIGH = 1;
     uint8 private constant _PAY = 2;
     uint8 private constant _EQUAL = 3;
+    /// @dev An identity's life after registration: active (`_registered`), exiting (bond locked until
+    /// `_exits[robot].at`), closed (bond returned or forfeited; the robot may not register again).
+    uint8 private constant _EXITING = 1;
+    uint8 private constant _CLOSED = 2;
 
     /// @notice Role that grants and revokes every role (as AccessControl's DEFAULT_ADMIN_ROLE).
     bytes32 public constant ADMIN_ROLE = 0x00;
@@ -463,6 +516,8 @@ contract InformationMarket {
     uint256 private immutable _registrarThreshold;
     uint256 private immutable _registrarQuota;
     uint64 private immutable _registrarPeriod;
+    uint256 private immutable _registrationBond;
+    uint64 private immutable _bondDelay;
     uint256 private immutable _cachedChainId;
     bytes32 private immutable _cachedDomainSeparator;
 
@@ -489,6 +544,12 @@ contract InformationMarket {
     /// @dev (period << 128) | approvals the registrar made in that period.
     mapping(address registrar => uint256) private _quotaUsed;
     bool private _paused;
+    /// @dev Exits: the block from which the bond may be withdrawn, and the identity's state.
+    struct Exit {
+        uint64 at;
+        uint8 state;
+    }
+    mapping(address robot => Exit) private _exits;
 
     /// @notice Deploys a market with a fixed payment scheme and its trust policy.
     /// @param market_ Account of the market node: it receives the admin, depositor and pauser roles.
@@ -513,6 +574,10 @@ contract InformationMarket {
     /// @param nest_ Account that receives the nest role (acknowledges deposits).
     /// @param settleBounty_ Paid to a registered robot per unit of settlement work it does, 1e-9 units;
     /// the bounty of the largest settlement must fit in the reward's share.
+    /// @param registrationBond_ Bond every registration locks out of the grant, 1e-9 units (at most
+    /// `maxGrant_`).
+    /// @param bondDelay_ Blocks between a robot's `exit` and the return of its bond (>= 1): the time the
+    /// registrars have to revoke it.
     constructor(
         address market_,
         Scheme scheme_,
@@ -532,7 +597,9 @@ contract InformationMarket {
         uint256 registrarQuota_,
         uint64 registrarPeriod_,
         address nest_,
-        uint256 settleBounty_
+        uint256 settleBounty_,
+        uint256 registrationBond_,
+        uint64 bondDelay_
     ) {
         if (market_ == address(0)) revert InfoMarketInvalidParameter("market", 0);
         if (nest_ == address(0)) revert InfoMarketInvalidParameter("nest", 0);
@@ -559,6 +626,12 @@ contract InformationMarket {
             revert InfoMarketInvalidParameter("settleBatch", int256(settleBatch_));
         }
         if (settlementDeadline_ == 0) revert InfoMarketInvalidParameter("settlementDeadline", 0);
+        if (registrationBond_ > maxGrant_) {
+            revert InfoMarketInvalidParameter("registrationBond", int256(registrationBond_));
+        }
+        if (bondDelay_ == 0) revert InfoMarketInvalidParameter("bondDelay", 0);
+        _registrationBond = registrationBond_;
+        _bondDelay = bondDelay_;
         _grantRole(ADMIN_ROLE, market_);
         _grantRole(DEPOSITOR_ROLE, market_);
         _grantRole(PAUSER_ROLE, market_);
@@ -594,17 +667,20 @@ contract InformationMarket {
     /// @notice Approves registering `robot` with `amount` tokens of initial wealth (0 allowed); the
     /// `registrarThreshold`-th distinct registrar to approve the same (robot, amount) registers it and
     /// mints the grant. Only registered robots may buy, sell or deposit.
+    /// The registration locks `registrationBond` of the grant as the robot's bond.
     /// @dev Requirements: the caller is a registrar within its quota for the period; not paused;
-    /// `robot` is not registered yet; `amount` is at most `maxGrant`; the caller has not approved this
-    /// (robot, amount) yet. Emits {RegistrationApproved}, and {WealthGranted} when it registers.
+    /// `robot` is not registered and never was; `amount` covers the bond and is at most `maxGrant`; the
+    /// caller has not approved this (robot, amount) yet. Emits {RegistrationApproved}, and
+    /// {WealthGranted} and {BondLocked} when it registers.
     /// @param robot Receiving account.
     /// @param amount Tokens, 1e-9 units.
     /// @return registered Whether this approval registered the robot.
     function grantWealth(address robot, uint256 amount) external returns (bool registered) {
         _requireRole(REGISTRAR_ROLE);
         _requireNotPaused();
-        if (_registered[robot]) revert InfoMarketAlreadyRegistered(robot);
+        if (_registered[robot] || _exits[robot].state != 0) revert InfoMarketAlreadyRegistered(robot);
         if (amount > _maxGrant) revert InfoMarketGrantTooLarge(amount, _maxGrant);
+        if (amount < _registrationBond) revert InfoMarketGrantBelowBond(amount, _registrationBond);
         uint256 period = block.number / _registrarPeriod;
         uint256 used = _quotaUsed[msg.sender];
         used = used >> 128 == period ? used & type(uint128).max : 0;
@@ -619,9 +695,61 @@ contract InformationMarket {
         if (count < _registrarThreshold) return false;
         registered = true;
         _registered[robot] = true;
-        _balances[robot] += amount;
+        _balances[robot] += amount - _registrationBond;
         _totalSupply += amount;
         emit WealthGranted(robot, amount);
+        emit BondLocked(robot, _registrationBond);
+    }
+
+    /// @notice The caller leaves the market: it may no longer buy, sell or deposit, and its bond comes
+    /// back with `withdrawBond` from `bondDelay` blocks on, unless the registrars revoke it meanwhile.
+    /// Its sales still pending are paid as usual.
+    /// @dev Requirements: the caller is registered. Emits {ExitRequested}.
+    function exit() external {
+        if (!_registered[msg.sender]) revert InfoMarketUnregistered(msg.sender);
+        _registered[msg.sender] = false;
+        uint64 at = uint64(block.number) + _bondDelay;
+        _exits[msg.sender] = Exit(at, _EXITING);
+        emit ExitRequested(msg.sender, at);
+    }
+
+    /// @notice Returns `robot`'s bond to its balance after its exit delay; anyone may call it.
+    /// @dev Requirements: `robot` exited and was not revoked; the delay has passed. Emits {BondReturned}.
+    /// @param robot The exited robot.
+    /// @return amount The bond returned, 1e-9 units.
+    function withdrawBond(address robot) external returns (uint256 amount) {
+        Exit storage e = _exits[robot];
+        if (e.state != _EXITING) revert InfoMarketNotExiting(robot);
+        if (block.number < e.at) revert InfoMarketBondLocked(robot, e.at);
+        e.state = _CLOSED;
+        amount = _registrationBond;
+        _balances[robot] += amount;
+        emit BondReturned(robot, amount);
+    }
+
+    /// @notice Approves revoking `robot` (registered, or exited within its bond delay); the
+    /// `registrarThreshold`-th distinct registrar to approve revokes it: it may no longer buy, sell or
+    /// deposit, nor register again, and its bond is burned. Works while paused.
+    /// @dev Requirements: the caller is a registrar that has not approved revoking `robot` yet; `robot`
+    /// holds a bond. Emits {RevocationApproved}, and {BondForfeited} when it revokes.
+    /// @param robot The robot.
+    /// @return revoked Whether this approval revoked it.
+    function revokeRegistration(address robot) external returns (bool revoked) {
+        _requireRole(REGISTRAR_ROLE);
+        Exit storage e = _exits[robot];
+        if (!_registered[robot] && e.state != _EXITING) revert InfoMarketUnregistered(robot);
+        bytes32 revocation = keccak256(abi.encode("revoke", robot));
+        if (_approvedBy[revocation][msg.sender]) revert InfoMarketAlreadyApproved(msg.sender, robot);
+        _approvedBy[revocation][msg.sender] = true;
+        uint256 count = _approvals[revocation] + 1;
+        _approvals[revocation] = count;
+        emit RevocationApproved(msg.sender, robot, count);
+        revoked = count >= _registrarThreshold;
+        if (!revoked) return false;
+        _registered[robot] = false;
+        e.state = _CLOSED;
+        _totalSupply -= _registrationBond;
+        emit BondForfeited(robot, _registrationBond);
     }
 
     /// @notice Buys the item `robot` deposited: pays it the reward, closes its round trip and settles
@@ -655,16 +783,18 @@ contract InformationMarket {
         _totalSupply += _reward;
         _pots[robot] = 0;
         uint64 start = round.start;
+        uint64 first = round.first;
         uint64 end = round.count;
         round.start = end;
         round.first = end;
         round.trip += 1;
-        emit ItemBought(robot, _reward, pot, end - start);
+        emit ItemBought(robot, _reward, pot, end - first);
         s.next = start;
         s.end = end;
         s.closedAt = uint64(block.number);
         s.live = start;
         s.phase = _EXPIRE;
+        s.first = first;
         s.escrow = share + pot;
         done = _settle(robot, _settleBatch);
     }
@@ -1038,11 +1168,24 @@ contract InformationMarket {
     }
 
     /// @notice The registration policy.
-    /// @return threshold Distinct registrar approvals that register a robot.
+    /// @return threshold Distinct registrar approvals that register (or revoke) a robot.
     /// @return quota Most approvals per registrar per period.
     /// @return period Its length, blocks.
-    function policy() external view returns (uint256 threshold, uint256 quota, uint64 period) {
-        return (_registrarThreshold, _registrarQuota, _registrarPeriod);
+    /// @return bond Bond a registration locks, 1e-9 units.
+    /// @return bondDelay Blocks from a robot's exit to the return of its bond.
+    function policy()
+        external
+        view
+        returns (uint256 threshold, uint256 quota, uint64 period, uint256 bond, uint64 bondDelay)
+    {
+        return (_registrarThreshold, _registrarQuota, _registrarPeriod, _registrationBond, _bondDelay);
+    }
+
+    /// @notice The bond `robot` has locked (registered, or exited and not yet withdrawn; 0 otherwise).
+    /// @param robot The account.
+    /// @return The bond, 1e-9 units.
+    function bondOf(address robot) external view returns (uint256) {
+        return _registered[robot] || _exits[robot].state == _EXITING ? _registrationBond : 0;
     }
 
     // ------------------------------------------------------------------------------------------------
@@ -1127,9 +1270,11 @@ contract InformationMarket {
     }
 
     /// @dev Runs the pending settlement of `robot` for at most `budget` units of work, phase by phase:
-    /// refund the expired prefix, weigh the live records, pay them; then return the rest. Weighing not
-    /// finished `settlementDeadline` blocks after the deposit stops there, and the live records are paid
-    /// equal parts instead (the delayed rule), so the robot gains nothing by a settlement left pending.
+    /// refund the expired prefix, weigh the live records, pay every record of the round trip (an
+    /// expired one the share over the number of records, the live ones the rest by weight); then return
+    /// the rest. Weighing not finished `settlementDeadline` blocks after the deposit stops there, and
+    /// the live records are paid equal parts instead (the delayed rule), so the robot gains nothing by
+    /// a settlement left pending.
     /// A registered caller earns `settleBounty` per unit: for refunding and weighing from the escrow
     /// before the paid amount is fixed, for paying from each record's share.
     function _settle(address robot, uint256 budget) private returns (bool) {
@@ -1153,7 +1298,6 @@ contract InformationMarket {
         }
         if (phase == _WEIGH && block.number >= uint256(s.closedAt) + _settlementDeadline) {
             phase = _EQUAL;
-            next = s.live;
         }
         if (phase == _WEIGH) {
             // Weighing one record compares it with every live record: it costs ceil(m / pairs per unit)
@@ -1175,25 +1319,36 @@ contract InformationMarket {
                 return _pause(robot, next, escrow, rate * (units - budget));
             }
             phase = _PAY;
-            next = s.live;
         }
         uint256 bounty;
+        uint64 first = s.first;
+        uint64 live = s.live;
         if (phase != s.phase) {
-            // Paying starts: the work so far is paid from the escrow, then what the live records share
-            // is fixed.
+            // Paying starts, from the round trip's first record: the work so far is paid from the
+            // escrow, then what the records share is fixed. Each expired record is paid an equal part
+            // of the share, stake excluded (it went back to its seller), so a robot that waits for its
+            // records to expire before depositing pays the share all the same.
             bounty = rate * (units - budget);
             escrow -= bounty;
             s.amount = escrow;
-            if (phase == _EQUAL || _scheme == Scheme.Delayed) s.totalWeight = end - s.live;
+            if (phase == _EQUAL || _scheme == Scheme.Delayed) s.totalWeight = end - live;
+            if (live > first) s.perExpired = (escrow - (end - live) * _stake) / (end - first);
             s.phase = phase;
+            next = first;
         }
         uint256 amount = s.amount;
         uint256 total = s.totalWeight;
+        uint256 perExpired = live > first ? s.perExpired : 0;
+        uint256 liveAmount = amount - (live - first) * perExpired;
         bool equal = phase == _EQUAL || _scheme == Scheme.Delayed;
         while (next < end && budget > 0) {
             Information storage record = _records[robot][next];
-            uint256 weight = equal ? 1 : record.weight;
-            uint256 share = (amount * weight) / total;
+            uint256 weight;
+            uint256 share = perExpired;
+            if (next >= live) {
+                weight = equal ? 1 : record.weight;
+                share = (liveAmount * weight) / total;
+            }
             uint256 cut = rate < share ? rate : share;
             _balances[record.seller] += share - cut;
             escrow -= share;
@@ -1208,7 +1363,7 @@ contract InformationMarket {
             s.escrow = escrow;
             return false;
         }
-        return _finish(robot, escrow, s.live < end ? amount - escrow : 0, total);
+        return _finish(robot, escrow, first < end ? amount - escrow : 0, total);
     }
 
     /// @dev Stops a settlement call before paying: records where it stands and pays the bounty.

@@ -93,7 +93,7 @@ def test_the_chain_report_prints_every_amendment_and_deviation():
     md = chain_study.markdown(chain_study.answer(pd.DataFrame(columns=["experiment"])))
     for r in chain_study.DECLARATION.records():
         assert r.markdown() in md
-    assert md.count("- **Amendment, ") == 2 and md.count("- **Deviation, ") == 3
+    assert md.count("- **Amendment, ") == 2 and md.count("- **Deviation, ") == 4
 
 
 def test_the_shipped_records_are_printed_by_their_reports(paper_report):

@@ -5,8 +5,10 @@ check the contract against the rules themselves (within the rounding bound), not
 the contract's own integer arithmetic. Directions are compared in degrees, as the simulation does; the
 contract compares vectors, so tests build each vector from its direction (``vector_for``) far enough
 from Theta that the micro-unit rounding cannot matter. With ``expiry`` = T > 0 it also applies the
-stake-expiry rule: at ``advance(step)``, transactions opened at a step t with t + T <= step are
-dropped and their stakes returned.
+stake-expiry rule: at ``advance(step)``, transactions opened at a step t with t + T <= step leave
+the weighing and their stakes are returned; the buyer's next deposit pays each of them share / n (n:
+every transaction of the round trip, expired or not), and the live ones share the rest, share * live / n
+plus their stakes, by the scheme's weights.
 """
 from __future__ import annotations
 
@@ -46,12 +48,15 @@ class ExactLedger:
     balance: list[Fraction] = field(init=False)
     pot: list[Fraction] = field(init=False)
     open: list[list[tuple[int, int, Fraction, int]]] = field(init=False)
+    #: per buyer, the sellers of its round trip's expired transactions
+    expired: list[list[int]] = field(init=False)
     bound: list[int] = field(init=False)
 
     def __post_init__(self) -> None:
         self.balance = [self.initial] * self.robots
         self.pot = [Fraction(0)] * self.robots
         self.open = [[] for _ in range(self.robots)]
+        self.expired = [[] for _ in range(self.robots)]
         self.bound = [0] * self.robots
 
     def advance(self, step: int) -> None:
@@ -63,6 +68,7 @@ class ExactLedger:
             for seller, _, _, _ in txs[: len(txs) - len(keep)]:
                 self.balance[seller] += self.stake
                 self.pot[buyer] -= self.stake
+                self.expired[buyer].append(seller)
             self.open[buyer] = keep
 
     def purchase(self, buyer: int, seller: int, site: int, direction: Fraction, step: int = 0) -> bool:
@@ -76,9 +82,15 @@ class ExactLedger:
         return True
 
     def deposit(self, robot: int) -> None:
-        txs = self.open[robot]
+        txs, expired = self.open[robot], self.expired[robot]
         self.balance[robot] += self.reward + self.pot[robot]
-        amount = self.share * self.reward + self.pot[robot]
+        n = len(txs) + len(expired)
+        for seller in expired:
+            self.balance[seller] += self.share * self.reward / n
+            self.balance[robot] -= self.share * self.reward / n
+            self.bound[seller] += 1
+        self.bound[robot] += len(expired)
+        amount = self.share * self.reward * Fraction(len(txs), n or 1) + self.pot[robot]
         self.pot[robot] = Fraction(0)
         if txs:
             if self.scheme == "delayed":
@@ -99,3 +111,4 @@ class ExactLedger:
             self.balance[robot] -= amount
             self.bound[robot] += len(txs)
         self.open[robot] = []
+        self.expired[robot] = []

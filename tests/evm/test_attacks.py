@@ -281,12 +281,15 @@ def test_the_trip_bound_and_the_batch_bound_cannot_be_configured_away(make_marke
                                 ("registrar_quota", 0, "registrarQuota"), ("registrar_period", 0, "registrarPeriod"),
                                 # 512 * 15 units of the largest settlement at 65_105 units exceed the
                                 # 500_000_000 units of the share; 65_104 fit
-                                ("settle_bounty", 65_105, "settleBounty")):
+                                ("settle_bounty", 65_105, "settleBounty"),
+                                # a bond above the largest grant would let no one register
+                                ("registration_bond", 10**12 + 1, "registrationBond"), ("bond_delay", 0, "bondDelay")):
         with pytest.raises(ContractRevert) as info:
             make_market("outlier", **{option: value})
         assert info.value.name == "InfoMarketInvalidParameter"
         assert info.value.args_by_name == {"parameter": name.encode().ljust(32, b"\0"), "value": value}
     make_market("outlier", settle_bounty=65_104, wealth=0.0)
+    make_market("outlier", registration_bond=10**12, wealth=0.0)  # the whole largest grant: allowed
 
 
 def test_no_call_does_more_than_one_batch_of_work_whatever_it_asks(make_market, robots):
@@ -354,9 +357,10 @@ def test_the_market_grants_wealth_once_per_robot_and_within_its_cap(make_market,
     refused(lambda: market.grant_wealth(robots[0].address, 1), "InfoMarketAlreadyRegistered",
             robot=robots[0].address)
     newcomer = derived_account("newcomer", 0)
-    refused(lambda: market.grant_wealth(newcomer.address, 5_000_000_001), "InfoMarketGrantTooLarge",
+    # the client grants the free wealth asked plus the bond (1 token): the grant is what maxGrant caps
+    refused(lambda: market.grant_wealth(newcomer.address, 4_000_000_001), "InfoMarketGrantTooLarge",
             amount=5_000_000_001, limit=5_000_000_000)
-    market.grant_wealth(newcomer.address, 5_000_000_000)
+    market.grant_wealth(newcomer.address, 4_000_000_000)
     assert market.total_supply() == supply + 5_000_000_000
 
 

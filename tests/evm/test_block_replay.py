@@ -114,27 +114,27 @@ def test_a_reveal_the_branch_cannot_pay_fails_on_the_evm_too():
 
 
 def test_gas_is_billed_by_the_models_rule():
-    # gas price 1e-7: a reveal 1e-7 x 128 652 = 0.0128652 (docs/gas.md, reveal with staking; its sender's view
-    # set it aside), a deposit settling one record 1e-7 x 165 760 (outlier with staking, n = 1) = 0.016576
+    # gas price 1e-7: a reveal 1e-7 x 128 645 = 0.0128645 (docs/gas.md, reveal with staking; its sender's view
+    # set it aside), a deposit settling one record 1e-7 x 167 885 (outlier with staking, n = 1) = 0.0167885
     config = _tiny(gas_price=1e-7)
-    assert table_gas(np.array([1.0, 4.0]), np.array([165_760.0, 215_575.0]), 1.0) == 165_760
+    assert table_gas(np.array([1.0, 4.0]), np.array([167_885.0, 217_803.0]), 1.0) == 167_885
     blocks = [_block(0, [], [1.0, 1.0]),
-              _block(1, [_reveal(0, 1, gas=0.0128652)], [1.0 - 0.04 - 0.0128652, 1.0]),
+              _block(1, [_reveal(0, 1, gas=0.0128645)], [1.0 - 0.04 - 0.0128645, 1.0]),
               # buyer: +1 reward +0.04 pot -(0.5 + 0.04) to the seller, then the deposit's gas
-              _block(2, [_deposit(1, 2)], [0.9471348 + 0.54, 1.5 - 0.016576])]
+              _block(2, [_deposit(1, 2)], [0.9471355 + 0.54, 1.5 - 0.0167885])]
     report = replay_blocks(blocks, {0: _event(0, 1)}, config)
     assert report.ok, report.first_mismatch
-    assert report.model_deposit_gas == [165_760] and report.model_reveal_gas == [pytest.approx(128_652)]
+    assert report.model_deposit_gas == [167_885] and report.model_reveal_gas == [pytest.approx(128_645)]
     # without the deposit's gas in the modelled ledger the buyer differs at block 2
-    free = [*blocks[:2], _block(2, blocks[2].txs, [0.9471348 + 0.54, 1.5])]
+    free = [*blocks[:2], _block(2, blocks[2].txs, [0.9471355 + 0.54, 1.5])]
     m = replay_blocks(free, {0: _event(0, 1)}, config).first_mismatch
-    assert (m.height, m.robot) == (2, 1) and m.diff_units == pytest.approx(-16_576_000, abs=1)
+    assert (m.height, m.robot) == (2, 1) and m.diff_units == pytest.approx(-16_788_500, abs=1)
 
 
 def test_a_reveal_the_models_gas_check_refuses_is_not_sent():
-    # wealth 0.045 covers the stake (0.04) but not stake + gas (0.0528652): the model fails the reveal
+    # wealth 0.045 covers the stake (0.04) but not stake + gas (0.0528645): the model fails the reveal
     config = _tiny(gas_price=1e-7, wealth=0.045)
-    blocks = [_block(0, [], [0.045, 0.045]), _block(1, [_reveal(0, 1, gas=0.0128652)], [0.045, 0.045])]
+    blocks = [_block(0, [], [0.045, 0.045]), _block(1, [_reveal(0, 1, gas=0.0128645)], [0.045, 0.045])]
     report = replay_blocks(blocks, {0: _event(0, 1)}, config)
     assert report.ok and report.gas_refused == 1 and report.reveals == 0
 

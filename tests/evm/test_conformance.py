@@ -93,6 +93,27 @@ DISTINCT_CASES = [
 ]
 
 
+#: Robot 0 buys from 1 (10 degrees) and 2 (15) at step 1, from 3 (20), 4 (25) and 5 (100) at step 6, and
+#: deposits at step 6 (stake expiry 5: the first two expired at the start of step 6) or at step 20 (all
+#: five expired). Every record of the round trip is paid: an expired one share / 5 = 0.1 (its stake went
+#: back), the live ones 0.5 * 3 / 5 = 0.3 plus their stakes by weight; 20 and 25 degrees agree (2
+#: similar records, or 2 distinct sellers), 100 is alone (1): 2/5, 2/5, 1/5. The buyer gains 0.5 either way.
+_LATE = [purchase(1, 0, 1, 0, 10.0, 0), purchase(1, 0, 2, 0, 15.0, 1), purchase(6, 0, 3, 0, 20.0, 2),
+         purchase(6, 0, 4, 0, 25.0, 3), purchase(6, 0, 5, 0, 100.0, 4)]
+
+
+def _late(scheme, stake, weights):
+    live = [1 - stake + (F(3, 10) + 3 * stake) * w for w in weights]
+    return [(scheme, _LATE + [deposit(6, 0)], [F(3, 2), F(11, 10), F(11, 10), *live]),
+            (scheme, _LATE + [deposit(20, 0)], [F(3, 2)] + [F(11, 10)] * 5)]
+
+
+LATE_CASES = [*_late("delayed", 0, [F(1, 3)] * 3), *_late("outlier", 0, [F(2, 5), F(2, 5), F(1, 5)]),
+              *_late("outlier+stake", F(1, 25), [F(2, 5), F(2, 5), F(1, 5)]),
+              *_late("distinct", 0, [F(2, 5), F(2, 5), F(1, 5)]),
+              *_late("distinct+stake", F(1, 25), [F(2, 5), F(2, 5), F(1, 5)])]
+
+
 def exact_run(robots, scheme, wealth, expiry, events) -> tuple[ExactLedger, list[bool]]:
     """The rational model, and whether each purchase is accepted (the simulation decides refusals:
     the event kinds fed to the ledgers are taken from this model, as the simulator's log would be)."""
@@ -146,6 +167,19 @@ class LedgerConformance:
         shares = sum(1 for e in events if e["kind"] == "purchase")
         for i, value in enumerate(expected):
             assert balances[i] == pytest.approx(float(value), abs=self.tolerance(shares) + 1e-9), i
+
+    @pytest.mark.parametrize(("scheme", "events", "expected"), LATE_CASES,
+                             ids=[f"{c[0]}-{c[1][-1]['step']}" for c in LATE_CASES])
+    def test_a_late_deposit_pays_every_record_by_hand(self, scheme, events, expected):
+        """Shared hand-computed cases of stake expiry: a deposit after some or all records expired."""
+        if self.expiries == (0,):
+            pytest.skip("this ledger replays one block per transaction: no stake expiry")
+        events = [dict(e) for e in events]
+        balances = self.run(len(expected), scheme, 1.0, 5, events)
+        for i, value in enumerate(expected):
+            assert balances[i] == pytest.approx(float(value), abs=self.tolerance(5) + 1e-9), i
+        exact, _ = exact_run(len(expected), scheme, 1.0, 5, [dict(e) for e in events])
+        assert exact.balance == expected  # the rational model, checked by hand here too
 
     def test_random_event_sequences_agree_with_the_exact_model(self):
         @settings(max_examples=self.examples, deadline=None, derandomize=True,

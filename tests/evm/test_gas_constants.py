@@ -54,16 +54,16 @@ def test_each_scheme_is_charged_its_own_table(scheme, stake, heading):
 
 
 def test_the_deposit_rule_interpolates_and_stops_at_the_bound():
-    """outlier + staking: n = 384 is halfway between n = 256 (80 237 542) and n = 512 (419 122 911):
-    249 680 226.5; beyond 512 (the contract refuses the reveals) the 512 figure; n = 0 the n = 1 figure;
-    n = 10 halfway between n = 4 (215 575) and n = 16 (546 425)."""
+    """outlier + staking: n = 384 is halfway between n = 256 (80 253 716) and n = 512 (419 152 439):
+    249 703 077.5; beyond 512 (the contract refuses the reveals) the 512 figure; n = 0 the n = 1 figure;
+    n = 10 halfway between n = 4 (217 803) and n = 16 (549 726)."""
     xs = np.asarray(gas.GAS_DEPOSIT_N, float)
     ys = np.asarray(gas.GAS_DEPOSIT["outlier + staking"], float)
-    assert gas.table_gas(xs, ys, 384.0) == pytest.approx(249_680_226.5)
-    assert gas.table_gas(xs, ys, 512.0) == 419_122_911
-    assert gas.table_gas(xs, ys, 2000.0) == 419_122_911
-    assert gas.table_gas(xs, ys, 0.0) == 165_760
-    assert gas.table_gas(xs, ys, 10.0) == pytest.approx((215_575 + 546_425) / 2)
+    assert gas.table_gas(xs, ys, 384.0) == pytest.approx(249_703_077.5)
+    assert gas.table_gas(xs, ys, 512.0) == 419_152_439
+    assert gas.table_gas(xs, ys, 2000.0) == 419_152_439
+    assert gas.table_gas(xs, ys, 0.0) == 167_885
+    assert gas.table_gas(xs, ys, 10.0) == pytest.approx((217_803 + 549_726) / 2)
 
 
 def test_the_report_prints_the_constants_it_was_rendered_from():

@@ -55,7 +55,8 @@ def test_buy_item_without_records_pays_only_the_reward(make_market, robots):
     result = market.buy_item(robots[3].address)
     assert result.of("ItemBought") == [{"robot": robots[3].address, "reward": TOKEN_UNIT, "pot": 0, "transactions": 0}]
     assert market.balance_of(robots[3].address) == 2 * TOKEN_UNIT
-    assert market.total_supply() == len(robots) * TOKEN_UNIT + TOKEN_UNIT
+    # every robot was granted one token of free wealth and its bond (locked), then one reward
+    assert market.total_supply() == len(robots) * (TOKEN_UNIT + market.bond) + TOKEN_UNIT
     assert market.pending_settlement(robots[3].address) == (False, 0, 0)
 
 
@@ -139,7 +140,7 @@ def test_a_long_round_trip_settles_across_transactions_and_pays_what_the_rules_s
     for i, account in enumerate(robots):
         gap = market.balance_of(account.address) - exact.balance[i] * TOKEN_UNIT
         assert abs(gap) < max(exact.bound[i], 1)
-    assert market.total_supply() == sum(market.balance_of(a.address) for a in robots)
+    assert market.total_supply() == sum(market.balance_of(a.address) + market.bond_of(a.address) for a in robots)
 
 
 def test_a_pending_settlement_blocks_the_next_deposit_until_settled(make_market, robots):
@@ -181,12 +182,12 @@ def test_a_robot_that_dies_mid_trip_strands_nobodys_stake(make_market, robots):
     assert market.locked_stake(dead.address) == 0
     assert [market.balance_of(robots[k].address) for k in (1, 2, 3)] == [TOKEN_UNIT] * 3
     assert market.contributors(dead.address) == []
-    assert market.total_supply() == sum(market.balance_of(a.address) for a in robots)
+    assert market.total_supply() == sum(market.balance_of(a.address) + market.bond_of(a.address) for a in robots)
 
 
-def test_settlement_drops_expired_records_whether_or_not_anyone_refunded_them(make_market, robots):
-    """Deposit at block t + T: the record opened at t is expired (refund, no share), the one opened
-    at t + 1 still shares the reward with everything it carries."""
+def test_settlement_refunds_expired_records_whether_or_not_anyone_refunded_them(make_market, robots):
+    """Deposit at block t + T: the record opened at t is expired (its stake back, not weighed, paid
+    0.5 / 2 of the share), the one opened at t + 1 shares the rest, 0.5 / 2, with the pot."""
     market = make_market("outlier", stake=0.04, stake_expiry=5)
     buyer = robots[0]
     first = sell(market, robots[1], buyer, FOOD, 10.0)[0].block_number
@@ -197,9 +198,9 @@ def test_settlement_drops_expired_records_whether_or_not_anyone_refunded_them(ma
     (expired,) = [e for r in results for e in r.of("RecordExpired")]
     assert (expired["seller"], expired["amount"]) == (robots[1].address, 40_000_000)
     assert [(e["seller"], e["weight"], e["amount"]) for e in shares_of(results)] == [
-        (robots[2].address, 1, 500_000_000 + 40_000_000)]
-    assert market.balance_of(robots[1].address) == TOKEN_UNIT
-    assert market.balance_of(robots[2].address) == TOKEN_UNIT + 500_000_000
+        (robots[1].address, 0, 250_000_000), (robots[2].address, 1, 250_000_000 + 40_000_000)]
+    assert market.balance_of(robots[1].address) == TOKEN_UNIT + 250_000_000
+    assert market.balance_of(robots[2].address) == TOKEN_UNIT + 250_000_000
     assert market.balance_of(buyer.address) == TOKEN_UNIT + 500_000_000
 
 
@@ -288,4 +289,5 @@ def test_contract_reproduces_the_original_simulators_payments(case, vector_marke
             assert -max(exact.bound[i], 1) < gap <= 0
         assert abs(chain[i] - expected * TOKEN_UNIT) <= exact.bound[i] + FLOAT_SLACK_UNITS
     pots = sum(market.locked_stake(robots[i].address) for i in range(n))
-    assert sum(chain) + pots == market.total_supply() == to_units(case["initial_wealth"]) * n + TOKEN_UNIT
+    bonds = sum(market.bond_of(a.address) for a in robots)  # every robot registered, each locked its bond
+    assert sum(chain) + pots + bonds == market.total_supply() == to_units(case["initial_wealth"]) * n + TOKEN_UNIT + bonds

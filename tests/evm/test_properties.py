@@ -2,7 +2,8 @@
 
 For random sequences (random buyers, sellers, sites, directions, schemes, and initial wealth small
 enough that stakes get refused), after every operation:
-- every token is accounted for: balances + locked stakes == totalSupply == wealth granted + rewards;
+- every token is accounted for: balances + locked stakes + bonds == totalSupply == wealth granted +
+  rewards;
 - the contract accepts exactly the sales the model accepts (a refused one fails with
   InfoMarketInsufficientStake, never with an arithmetic panic), so no balance is ever driven below 0;
 - every balance is within its rounding bound of the exact rational model (tests/evm/exact_ledger.py).
@@ -72,7 +73,8 @@ def test_random_sequences_conserve_supply_and_never_go_negative(deployed, robots
 
         balances = [market.balance_of(r.address) for r in robots[:N]]
         pots = [market.locked_stake(r.address) for r in robots[:N]]
-        assert sum(balances) + sum(pots) == market.total_supply() == minted
+        bonds = sum(market.bond_of(r.address) for r in robots)  # every robot registered, each bonded
+        assert sum(balances) + sum(pots) + bonds == market.total_supply() == minted + bonds
         assert pots == [to_units(float(p)) for p in exact.pot]
         for i in range(N):
             assert exact.balance[i] >= 0

@@ -54,7 +54,7 @@ class Twin:
         self.markets = [ChainMarket(b, ref_address, owner, artifact["abi"], registrars=[owner], nest=owner)
                         for b in (self.ref, self.fast)]
         for account, amount in zip(self.sellers + self.buyers, wealth):
-            self.tx("grantWealth", None, account.address, to_units(amount))
+            self.tx("grantWealth", None, account.address, to_units(amount) + params.registration_bond)
 
     def _align(self) -> None:
         self.fast.advance_to(self.ref.block_number)
@@ -148,7 +148,7 @@ def test_every_kind_of_transaction_costs_the_same_gas_on_revm_as_on_py_evm(schem
 def test_a_large_round_trip_settles_at_the_same_gas_on_revm():
     """A round trip of 120 records, every pair similar (the weighing's worst case): buyItem and every
     settle call load all live records; their gas grows with the cold loads, which revm must charge."""
-    twin = Twin("large", "outlier_distinct", 0.04, [1000.0] * SELLERS + [0.0, 0.0])
+    twin = Twin("large", "outlier_distinct", 0.04, [100.0] * SELLERS + [0.0, 0.0])
     buyer = twin.buyers[0]
     for k in range(120):
         twin.sell(twin.sellers[k % SELLERS], buyer, k, 5.0 + (k % 7))
@@ -208,3 +208,16 @@ def test_transient_storage_does_not_outlive_its_transaction(backend):
     address, _ = chain.deploy(deployer, init)
     logged = [chain.transact(deployer, address, b"").logs for _ in range(3)]
     assert [[int.from_bytes(lg.data, "big") for lg in logs] for logs in logged] == [[0], [0], [0]]
+
+
+def test_an_exit_a_bond_withdrawal_and_a_revocation_cost_the_same_gas_on_revm():
+    twin = Twin("bond", "outlier", 0.04, [1.0] * SELLERS + [0.0, 0.0], bond_delay=3)
+    leaving, revoked = twin.sellers[:2]
+    twin.tx("exit", leaving, label="exit")
+    twin.advance(3)
+    twin.tx("withdrawBond", None, leaving.address, label="withdrawBond")
+    twin.tx("revokeRegistration", None, revoked.address, label="revokeRegistration")  # the one registrar
+    twin.assert_same_state()
+    twin.assert_same_gas()
+    assert [what for what, *_ in twin.gas][-3:] == ["exit", "withdrawBond", "revokeRegistration"]
+    assert twin.markets[1].total_supply() == twin.markets[0].total_supply()

@@ -365,24 +365,24 @@ def test_money_is_conserved_on_every_branch_of_a_forking_swarm():
 # ---- gas -------------------------------------------------------------------------------------------------
 
 def test_gas_is_charged_exactly():
-    """Gas price 1e-7, delayed payment, backbone, P = 1.  Robot 0 sells to robot 1 (a reveal: 115 342 gas,
-    docs/gas.md), then robot 1 deposits (settling 1 reveal: 153 856 gas).  Seller: 1 - 0.0115342 + 0.5;
-    buyer: 1 + 1 - 0.5 - 0.0153856."""
+    """Gas price 1e-7, delayed payment, backbone, P = 1.  Robot 0 sells to robot 1 (a reveal: 115 335 gas,
+    docs/gas.md), then robot 1 deposits (settling 1 reveal: 155 967 gas).  Seller: 1 - 0.0115335 + 0.5;
+    buyer: 1 + 1 - 0.5 - 0.0155967."""
     sim = im.Simulation(_config(2, period=1, backbone=True, gas_price=1e-7), 1)
     _place(sim, [(100.0, 100.0), (130.0, 100.0)])
     w = sim.world
     assert bool(mempool.reveal(sim._view, 1, 0, 0, 45.0))
-    assert w.view_avail[0] == pytest.approx(1.0 - 0.0115342, abs=1e-15)
+    assert w.view_avail[0] == pytest.approx(1.0 - 0.0115335, abs=1e-15)
     sim.step(1)
-    assert w.balance.tolist() == pytest.approx([1.0 - 0.0115342, 1.0], abs=1e-15)
+    assert w.balance.tolist() == pytest.approx([1.0 - 0.0115335, 1.0], abs=1e-15)
     _deposit(sim, 1)
     sim.step(1)
-    assert w.balance.tolist() == pytest.approx([1.0 - 0.0115342 + 0.5, 1.0 + 1.0 - 0.5 - 0.0153856], abs=1e-12)
-    assert w.gas_paid.tolist() == pytest.approx([0.0115342, 0.0153856], abs=1e-15)
+    assert w.balance.tolist() == pytest.approx([1.0 - 0.0115335 + 0.5, 1.0 + 1.0 - 0.5 - 0.0155967], abs=1e-12)
+    assert w.gas_paid.tolist() == pytest.approx([0.0115335, 0.0155967], abs=1e-15)
 
 
 def test_a_seller_whose_view_cannot_pay_the_gas_is_refused():
-    """Gas price 5e-6: a reveal costs 0.57671 (115 342 gas), so a seller holding 1 can sign one light
+    """Gas price 5e-6: a reveal costs 0.576675 (115 335 gas), so a seller holding 1 can sign one light
     contract but not a second before a block confirms anything."""
     sim = im.Simulation(_config(2, period=1000, gas_price=5e-6), 1)
     assert bool(mempool.reveal(sim._view, 1, 0, 0, 45.0))
@@ -390,13 +390,13 @@ def test_a_seller_whose_view_cannot_pay_the_gas_is_refused():
 
 
 def test_the_deposit_gas_table_interpolates_the_measured_points():
-    """Delayed payment (docs/gas.md): between the measured n = 4 (179 593) and n = 16 (282 592), n = 10 is
-    halfway, 231 092.5; n = 0 costs n = 1's 153 856; beyond the contract's bound of 512 records, 512's
-    4 473 377."""
+    """Delayed payment (docs/gas.md): between the measured n = 4 (181 808) and n = 16 (285 219), n = 10 is
+    halfway, 233 513.5; n = 0 costs n = 1's 155 967; beyond the contract's bound of 512 records, 512's
+    4 502 649."""
     sim = im.Simulation(_config(2, period=1000), 1)
-    assert blocks.deposit_gas(sim._view, 10.0) == pytest.approx(231_092.5)
-    assert blocks.deposit_gas(sim._view, 0.0) == 153_856.0
-    assert blocks.deposit_gas(sim._view, 1024.0) == 4_473_377.0
+    assert blocks.deposit_gas(sim._view, 10.0) == pytest.approx(233_513.5)
+    assert blocks.deposit_gas(sim._view, 0.0) == 155_967.0
+    assert blocks.deposit_gas(sim._view, 1024.0) == 4_502_649.0
 
 
 # ---- the instant ledger is the chain's limit ---------------------------------------------------------------

@@ -35,7 +35,7 @@ CASES = {
 
 EXPECTED = {
     'fig4C poa period 5': 'ed0faa5218c583a8e9ff046c8a6ae642b76959ebfc3232180919cf4d8e08d15b',
-    'fig4C poa period 3 loss 0.2 gas finality 8': '4f257b9420b7542c1ac55a6b20e3eac98a6301efe27c990c96804d43c8c15078',
+    'fig4C poa period 3 loss 0.2 gas finality 8': '1cb54ffc632353e805e99a3d81db2873363c182e7ee079409d7e5453a0ed5ed1',
     'fig4C poa period 2 backbone latency 3 signers': '8ff45543e4362df856d6b68ed86013af9d5eef676cbabdf1e0f0e799bdc3a121',
 }
 

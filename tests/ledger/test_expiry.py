@@ -23,10 +23,11 @@ def test_no_stake_stays_locked_longer_than_the_bound():
         w = sim.world
         for i in range(25):
             a, k = int(w.tx_off[i]), int(w.tx_count[i])
-            if k:
-                age = int(w.clock[0]) - int(w.tx_step[a:a + k].min())
+            locked = w.tx_stake[a:a + k] > 0.0
+            if locked.any():
+                age = int(w.clock[0]) - int(w.tx_step[a:a + k][locked].min())
                 oldest_seen = max(oldest_seen, age)
-                assert age < T  # opened at t, gone at the start of step t + T
+                assert age < T  # opened at t, its stake back at the start of step t + T
             # a pot holds exactly the stakes of the buyer's open transactions
             assert w.pot[i] == pytest.approx(float(w.tx_stake[a:a + k].sum()), abs=1e-12)
     assert oldest_seen > T // 2  # purchases did stay open long enough for the rule to matter
@@ -46,12 +47,18 @@ def test_expiry_changes_nothing_until_a_stake_would_expire():
     assert not np.array_equal(a.world.balance, c.world.balance)  # with a short bound, stakes came back
 
 
-def test_expired_transactions_leave_the_round_trip_in_order():
+def test_expired_transactions_stay_in_the_round_trip_in_order_without_their_stakes():
+    """They are paid an equal part of the share at the deposit (tests/evm/test_conformance.py)."""
     sim, _ = _run(30)
     sim.step(1500)
     w = sim.world
+    expired = 0
     for i in range(25):
         sellers, sites, directions = open_transactions(w, i)
         a, k = int(w.tx_off[i]), int(w.tx_count[i])
-        steps = w.tx_step[a:a + k]
-        assert (np.diff(steps) >= 0).all() and (steps > int(w.clock[0]) - 30).all()
+        steps, stakes = w.tx_step[a:a + k], w.tx_stake[a:a + k]
+        old = steps <= int(w.clock[0]) - 30
+        assert (np.diff(steps) >= 0).all() and len(sellers) == k
+        assert (stakes[old] == 0.0).all() and (stakes[~old] > 0.0).all()
+        expired += int(old.sum())
+    assert expired > 0  # the rule was exercised

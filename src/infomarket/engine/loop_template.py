@@ -24,7 +24,7 @@ from numba import njit
 
 from infomarket.engine.step import record_history, variant
 from infomarket.ledger.backends import operations
-from infomarket.ledger.kernels import burn_fuel, distribute, expire_stakes, settlement
+from infomarket.ledger.kernels import burn_fuel, distribute, expire_stakes, live_count, settlement
 from infomarket.ledger.poa.lists import keep_weights, weighed_before, weights_of
 from infomarket.state.view import unlock
 
@@ -77,7 +77,7 @@ def settle(w, i, rng):
         if weighed_before(w, i):
             distribute(w, i, weights_of(w, i))
             return
-    weights = np.zeros(w.tx_count[i])
+    weights = np.zeros(live_count(w, i))
     weigh(w, i, weights, rng)
     if POA:
         keep_weights(w, i, weights)

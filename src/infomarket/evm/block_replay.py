@@ -135,7 +135,7 @@ def replay_blocks(blocks, purchase_of: dict, config, *, seed: int = 0, backend: 
     bound = [0] * robots
     gas_bill = [0.0] * robots        # money the model burned from each robot as gas, so far
     open_sellers: list[list[int]] = [[] for _ in range(robots)]
-    minted = wealth * robots
+    minted = (wealth + market.bond) * robots
 
     def balance(i: int) -> int:
         return market.balance_of(accounts[i].address)
@@ -190,6 +190,7 @@ def replay_blocks(blocks, purchase_of: dict, config, *, seed: int = 0, backend: 
 
 
 def _finish(report: BlockReplayReport, market, accounts, minted: int) -> BlockReplayReport:
-    held = sum(market.balance_of(a.address) + market.locked_stake(a.address) for a in accounts)
+    held = sum(market.balance_of(a.address) + market.locked_stake(a.address) + market.bond_of(a.address)
+               for a in accounts)
     report.conserved = held == market.total_supply() == minted
     return report

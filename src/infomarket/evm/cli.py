@@ -242,7 +242,7 @@ def _report_text(report, rows) -> str:
         f"  refusals confirmed      {s['refusals_confirmed']}",
         f"  records expired         {s['expired']}",
         f"  money conserved         {'yes' if report.conserved() else 'NO'} "
-        f"(supply {report.total_supply / 1e9:.9f} = balances + locked stakes)",
+        f"(supply {report.total_supply / 1e9:.9f} = balances + locked stakes and bonds)",
         "  robot   on chain        simulated       diff (units)  bound",
     ]
     lines += [f"  {r.robot:5d}   {r.chain_units / 1e9:13.9f}   {r.expected:13.9f}   {r.diff_units:11.3f}  "

@@ -72,6 +72,8 @@ class ReplayReport:
     rounding_bound: list[int] = field(default_factory=list)
     total_supply: int = 0
     minted: int = 0
+    #: the robots' registration bonds, locked (part of what was minted)
+    bonds: int = 0
 
     @property
     def items(self) -> int:
@@ -88,7 +90,7 @@ class ReplayReport:
 
     def conserved(self) -> bool:
         """Money on chain is exactly what was granted plus the rewards: nothing created or lost."""
-        return sum(self.balances) + sum(self.pots) == self.total_supply == self.minted
+        return sum(self.balances) + sum(self.pots) + self.bonds == self.total_supply == self.minted
 
     def compare(self, expected: Sequence[float]) -> list[BalanceRow]:
         """Each robot's on-chain balance against ``expected`` (the simulated ledger's, in tokens)."""
@@ -142,7 +144,7 @@ def replay_on_chain(events: Iterable[Mapping] | object, *, robots: int, params: 
     chain.advance_to(base)
 
     report = ReplayReport(robots, first_block=chain.block_number, rounding_bound=[0] * robots,
-                          minted=wealth * robots)
+                          minted=(wealth + market.bond) * robots)
     open_steps: list[list[tuple[int, int]]] = [[] for _ in range(robots)]  # (step, seller) per open record
     step = None
     for number, ev in enumerate(records):
@@ -197,6 +199,7 @@ def replay_on_chain(events: Iterable[Mapping] | object, *, robots: int, params: 
     report.balances = [market.balance_of(a.address) for a in accounts]
     report.pots = [market.locked_stake(a.address) for a in accounts]
     report.total_supply = market.total_supply()
+    report.bonds = sum(market.bond_of(a.address) for a in accounts)
     report.backend = chain.name
     report.cold_storage = chain.cold_storage
     return report

@@ -109,7 +109,7 @@ def _market(scheme: str, backend, seed: int, buyers: int, sellers: int = SELLERS
     buyer_accounts = [derived_account("gas-buyer", i, seed) for i in range(buyers)]
     backend.fund([a.address for a in sellers + buyer_accounts])
     for s in sellers:
-        market.grant_wealth(s, to_units(1000.0))
+        market.grant_wealth(s, to_units(100.0))
     for b in buyer_accounts:
         market.grant_wealth(b, 0)  # registers the buyer
     return market, sellers, buyer_accounts

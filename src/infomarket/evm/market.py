@@ -67,6 +67,12 @@ DEFAULT_REGISTRARS = 3
 DEFAULT_REGISTRAR_THRESHOLD = 2
 DEFAULT_REGISTRAR_QUOTA = 32
 DEFAULT_REGISTRAR_PERIOD = 5_000
+#: The bond every registration locks out of the robot's grant, 1e-9 units (one token: a robot's whole
+#: initial wealth in the paper's runs), and the blocks between a robot's exit and the bond's return
+#: (a registrar period: the registrars' window to revoke it, which burns the bond). docs/chain.md,
+#: "Trust model", states what 8 bonded identities cost a cartel against what it takes.
+DEFAULT_REGISTRATION_BOND = 10**9
+DEFAULT_BOND_DELAY = 5_000
 #: The settlement bounty per unit of work is the reward's share divided by this: the bounty of the
 #: largest settlement (512 records, 7 680 units) is at most 15 % of the share.
 SETTLE_BOUNTY_DIVISOR = 50_000
@@ -110,6 +116,8 @@ class MarketParams:
     registrar_period: int = DEFAULT_REGISTRAR_PERIOD
     #: per unit of settlement work, 1e-9 units; None: the share over ``SETTLE_BOUNTY_DIVISOR``
     settle_bounty: int | None = None
+    registration_bond: int = DEFAULT_REGISTRATION_BOND
+    bond_delay: int = DEFAULT_BOND_DELAY
 
     @property
     def bounty(self) -> int:
@@ -138,7 +146,8 @@ class MarketParams:
         return (market, SCHEMES[self.scheme], self.reward, self.information_share, self.stake,
                 self.cos_theta, self.stake_expiry, self.max_records_per_seller, self.max_records_per_trip,
                 self.max_validity, self.settle_batch, self.settlement_deadline, self.max_grant, registrars,
-                self.registrar_threshold, self.registrar_quota, self.registrar_period, nest, self.bounty)
+                self.registrar_threshold, self.registrar_quota, self.registrar_period, nest, self.bounty,
+                self.registration_bond, self.bond_delay)
 
 
 class Event(NamedTuple):
@@ -225,12 +234,14 @@ class ChainMarket:
 
     def __init__(self, backend, address: str, market: LocalAccount, abi: list | None = None, *,
                  registrars: list[LocalAccount] = (), threshold: int = 1, nest: LocalAccount | None = None,
-                 max_acceptances_per_trip: int = DEFAULT_MAX_ACCEPTANCES_PER_TRIP,
+                 bond: int = 0, max_acceptances_per_trip: int = DEFAULT_MAX_ACCEPTANCES_PER_TRIP,
                  max_acceptances_per_seller: int = DEFAULT_MAX_ACCEPTANCES_PER_SELLER):
         self.backend = backend
         self.market = market
         self.registrars = list(registrars) or [market]
         self.threshold = threshold
+        #: the bond a registration locks (``grant_wealth`` grants it on top of the wealth it gives)
+        self.bond = bond
         self.nest = nest or market
         self.address = to_checksum_address(address)
         self.codec = _Codec(abi or load_artifact()["abi"])
@@ -263,16 +274,31 @@ class ChainMarket:
         except RevertedCall as exc:
             raise codec.refusal(exc.data) or exc from exc
         return cls(backend, address, market, artifact["abi"], registrars=registrars,
-                   threshold=params.registrar_threshold, nest=nest,
+                   threshold=params.registrar_threshold, nest=nest, bond=params.registration_bond,
                    max_acceptances_per_seller=8 * params.max_records_per_seller)
 
     # -- transactions -------------------------------------------------------------------------------
 
     def grant_wealth(self, robot: Robot, amount: int) -> TxResult:
-        """Register ``robot`` with ``amount`` units of initial wealth: the first ``threshold``
-        registrars approve it; the last approval's result (which registers it) is returned."""
+        """Register ``robot`` with ``amount`` units of initial (free) wealth: the first ``threshold``
+        registrars approve a grant of ``amount`` plus the bond, which the registration locks; the last
+        approval's result (which registers it) is returned."""
         address = self._remember(robot)
-        results = [self.approve(registrar, address, amount) for registrar in self.registrars[:self.threshold]]
+        grant = amount + self.bond
+        results = [self.approve(registrar, address, grant) for registrar in self.registrars[:self.threshold]]
+        return results[-1]
+
+    def exit(self, robot: LocalAccount) -> TxResult:
+        """``robot`` leaves the market; its bond comes back after the bond delay (``withdraw_bond``)."""
+        return self.transact(robot, "exit")
+
+    def withdraw_bond(self, robot: str, sender: LocalAccount | None = None) -> TxResult:
+        return self.transact(sender or self.market, "withdrawBond", robot)
+
+    def revoke(self, robot: str, registrars: list[LocalAccount] | None = None) -> TxResult:
+        """The first ``threshold`` registrars (or ``registrars``) revoke ``robot``: its bond is burned."""
+        results = [self.transact(r, "revokeRegistration", robot)
+                   for r in (registrars if registrars is not None else self.registrars[:self.threshold])]
         return results[-1]
 
     def approve(self, registrar: LocalAccount, robot: str, amount: int) -> TxResult:
@@ -422,6 +448,9 @@ class ChainMarket:
 
     def total_supply(self) -> int:
         return self.view("totalSupply")
+
+    def bond_of(self, robot: str) -> int:
+        return self.view("bondOf", robot)
 
     def round_trip(self, buyer: str) -> int:
         """The buyer's open round trip (what its acceptances name)."""

@@ -16,19 +16,19 @@ from numba import njit
 #: calls) by the number of reveals it settles, GAS_DEPOSIT_N ("deposit, later trips": the steady state of
 #: a running swarm).  The last size is the contract's bound of live records per round trip.
 GAS_REVEAL = {
-    "delayed": 115_342,
-    "outlier": 115_341,
-    "outlier + staking": 128_652,
-    "outlier_distinct": 115_343,
-    "outlier_distinct + staking": 128_655,
+    "delayed": 115_335,
+    "outlier": 115_335,
+    "outlier + staking": 128_645,
+    "outlier_distinct": 115_338,
+    "outlier_distinct + staking": 128_646,
 }
 GAS_DEPOSIT_N = (1, 4, 16, 64, 128, 256, 512)
 GAS_DEPOSIT = {
-    "delayed": (153_856, 179_593, 282_592, 747_580, 1_245_533, 2_360_156, 4_473_377),
-    "outlier": (163_520, 213_335, 548_425, 4_657_410, 17_832_915, 80_239_542, 419_124_911),
-    "outlier + staking": (165_760, 215_575, 546_425, 4_655_410, 17_830_915, 80_237_542, 419_122_911),
-    "outlier_distinct": (164_767, 222_099, 669_344, 4_736_283, 18_962_603, 98_892_425, 629_538_919),
-    "outlier_distinct + staking": (167_007, 224_339, 667_344, 4_734_283, 18_960_603, 98_890_425, 629_536_919),
+    "delayed": (155_967, 181_808, 285_219, 753_394, 1_254_565, 2_376_090, 4_502_649),
+    "outlier": (165_645, 215_563, 551_726, 4_663_256, 17_842_035, 80_255_716, 419_154_439),
+    "outlier + staking": (167_885, 217_803, 549_726, 4_661_256, 17_840_035, 80_253_716, 419_152_439),
+    "outlier_distinct": (166_892, 224_327, 672_645, 4_742_140, 18_972_220, 98_908_486, 629_566_432),
+    "outlier_distinct + staking": (169_132, 226_567, 670_645, 4_740_140, 18_970_220, 98_906_486, 629_564_432),
 }
 
 

@@ -19,7 +19,6 @@ from ..state.view import unlock
 from .instant import open_transaction as instant_open
 from .poa.mempool import reveal as poa_reveal
 from .poa.spec import runs_poa
-from .pool import move_transaction
 #: A settled sale counts as an outlier in its seller's reputation record when the scheme weighed it
 #: below this fraction of the best weight given to the same site in that settlement (or 0).  Half, not
 #: "below the best": with outlier penalisation honest sales weigh anywhere near the best (drift spreads
@@ -85,34 +84,51 @@ def _open_transaction(w, buyer, seller, site, direction):
     return lambda w, buyer, seller, site, direction: instant_open(w, buyer, seller, site, direction)
 
 
-@njit
-def expire_stakes(w, buyer):
-    """The stake-expiry rule (docs/chain.md): at the start of step s, each open transaction of the
-    buyer opened at a step t with t + stake_expiry <= s gives its stake back to its seller and leaves
-    the round trip.  Transactions are in step order, so the expired ones are a prefix."""
+@njit(inline="always")
+def expired_count(w, buyer):
+    """How many of the buyer's open transactions have expired (0 without stake expiry): those opened at
+    a step t with t + stake_expiry <= now.  Transactions are in step order, so they are a prefix."""
+    if w.stake_expiry <= 0:
+        return 0
     k = w.tx_count[buyer]
     a = w.tx_off[buyer]
     now = w.clock[0]
     m = 0
     while m < k and w.tx_step[a + m] + w.stake_expiry <= now:
         m += 1
-    if m == 0:
-        return
-    balance, money, pot = unlock(w.balance), unlock(w.money), unlock(w.pot)
-    for x in range(m):
-        balance[w.tx_seller[a + x]] += w.tx_stake[a + x]
-        money[0] += w.tx_stake[a + x]
-        pot[buyer] -= w.tx_stake[a + x]
-    for x in range(k - m):
-        move_transaction(w, a + m + x, a + x)
-    unlock(w.tx_count)[buyer] = k - m
+    return m
+
+
+@njit(inline="always")
+def live_count(w, buyer):
+    """The buyer's open transactions that have not expired: the ones its deposit weighs."""
+    return w.tx_count[buyer] - expired_count(w, buyer)
+
+
+@njit
+def expire_stakes(w, buyer):
+    """The stake-expiry rule (docs/chain.md): at the start of step s, each open transaction of the
+    buyer opened at a step t with t + stake_expiry <= s gives its stake back to its seller.  It stays
+    in the round trip, out of the weighing: the deposit pays it an equal part of the share
+    (``distribute``), so a buyer gains nothing by waiting for its transactions to expire.  The ones
+    refunded at an earlier step hold no stake any more."""
+    a = w.tx_off[buyer]
+    balance, money, pot, stake = unlock(w.balance), unlock(w.money), unlock(w.pot), unlock(w.tx_stake)
+    for x in range(expired_count(w, buyer)):
+        if stake[a + x] == 0.0:
+            continue
+        balance[w.tx_seller[a + x]] += stake[a + x]
+        money[0] += stake[a + x]
+        pot[buyer] -= stake[a + x]
+        stake[a + x] = 0.0
 
 
 @njit
 def settlement(w, buyer):
-    """The buyer's open transactions as (sellers, sites, directions): views of its pool block."""
-    a = w.tx_off[buyer]
-    b = a + w.tx_count[buyer]
+    """The buyer's live (unexpired) open transactions as (sellers, sites, directions): views of its pool
+    block, what the scheme weighs."""
+    a = w.tx_off[buyer] + expired_count(w, buyer)
+    b = w.tx_off[buyer] + w.tx_count[buyer]
     return w.tx_seller[a:b], w.tx_site[a:b], w.tx_dir[a:b]
 
 
@@ -140,11 +156,16 @@ def _record_sale(w, seller, weight, top, pay, stake):
 
 @njit
 def distribute(w, buyer, weights):
-    """Settle a deposit: reward and pot to the buyer, then ``info_share * reward + pot`` from the buyer
-    to the sellers of its open transactions in proportion to ``weights``; clear its transactions.
-    Each seller's reputation record is updated from its weight (an outlier when below half the best
-    weight of its site in this settlement), so rules can read how the market has judged it."""
-    k = w.tx_count[buyer]
+    """Settle a deposit: reward and pot to the buyer, then from the buyer to the sellers of its n open
+    transactions: each expired one (its stake already returned) ``info_share * reward / n``, an equal
+    part of the share, and the live ones ``info_share * reward * live / n + pot`` in proportion to
+    ``weights`` (one per live transaction); clear its transactions.  Without expiry that is the paper's
+    ``info_share * reward + pot`` by weight.  Each live seller's reputation record is updated from its
+    weight (an outlier when below half the best weight of its site in this settlement), so rules can
+    read how the market has judged it; an expired sale counts as settled, not as an outlier."""
+    e = expired_count(w, buyer)
+    n = w.tx_count[buyer]
+    k = n - e
     balance, tx_count = unlock(w.balance), unlock(w.tx_count)
     balance[buyer] += w.reward
     pot = w.pot[buyer]
@@ -155,7 +176,7 @@ def distribute(w, buyer, weights):
     total = 0.0
     top0 = 0.0
     top1 = 0.0
-    a = w.tx_off[buyer]
+    a = w.tx_off[buyer] + e
     for x in range(k):
         wx = weights[x]
         if not (wx >= 0.0) or math.isinf(wx):
@@ -167,7 +188,11 @@ def distribute(w, buyer, weights):
             top0 = max(top0, wx)
         else:
             top1 = max(top1, wx)
-    amount = w.info_share * w.reward + pot
+    if e == 0:
+        amount = w.info_share * w.reward + pot
+    else:
+        _pay_expired(w, buyer, e, w.info_share * w.reward / n)
+        amount = w.info_share * w.reward * k / n + pot
     paid = k > 0 and total > 0.0
     for x in range(k):
         seller = w.tx_seller[a + x]
@@ -185,6 +210,21 @@ def distribute(w, buyer, weights):
             log_payment(w, buyer, a + x, 0.0, 0.0)
     tx_count[buyer] = 0
     log_event(w, EV_DEPOSIT, buyer, -1, -1, 0.0, 0.0, 0.0, 0, 0.0, 0.0, 0.0)
+
+
+@njit
+def _pay_expired(w, buyer, e, part):
+    """The buyer pays each of its ``e`` expired transactions (the first of its block) ``part``."""
+    balance = unlock(w.balance)
+    a = w.tx_off[buyer]
+    for x in range(e):
+        seller = w.tx_seller[a + x]
+        balance[seller] += part
+        balance[buyer] -= part
+        unlock(w.rep_settled)[seller] += 1
+        unlock(w.rep_earned)[seller] += part
+        if w.record:
+            log_payment(w, buyer, a + x, 0.0, part)
 
 
 @njit(inline="always")

@@ -15,7 +15,7 @@ from ..errors import ConfigError, SimulationError
 from ..registry import get_payment
 from ..state.flags import ErrorFlags
 from ..state.view import make_view
-from .kernels import distribute, expire_stakes, open_transaction
+from .kernels import distribute, expire_stakes, expired_count, open_transaction
 from .pool import reserve
 from .state import REPUTATION, grow_book, new_book
 
@@ -95,8 +95,8 @@ class Ledger:
             self.book = book = grow_book(book, book.tx_count, int(book.ev_count[0]) + 1,
                                          int(book.pay_count[0]) + int(book.tx_count[buyer]))
             self.view = make_view("book", book)
-        a = int(book.tx_off[buyer])
-        b = a + int(book.tx_count[buyer])
+        a = int(book.tx_off[buyer]) + int(expired_count(self.view, buyer))  # the scheme weighs the live ones
+        b = int(book.tx_off[buyer]) + int(book.tx_count[buyer])
         weights = np.zeros(b - a)
         rule = self.scheme.weights
         extra = ([self.view] if rule.wants_market else []) + ([self.rng] if rule.wants_rng else [])
@@ -115,8 +115,9 @@ def replay_events(events: Iterable, robots: int, *, scheme: str = "delayed", ini
 
     ``stake_expiry`` = T > 0 applies the stake-expiry rule (docs/chain.md): at the start of each step
     s (before its first event), every open transaction opened at a step t with t + T <= s expires:
-    its stake goes back to its seller and it leaves the buyer's round trip.  ``reputation_decay`` < 1 keeps
-    the decayed reputation record (``payment.reputation_decay``)."""
+    its stake goes back to its seller, and the buyer's deposit pays it an equal part of the share
+    (``ledger.kernels.distribute``) instead of weighing it.  ``reputation_decay`` < 1 keeps the decayed
+    reputation record (``payment.reputation_decay``)."""
     ledger = Ledger(robots, scheme=scheme, initial_wealth=initial_wealth, reward=reward,
                     information_share=information_share, stake=stake, params=params, stake_expiry=stake_expiry,
                     reputation_decay=reputation_decay)

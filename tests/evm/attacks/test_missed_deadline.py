@@ -46,7 +46,8 @@ def test_a_robot_that_settles_earns_the_bounty_from_the_share(make_market, robot
     (done,) = results[-1].of("SettlementCompleted")
     gains = sum(market.balance_of(s.address) - 960_000_000 for s in robots[1:5])
     assert gains + paid + done["kept"] == AMOUNT  # the bounty came out of what the sellers share
-    supply = sum(market.balance_of(r.address) for r in robots) + market.locked_stake(buyer.address)
+    supply = sum(market.balance_of(r.address) + market.bond_of(r.address) for r in robots)
+    supply += market.locked_stake(buyer.address)
     assert supply == market.total_supply()
 
 

@@ -31,5 +31,7 @@ def test_a_refunded_record_under_a_pending_settlement_keeps_its_sellers_link(mak
     for age, seller in enumerate(sellers):
         sell(market, seller, buyer, 10.0 + age, age=10 + age)
     shares = [e for r in market.deposit(buyer.address) for e in r.of("RewardShared")]
-    # Four distinct sellers, every pair within theta: four equal voices, a quarter of 0.5 token each.
-    assert sorted((e["seller"], e["amount"]) for e in shares) == sorted((s.address, 125_000_000) for s in sellers)
+    # Five records: the refunded one is paid 0.5 / 5 token (weight 0, an expired record); four distinct
+    # sellers, every pair within theta, share the rest, 0.5 * 4 / 5: four equal voices, 0.1 token each.
+    expected = [(refunded.address, 0, 100_000_000)] + [(s.address, 4 * 10**27, 100_000_000) for s in sellers]
+    assert sorted((e["seller"], e["weight"], e["amount"]) for e in shares) == sorted(expected)

@@ -4,9 +4,14 @@ The exploit: one market key registered any address with any wealth, without limi
 deposits nobody could check, and could be neither rotated, shared nor paused. Now: a robot is
 registered by `registrarThreshold` distinct registrars (2 of 3 by default), each within a quota per
 period; a deposit carries the robot's signature over its round trip and a nest's acknowledgement; an
-admin rotates keys; a pauser stops registrations, reveals and deposits, never refunds or settlements.
+admin rotates keys; a pauser stops registrations, reveals and deposits, never refunds or settlements;
+every registration locks a bond out of the grant (1 token by default), returned `bondDelay` blocks
+after a clean exit and burned when the registrars revoke the robot.
 """
 from __future__ import annotations
+
+import math
+from fractions import Fraction
 
 import pytest
 from eth_account import Account
@@ -41,16 +46,20 @@ def fresh(chain, artifact):
 def test_one_registrar_cannot_register_a_robot_alone(fresh):
     market, (robot, *_) = fresh()
     first, second, _ = market.registrars
-    assert market.view("policy") == (2, 32, 5_000)
-    market.approve(first, robot.address, 10**9)
+    assert market.view("policy") == (2, 32, 5_000, 10**9, 5_000)
+    market.approve(first, robot.address, 2 * 10**9)
     assert not market.view("isRegistered", robot.address) and market.balance_of(robot.address) == 0
-    refused(lambda: market.approve(first, robot.address, 10**9), "InfoMarketAlreadyApproved",
+    refused(lambda: market.approve(first, robot.address, 2 * 10**9), "InfoMarketAlreadyApproved",
             registrar=first.address, robot=robot.address)
-    market.approve(second, robot.address, 5 * 10**8)  # another grant: a separate request, 1 approval
+    market.approve(second, robot.address, 3 * 10**9 // 2)  # another grant: a separate request, 1 approval
     assert not market.view("isRegistered", robot.address)
-    done = market.approve(second, robot.address, 10**9)
-    assert done.of("WealthGranted") == [{"robot": robot.address, "amount": 10**9}]
+    refused(lambda: market.approve(second, robot.address, 10**9 - 1), "InfoMarketGrantBelowBond",
+            amount=10**9 - 1, bond=10**9)
+    done = market.approve(second, robot.address, 2 * 10**9)
+    assert done.of("WealthGranted") == [{"robot": robot.address, "amount": 2 * 10**9}]
+    assert done.of("BondLocked") == [{"robot": robot.address, "amount": 10**9}]
     assert market.view("isRegistered", robot.address) and market.balance_of(robot.address) == 10**9
+    assert market.bond_of(robot.address) == 10**9 and market.total_supply() == 2 * 10**9
 
 
 def test_only_registrars_approve_and_each_within_its_quota(fresh):
@@ -63,11 +72,11 @@ def test_only_registrars_approve_and_each_within_its_quota(fresh):
     backend = market.backend
     backend.advance_to((backend.block_number // 1_000 + 1) * 1_000)  # the start of a period
     for robot in robots[:2]:
-        market.approve(registrar, robot.address, 0)
-    refused(lambda: market.approve(registrar, robots[2].address, 0), "InfoMarketRegistrarQuotaExceeded",
+        market.approve(registrar, robot.address, 10**9)
+    refused(lambda: market.approve(registrar, robots[2].address, 10**9), "InfoMarketRegistrarQuotaExceeded",
             registrar=registrar.address, limit=2)
     backend.advance_to(backend.block_number + 1_000)  # the next period
-    market.approve(registrar, robots[2].address, 0)
+    market.approve(registrar, robots[2].address, 10**9)
 
 
 def test_a_single_compromised_registrar_registers_no_cartel(fresh):
@@ -87,11 +96,14 @@ def test_a_single_compromised_registrar_registers_no_cartel(fresh):
     assert market.balance_of(honest.address) == 10**9 + 500_000_000
 
 
-@pytest.mark.parametrize("colluders, cartel_share", [(3, (9, 18)), (8, (64, 73))])
-def test_a_registered_cartel_outvotes_three_honest_sellers(fresh, colluders, cartel_share):
+@pytest.mark.parametrize("colluders, cartel_share, trips", [(3, (9, 18), 12), (8, (64, 73), 16)])
+def test_a_registered_cartel_outvotes_three_honest_sellers(fresh, colluders, cartel_share, trips):
     """What registration must keep out (docs/chain.md): c registered colluders agreeing on a false
     direction against 3 honest sellers under outlier_distinct. By hand: each honest record weighs 3
-    voices, each colluder's c, so the cartel takes c^2 / (c^2 + 9) of 0.5 + (c + 3) * 0.04 token."""
+    voices, each colluder's c, so the cartel takes c^2 / (c^2 + 9) of 0.5 + (c + 3) * 0.04 token; less
+    its own stakes, it nets 0.25 token per round trip at c = 3 and 0.504 at c = 8, while its c bonds
+    (1 token each) are locked: the bonds are repaid after 12 and 16 such round trips, so a cartel that
+    the registrars revoke (burning its bonds) before that loses money."""
     market, robots = fresh(stake=0.04, accounts=colluders + 4, label=f"cartel{colluders}")
     buyer, honest, cartel = robots[0], robots[1:4], robots[4:]
     for robot in robots:
@@ -105,6 +117,61 @@ def test_a_registered_cartel_outvotes_three_honest_sellers(fresh, colluders, car
     took = sum(market.balance_of(m.address) - 960_000_000 for m in cartel)
     num, den = cartel_share
     assert amount * num // den - colluders <= took <= amount * num // den
+    net = Fraction(amount * num, den) - colluders * 40_000_000  # what the cartel gains by a round trip
+    assert net - colluders <= took - colluders * 40_000_000 <= net
+    bonds = sum(market.bond_of(m.address) for m in cartel)
+    assert bonds == colluders * 10**9 and math.ceil(bonds / net) == trips
+    market.revoke(cartel[0].address)  # found out: its bond is burned
+    assert market.bond_of(cartel[0].address) == 0 and market.balance_of(cartel[0].address) < 10**9 + net
+
+
+def test_a_bond_comes_back_only_after_a_clean_exit_and_its_delay(fresh):
+    market, (robot, buyer, other, _) = fresh(bond_delay=20)
+    for account in (robot, buyer):
+        market.grant_wealth(account, 10**9)  # one token free, one (the bond) locked
+    supply = market.total_supply()
+    refused(lambda: market.withdraw_bond(robot.address), "InfoMarketNotExiting", robot=robot.address)
+    refused(lambda: market.exit(other), "InfoMarketUnregistered", robot=other.address)
+    unlock = market.exit(robot).of("ExitRequested")[0]["unlockBlock"]
+    assert not market.view("isRegistered", robot.address) and market.bond_of(robot.address) == 10**9
+    refused(lambda: sell(market, robot, buyer, 10.0), "InfoMarketUnregistered", robot=robot.address)
+    refused(lambda: market.exit(robot), "InfoMarketUnregistered", robot=robot.address)
+    market.backend.advance_to(unlock - 2)  # the withdrawal lands in block unlock - 1
+    refused(lambda: market.withdraw_bond(robot.address), "InfoMarketBondLocked", robot=robot.address,
+            unlockBlock=unlock)
+    market.backend.advance_to(unlock)
+    assert market.withdraw_bond(robot.address, sender=other).of("BondReturned") == [
+        {"robot": robot.address, "amount": 10**9}]
+    assert market.balance_of(robot.address) == 2 * 10**9 and market.bond_of(robot.address) == 0
+    assert market.total_supply() == supply
+    refused(lambda: market.withdraw_bond(robot.address), "InfoMarketNotExiting", robot=robot.address)
+    refused(lambda: market.grant_wealth(robot, 10**9), "InfoMarketAlreadyRegistered", robot=robot.address)
+
+
+def test_the_registrars_revoke_a_robot_and_burn_its_bond_even_during_its_exit(fresh):
+    market, (robot, leaving, buyer, stranger) = fresh(bond_delay=50)
+    for account in (robot, leaving, buyer):
+        market.grant_wealth(account, 10**9)
+    supply = market.total_supply()
+    first, second, _ = market.registrars
+    refused(lambda: market.transact(stranger, "revokeRegistration", robot.address), "InfoMarketUnauthorized",
+            caller=stranger.address, role=ROLES["registrar"])
+    refused(lambda: market.revoke(stranger.address, [first]), "InfoMarketUnregistered", robot=stranger.address)
+    assert market.revoke(robot.address, [first]).of("RevocationApproved")[0]["approvals"] == 1
+    assert market.view("isRegistered", robot.address)  # one registrar alone revokes no one
+    refused(lambda: market.revoke(robot.address, [first]), "InfoMarketAlreadyApproved", registrar=first.address,
+            robot=robot.address)
+    done = market.revoke(robot.address, [second])
+    assert done.of("BondForfeited") == [{"robot": robot.address, "amount": 10**9}]
+    assert not market.view("isRegistered", robot.address) and market.bond_of(robot.address) == 0
+    refused(lambda: sell(market, robot, buyer, 10.0), "InfoMarketUnregistered", robot=robot.address)
+    refused(lambda: market.grant_wealth(robot, 10**9), "InfoMarketAlreadyRegistered", robot=robot.address)
+    unlock = market.exit(leaving).of("ExitRequested")[0]["unlockBlock"]
+    market.revoke(leaving.address)  # within its exit delay: still revocable
+    market.backend.advance_to(unlock)
+    refused(lambda: market.withdraw_bond(leaving.address), "InfoMarketNotExiting", robot=leaving.address)
+    assert market.balance_of(robot.address) == market.balance_of(leaving.address) == 10**9
+    assert market.total_supply() == supply - 2 * 10**9  # both bonds burned
 
 
 def test_a_deposit_needs_the_robots_signed_trip_and_a_nests_acknowledgement(fresh):
