@@ -71,10 +71,11 @@ def test_bad_chain_sections_are_refused_with_the_key(chain, message):
         _config(**chain)
 
 
-def test_fuel_and_stake_expiry_are_refused_with_the_chain():
-    with pytest.raises(ConfigError, match="fuel_cost or payment.stake_expiry"):
+@pytest.mark.parametrize("payment", [{"stake_expiry": 10}, {"reputation_decay": 0.9}])
+def test_fuel_stake_expiry_and_reputation_decay_are_refused_with_the_chain(payment):
+    with pytest.raises(ConfigError, match=r"fuel_cost, payment\.stake_expiry or payment\.reputation_decay"):
         validate({"swarm": {"robots": 2, "groups": [{"behaviour": "naive", "count": 2}]},
-                     "payment": {"stake_expiry": 10}, "chain": {"consensus": "poa"}})
+                  "payment": payment, "chain": {"consensus": "poa"}})
 
 
 # ---- blocks ----------------------------------------------------------------------------------------------
