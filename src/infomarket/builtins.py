@@ -9,6 +9,9 @@ from .behaviours import byzantine, naive, sceptical, waypoint
 from .payments import schemes
 from .registry import register_behaviour, register_payment
 
+#: the limit of every angle parameter (Theta, a rotation cap, a slash angle): degrees in (0, 180]
+_ANGLE = ("in (0, 180]", lambda v: 0 < v <= 180)
+
 register_behaviour("naive", buy=naive.naive_buy, sell=naive.honest_sell, honest=True,
                    description="buys younger information and averages it in; sells its own entry")
 register_behaviour("sceptical", buy=sceptical.sceptical_buy, sell="naive", honest=True,
@@ -31,7 +34,7 @@ register_payment("delayed", schemes.delayed_weights,
                  description="sellers share information_share * reward per transaction")
 register_payment("outlier", schemes.outlier_weights,
                  description="sellers share information_share * reward + stakes by similarity weight",
-                 limits={"theta": ("in (0, 180]", lambda v: 0 < v <= 180)})
+                 limits={"theta": _ANGLE})
 
 # The paper's open questions (docs/research.md): rules that read the ledger's reputation record.
 from .behaviours import reputation  # noqa: E402
@@ -56,18 +59,18 @@ register_behaviour("theta_surfer", buy="sceptical", sell=reputation.theta_surfer
                    description="sceptical buyer that lies by rotation_angle, capped at margin x the outlier "
                                "threshold the (adaptive = 1: adaptive) contract applies to it now",
                    limits={"margin": ("in (0, 1]", lambda v: 0 < v <= 1),
-                           "theta": ("in (0, 180]", lambda v: 0 < v <= 180),
-                           "theta_min": ("in (0, 180]", lambda v: 0 < v <= 180),
+                           "theta": _ANGLE,
+                           "theta_min": _ANGLE,
                            "adaptive": ("0 or 1", lambda v: v in (0, 1))})
 register_payment("outlier_distinct", distinct.outlier_distinct_weights,
                  description="outlier penalisation counting sellers, not sales: a seller counts once in a "
                              "transaction's weight and its weight is split across its transactions",
-                 limits={"theta": ("in (0, 180]", lambda v: 0 < v <= 180)})
+                 limits={"theta": _ANGLE})
 register_payment("adaptive_outlier", adaptive.adaptive_outlier_weights,
                  description="outlier penalisation with each seller's Theta between theta_min and theta by its "
                              "reputation",
-                 limits={"theta": ("in (0, 180]", lambda v: 0 < v <= 180),
-                         "theta_min": ("in (0, 180]", lambda v: 0 < v <= 180)})
+                 limits={"theta": _ANGLE,
+                         "theta_min": _ANGLE})
 
 # The parameterised attack family, the threats the hand-written set lacked, and continuous trust.
 from .behaviours import attacks, weighted  # noqa: E402
@@ -80,8 +83,8 @@ register_behaviour("attacker", buy=attacks.policy_buy, sell=attacks.policy_sell,
                                "a function of its record, its buyers, Θ and the sellers in range; gates; collusion",
                    limits={**{name: (f"in [{lo:g}, {hi:g}]", lambda v, lo=lo, hi=hi: lo <= v <= hi)
                               for name, _, lo, hi in attacks.POLICY},
-                           "theta": ("in (0, 180]", lambda v: 0 < v <= 180),
-                           "theta_min": ("in (0, 180]", lambda v: 0 < v <= 180),
+                           "theta": _ANGLE,
+                           "theta_min": _ANGLE,
                            "adaptive": ("0 or 1", lambda v: v in (0, 1)), "threshold": ("> 0", lambda v: v > 0)})
 register_behaviour("colluder", buy=attacks.colluder_buy, sell=attacks.colluder_sell, honest=False,
                    description="liars that agree on one rotation_angle and buy each other's offers to inflate their "
@@ -97,7 +100,7 @@ register_behaviour("sceptic_surfer", buy="sceptical", sell=attacks.sceptic_surfe
                    description="Θ-surfer aimed at the sceptic: lies by at most margin x the angle its confirmation "
                                "test accepts and margin x Θ",
                    limits={"rotation_angle": _ANGLE, "margin": ("in (0, 1]", lambda v: 0 < v <= 1),
-                           "threshold": ("> 0", lambda v: v > 0), "theta": ("in (0, 180]", lambda v: 0 < v <= 180)})
+                           "threshold": ("> 0", lambda v: v > 0), "theta": _ANGLE})
 register_behaviour("tuned_farmer", buy="sceptical", sell=attacks.tuned_farmer_sell, honest=False,
                    description="reputation farmer tuned to the trust it targets: honest until farm_record settled "
                                "sales at reputation >= farm_reputation (the reputation sceptic's 10 and 0.85)",
@@ -128,8 +131,8 @@ from .payments import consensus  # noqa: E402
 register_payment("consensus_slash", consensus.consensus_slash_weights,
                  description="a record d degrees from its site's settled consensus (medoid) loses min(1, d / "
                              "slash_angle) of its stake and earns that much less of the share",
-                 limits={"slash_angle": ("in (0, 180]", lambda v: 0 < v <= 180)})
+                 limits={"slash_angle": _ANGLE})
 register_payment("capped_outlier", consensus.capped_outlier_weights,
                  description="outlier penalisation counting at most `cap` records per seller per round trip; "
                              "later ones are void: stake back, no pay",
-                 limits={"theta": ("in (0, 180]", lambda v: 0 < v <= 180), "cap": (">= 1", lambda v: v >= 1)})
+                 limits={"theta": _ANGLE, "cap": (">= 1", lambda v: v >= 1)})
