@@ -23,6 +23,7 @@ SUBCOMMAND_MODULES += ("infomarket.analysis.terrain",)  # terrain-report (docs/t
 SUBCOMMAND_MODULES += ("infomarket.search.cli",)  # attack-search (docs/attack-search.md)
 SUBCOMMAND_MODULES += ("infomarket.rl.cli",)  # rl-train (docs/rl.md)
 SUBCOMMAND_MODULES += ("infomarket.search.adaptive_cli",)  # adaptive-attack (docs/rl.md)
+SUBCOMMAND_MODULES += ("infomarket.defence.cli",)  # defence-search (docs/defences.md)
 
 
 def _print_summary(robots, title: str) -> None:

@@ -117,16 +117,16 @@ def provenance(questions=QUESTIONS) -> dict:
             "questions_sha256": hashlib.sha256(questions.read_bytes()).hexdigest()}
 
 
-def record_provenance(store: Store, questions=QUESTIONS) -> dict:
-    """Record in the store's metadata (``store.json``, key ``attack_search``), once, before the study's
-    first run: the questions file's commit and hash, and the UTC time of the first run."""
+def record_provenance(store: Store, questions=QUESTIONS, key: str = "attack_search") -> dict:
+    """Record in the store's metadata (``store.json``, under ``key``), once, before the study's first run:
+    the questions file's commit and hash, and the UTC time of the first run."""
     with store.writing():
         meta = store.meta()
-        if "attack_search" not in meta:
+        if key not in meta:
             first = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
-            meta["attack_search"] = {**provenance(questions), "first_run_utc": first}
+            meta[key] = {**provenance(questions), "first_run_utc": first}
             store._write_meta(meta)  # under the store's lock, as Store writes it
-        return meta["attack_search"]
+        return meta[key]
 
 
 class _Evaluator:
