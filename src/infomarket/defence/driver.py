@@ -54,8 +54,9 @@ class Judged:
 
     def trade(self, target: int, max_cost: float) -> float:
         """``loss(target) + max(0, cost - max_cost)``; infinite where either is undefined (no items)."""
-        v = self.losses[target] + max(0.0, self.cost - max_cost)
-        return v if np.isfinite(v) else float("inf")
+        if not (np.isfinite(self.cost) and np.isfinite(self.losses[target])):
+            return float("inf")
+        return self.losses[target] + max(0.0, self.cost - max_cost)
 
 
 @dataclass

@@ -167,8 +167,9 @@ def figure(a: dict):
         x, y = d["cost"][k], d["loss"][k]
         if not (math.isfinite(x) and math.isfinite(y)):
             continue
-        xerr = [[x - d["cost_low"][k]], [d["cost_high"][k] - x]]
-        yerr = [[y - d["loss_low"][k]], [d["loss_high"][k] - y]]
+        # floored at 0: an estimate can sit a rounding error outside an interval whose ends equal it
+        xerr = [[max(0.0, x - d["cost_low"][k])], [max(0.0, d["cost_high"][k] - x)]]
+        yerr = [[max(0.0, y - d["loss_low"][k])], [max(0.0, d["loss_high"][k] - y)]]
         existing = d["origin"][k] == "existing"
         ax.errorbar([x], [y], xerr=xerr, yerr=yerr, fmt="s" if existing else "o",
                     color="tab:red" if existing else "tab:blue", capsize=2, ms=5)

@@ -12,12 +12,14 @@ import os
 import sys
 import threading
 import time
+import warnings
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+from numba.core.errors import NumbaPedanticWarning
 
 from ..config.schema import Experiment
 from ..config.load import load_experiment
@@ -322,9 +324,19 @@ def compile_notice(kinds, scheme: str, after: float | None = None):
     """Say on stderr, once ``after`` seconds have gone by inside the block, that the step kernel is being
     compiled (the first run of a behaviour mix waits 10-20 s with nothing else to show)."""
     after = COMPILE_NOTICE_AFTER if after is None else after
-    if os.environ.get("INFOMARKET_COMPILE_NOTICE", "1") == "0":
-        yield
-        return
+    with warnings.catch_warnings():
+        # numba's pedantic IR checks flag the inlined ledger closures ("variable ... is not in scope"): a
+        # note to numba's developers about its own IR, dozens of lines per kernel, nothing a user can act on
+        warnings.simplefilter("ignore", NumbaPedanticWarning)
+        if os.environ.get("INFOMARKET_COMPILE_NOTICE", "1") == "0":
+            yield
+            return
+        with _notice(kinds, scheme, after):
+            yield
+
+
+@contextmanager
+def _notice(kinds, scheme: str, after: float):
     names = "+".join(str(k) for k in dict.fromkeys(kinds))
 
     def say() -> None:

@@ -1,0 +1,166 @@
+"""`infomarket defence-search` on a tiny declared study (tests/defence/tiny.toml): it completes, records
+its questions file, keeps the confirmation seeds fresh, reruns bit for bit, resumes after SIGKILL with
+nothing lost or repeated, gives the same frontier on Dask, and refuses bad input before writing."""
+import hashlib
+import json
+import signal
+import subprocess
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from infomarket.cli import main
+from infomarket.store import Store
+
+from ..procs import HANG
+
+TINY_FILE = Path(__file__).with_name("tiny.toml")
+TINY = ["defence-search", "attack_search", "--questions", str(TINY_FILE), "--family", "theta", "--byzantines", "3",
+        "--steps", "1500", "--transitory", "500"]
+
+
+def _answers(out: Path) -> dict:
+    """Everything the report decides (not how long it took, nor what this call made or found)."""
+    a = json.loads((out / "defence.json").read_text())
+    for k in ("wall_seconds", "made", "found", "provenance"):
+        a.pop(k)
+    return a
+
+
+def _same(a: Path, b: Path) -> None:
+    assert _answers(a) == _answers(b)
+    for name in ("defence_cost.parquet", "defence_attacks.parquet"):
+        pd.testing.assert_frame_equal(pd.read_parquet(a / name), pd.read_parquet(b / name), check_exact=True)
+
+
+def _runs(out: Path) -> pd.DataFrame:
+    return Store(out / "store").runs().sort_values(["experiment", "condition", "run"]).reset_index(drop=True)
+
+
+@pytest.fixture(scope="module")
+def inline(tmp_path_factory):
+    out = tmp_path_factory.mktemp("defence") / "study"
+    assert main(TINY + ["--workers", "1", "--quiet", "--out", str(out)]) == 0
+    return out
+
+
+def test_a_tiny_study_judges_every_candidate_and_confirms_the_frontier(inline):
+    a = json.loads((inline / "defence.json").read_text())
+    # tiny.toml: 2 first candidates and 1 refinement of the one family (the existing defences left out)
+    labels = [r["label"] for r in a["search"]]
+    assert labels == ["theta0", "theta1", "theta2"]
+    assert [r["origin"] for r in a["search"]] == ["default", "design", "refine"]
+    confirmed = [r["label"] for r in a["confirmed"]]
+    assert 1 <= len(confirmed) <= 2  # frontier = 2 at most
+    assert set(confirmed) <= {r["label"] for r in a["search"] if r["pareto"]}
+    cost = pd.read_parquet(inline / "defence_cost.parquet")
+    attacks = pd.read_parquet(inline / "defence_attacks.parquet")
+    assert sorted(cost.label.unique()) == sorted(confirmed) and (cost.groupby("label").run.count() == 3).all()
+    assert (attacks.groupby(["label", "byzantines"]).run.count() == 3).all()
+    assert {r["answer"] for r in a["confirmed"]} <= {"yes", "no", "inconclusive"}
+    runs = _runs(inline)
+    assert not runs.duplicated(["experiment", "condition", "run"]).any()
+    assert (inline / "frontier.png").stat().st_size > 0 and "# Defence search" in (inline / "defence.md").read_text()
+
+
+def test_the_confirmation_seeds_are_touched_by_no_other_phase(inline):
+    runs = _runs(inline)
+    conf = runs[runs.seed_set == "confirmation"]
+    assert set(conf.phase) == {"cost", "defence_confirmation"} or set(conf.phase) == {"cost", "defence_confirmation",
+                                                                                     "confirmation"}
+    mine = runs[runs.phase.isin(["cost", "defence_confirmation"]) & (runs.seed_set == "confirmation")]
+    others = runs.drop(mine.index)
+    assert set(mine.seed) and not set(mine.seed) & set(others.seed)
+    # every confirmed defence, the undefended swarm and every attack ran on the same three seeds
+    assert mine.groupby(["experiment", "condition"]).seed.apply(lambda s: tuple(sorted(s))).nunique() == 1
+
+
+def test_the_store_records_the_questions_file(inline):
+    meta = Store(inline / "store").meta()["defence_search"]
+    assert meta["questions_sha256"] == hashlib.sha256(TINY_FILE.read_bytes()).hexdigest()
+    assert meta["questions_file"] == "tiny.toml" and meta["first_run_utc"].endswith("Z")
+
+
+def test_a_second_study_into_another_store_is_the_same_bit_for_bit(inline, tmp_path):
+    out = tmp_path / "again"
+    assert main(TINY + ["--workers", "1", "--quiet", "--out", str(out)]) == 0
+    _same(inline, out)
+
+
+def test_a_killed_study_resumes_without_losing_or_repeating_a_run(inline, tmp_path, capsys, procs):
+    out = tmp_path / "study"
+    proc = procs.cli(*TINY, "--workers", "1", "--quiet", "--out", out, env={"INFOMARKET_COMPILE_NOTICE": "0"},
+                     stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    runs_dir = out / "store" / "runs"
+    deadline = time.monotonic() + HANG
+    while time.monotonic() < deadline and proc.poll() is None:  # killed in the outer search
+        if runs_dir.exists() and len(list(runs_dir.glob("part-*.parquet"))) >= 4:
+            break
+        time.sleep(0.02)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    assert proc.returncode == -signal.SIGKILL, proc.stderr.read().decode()[-2000:]
+    kept = len(Store(out / "store").completed_runs())
+    total = len(_runs(inline))
+    assert 0 < kept < total
+    assert main(TINY + ["--workers", "1", "--quiet", "--out", str(out)]) == 0
+    runs = _runs(out)
+    assert len(runs) == total and not runs.duplicated(["experiment", "condition", "run"]).any()
+    _same(inline, out)
+
+
+def test_the_same_study_on_dask_gives_the_same_frontier(inline, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                                  dashboard_address=None) as cluster:
+        out = tmp_path / "dask"
+        assert main(TINY + ["--dask", cluster.scheduler_address, "--quiet", "--out", str(out)]) == 0
+    _same(inline, out)
+
+
+BAD_FAMILY = """
+[defence]
+candidates = 2
+[families.f]
+set = {}
+params.a = { paths = "payment.stake", low = 1, high = 0 }
+[undefended]
+set = { "payment.stake" = 0.0 }
+"""
+
+
+@pytest.mark.parametrize("option, words", [
+    (["--family", "nope"], ["--family nope", "allowed: theta, existing"]),
+    (["--family", " "], ["--family ' '"]),
+    (["--byzantines", "5"], ["--byzantines 5", "allowed: 1, 3, 8"]),
+    (["--transitory", "1500"], ["--transitory 1500", "below --steps 1500"]),
+    (["--inner-race", "4,2"], ["race = [4, 2]"]),
+    (["--questions", "/nonexistent/q.toml"], ["--questions /nonexistent/q.toml", "no such file"]),
+    (["--out", " "], ["--out ' '"]),
+])
+def test_bad_input_is_refused_before_anything_is_written(tmp_path, capsys, option, words):
+    args = list(TINY)
+    args += ["--out", str(tmp_path / "out")] if "--out" not in option else []
+    assert main(args + option) == 2
+    err = capsys.readouterr().err
+    assert all(w in err for w in words), err
+    assert "Traceback" not in err and not (tmp_path / "out").exists()
+
+
+def test_a_malformed_questions_file_is_refused_naming_what_is_wrong(tmp_path, capsys):
+    q = tmp_path / "q.toml"
+    q.write_text(BAD_FAMILY)
+    assert main(["defence-search", "attack_search", "--questions", str(q), "--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert "[families.f] params.a" in err and "low must be below high" in err and not (tmp_path / "o").exists()
+    q.write_text(BAD_FAMILY.replace("[families.f]", "[famlies.f]"))
+    assert main(["defence-search", "attack_search", "--questions", str(q), "--out", str(tmp_path / "o")]) == 2
+    assert "unknown table [famlies]" in capsys.readouterr().err
+
+
+def test_the_families_are_listed(capsys):
+    assert main(["defence-search", "attack_search", "--list-families"]) == 0
+    out = capsys.readouterr().out
+    assert "robust_median" in out and "vectors\tint [2, 9], default 5" in out and "staking\texisting" in out
