@@ -23,6 +23,7 @@ RUN = {
     "infomarket check corridor_waypoints",
     "infomarket check attack_search",
     "infomarket check chain_paper",
+    "infomarket defence-search attack_search --list-families",
 }
 #: Parsed only, with the reason they are not run here.
 NOT_RUN = {
@@ -98,6 +99,12 @@ NOT_RUN = {
     "--confirmation-runs 16 --seed 7 --out /tmp/attack-reduced": "~2 500 full runs; tests/search runs a tiny search",
     "infomarket attack-search attack_search --defence staking,theta20 --byzantines 3 --dask tcp://head:8786 "
     "--out results/as-dask": "needs a Dask scheduler at that address; tests/search runs one on a LocalCluster",
+    # docs/defences.md
+    "infomarket defence-search attack_search --out results/defence --workers 2": "the declared study, about 176 000 runs",
+    "infomarket defence-search attack_search --family robust_median --byzantines 3 --candidates 2 --refine 0 "
+    "--steps 3000 --transitory 1000 --inner-budget 4 --inner-runs 2 --inner-grid-step 90 --inner-race 2,4 "
+    "--cost-runs 4 --frontier 2 --confirmation-runs 8 --out /tmp/defence":
+        "minutes of runs; tests/defence/test_cli.py runs a tiny declared study",
     # docs/rl.md
     "infomarket bench --env --json": "5 timed episodes of 64 runs; tests/bench/test_bench_env.py runs it with --steps 60",
     "infomarket rl-train --steps 4000 --transitory 1000 --iterations 60 --pairs 32 --eval-runs 32 --seed 0 "
