@@ -18,7 +18,7 @@ from ..procs import HANG
 
 TINY_FILE = Path(__file__).with_name("tiny.toml")
 TINY = ["defence-search", "attack_search", "--questions", str(TINY_FILE), "--family", "theta", "--byzantines", "3",
-        "--steps", "1500", "--transitory", "500"]
+        "--steps", "1500", "--transitory", "500", "--seed", "6"]
 
 
 def _answers(out: Path) -> dict:
@@ -164,3 +164,15 @@ def test_the_families_are_listed(capsys):
     assert main(["defence-search", "attack_search", "--list-families"]) == 0
     out = capsys.readouterr().out
     assert "robust_median" in out and "vectors\tint [2, 9], default 5" in out and "staking\texisting" in out
+
+
+def test_a_reduced_study_with_the_declared_seed_is_refused_and_a_part_of_the_study_is_not(tmp_path, capsys):
+    """[seed_sets]: a reduced run's confirmation runs would be the study's own, seen before the study."""
+    reduced = [a for a in TINY if a not in ("--seed", "6")]  # tiny.toml declares seed 5
+    assert main(reduced + ["--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert "--seed 5 is the study's declared seed" in err and "--steps 1500" in err and not (tmp_path / "o").exists()
+    # the declared settings on some of the families and counts: the study itself, in parts (only listed here)
+    part = ["defence-search", "attack_search", "--questions", str(TINY_FILE), "--family", "theta",
+            "--byzantines", "3", "--list-families"]
+    assert main(part) == 0

@@ -234,3 +234,18 @@ def test_the_adaptive_attacker_is_the_second_searcher_on_the_same_confirmation_s
     d = expected.sort_values("run")["items"].to_numpy() - search  # adaptive - search, seed by seed
     walsh = [(d[i] + d[j]) / 2 for i in range(3) for j in range(i, 3)]  # Hodges-Lehmann by hand
     assert cell_report[EXTRA_QUESTION]["adaptive"]["hl"] == pytest.approx(float(np.median(walsh)))
+
+
+def test_a_reduced_search_with_the_declared_seed_is_refused_and_some_cells_are_not(tmp_path, capsys):
+    """questions.toml [seed_sets]: a pilot or reduced search must not touch the study's confirmation seeds."""
+    declared = str(study.load_declarations()["search"]["seed"])
+    args = list(TINY)
+    args[args.index("--seed") + 1] = declared
+    assert main(args + ["--out", str(tmp_path / "o")]) == 2
+    err = capsys.readouterr().err
+    assert f"--seed {declared} is the study's declared seed" in err and "--budget 4" in err
+    assert not (tmp_path / "o").exists()
+    st = study.load(load_experiment("attack_search"))
+    from infomarket.search.cli import refuse_declared_seed
+
+    refuse_declared_seed(st.settings.seed, st.settings.seed, [])  # some cells, declared settings: allowed

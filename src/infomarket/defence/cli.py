@@ -60,6 +60,7 @@ def cmd_defence_search(args) -> int:
     from ..config import load_experiment
     from ..runner.execute import default_workers, local_executor, warm
     from ..runner.progress import progress
+    from ..search.cli import refuse_declared_seed
     from ..search.driver import store_runner
     from ..store import Store
     from . import driver, report
@@ -87,7 +88,12 @@ def cmd_defence_search(args) -> int:
     st = study_mod.with_length(st, args.steps, args.transitory)
     every = [c for f in st.families.values() for c in first(f, st.settings.candidates, st.settings.seed)]
     study_mod.check(st, every + st.existing_candidates())
-    reduced = "; ".join(([args.reduced] if args.reduced else []) + _reductions(st, study_mod.load(exp, declaration), args))
+    declared = study_mod.load(exp, declaration)
+    smaller = _reductions(st, declared, args)
+    parts = ("families ", "Byzantine counts ")  # a part of the study, with its declared settings
+    refuse_declared_seed(st.settings.seed, declared.settings.seed,
+                         ([args.reduced] if args.reduced else []) + [r for r in smaller if not r.startswith(parts)])
+    reduced = "; ".join(([args.reduced] if args.reduced else []) + smaller)
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {out}: exists and is not a directory")

@@ -57,6 +57,17 @@ def _reductions(st, declared, exp, chosen, all_cells, args) -> list[str]:
     return out
 
 
+def refuse_declared_seed(seed: int, declared: int, reductions: list[str]) -> None:
+    """A study's declared seed keys its confirmation seeds, which no run may touch before the study's own
+    (questions.toml [seed_sets]): a run with smaller settings than declared (a pilot, a reduced search)
+    must take another ``--seed``.  Running some of the declared cells with the declared settings is the
+    study itself, in parts, and is allowed."""
+    if reductions and seed == declared:
+        raise UsageError(f"--seed {seed} is the study's declared seed, and this run is reduced "
+                         f"({'; '.join(reductions)}): its confirmation runs would be the study's own, seen before "
+                         f"the study; give another --seed (the declared settings alone may use the declared seed)")
+
+
 def _list_baselines(st) -> int:
     grid = rotation_grid(st.settings.grid_step)
     for name, params in st.baselines.items():
@@ -95,8 +106,11 @@ def cmd_attack_search(args) -> int:
     for c in chosen:  # every configuration is checked before anything runs
         c.with_attack({}, steps=args.steps, transitory=args.transitory)
     first = chosen[0].with_attack({}, steps=args.steps, transitory=args.transitory)
-    reduced = "; ".join(([args.reduced] if args.reduced else [])
-                        + _reductions(st, study_mod.load(exp), exp, chosen, cells(st), args))
+    declared = study_mod.load(exp)
+    smaller = _reductions(st, declared, exp, chosen, cells(st), args)
+    refuse_declared_seed(st.settings.seed, declared.settings.seed,
+                         ([args.reduced] if args.reduced else []) + [r for r in smaller if not r.endswith(" cells")])
+    reduced = "; ".join(([args.reduced] if args.reduced else []) + smaller)
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {out}: exists and is not a directory")
