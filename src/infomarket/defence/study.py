@@ -35,7 +35,7 @@ class Settings:
     max_cost: float = 0.05
     frontier: int = 6
     confirmation_runs: int = 128
-    seed: int = 71003
+    seed: int = 71041
 
 
 WHOLE = {"candidates": 1, "refine": 0, "cost_runs": 2, "target": 0, "frontier": 0, "confirmation_runs": 2, "seed": 0}
