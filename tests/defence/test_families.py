@@ -1,4 +1,5 @@
 """Defence families: parameter scales, the declared file's checks, and the configurations candidates write."""
+import dataclasses
 import math
 
 import numpy as np
@@ -108,3 +109,17 @@ def test_the_shipped_study_builds_every_configuration_it_will_run():
     every = [c for f in st.families.values() for c in candidates(f, st.settings.candidates, st.settings.seed)]
     study.check(st, every + st.existing_candidates())
     assert st.undefended_config().swarm.groups[0].behaviour == "naive"
+
+
+def test_a_family_whose_labels_would_be_an_existing_defences_is_refused():
+    decl = study.read(None)
+    data = {**decl.data, "families": {"theta": {"set": {}, "params": {"t": {"paths": "payment.params.theta",
+                                                                          "low": 10, "high": 40}}}}}
+    exp = load_experiment("attack_search")
+    # theta20 and theta26 are existing defences: 30 candidates would label one of them theta20
+    with pytest.raises(ConfigError, match="'theta20', an existing defence"):
+        study.load(exp, dataclasses.replace(decl, data={**data, "defence": {**data["defence"], "candidates": 30}}))
+    study.load(exp, dataclasses.replace(decl, data=data))  # 8 + 4 candidates: theta0 .. theta11, no clash
+    bad = {**data, "families": {"a b": data["families"]["theta"]}}
+    with pytest.raises(ConfigError, match="letters, digits and _"):
+        study.load(exp, dataclasses.replace(decl, data=bad))

@@ -7,6 +7,7 @@ defences.  Every value is checked here, before any run, so a mistake is one mess
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -127,6 +128,7 @@ def load(experiment: Experiment, declaration: Declaration | None = None, *, fami
             raise UsageError(f"--family {f}: not a family of the study; allowed: {', '.join(have)}")
     chosen = {n: f for n, f in declared.items() if not families or n in families}
     exist = existing(experiment) if not families or EXISTING in families else {}
+    _distinct_labels(declared, existing(experiment), s, declaration.path.name)
     counts = list(dict.fromkeys(int(c.keys["byzantines"]) for c in conditions(experiment)))
     for b in byzantines or []:
         if b not in counts:
@@ -140,6 +142,20 @@ def load(experiment: Experiment, declaration: Declaration | None = None, *, fami
     if not undefended:
         raise ConfigError(f"{declaration.path.name}: [undefended] set: the swarm the cost is measured against is missing")
     return Study(experiment, s, inner_study, chosen, exist, undefended, use, d.get("questions", {}), declaration)
+
+
+def _distinct_labels(families: dict[str, Family], exist: dict, s: Settings, source: str) -> None:
+    """Every candidate's label (``FAMILYk``, and the existing defences' names) names its runs in the store:
+    two candidates with one label would share runs, so a collision is refused before anything runs."""
+    for name in families:
+        if not re.fullmatch(r"[A-Za-z_][A-Za-z0-9_]*", name):
+            raise ConfigError(f"{source}: [families.{name}]: a family's name is letters, digits and _ "
+                              f"(it names the store's experiments)")
+        clash = sorted(n for n in exist if re.fullmatch(rf"{re.escape(name)}\d+", n)
+                       and int(n[len(name):]) < s.candidates + s.refine)
+        if clash:
+            raise ConfigError(f"{source}: [families.{name}]: its candidates' labels ({name}0, {name}1, ...) "
+                              f"include {clash[0]!r}, an existing defence of the experiment; rename the family")
 
 
 def check(study: Study, candidates: list[Candidate]) -> None:
