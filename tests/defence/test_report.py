@@ -98,7 +98,12 @@ def test_the_figure_draws_exactly_the_table_numbers(st, tmp_path):
     for k, lab in enumerate(d["label"]):
         assert d["cost"][k] == rows[lab]["cost"]["hl"] and d["loss"][k] == rows[lab]["loss"]["3"]["hl"]
         assert (d["loss_low"][k], d["loss_high"][k]) == (rows[lab]["loss"]["3"]["low"], rows[lab]["loss"]["3"]["high"])
+    g = report.growth_data(a)
+    assert g["good"]["loss"] == [rows["good"]["loss"][c]["hl"] for c in ("1", "3", "8")]
+    assert g["floor"]["kappa"] == pytest.approx([1 / 23, 3 / 19, 8 / 9]) and g["floor"]["share"] == [0.04, 0.12, 0.32]
+    # by hand: the undefended swarm collects 10 per seed, "good" 10 x (0.99 - spread): 0.1 lost per robot
+    assert rows["good"]["cost_items"]["hl"] == pytest.approx(0.1)
     paths = report.write(tmp_path, a)
     assert {p.name for p in paths} == {"defence.json", "defence.md", "frontier.png"}
     text = (tmp_path / "defence.md").read_text()
-    assert "| good | robust_median | 1.0% [" in text and "**Is there a defence" in text
+    assert "| good | robust_median | 1.0% [" in text and "| 0.10 [" in text and "**Is there a defence" in text

@@ -74,10 +74,11 @@ def analyse(study: Study, result: Result) -> dict:
     rule = _rule(study, "bounded_defence")
     target = int(rule.get("byzantines", s.target))
     max_loss, max_cost = float(rule.get("max_loss", 0.10)), float(rule.get("max_cost", s.max_cost))
-    costs, losses = [], {b: [] for b in study.byzantines}
+    costs, lost, losses = [], [], {b: [] for b in study.byzantines}
     for lab in labels:
         c = result.cost_runs[result.cost_runs.label == lab].sort_values("run")
         costs.append(_ratio_loss(c["items"].to_numpy(float), c.undefended.to_numpy(float)))
+        lost.append(c.undefended.to_numpy(float) - c["items"].to_numpy(float))  # items per robot lost
         for b in study.byzantines:
             a = result.attack_runs[(result.attack_runs.label == lab) & (result.attack_runs.byzantines == b)]
             a = a.sort_values("run")
@@ -91,6 +92,7 @@ def analyse(study: Study, result: Result) -> dict:
         rows.append({
             "label": j.candidate.label, "family": j.candidate.family, "origin": j.candidate.origin,
             "values": dict(j.candidate.values), "cost": {**_interval(costs[i], rule["confidence"]), **cost_t[i]},
+            "cost_items": _interval(lost[i], rule["confidence"]),
             "loss": {str(b): _interval(losses[b][i], rule["confidence"]) for b in study.byzantines},
             "loss_target": loss_t[i], "answer": stats.answer(yes, no),
             "attacks": {str(b): j.attacks[b] for b in study.byzantines},
@@ -159,7 +161,7 @@ def figure(a: dict):
 
     d = figure_data(a)
     t = str(a["target"])
-    fig, ax = plt.subplots(figsize=(7.5, 5.5))
+    fig, (ax, growth) = plt.subplots(1, 2, figsize=(13, 5.5), gridspec_kw={"width_ratios": [3, 2]})
     search = [r for r in a["search"] if t in r["losses"]]
     ax.scatter([r["cost"] for r in search], [r["losses"][t] for r in search], s=12, color="0.75",
                label="every candidate (search seeds)")
@@ -182,8 +184,43 @@ def figure(a: dict):
     ax.yaxis.set_major_formatter(matplotlib.ticker.PercentFormatter(1.0))
     ax.set_title("confirmed: existing (squares), new (circles); 95 % Hodges-Lehmann intervals", fontsize=9)
     ax.legend(fontsize=8, loc="upper right")
+    _growth(growth, a, matplotlib)
     fig.tight_layout()
     return fig
+
+
+def growth_data(a: dict) -> dict[str, dict[str, list[float]]]:
+    """Per confirmed defence: Byzantine share, confirmed loss and its interval at each count (the table's
+    numbers), and the floor kappa of the swarm at the same shares."""
+    counts = [str(b) for b in a["byzantines"]]
+    out = {r["label"]: {"share": [int(c) / a["robots"] for c in counts],
+                        "loss": [r["loss"][c]["hl"] for c in counts],
+                        "low": [r["loss"][c]["low"] for c in counts],
+                        "high": [r["loss"][c]["high"] for c in counts]} for r in a["confirmed"]}
+    out["floor"] = {"share": [int(c) / a["robots"] for c in counts],
+                    "kappa": [math.inf if a["floor"][c] is None else a["floor"][c] for c in counts]}
+    return out
+
+
+def _growth(ax, a: dict, matplotlib) -> None:
+    """The confirmed worst-case loss against the Byzantine share, per defence, with the swarm's floor
+    kappa >= f / (n - 2f) on its own axis (a bound on any combination's error, not on items)."""
+    g = growth_data(a)
+    floor_ = g.pop("floor")
+    for label, v in g.items():
+        lo = [max(0.0, y - x) if math.isfinite(x) else 0.0 for y, x in zip(v["loss"], v["low"])]
+        hi = [max(0.0, x - y) if math.isfinite(x) else 0.0 for y, x in zip(v["loss"], v["high"])]
+        ax.errorbar(v["share"], v["loss"], yerr=[lo, hi], marker="o", ms=3, lw=1, capsize=2, label=label)
+    ax.axhline(a["max_loss"], ls="--", color="k", lw=0.8)
+    ax.set_xlabel("share of Byzantine robots")
+    ax.set_ylabel("confirmed worst-case loss found")
+    ax.xaxis.set_major_formatter(matplotlib.ticker.PercentFormatter(1.0))
+    ax.yaxis.set_major_formatter(matplotlib.ticker.PercentFormatter(1.0))
+    kappa = ax.twinx()
+    kappa.plot(floor_["share"], floor_["kappa"], ls=":", color="0.3", marker="x", label="floor f/(n-2f), n = 25")
+    kappa.set_ylabel("floor of robust aggregation, kappa", fontsize=8)
+    kappa.legend(fontsize=7, loc="lower right")
+    ax.legend(fontsize=6, loc="upper left", ncol=2)
 
 
 def _pct(v: dict) -> str:
@@ -217,12 +254,14 @@ def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, p
     counts = [str(b) for b in a["byzantines"]]
     lines += [f"Confirmed on {a['runs']} paired runs per defence and count (Hodges-Lehmann estimate [95 % "
               "interval]; loss to the worst attack the inner search found, against truthful Byzantines):", "",
-              "| defence | family | cost, none | " + " | ".join(f"loss, {c}" for c in counts)
-              + " | answer | parameters |",
-              "|---|---|---|" + "---|" * len(counts) + "---|---|"]
+              "| defence | family | cost, none | items lost per robot, none | "
+              + " | ".join(f"loss, {c}" for c in counts) + " | answer | parameters |",
+              "|---|---|---|---|" + "---|" * len(counts) + "---|---|"]
     for r in a["confirmed"]:
         vals = ", ".join(f"{k} {v:.4g}" for k, v in r["values"].items()) or "–"
-        lines.append(f"| {r['label']} | {r['family']} | {_pct(r['cost'])} | "
+        ci = r["cost_items"]
+        items = (f"{ci['hl']:.2f} {_ci(ci['low'], ci['high'], '.2f')}" if math.isfinite(ci["hl"]) else "undefined")
+        lines.append(f"| {r['label']} | {r['family']} | {_pct(r['cost'])} | {items} | "
                      + " | ".join(_pct(r["loss"][c]) for c in counts) + f" | {r['answer']} | {vals} |")
     lines += ["", "The floor of robust aggregation (Allouah et al. 2023), kappa >= f / (n - 2f): for the swarm "
               f"(n = {a['robots']} voices, f = the Byzantine count) "
