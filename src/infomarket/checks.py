@@ -13,7 +13,7 @@ import numba
 import numpy as np
 
 from .config import validate
-from .engine.simulation import Simulation
+from .engine.simulation import Simulation, quiet_compiles
 from .errors import InfomarketError, RuleRunError
 from .ledger import LedgerEvent, replay_events
 from .ledger.replay import Ledger
@@ -80,7 +80,8 @@ def _behaviour_bounds_checked(name: str, cfg, seed: int, steps: int, kinds) -> N
                      else [(int(me), np.array([j for j in range(w.kind.shape[0]) if j != me], np.int64))])
             for args in calls:
                 try:
-                    checked(view, *args, *extra)
+                    with quiet_compiles():  # the first call compiles the rule
+                        checked(view, *args, *extra)
                 except (IndexError, ZeroDivisionError) as exc:
                     # plain Python on the world's arrays names the line
                     raise CheckFailed(f"behaviour {name!r}: its {role} rule "
@@ -183,7 +184,8 @@ def _bounds_checked(name: str, events: list, robots: int, stake: float) -> None:
         return ledger
 
     try:
-        _replay(ledger_with(checked), events)
+        with quiet_compiles():  # the first call compiles the rule
+            _replay(ledger_with(checked), events)
     except (IndexError, ZeroDivisionError) as exc:
         raise CheckFailed(f"payment scheme {name!r}: its rule "
                           + _located(exc, py, lambda: _replay(ledger_with(py), events))) from None

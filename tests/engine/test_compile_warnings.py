@@ -25,3 +25,4 @@ def test_quiet_compiles_are_silenced_too(monkeypatch):
         with compile_notice(["naive"], "delayed"):
             warnings.warn("variable 'x.1' is not in scope", NumbaIRAssumptionWarning)
     assert seen == []
+

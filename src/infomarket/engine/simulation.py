@@ -320,14 +320,21 @@ COMPILE_NOTICE_AFTER = 1.0
 
 
 @contextmanager
+def quiet_compiles():
+    """Compile inside without numba's pedantic warnings: its IR checks flag the inlined ledger closures
+    ("variable ... is not in scope"), a note to numba's developers about its own IR, dozens of lines per
+    kernel or rule, nothing a user can act on.  Every other warning passes."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", NumbaPedanticWarning)
+        yield
+
+
+@contextmanager
 def compile_notice(kinds, scheme: str, after: float | None = None):
     """Say on stderr, once ``after`` seconds have gone by inside the block, that the step kernel is being
     compiled (the first run of a behaviour mix waits 10-20 s with nothing else to show)."""
     after = COMPILE_NOTICE_AFTER if after is None else after
-    with warnings.catch_warnings():
-        # numba's pedantic IR checks flag the inlined ledger closures ("variable ... is not in scope"): a
-        # note to numba's developers about its own IR, dozens of lines per kernel, nothing a user can act on
-        warnings.simplefilter("ignore", NumbaPedanticWarning)
+    with quiet_compiles():
         if os.environ.get("INFOMARKET_COMPILE_NOTICE", "1") == "0":
             yield
             return
