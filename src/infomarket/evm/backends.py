@@ -40,9 +40,10 @@ from __future__ import annotations
 import re
 from typing import NamedTuple
 
-from eth_utils import keccak, to_checksum_address
+from eth_utils import keccak
 
 from .errors import ChainError, revert_data
+from .protocol import checksum
 
 #: Gas money given to every robot and to the market account (wei); far above what a demo spends.
 GAS_ALLOWANCE_WEI = 10**20
@@ -157,7 +158,7 @@ class Web3Backend:
                 raise
             raise RevertedCall(raw) from exc
         receipt = self.transact(sender, None, code)
-        return to_checksum_address(self.last_address), receipt
+        return checksum(self.last_address), receipt
 
     def snapshot(self):
         return self.w3.provider.ethereum_tester.take_snapshot()
@@ -291,7 +292,7 @@ class RevmBackend:
         address = self._isolated(lambda: self.evm.deploy(sender.address, code, gas=self.gas_limit), keep=True)
         receipt = self._receipt()
         self._mined()
-        return to_checksum_address(address), receipt
+        return checksum(address), receipt
 
     def _mined(self) -> None:
         if self.automine:
@@ -396,7 +397,7 @@ class RevmBackend:
 
     def _receipt(self) -> Receipt:
         result = self.evm.result
-        logs = [Log(to_checksum_address(lg.address), [bytes.fromhex(t.removeprefix("0x")) for t in lg.topics],
+        logs = [Log(checksum(lg.address), [bytes.fromhex(t.removeprefix("0x")) for t in lg.topics],
                     bytes(lg.data[1])) for lg in result.logs]
         return Receipt(result.gas_used, self._block, logs)
 
