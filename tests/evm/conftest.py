@@ -8,7 +8,6 @@ mutation check (tests/evm/mutation.py) uses it to run the attack tests against p
 """
 from __future__ import annotations
 
-import copy
 import json
 import os
 from pathlib import Path
@@ -17,6 +16,8 @@ import pytest
 
 from infomarket.evm.market import ChainMarket, MarketParams, connect, derived_account
 from infomarket.evm.units import to_units
+
+from .clients import client_copy
 
 ROBOTS = 8
 BACKENDS = os.environ.get("INFOMARKET_CHAIN_BACKENDS", "revm,py-evm").split(",")
@@ -94,23 +95,14 @@ class Deployments:
         if first and key in self.kept and self._revertible(self.kept[key][1]):
             template, handle = self.kept[key]
             self.revert(handle)
-            return _client_copy(template)
+            return client_copy(template)
         params = MarketParams.from_floats(scheme, stake=stake, theta_deg=theta_deg, **options)
         market = ChainMarket.deploy(params, backend=self.chain, artifact=self.artifact)
         wealths = wealth if isinstance(wealth, list) else [wealth] * len(self.robots)
         for account, amount in zip(self.robots, wealths):  # registers every robot, with or without wealth
             market.grant_wealth(account, to_units(amount))
-        self.kept[key] = (_client_copy(market), self.snapshot(ours=True))
+        self.kept[key] = (client_copy(market), self.snapshot(ours=True))
         return market
-
-
-def _client_copy(market: ChainMarket) -> ChainMarket:
-    """A client of the same contract with its own copy of what it has recorded (acceptances, keys)."""
-    new = copy.copy(market)
-    for name, value in vars(market).items():
-        if isinstance(value, (dict, list, set)):
-            setattr(new, name, copy.copy(value))
-    return new
 
 
 @pytest.fixture(scope="session")

@@ -161,10 +161,19 @@ class Web3Backend:
         return checksum(self.last_address), receipt
 
     def snapshot(self):
-        return self.w3.provider.ethereum_tester.take_snapshot()
+        """A handle to the current state for ``revert``: py-evm's, or a node's ``evm_snapshot`` (which a
+        node lets be reverted to once, dropping every later one)."""
+        tester = getattr(self.w3.provider, "ethereum_tester", None)
+        if tester is not None:
+            return tester.take_snapshot()
+        return self.w3.provider.make_request("evm_snapshot", [])["result"]
 
     def revert(self, snapshot) -> None:
-        self.w3.provider.ethereum_tester.revert_to_snapshot(snapshot)
+        tester = getattr(self.w3.provider, "ethereum_tester", None)
+        if tester is not None:
+            tester.revert_to_snapshot(snapshot)
+        elif not self.w3.provider.make_request("evm_revert", [snapshot]).get("result"):
+            raise ChainError(f"the node could not go back to its snapshot {snapshot}")
 
 
 _REVERT_OUTPUT = re.compile(r"output: 0x([0-9a-fA-F]*)")
