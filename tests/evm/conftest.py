@@ -44,7 +44,7 @@ def robots(chain):
 class Deployments:
     """``make_market``: a market with every robot granted ``wealth`` tokens, as deployed and granted afresh.
 
-    Deploying and granting costs about 0.4 CPU s on py-evm, and most tests ask for one of a few
+    Deploying and granting is a dozen transactions, slow on py-evm, and most tests ask for one of a few
     configurations; so each configuration's market is kept with a snapshot of the chain taken right
     after it was deployed and granted, and a test's first market is that snapshot reverted to (its
     client copied as it was then) when nothing has changed the chain since the test began and every
