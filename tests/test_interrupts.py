@@ -95,6 +95,33 @@ def test_a_compile_in_a_child_is_killed_at_once_and_a_finished_one_is_loaded_her
     assert interrupts.compiled_apart(lambda: "plain", None) == "plain"  # outside a command: just the call
 
 
+
+class _Unpicklable(ValueError):
+    def __reduce__(self):
+        raise TypeError("not picklable")
+
+
+def test_a_compile_that_fails_in_the_child_is_raised_here_without_compiling_again(tmp_path):
+    """A failed compile is not cached, so compiling it again here would pay it twice: the child's error is
+    raised here.  One the child cannot hand over is met by running the call here, as before."""
+    parent, marker = os.getpid(), tmp_path / "kernel.simulation.compiled"
+
+    def failing(error):
+        def compile_():
+            (tmp_path / str(os.getpid())).touch()
+            raise error("rule three_values_sell returns 3 values")
+        return compile_
+
+    with interrupts.handling(), pytest.raises(ValueError, match="returns 3 values"):
+        interrupts.compiled_apart(failing(ValueError), marker)
+    calls = [int(p.name) for p in tmp_path.iterdir()]
+    assert len(calls) == 1 and calls[0] != parent and not marker.exists()  # the child's compile only
+    (tmp_path / str(calls[0])).unlink()
+    with interrupts.handling(), pytest.raises(_Unpicklable, match="returns 3 values"):
+        interrupts.compiled_apart(failing(_Unpicklable), marker)
+    assert parent in [int(p.name) for p in tmp_path.iterdir()] and not marker.exists()
+
+
 def _threads(pid: int) -> int:
     try:
         status = Path(f"/proc/{pid}/status").read_text()

@@ -33,8 +33,10 @@ from __future__ import annotations
 import contextlib
 import ctypes
 import os
+import pickle
 import signal
 import sys
+import tempfile
 import threading
 from collections.abc import Callable
 from pathlib import Path
@@ -287,31 +289,53 @@ def compiled_apart(compile_: Callable[[], T], marker: Path | None) -> T:
     """``compile_()``, whose first call in a process compiles and caches on disk, made stoppable: while a
     command is running (``handling``) and ``marker`` does not exist yet, it is first run in a forked
     child (which creates ``marker`` when it succeeds), so a signal during the compile kills the child at
-    once; then it runs here, loading from the cache.  A child that failed leaves the error to the call
-    here.  ``marker`` None (not cacheable), outside a command, off the main thread or without ``fork``:
-    just ``compile_()``."""
+    once; then it runs here, loading from the cache.  A child that failed hands its error back, raised
+    here (a failed compile is not cached: running it here would compile it all again); an error it
+    cannot hand back is left to the call here.  ``marker`` None (not cacheable), outside a command, off
+    the main thread or without ``fork``: just ``compile_()``."""
     if (marker is None or not _state.active or marker.exists() or not hasattr(os, "fork")
             or threading.current_thread() is not threading.main_thread()):
         return _here(compile_)
     parent = os.getpid()
-    pid = os.fork()
-    if pid == 0:  # pragma: no cover - the child (its coverage is not collected)
-        code = 1
+    with tempfile.TemporaryFile() as failure:
+        pid = os.fork()
+        if pid == 0:  # pragma: no cover - the child (its coverage is not collected)
+            code = 1
+            try:
+                detach(parent)
+                compile_()
+                marker.touch()
+                code = 0
+            except Exception as exc:  # noqa: BLE001 - handed to the parent, which raises it
+                with contextlib.suppress(Exception):
+                    failure.write(pickle.dumps(exc))
+                    failure.flush()
+            finally:
+                os._exit(code)
         try:
-            detach(parent)
-            compile_()
-            marker.touch()
-            code = 0
-        finally:
-            os._exit(code)
-    try:
-        os.waitpid(pid, 0)  # a signal raises KeyboardInterrupt here, at once
-    except BaseException:
-        kill_group(pid)
-        with contextlib.suppress(ChildProcessError):
-            os.waitpid(pid, 0)
-        raise
+            os.waitpid(pid, 0)  # a signal raises KeyboardInterrupt here, at once
+        except BaseException:
+            kill_group(pid)
+            with contextlib.suppress(ChildProcessError):
+                os.waitpid(pid, 0)
+            raise
+        failure.seek(0)
+        error = _unpickled(failure.read())
+    if error is not None:
+        check()
+        raise error
     return _here(compile_)
+
+
+def _unpickled(data: bytes) -> Exception | None:
+    """The exception a child pickled, or None (nothing written, or it does not load here)."""
+    if not data:
+        return None
+    try:
+        error = pickle.loads(data)
+    except Exception:  # noqa: BLE001 - the parent then compiles and meets the error itself
+        return None
+    return error if isinstance(error, Exception) else None
 
 
 def _here(compile_: Callable[[], T]) -> T:

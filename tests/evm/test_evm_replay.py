@@ -7,9 +7,10 @@ from pathlib import Path
 
 import pytest
 
+from infomarket.errors import ArgumentError
 from infomarket.evm.errors import ChainError
 from infomarket.evm.market import MarketParams
-from infomarket.evm.evm_replay import BalanceRow, replay_on_chain
+from infomarket.evm.evm_replay import BalanceRow, replay_market, replay_on_chain
 
 from .exact_ledger import SELLER_POSITION, ExactLedger, vector_for
 
@@ -101,3 +102,11 @@ def test_unknown_event_kinds_stop_the_replay():
     with pytest.raises(ChainError, match="unknown kind"):
         replay_on_chain([{"kind": "gift", "buyer": 0}], robots=1,
                         params=MarketParams.from_floats("delayed"), initial_wealth=1.0)
+
+
+def test_a_market_made_for_another_swarm_size_is_refused():
+    params = MarketParams.from_floats("delayed")
+    start = replay_market(robots=2, params=params, initial_wealth=1.0)
+    with pytest.raises(ArgumentError, match="registers 2 robots, not 3"):
+        replay_on_chain([deposit(0)], robots=3, params=params, initial_wealth=1.0, start=start)
+    assert replay_on_chain([deposit(0)], robots=2, params=params, initial_wealth=1.0, start=start).conserved()

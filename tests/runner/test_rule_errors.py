@@ -47,6 +47,8 @@ def string_default_sell(w, me, site, mode="fast"):
     return own_entry(w, me, site)
 '''
 
+# k = 0 raises at the first paid deposit; k = -1 gives every weight -1: one weight rule, one step kernel for
+# the two tests (a kernel's name hashes its rules' file and source, not their parameters)
 PAY = '''
 import infomarket as im
 
@@ -66,9 +68,9 @@ def shared(tmp_path_factory):
 
 
 def experiment(tmp_path, name: str, plugin: str, behaviour: str = "naive", scheme: str = "delayed",
-               steps: int = 200, runs: int = 2, robots: int = 6, plugins=None) -> str:
+               steps: int = 200, runs: int = 2, robots: int = 6, plugins=None, k: float | None = None) -> str:
     """The experiment ``name``, its plugin written as ``name.py`` in ``plugins`` (default ``tmp_path``; kept
-    when it is there already) and its file in ``tmp_path``."""
+    when it is there already) and its file in ``tmp_path``; ``k``: the payment scheme's parameter."""
     path = (plugins or tmp_path) / f"{name}.py"
     if not path.exists():
         path.write_text(plugin)
@@ -92,7 +94,7 @@ def experiment(tmp_path, name: str, plugin: str, behaviour: str = "naive", schem
 
         [payment]
         scheme = "{scheme}"
-        '''))
+        ''') + (f"params = {{ k = {k} }}\n" if k is not None else ""))
     return str(tmp_path / f"{name}.toml")
 
 
@@ -143,16 +145,15 @@ def _first_paid_deposit(cfg, seed: int) -> int:
     raise AssertionError("no paid deposit")
 
 
-def test_a_weight_rule_raising_at_a_deposit_is_named_with_the_step(tmp_path, capsys):
-    exp = experiment(tmp_path, "divided", PAY, scheme="divided", steps=2000, runs=1,
-                     robots=25)
+def test_a_weight_rule_raising_at_a_deposit_is_named_with_the_step(tmp_path, shared, capsys):
+    exp = experiment(tmp_path, "divided", PAY, scheme="divided", steps=2000, runs=1, robots=25, plugins=shared, k=0.0)
     out = tmp_path / "store"
     assert main(["sweep", exp, "--out", str(out), "--workers", "1", "--quiet"]) == 2
     err = one_message(capsys)
     cfg = im.load_experiment(exp)
     seed = int(Store(out).runs().seed.iloc[0])
     step = _first_paid_deposit(cfg, seed)
-    at = f"{tmp_path / 'divided.py'}:{line_of(tmp_path / 'divided.py', 'weights[x] = 1.0 / k')}"
+    at = f"{shared / 'divided.py'}:{line_of(shared / 'divided.py', 'weights[x] = 1.0 / k')}"
     assert f"payment scheme 'divided': its weight rule divided raised ZeroDivisionError" in err
     assert f"at step {step} (buyer " in err and at in err
 
@@ -219,27 +220,17 @@ def test_replay_names_the_rule_and_writes_nothing(tmp_path, shared, capsys):
     assert not np.any([p.name.startswith(".late") for p in tmp_path.iterdir()])  # no temporary file left
 
 
-NEGATIVE = '''
-import infomarket as im
-
-
-@im.payment("negative_weights", description="weights below zero")
-def negative_weights(buyer, sellers, sites, directions, weights):
-    for x in range(len(sellers)):
-        weights[x] = -1.0
-'''
-
-
-def test_a_weight_rule_giving_negative_weights_is_named_with_the_step(tmp_path, capsys):
-    """Before: "step N: a payment rule returned a negative or non-finite weight", naming no scheme, exit 1."""
-    exp = experiment(tmp_path, "negative", NEGATIVE, scheme="negative_weights", steps=2000, runs=1, robots=25)
+def test_a_weight_rule_giving_negative_weights_is_named_with_the_step(tmp_path, shared, capsys):
+    """Before: "step N: a payment rule returned a negative or non-finite weight", naming no scheme, exit 1.
+    The dividing rule with k = -1: every weight -1, no error raised."""
+    exp = experiment(tmp_path, "divided", PAY, scheme="divided", steps=2000, runs=1, robots=25, plugins=shared, k=-1.0)
     out = tmp_path / "store"
     assert main(["sweep", exp, "--out", str(out), "--workers", "1", "--quiet"]) == 2
     err = one_message(capsys)
     cfg = im.load_experiment(exp)
     step = _first_paid_deposit(cfg, int(Store(out).runs().seed.iloc[0]))
-    at = f"{tmp_path / 'negative.py'}:{line_of(tmp_path / 'negative.py', '@im.payment')}"
-    assert (f"payment scheme 'negative_weights': its weight rule negative_weights ({at}) gave a negative or "
+    at = f"{shared / 'divided.py'}:{line_of(shared / 'divided.py', '@im.payment')}"
+    assert (f"payment scheme 'divided': its weight rule divided ({at}) gave a negative or "
             f"non-finite weight at step {step}") in err
 
 

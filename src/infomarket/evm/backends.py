@@ -40,9 +40,10 @@ from __future__ import annotations
 import re
 from typing import NamedTuple
 
-from eth_utils import keccak, to_checksum_address
+from eth_utils import keccak
 
 from .errors import ChainError, revert_data
+from .protocol import checksum
 
 #: Gas money given to every robot and to the market account (wei); far above what a demo spends.
 GAS_ALLOWANCE_WEI = 10**20
@@ -157,13 +158,22 @@ class Web3Backend:
                 raise
             raise RevertedCall(raw) from exc
         receipt = self.transact(sender, None, code)
-        return to_checksum_address(self.last_address), receipt
+        return checksum(self.last_address), receipt
 
     def snapshot(self):
-        return self.w3.provider.ethereum_tester.take_snapshot()
+        """A handle to the current state for ``revert``: py-evm's, or a node's ``evm_snapshot`` (which a
+        node lets be reverted to once, dropping every later one)."""
+        tester = getattr(self.w3.provider, "ethereum_tester", None)
+        if tester is not None:
+            return tester.take_snapshot()
+        return self.w3.provider.make_request("evm_snapshot", [])["result"]
 
     def revert(self, snapshot) -> None:
-        self.w3.provider.ethereum_tester.revert_to_snapshot(snapshot)
+        tester = getattr(self.w3.provider, "ethereum_tester", None)
+        if tester is not None:
+            tester.revert_to_snapshot(snapshot)
+        elif not self.w3.provider.make_request("evm_revert", [snapshot]).get("result"):
+            raise ChainError(f"the node could not go back to its snapshot {snapshot}")
 
 
 _REVERT_OUTPUT = re.compile(r"output: 0x([0-9a-fA-F]*)")
@@ -291,7 +301,7 @@ class RevmBackend:
         address = self._isolated(lambda: self.evm.deploy(sender.address, code, gas=self.gas_limit), keep=True)
         receipt = self._receipt()
         self._mined()
-        return to_checksum_address(address), receipt
+        return checksum(address), receipt
 
     def _mined(self) -> None:
         if self.automine:
@@ -396,7 +406,7 @@ class RevmBackend:
 
     def _receipt(self) -> Receipt:
         result = self.evm.result
-        logs = [Log(to_checksum_address(lg.address), [bytes.fromhex(t.removeprefix("0x")) for t in lg.topics],
+        logs = [Log(checksum(lg.address), [bytes.fromhex(t.removeprefix("0x")) for t in lg.topics],
                     bytes(lg.data[1])) for lg in result.logs]
         return Receipt(result.gas_used, self._block, logs)
 

@@ -110,9 +110,42 @@ class ReplayReport:
                 "settle_calls": self.settle_calls}
 
 
+@dataclass(frozen=True)
+class ReplayMarket:
+    """What a replay starts from: ``market`` deployed with ``params`` (the simulation's "no expiry" made
+    one the replay cannot reach), every robot in ``accounts`` registered with ``wealth`` units."""
+
+    market: ChainMarket
+    params: MarketParams
+    accounts: list
+    wealth: int
+    expire: bool
+
+
+def replay_market(*, robots: int, params: MarketParams, initial_wealth: float, rpc_url: str | None = None,
+                  backend: str | None = None, seed: int = 0, chain=None) -> ReplayMarket:
+    """Deploy a market for ``replay_on_chain`` and register ``robots`` accounts with their initial wealth,
+    on ``chain`` (a backend) or else a new connection (``rpc_url``, ``backend``)."""
+    if not params.stake_expiry:
+        # The simulation's "no expiry" (0): the contract always has one, so pick one the replay cannot reach.
+        params = replace(params, stake_expiry=REPLAY_NO_EXPIRY)
+        expire = False
+    else:
+        expire = True
+    chain = chain or connect(rpc_url, backend)
+    market = ChainMarket.deploy(params, backend=chain, seed=seed)
+    accounts = [derived_account("robot", i, seed) for i in range(robots)]
+    chain.fund([a.address for a in accounts])
+    wealth = to_units(initial_wealth)
+    for a in accounts:
+        market.grant_wealth(a, wealth)  # registers every robot, with or without wealth
+    return ReplayMarket(market, params, accounts, wealth, expire)
+
+
 def replay_on_chain(events: Iterable[Mapping] | object, *, robots: int, params: MarketParams,
                     initial_wealth: float, rpc_url: str | None = None, backend: str | None = None,
-                    seed: int = 0, blocks_valid: int = 8, progress=None) -> ReplayReport:
+                    seed: int = 0, blocks_valid: int = 8, progress=None,
+                    start: ReplayMarket | None = None) -> ReplayReport:
     """Deploy a market, give ``robots`` accounts their initial wealth, and replay ``events``.
 
     ``events`` are the simulator's event records (a DataFrame or mappings) with ``kind`` in
@@ -124,22 +157,17 @@ def replay_on_chain(events: Iterable[Mapping] | object, *, robots: int, params: 
     first event of each step, the stakes that expire at that step are refunded (``refundExpired``),
     as the simulation does at the start of its step. A deposit is ``buyItem`` followed by ``settle``
     until the round trip is settled. A purchase the chain refuses, or a refusal the chain would accept,
-    is recorded in ``disagreements`` rather than stopping the replay.
+    is recorded in ``disagreements`` rather than stopping the replay. ``start``: the market to replay
+    on, as ``replay_market`` deploys it with the same arguments (a caller replaying many event logs
+    on one chain reverts to it), instead of deploying one.
     """
     records = events.to_dict("records") if hasattr(events, "to_dict") else list(events)
-    if not params.stake_expiry:
-        # The simulation's "no expiry" (0): the contract always has one, so pick one the replay cannot reach.
-        params = replace(params, stake_expiry=REPLAY_NO_EXPIRY)
-        expire = False
-    else:
-        expire = True
-    chain = connect(rpc_url, backend)
-    market = ChainMarket.deploy(params, backend=chain, seed=seed)
-    accounts = [derived_account("robot", i, seed) for i in range(robots)]
-    chain.fund([a.address for a in accounts])
-    wealth = to_units(initial_wealth)
-    for a in accounts:
-        market.grant_wealth(a, wealth)  # registers every robot, with or without wealth
+    start = start or replay_market(robots=robots, params=params, initial_wealth=initial_wealth, rpc_url=rpc_url,
+                                   backend=backend, seed=seed)
+    market, params, accounts, wealth, expire = start.market, start.params, start.accounts, start.wealth, start.expire
+    if len(accounts) != robots:
+        raise ArgumentError(f"the replay's market registers {len(accounts)} robots, not {robots}")
+    chain = market.backend
     base = chain.block_number + 1
     chain.advance_to(base)
 

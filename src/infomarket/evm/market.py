@@ -24,14 +24,15 @@ from eth_abi import decode as abi_decode
 from eth_abi import encode as abi_encode
 from eth_account import Account
 from eth_account.signers.local import LocalAccount
-from eth_utils import keccak, to_checksum_address
+from eth_utils import keccak
 from eth_utils.abi import event_abi_to_log_topic, function_abi_to_4byte_selector, get_abi_input_types, get_abi_output_types
 
 from ..errors import ConfigError
 from ..payments import default_theta
 from .backends import Receipt, RevertedCall, make_backend
 from .errors import ChainError, ContractRevert
-from .protocol import Domain, LightContract, Offer, PathInfo, ProtocolError, accept_offer, sign_deposit, sign_offer
+from .protocol import (Domain, LightContract, Offer, PathInfo, ProtocolError, accept_offer, checksum, sign_deposit,
+                       sign_offer)
 from .units import COS_SCALE, share_to_wad, to_units
 
 SCHEMES = {"delayed": 0, "outlier": 1, "outlier_distinct": 2}
@@ -223,7 +224,7 @@ class _Codec:
 
 
 def _checksum(value):
-    return to_checksum_address(value) if isinstance(value, str) and value.startswith("0x") and len(value) == 42 else value
+    return checksum(value) if isinstance(value, str) and value.startswith("0x") and len(value) == 42 else value
 
 
 Robot = LocalAccount | str
@@ -243,7 +244,7 @@ class ChainMarket:
         #: the bond a registration locks (``grant_wealth`` grants it on top of the wealth it gives)
         self.bond = bond
         self.nest = nest or market
-        self.address = to_checksum_address(address)
+        self.address = checksum(address)
         self.codec = _Codec(abi or load_artifact()["abi"])
         #: the buyers' clients: acceptances signed per (buyer, round trip) and per (buyer, seller, round
         #: trip), capped
@@ -321,7 +322,7 @@ class ChainMarket:
 
     def _remember(self, robot: Robot) -> str:
         if isinstance(robot, str):
-            return to_checksum_address(robot)
+            return checksum(robot)
         self._keys[robot.address] = robot
         return robot.address
 
@@ -384,7 +385,7 @@ class ChainMarket:
 
     def _result(self, receipt: Receipt) -> TxResult:
         events = [self.codec.decode_event(lg.topics, lg.data) for lg in receipt.logs
-                  if to_checksum_address(lg.address) == self.address]
+                  if checksum(lg.address) == self.address]
         return TxResult(receipt.gas_used, receipt.block_number, [e for e in events if e is not None])
 
     # -- the light-contract protocol, both sides ----------------------------------------------------
@@ -393,7 +394,7 @@ class ChainMarket:
     def domain(self) -> Domain:
         """This market's EIP-712 domain, read from the contract itself (EIP-5267)."""
         _, name, version, chain_id, contract, _, _ = self._call(self.market.address, "eip712Domain")
-        return Domain(chain_id, to_checksum_address(contract), name, version)
+        return Domain(chain_id, checksum(contract), name, version)
 
     def light_contract(self, seller: LocalAccount, buyer: LocalAccount, site: int, age: int, info: PathInfo,
                        seller_position: tuple[float, float], blocks_valid: int = 8,
@@ -461,7 +462,7 @@ class ChainMarket:
 
     def contributors(self, buyer: str) -> list[tuple]:
         """The open round trip's records: (seller, openedAt, site, dx, dy, weight, prevGap)."""
-        return [(to_checksum_address(r[0]),) + tuple(r[1:]) for r in self.view("contributors", buyer)]
+        return [(checksum(r[0]),) + tuple(r[1:]) for r in self.view("contributors", buyer)]
 
 
 def _error_table(abi: list) -> dict[bytes, tuple[str, list[str], list[str]]]:

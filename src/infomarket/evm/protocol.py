@@ -58,6 +58,18 @@ _DOMAIN_FIELDS = [
 ]
 
 
+@functools.lru_cache(maxsize=4096)
+def checksum(address: str | bytes) -> str:
+    """``to_checksum_address``, remembered: a client checksums the same few addresses for every message it
+    signs and every log it reads (a keccak each time)."""
+    return to_checksum_address(address)
+
+
+@functools.lru_cache(maxsize=1024)
+def _address_of(key: bytes) -> str:
+    return Account.from_key(key).address
+
+
 class ProtocolError(ChainError, ValueError):
     """A light contract was malformed or badly signed before it ever reached the chain."""
 
@@ -76,7 +88,7 @@ class Domain:
             "name": self.name,
             "version": self.version,
             "chainId": self.chain_id,
-            "verifyingContract": to_checksum_address(self.verifying_contract),
+            "verifyingContract": checksum(self.verifying_contract),
         }
 
 
@@ -112,7 +124,7 @@ class Offer:
     path_hash: bytes
 
     def as_abi(self) -> tuple:
-        return (to_checksum_address(self.seller), self.site, self.age, self.max_block, self.path_hash)
+        return (checksum(self.seller), self.site, self.age, self.max_block, self.path_hash)
 
     def message(self) -> dict:
         return dict(zip(("seller", "site", "age", "maxBlock", "pathHash"), self.as_abi()))
@@ -133,7 +145,7 @@ class LightContract:
     s: bytes
 
     def as_abi(self) -> tuple:
-        return (self.offer.as_abi(), to_checksum_address(self.buyer), self.seller_x, self.seller_y,
+        return (self.offer.as_abi(), checksum(self.buyer), self.seller_x, self.seller_y,
                 self.trip, self.v, self.r, self.s)
 
 
@@ -154,7 +166,7 @@ def acceptance_typed_data(domain: Domain, offer: Offer, buyer: str, seller_x: in
         "types": {"EIP712Domain": _DOMAIN_FIELDS, "Offer": _OFFER_FIELDS, "Acceptance": _ACCEPTANCE_FIELDS},
         "primaryType": "Acceptance",
         "domain": domain.as_dict(),
-        "message": {"offer": offer.message(), "buyer": to_checksum_address(buyer),
+        "message": {"offer": offer.message(), "buyer": checksum(buyer),
                     "sellerX": seller_x, "sellerY": seller_y, "trip": trip},
     }
 
@@ -170,7 +182,7 @@ _ACCEPTANCE_TYPEHASH = keccak(text="Acceptance(Offer offer,address buyer,int64 s
 def _separator(domain: Domain) -> bytes:
     return keccak(abi_encode(["bytes32", "bytes32", "bytes32", "uint256", "address"],
                              [_DOMAIN_TYPEHASH, keccak(text=domain.name), keccak(text=domain.version),
-                              domain.chain_id, to_checksum_address(domain.verifying_contract)]))
+                              domain.chain_id, checksum(domain.verifying_contract)]))
 
 
 def _offer_hash(offer: Offer) -> bytes:
@@ -186,7 +198,7 @@ def offer_digest(domain: Domain, offer: Offer) -> bytes:
 def acceptance_digest(domain: Domain, offer: Offer, buyer: str, seller_x: int, seller_y: int, trip: int) -> bytes:
     """The EIP-712 digest of ``acceptance_typed_data`` (what the contract's ``acceptanceDigest`` returns)."""
     struct = keccak(abi_encode(["bytes32", "bytes32", "address", "int64", "int64", "uint64"],
-                               [_ACCEPTANCE_TYPEHASH, _offer_hash(offer), to_checksum_address(buyer), seller_x, seller_y,
+                               [_ACCEPTANCE_TYPEHASH, _offer_hash(offer), checksum(buyer), seller_x, seller_y,
                                 trip]))
     return keccak(b"\x19\x01" + _separator(domain) + struct)
 
@@ -203,7 +215,7 @@ _DEPOSIT_TYPEHASH = keccak(text="Deposit(address robot,uint64 trip)")
 def deposit_digest(domain: Domain, robot: str, trip: int) -> bytes:
     """The EIP-712 digest of ``Deposit(robot, trip)`` (the contract's ``depositDigest``): what the robot
     signs to end round trip ``trip`` with a deposit, and what the nest signs to acknowledge it."""
-    struct = keccak(abi_encode(["bytes32", "address", "uint64"], [_DEPOSIT_TYPEHASH, to_checksum_address(robot), trip]))
+    struct = keccak(abi_encode(["bytes32", "address", "uint64"], [_DEPOSIT_TYPEHASH, checksum(robot), trip]))
     return keccak(b"\x19\x01" + _separator(domain) + struct)
 
 
@@ -214,7 +226,7 @@ def sign_deposit(key: bytes, domain: Domain, robot: str, trip: int) -> tuple[int
 
 def sign_offer(seller_key: bytes, domain: Domain, offer: Offer) -> bytes:
     """The seller's 65-byte signature over its offer."""
-    if Account.from_key(seller_key).address != to_checksum_address(offer.seller):
+    if _address_of(bytes(seller_key)) != checksum(offer.seller):
         raise ProtocolError("an offer can only be signed by the seller it names")
     v, r, s = _sign(seller_key, offer_digest(domain, offer))
     return r + s + bytes([v])
@@ -231,9 +243,9 @@ def accept_offer(buyer_key: bytes, domain: Domain, offer: Offer, offer_signature
     round trip is capped by its client (``market.AcceptanceBook``), not here.
     """
     signer = Account._recover_hash(offer_digest(domain, offer), signature=offer_signature)
-    if signer != to_checksum_address(offer.seller):
+    if signer != checksum(offer.seller):
         raise ProtocolError(f"offer claims seller {offer.seller} but is signed by {signer}")
-    buyer = Account.from_key(buyer_key).address
+    buyer = _address_of(bytes(buyer_key))
     sx, sy = to_micro(seller_position[0]), to_micro(seller_position[1])
     v, r, s = _sign(buyer_key, acceptance_digest(domain, offer, buyer, sx, sy, trip))
     return LightContract(offer, offer_signature, buyer, sx, sy, trip, v, r, s)
