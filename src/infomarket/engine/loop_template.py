@@ -7,7 +7,9 @@ a variant the kernel does not use is pruned before numba types it.
 
 Order of operations per step (docs/model.md §3): neighbours; communication (offers from start-of-step
 tables, then every robot buys in id order); move (foraging and payment, install the new table,
-behaviour step, noisy motion), robots in id order.
+behaviour step, noisy motion), robots in id order.  An offer is read only by the seller's neighbours, so
+a robot without one is not asked for an offer, unless its sell rule draws random numbers (``SELL_DRAWS``:
+then it is asked, so the run's draws stay in order).
 
 ``LEDGER`` names the ledger (``ledger.backends``): ``"instant"``, the paper's, or ``"poa"``, the chain
 model (docs/chain-model.md), where a step also opens with a gossip round after the neighbours, purchases
@@ -37,7 +39,8 @@ NEED_ROOM = 1
 #: sell_dispatch(kind, w, i, site, rng) -> (valid, x, y, age): robot i's offer for ``site``
 #: buy_dispatch(kind, w, i, nbrs, rng): robot i buys from its neighbours
 #: pay_dispatch(w, buyer, sellers, sites, directions, weights, rng): the scheme's weights
-sell_dispatch = buy_dispatch = pay_dispatch = None
+#: SELL_DRAWS: per kind, whether its sell rule takes ``rng`` (a tuple of bools)
+sell_dispatch = buy_dispatch = pay_dispatch = SELL_DRAWS = None
 
 #: This kernel's step pieces (engine.step.variant), chosen by its options before anything compiles.
 find_neighbours, begin_communication, install_table, forage, sense_sites, behaviour_step, move = variant(TERRAIN, PATHS)
@@ -109,6 +112,8 @@ def run_steps(w, rng, t_end):
                 expire_stakes(w, i)
         begin_communication(w)
         for i in range(n):
+            if nbr_count[i] == 0 and not SELL_DRAWS[kind[i]]:
+                continue  # no neighbour can buy its offer this step, and asking for it draws nothing
             for site in range(2):
                 if cool[i] == 0:
                     valid, x, y, age = sell_dispatch(kind[i], w, i, site, rng)
