@@ -9,7 +9,9 @@ Order of operations per step (docs/model.md §3): neighbours; communication (off
 tables, then every robot buys in id order); move (foraging and payment, install the new table,
 behaviour step, noisy motion), robots in id order.  An offer is read only by the seller's neighbours, so
 a robot without one is not asked for an offer, unless its sell rule draws random numbers (``SELL_DRAWS``:
-then it is asked, so the run's draws stay in order).
+then it is asked, so the run's draws stay in order); nor does it buy, when its buy rule is registered as
+doing nothing without a neighbour (``BUY_ALONE`` false: ``registry.register_behaviour``'s
+``needs_neighbours``).
 
 ``LEDGER`` names the ledger (``ledger.backends``): ``"instant"``, the paper's, or ``"poa"``, the chain
 model (docs/chain-model.md), where a step also opens with a gossip round after the neighbours, purchases
@@ -40,7 +42,8 @@ NEED_ROOM = 1
 #: buy_dispatch(kind, w, i, nbrs, rng): robot i buys from its neighbours
 #: pay_dispatch(w, buyer, sellers, sites, directions, weights, rng): the scheme's weights
 #: SELL_DRAWS: per kind, whether its sell rule takes ``rng`` (a tuple of bools)
-sell_dispatch = buy_dispatch = pay_dispatch = SELL_DRAWS = None
+#: BUY_ALONE: per kind, whether its buy rule is called for a robot without a neighbour (a tuple of bools)
+sell_dispatch = buy_dispatch = pay_dispatch = SELL_DRAWS = BUY_ALONE = None
 
 #: This kernel's step pieces (engine.step.variant), chosen by its options before anything compiles.
 find_neighbours, begin_communication, install_table, forage, sense_sites, behaviour_step, move = variant(TERRAIN, PATHS)
@@ -124,7 +127,7 @@ def run_steps(w, rng, t_end):
                 else:
                     off_valid[i, site] = False
         for i in range(n):
-            if cool[i] == 0:
+            if cool[i] == 0 and (nbr_count[i] > 0 or BUY_ALONE[kind[i]]):
                 buy_dispatch(kind[i], w, i, nbr[i, :nbr_count[i]], rng)
         for i in range(n):
             if forage(w, i, bits):
