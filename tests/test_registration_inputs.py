@@ -28,6 +28,7 @@ def weights(buyer, sellers, sites, directions, weights, k=1.0):
     (dict(sell=len), RuleError, ["a rule must be a Python function", "len"]),
     (dict(buy="no_such_rule"), RegistrationError, ["buy='no_such_rule' names no registered behaviour", "naive"]),
     (dict(honest="no"), RegistrationError, ["honest must be True or False"]),
+    (dict(needs_neighbours=1), RegistrationError, ["needs_neighbours must be True or False"]),
     (dict(limits={"zz": (">= 0", lambda v: v >= 0)}), RegistrationError, ["limits name 'zz'", "(k)"]),
     (dict(limits=5), RegistrationError, ["limits must be a dict"]),
     (dict(limits={"k": ">= 0"}), RegistrationError, ["the limit of 'k' must be (text, predicate)"]),

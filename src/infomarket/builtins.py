@@ -12,9 +12,9 @@ from .registry import register_behaviour, register_payment
 #: the limit of every angle parameter (Theta, a rotation cap, a slash angle): degrees in (0, 180]
 _ANGLE = ("in (0, 180]", lambda v: 0 < v <= 180)
 
-register_behaviour("naive", buy=naive.naive_buy, sell=naive.honest_sell, honest=True,
+register_behaviour("naive", buy=naive.naive_buy, sell=naive.honest_sell, honest=True, needs_neighbours=True,
                    description="buys younger information and averages it in; sells its own entry")
-register_behaviour("sceptical", buy=sceptical.sceptical_buy, sell="naive", honest=True,
+register_behaviour("sceptical", buy=sceptical.sceptical_buy, sell="naive", honest=True, needs_neighbours=True,
                    description="waits for a second, agreeing piece of information before using it",
                    limits={"threshold": ("> 0", lambda v: v > 0)})
 register_behaviour("saboteur", buy="naive", sell=byzantine.rotated_sell, honest=False,
@@ -27,7 +27,7 @@ register_behaviour("free_rider", buy="naive", sell=byzantine.free_rider_sell, ho
                    description="naive buyer that never sells")
 register_behaviour("sceptical_free_rider", buy="sceptical", sell=byzantine.free_rider_sell, honest=False,
                    description="sceptical buyer that never sells (the original's FreeRiderBehavior)")
-register_behaviour("waypoint", buy=waypoint.waypoint_buy, sell="naive", honest=True, paths=True,
+register_behaviour("waypoint", buy=waypoint.waypoint_buy, sell="naive", honest=True, paths=True, needs_neighbours=True,
                    description="naive buyer that buys and follows waypoint paths once a straight line failed it")
 
 register_payment("delayed", schemes.delayed_weights,
@@ -42,6 +42,7 @@ from .payments import adaptive  # noqa: E402
 from .payments import distinct  # noqa: E402
 
 register_behaviour("reputation_sceptic", buy=reputation.reputation_sceptic_buy, sell="naive", honest=True,
+                   needs_neighbours=True,
                    description="sceptical, but believes sellers with a high reputation or wealth share at once "
                                "and ignores sellers with a poor record",
                    limits={"threshold": ("> 0", lambda v: v > 0),
@@ -78,7 +79,7 @@ from .behaviours import attacks, weighted  # noqa: E402
 _UNIT = ("in [0, 1]", lambda v: 0 <= v <= 1)
 _ANGLE = ("in [0, 180]", lambda v: 0 <= v <= 180)
 _COUNT = (">= 0", lambda v: v >= 0)
-register_behaviour("attacker", buy=attacks.policy_buy, sell=attacks.policy_sell, honest=False,
+register_behaviour("attacker", buy=attacks.policy_buy, sell=attacks.policy_sell, honest=False, needs_neighbours=True,
                    description="the parameterised attack (search space of `infomarket attack-search`): rotation as "
                                "a function of its record, its buyers, Θ and the sellers in range; gates; collusion",
                    limits={**{name: (f"in [{lo:g}, {hi:g}]", lambda v, lo=lo, hi=hi: lo <= v <= hi)
@@ -87,6 +88,7 @@ register_behaviour("attacker", buy=attacks.policy_buy, sell=attacks.policy_sell,
                            "theta_min": _ANGLE,
                            "adaptive": ("0 or 1", lambda v: v in (0, 1)), "threshold": ("> 0", lambda v: v > 0)})
 register_behaviour("colluder", buy=attacks.colluder_buy, sell=attacks.colluder_sell, honest=False,
+                   needs_neighbours=True,
                    description="liars that agree on one rotation_angle and buy each other's offers to inflate their "
                                "records", limits={"rotation_angle": _ANGLE, "threshold": ("> 0", lambda v: v > 0)})
 register_behaviour("newcomer", buy="sceptical", sell=attacks.newcomer_sell, honest=False,
@@ -106,6 +108,7 @@ register_behaviour("tuned_farmer", buy="sceptical", sell=attacks.tuned_farmer_se
                                "sales at reputation >= farm_reputation (the reputation sceptic's 10 and 0.85)",
                    limits={"rotation_angle": _ANGLE, "farm_reputation": _UNIT, "farm_record": _COUNT})
 register_behaviour("reputation_weighted", buy=weighted.reputation_weighted_buy, sell="naive", honest=True,
+                   needs_neighbours=True,
                    description="buys like the naive robot but averages a purchase in with its age weight times the "
                                "seller's reputation ** power (continuous trust)",
                    limits={"power": (">= 0", lambda v: v >= 0)})

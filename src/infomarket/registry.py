@@ -58,6 +58,9 @@ class BehaviourSpec:
     #: Its robots keep waypoint paths (``behaviours.paths``): runs with it compile the step's paths
     #: variant (``engine.step``, ``engine.paths``), which dead-reckons and follows paths, even on the plane.
     paths: bool = False
+    #: Its buy rule reads and writes nothing for a robot without a neighbour (it only walks ``nbrs``), so
+    #: the step does not call it for one.  Off, it is called for every robot out of cooldown every step.
+    needs_neighbours: bool = False
 
     def check(self, name: str, value: float) -> str | None:
         """Why ``value`` is not allowed for parameter ``name``, or None."""
@@ -172,7 +175,8 @@ def _rule(func: Callable, fixed: tuple[str, ...], what: str, market: bool = Fals
 
 def register_behaviour(name: str, *, buy: Callable | str, sell: Callable | str, honest: bool,
                        description: str = "", limits: dict | None = None,
-                       replace: bool = False, paths: bool = False) -> BehaviourSpec:
+                       replace: bool = False, paths: bool = False,
+                       needs_neighbours: bool = False) -> BehaviourSpec:
     """Register a behaviour from a buy rule and a sell rule (functions, or names of registered behaviours
     whose rule to reuse).
 
@@ -184,6 +188,9 @@ def register_behaviour(name: str, *, buy: Callable | str, sell: Callable | str, 
     ``{"threshold": ("> 0", lambda v: v > 0)}``: configurations breaking it are rejected with the text.
     ``paths=True`` says the rules buy or install waypoint paths (``behaviours.paths``); runs with such a
     behaviour then compile the step's paths variant (``engine.step``, ``engine.paths``); other runs never pay for it.
+    ``needs_neighbours=True`` says the buy rule does nothing for a robot without a neighbour (no write, no
+    draw: it only walks ``nbrs``), so the step skips the call for such a robot; a reused buy rule keeps
+    its behaviour's setting.
     """
     _check_registration("behaviour", name, description, None, (), None)
     if name in _BEHAVIOURS and not replace:
@@ -214,20 +221,26 @@ def register_behaviour(name: str, *, buy: Callable | str, sell: Callable | str, 
     limits = {k: v for k, v in limits.items() if k in params}
     if any(isinstance(r, str) and _BEHAVIOURS[r].paths for r in (buy, sell)):
         paths = True  # a reused path rule needs the step that keeps paths
+    if not isinstance(needs_neighbours, bool):
+        raise RegistrationError(f"behaviour {name!r}: needs_neighbours must be True or False, got "
+                                f"{_shown(needs_neighbours)}")
+    if isinstance(buy, str):
+        needs_neighbours = needs_neighbours or _BEHAVIOURS[buy].needs_neighbours  # the same buy rule
     spec = BehaviourSpec(name, buy_rule, sell_rule, bool(honest), description, tuple(params), defaults, limits,
-                         bool(paths))
+                         bool(paths), needs_neighbours)
     _BEHAVIOURS[name] = spec
     return spec
 
 
 def behaviour(name: str, *, buy: Callable | str, honest: bool, description: str = "", limits: dict | None = None,
-              replace: bool = False, paths: bool = False):
+              replace: bool = False, paths: bool = False, needs_neighbours: bool = False):
     """Decorator form of :func:`register_behaviour` for the sell rule: ``@behaviour("liar", buy="naive",
-    honest=False)`` over ``def sell(w, me, site): ...``; ``limits`` and ``paths`` as there."""
+    honest=False)`` over ``def sell(w, me, site): ...``; ``limits``, ``paths`` and ``needs_neighbours`` as
+    there."""
 
     def wrap(sell: Callable) -> Callable:
         spec = register_behaviour(name, buy=buy, sell=sell, honest=honest, description=description,
-                                  limits=limits, replace=replace, paths=paths)
+                                  limits=limits, replace=replace, paths=paths, needs_neighbours=needs_neighbours)
         return spec.sell.func
 
     return wrap

@@ -22,7 +22,8 @@ def _steps(w, rng, k):
     bits = rng.bit_generator
     for _ in range(k):
         find_neighbours(w)
-        begin_communication(w)
+        for i in range(w.pos.shape[0]):
+            begin_communication(w, i)
         for i in range(w.pos.shape[0]):
             forage(w, i, bits)
             install_table(w, i)

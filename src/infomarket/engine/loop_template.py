@@ -7,7 +7,13 @@ a variant the kernel does not use is pruned before numba types it.
 
 Order of operations per step (docs/model.md §3): neighbours; communication (offers from start-of-step
 tables, then every robot buys in id order); move (foraging and payment, install the new table,
-behaviour step, noisy motion), robots in id order.
+behaviour step, noisy motion), robots in id order.  An offer is read only by the seller's neighbours, so
+a robot without one is not asked for an offer, unless its sell rule draws random numbers (``SELL_DRAWS``:
+then it is asked, so the run's draws stay in order); nor does it buy, when its buy rule is registered as
+doing nothing without a neighbour (``BUY_ALONE`` false: ``registry.register_behaviour``'s
+``needs_neighbours``).  A robot copies its table into the new one it buys into (``begin_communication``)
+just before its buy rule runs, and installs it when it moves, only if the rule ran: a robot that bought
+nothing keeps its table as it is.
 
 ``LEDGER`` names the ledger (``ledger.backends``): ``"instant"``, the paper's, or ``"poa"``, the chain
 model (docs/chain-model.md), where a step also opens with a gossip round after the neighbours, purchases
@@ -37,7 +43,9 @@ NEED_ROOM = 1
 #: sell_dispatch(kind, w, i, site, rng) -> (valid, x, y, age): robot i's offer for ``site``
 #: buy_dispatch(kind, w, i, nbrs, rng): robot i buys from its neighbours
 #: pay_dispatch(w, buyer, sellers, sites, directions, weights, rng): the scheme's weights
-sell_dispatch = buy_dispatch = pay_dispatch = None
+#: SELL_DRAWS: per kind, whether its sell rule takes ``rng`` (a tuple of bools)
+#: BUY_ALONE: per kind, whether its buy rule is called for a robot without a neighbour (a tuple of bools)
+sell_dispatch = buy_dispatch = pay_dispatch = SELL_DRAWS = BUY_ALONE = None
 
 #: This kernel's step pieces (engine.step.variant), chosen by its options before anything compiles.
 find_neighbours, begin_communication, install_table, forage, sense_sites, behaviour_step, move = variant(TERRAIN, PATHS)
@@ -98,6 +106,7 @@ def run_steps(w, rng, t_end):
     nbr, nbr_count = w.nbr, w.nbr_count
     fuel = w.fuel_cost
     bits = rng.bit_generator  # the engine's own draws (engine.draws); rules get the Generator
+    opened = np.zeros(n, np.bool_)  # this step, robot i's buy rule ran (so it has a new table to install)
     while clock[0] < t_end:
         find_neighbours(w)
         if not has_room(w):
@@ -107,8 +116,9 @@ def run_steps(w, rng, t_end):
         if w.stake_expiry > 0:
             for i in range(n):
                 expire_stakes(w, i)
-        begin_communication(w)
         for i in range(n):
+            if nbr_count[i] == 0 and not SELL_DRAWS[kind[i]]:
+                continue  # no neighbour can buy its offer this step, and asking for it draws nothing
             for site in range(2):
                 if cool[i] == 0:
                     valid, x, y, age = sell_dispatch(kind[i], w, i, site, rng)
@@ -119,12 +129,15 @@ def run_steps(w, rng, t_end):
                 else:
                     off_valid[i, site] = False
         for i in range(n):
-            if cool[i] == 0:
+            opened[i] = cool[i] == 0 and (nbr_count[i] > 0 or BUY_ALONE[kind[i]])
+            if opened[i]:
+                begin_communication(w, i)
                 buy_dispatch(kind[i], w, i, nbr[i, :nbr_count[i]], rng)
         for i in range(n):
             if forage(w, i, bits):
                 deposit(w, i, rng)
-            install_table(w, i)
+            if opened[i]:
+                install_table(w, i)
             if stop[i] > 0:
                 stop[i] -= 1
             elif fuel > 0.0 and balance[i] < fuel:

@@ -83,15 +83,14 @@ def drop_invalid(w, i):
 
 
 @njit(inline="always")
-def begin_paths(w):
-    """Start of the communication phase: purchases go to the new path; sellers keep the old one."""
-    for i in range(w.path_count.shape[0]):
-        for k in range(2):
-            m = w.path_count[i, k]
-            w.new_path_count[i, k] = m
-            for j in range(m):
-                w.new_path_vec[i, k, j, 0] = w.path_vec[i, k, j, 0]
-                w.new_path_vec[i, k, j, 1] = w.path_vec[i, k, j, 1]
+def begin_paths(w, i):
+    """Robot i is about to buy: its purchases go to a new path, a copy of the one it sells."""
+    for k in range(2):
+        m = w.path_count[i, k]
+        w.new_path_count[i, k] = m
+        for j in range(m):
+            w.new_path_vec[i, k, j, 0] = w.path_vec[i, k, j, 0]
+            w.new_path_vec[i, k, j, 1] = w.path_vec[i, k, j, 1]
 
 
 @njit(inline="always")

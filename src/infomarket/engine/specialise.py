@@ -88,6 +88,11 @@ def generate_source(behaviours: list[BehaviourSpec], payment: PaymentSpec, terra
         lines.append(f"_b{k}_buy = _rule_function('behaviour', {b.name!r}, 'buy')")
         lines.append(f"_b{k}_sell = _rule_function('behaviour', {b.name!r}, 'sell')")
     lines.append(f"_pay = _rule_function('payment', {payment.name!r}, 'weights')")
+    lines += ["", "#: Per kind: does its sell rule draw random numbers (then it is asked for an offer even when no",
+              "#: neighbour can buy it, so the draws stay in order)?",
+              f"SELL_DRAWS = ({''.join(f'{bool(b.sell.wants_rng)}, ' for b in behaviours)})",
+              "#: Per kind: is its buy rule called for a robot without a neighbour (registry: needs_neighbours)?",
+              f"BUY_ALONE = ({''.join(f'{not b.needs_neighbours}, ' for b in behaviours)})"]
     lines += ["", "", "@njit(cache=True, inline='always')", "def sell_dispatch(kind, w, i, site, rng):"]
     for k, b in enumerate(behaviours):
         call = f"return _b{k}_sell(w, i, site{_args(b.sell, b.params, 'w.bparams[i]')})"

@@ -160,23 +160,23 @@ def _variant(terrain: bool, paths: bool) -> Step:
         if terrain:
             drop_hidden_pairs(w)
 
-    @njit
-    def begin_communication(w):
-        """Start-of-phase copy: purchases go to the new table (and path); sellers keep selling the old one."""
-        tab_vec, new_vec, tab_age, new_age, tab_valid, new_valid = (w.tab_vec, w.new_vec, w.tab_age, w.new_age,
-                                                                    w.tab_valid, w.new_valid)
-        for i in range(tab_age.shape[0]):  # arrays read once, outside the loop
-            for s in range(2):
-                new_vec[i, s, 0] = tab_vec[i, s, 0]
-                new_vec[i, s, 1] = tab_vec[i, s, 1]
-                new_age[i, s] = tab_age[i, s]
-                new_valid[i, s] = tab_valid[i, s]
+    @njit(inline="always")
+    def begin_communication(w, i):
+        """Robot i is about to buy: its purchases go to a new table (and path), a copy of the one it sells.
+        Only robot i reads or writes its new table, and nobody writes its table before it moves, so the
+        copy is made just before its buy rule runs, and only for a robot whose buy rule runs."""
+        for s in range(2):
+            w.new_vec[i, s, 0] = w.tab_vec[i, s, 0]
+            w.new_vec[i, s, 1] = w.tab_vec[i, s, 1]
+            w.new_age[i, s] = w.tab_age[i, s]
+            w.new_valid[i, s] = w.tab_valid[i, s]
         if paths:
-            begin_paths(w)
+            begin_paths(w, i)
 
     @njit(inline="always")
     def install_table(w, i):
-        """The robot moves: what it bought becomes its table (and path)."""
+        """The robot moves: what it bought becomes its table (and path); called for a robot whose
+        ``begin_communication`` ran this step (for any other, the new table is not this step's)."""
         for s in range(2):
             w.tab_vec[i, s, 0] = w.new_vec[i, s, 0]
             w.tab_vec[i, s, 1] = w.new_vec[i, s, 1]

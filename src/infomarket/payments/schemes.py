@@ -16,10 +16,11 @@ def outlier_weights(buyer, sellers, sites, directions, weights, theta=30.0):
     """Outlier penalisation (eqs. 7-8): a transaction weighs as many same-site transactions (itself
     included) as point within ``theta`` degrees of it, so isolated directions earn little."""
     k = weights.shape[0]
-    for x in range(k):
-        c = 0
-        for y in range(k):
+    for x in range(k):  # itself
+        weights[x] = 1.0 if angular_distance(directions[x], directions[x]) < theta else 0.0
+    for x in range(k):  # each pair once: the distance is symmetric, bit for bit, and counts add exactly
+        for y in range(x + 1, k):
             if sites[y] == sites[x] and angular_distance(directions[x], directions[y]) < theta:
-                c += 1
-        weights[x] = c
+                weights[x] += 1.0
+                weights[y] += 1.0
 
