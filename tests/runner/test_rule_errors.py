@@ -21,11 +21,13 @@ import infomarket as im
 from infomarket.behaviours.api import own_entry
 '''
 
-# raises at step 37 exactly (the clock counts the step before any rule runs): a hand-chosen step
+# raises at step 37 exactly (the clock counts the step before any rule runs): a hand-chosen step.  It takes
+# the run's `rng` (and draws nothing) so that it is asked every step, with a neighbour or without one
+# (docs/extending.md): a rule without `rng` is asked only when some robot could buy its offer
 LATE = HEAD + '''
 
 @im.behaviour("late_divider", buy="naive", honest=False, description="divides by k at step 37")
-def late_divider_sell(w, me, site, k=0.0):
+def late_divider_sell(w, me, site, rng, k=0.0):
     valid, x, y, age = own_entry(w, me, site)
     if w.clock[0] == 37:
         x = x / k

@@ -13,7 +13,7 @@ from infomarket.behaviours.api import own_entry
 
 
 @im.behaviour("boom_seller", buy="naive", honest=True, description="a seller whose rule raises when boom > 0")
-def boom_sell(w, me, site, boom=0.0):
+def boom_sell(w, me, site, rng, boom=0.0):  # takes rng: asked every step, with a neighbour or not
     if boom > 0.0:
         raise ValueError("boom: a bug in a plugin")
     return own_entry(w, me, site)
