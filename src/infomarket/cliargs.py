@@ -89,3 +89,16 @@ def fraction(text: str) -> float:
     if not 0 < value <= 1:
         raise argparse.ArgumentTypeError(f"must be in (0, 1], got {text}")
     return value
+
+
+def dask_client(address: str, option: str = "--dask"):
+    """A dask.distributed Client of the scheduler at ``address``; a missing Dask or a scheduler that does not
+    answer is a UsageError naming ``option``."""
+    try:
+        from distributed import Client  # only when a command is sent to Dask: distributed is slow to import
+    except ImportError:
+        raise UsageError("Dask is not installed: pip install 'infomarket[dask]'") from None
+    try:
+        return Client(address, timeout="5s")
+    except (OSError, TimeoutError) as exc:
+        raise UsageError(f"{option} {address}: no Dask scheduler answers there ({exc})") from None

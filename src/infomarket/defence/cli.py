@@ -4,7 +4,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from ..cliargs import UsageError, at_least
+from ..cliargs import UsageError, at_least, dask_client
 
 #: outer settings an option may make smaller than declared (the report is then marked reduced)
 SIZES = ("candidates", "refine", "cost_runs", "frontier", "confirmation_runs")
@@ -97,16 +97,7 @@ def cmd_defence_search(args) -> int:
     out = Path(args.out)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {out}: exists and is not a directory")
-    client = None
-    if args.dask:
-        try:
-            from distributed import Client
-        except ImportError:
-            raise UsageError("Dask is not installed: pip install 'infomarket[dask]'") from None
-        try:
-            client = Client(args.dask, timeout="5s")
-        except (OSError, TimeoutError) as exc:
-            raise UsageError(f"--dask {args.dask}: no Dask scheduler answers there ({exc})") from None
+    client = dask_client(args.dask) if args.dask else None
     store = Store(out / "store", cache=True)
     store.refuse_foreign()
     workers = args.workers or default_workers()

@@ -4,7 +4,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from .. import interrupts
-from ..cliargs import UsageError, at_least, fraction, seed_value
+from ..cliargs import UsageError, at_least, dask_client, fraction, seed_value
 from ..errors import EXIT_FAILED, EXIT_USAGE, report
 
 PAPER = ("fig2A", "fig2B", "fig2C", "fig2D", "fig3A", "fig3B", "fig3C", "fig4A", "fig4B", "fig4C",
@@ -22,10 +22,7 @@ def _client(args):
     except ImportError:
         raise UsageError("Dask is not installed: pip install 'infomarket[dask]'") from None
     if args.scheduler:
-        try:
-            return Client(args.scheduler, timeout="5s"), None
-        except (OSError, TimeoutError) as exc:
-            raise UsageError(f"--scheduler {args.scheduler}: no Dask scheduler answers there ({exc})") from None
+        return dask_client(args.scheduler, "--scheduler"), None
     cluster = LocalCluster(n_workers=args.dask_local, threads_per_worker=1, processes=True,
                            dashboard_address=None)
     return Client(cluster), cluster

@@ -4,7 +4,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from ..cliargs import UsageError, at_least
+from ..cliargs import UsageError, at_least, dask_client
 from .baselines import rotation_grid
 
 
@@ -117,16 +117,7 @@ def cmd_attack_search(args) -> int:
     store = Store(out / "store", cache=True)  # read after every generation: each part read once
     store.refuse_foreign()
     total = planned_runs(st) * len(chosen)
-    client = None
-    if args.dask:
-        try:
-            from distributed import Client
-        except ImportError:
-            raise UsageError("Dask is not installed: pip install 'infomarket[dask]'") from None
-        try:
-            client = Client(args.dask, timeout="5s")
-        except (OSError, TimeoutError) as exc:
-            raise UsageError(f"--dask {args.dask}: no Dask scheduler answers there ({exc})") from None
+    client = dask_client(args.dask) if args.dask else None
     workers = args.workers or default_workers()
     learner = {**ADAPTIVE, **study_mod.DECLARATION.data.get("adaptive", {})}
     if args.adaptive_budget is not None:
