@@ -57,6 +57,9 @@ class Spec:
                 raise InternalError(f"{domain}.{f.name}: unknown writer {f.writer!r}")
         self.names = tuple(f.name for f in self.fields)
         self.tuple = namedtuple(domain.capitalize(), self.names)
+        # what ``check`` compares, worked out once: every run's build checks every field
+        self._expected = tuple((f, f.ndim, {"float": float, "int": int, "bool": bool}[f.dtype] if f.ndim == 0
+                                else np.dtype(f.dtype)) for f in self.fields)
 
     def __iter__(self):
         return iter(self.fields)
@@ -72,15 +75,14 @@ class Spec:
         missing = [n for n in self.names if n not in values]
         if missing:
             raise InternalError(f"{self.domain}: missing {', '.join(missing)}")
-        for f in self.fields:
+        for f, ndim, kind in self._expected:
             v = values[f.name]
-            if f.ndim == 0:
-                kind = {"float": float, "int": int, "bool": bool}[f.dtype]
+            if ndim == 0:
                 if type(v) is not kind:
                     raise InternalError(f"{self.domain}.{f.name}: {type(v).__name__}, spec says {f.dtype}")
-            elif not isinstance(v, np.ndarray) or v.dtype != np.dtype(f.dtype) or v.ndim != f.ndim:
+            elif not isinstance(v, np.ndarray) or v.dtype != kind or v.ndim != ndim:
                 got = f"{v.dtype} {v.ndim}-d" if isinstance(v, np.ndarray) else type(v).__name__
-                raise InternalError(f"{self.domain}.{f.name}: {got}, spec says {f.dtype} {f.ndim}-d")
+                raise InternalError(f"{self.domain}.{f.name}: {got}, spec says {f.dtype} {ndim}-d")
 
     def build(self, values: Mapping):
         """The domain's named tuple from a mapping, checked against the spec."""
