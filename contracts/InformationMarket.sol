@@ -306,7 +306,7 @@ contract InformationMarket {
     /// @param robot Depositing robot.
     /// @param shared Sum of the shares paid.
     /// @param kept Returned to the robot.
-    /// @param totalWeight Sum of the live records' weights.
+    /// @param totalWeight Sum of the live records' weights (under OutlierCapped, of their counts: C).
     event SettlementCompleted(address indexed robot, uint256 shared, uint256 kept, uint256 totalWeight);
 
     // ------------------------------------------------------------------------------------------------
@@ -1372,18 +1372,7 @@ contract InformationMarket {
         uint256 perExpired = live > first ? s.perExpired : 0;
         uint256 liveAmount = amount - (live - first) * perExpired;
         bool equal = phase == _EQUAL || _scheme == Scheme.Delayed;
-        // OutlierCapped: a void record weighs its stake, the counted ones share the rest, the share plus
-        // their stakes, by their counts (sum C): weights stake * C and (share + counted * stake) * count
-        // over C * (share + live records * stake), as the simulated ledger pays them.
         bool capped = !equal && _scheme == Scheme.OutlierCapped;
-        uint256 voidWeight;
-        uint256 countedScale;
-        if (capped) {
-            uint256 share = (_reward * _informationShare) / _WAD;
-            voidWeight = _stake * total;
-            countedScale = share + s.counted * _stake;
-            total *= share + (end - live) * _stake;
-        }
         while (next < end && budget > 0) {
             Information storage record = _records[robot][next];
             uint256 weight;
@@ -1391,8 +1380,7 @@ contract InformationMarket {
             if (next >= live) {
                 weight = equal ? 1 : record.weight;
                 if (capped) {
-                    weight = weight == 0 ? voidWeight : countedScale * weight;
-                    share = total == 0 ? 0 : (liveAmount * weight) / total;
+                    (weight, share) = _cappedShare(s, weight, liveAmount, end - live);
                 } else {
                     share = (liveAmount * weight) / total;
                 }
@@ -1412,6 +1400,22 @@ contract InformationMarket {
             return false;
         }
         return _finish(robot, escrow, first < end ? amount - escrow : 0, total);
+    }
+
+    /// @dev OutlierCapped: what a live record of count `count` (0: void) is paid of `liveAmount`, and its
+    /// weight. A void record weighs its stake, the counted ones share the rest (the share and their own
+    /// stakes) by their counts, C their sum: weights stake * C and (share + counted * stake) * count over
+    /// C * (share + m * stake) for m live records, as the simulated ledger pays them.
+    function _cappedShare(Settlement storage s, uint256 count, uint256 liveAmount, uint256 m)
+        private
+        view
+        returns (uint256 weight, uint256 share)
+    {
+        uint256 shared = (_reward * _informationShare) / _WAD;
+        uint256 sum = s.totalWeight;
+        weight = count == 0 ? _stake * sum : (shared + s.counted * _stake) * count;
+        uint256 total = sum * (shared + m * _stake);
+        share = total == 0 ? 0 : (liveAmount * weight) / total;
     }
 
     /// @dev Stops a settlement call before paying: records where it stands and pays the bounty.
