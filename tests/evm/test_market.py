@@ -293,7 +293,7 @@ def test_contract_reproduces_the_original_simulators_payments(case, vector_marke
     assert sum(chain) + pots + bonds == market.total_supply() == to_units(case["initial_wealth"]) * n + TOKEN_UNIT + bonds
 
 
-def test_the_cap_is_a_constructor_parameter_validated_like_the_others(chain, make_market):
+def test_the_cap_is_a_constructor_parameter_validated_like_the_others(chain, artifact, make_market):
     """OutlierCapped needs a cap of at least 1 and every other scheme a cap of 0; under OutlierCapped the
     reward and the stake stay below 2^96 units (so that no payment product overflows)."""
     from dataclasses import replace
@@ -306,7 +306,7 @@ def test_the_cap_is_a_constructor_parameter_validated_like_the_others(chain, mak
                                 (replace(capped, reward=2**96), "reward", 2**96),
                                 (replace(capped, stake=2**96), "stake", 2**96)):
         with pytest.raises(ContractRevert) as refused:
-            ChainMarket.deploy(params, backend=chain)
+            ChainMarket.deploy(params, backend=chain, artifact=artifact)
         assert refused.value.name == "InfoMarketInvalidParameter"
         assert refused.value.args_by_name == {"parameter": name.encode().ljust(32, b"\0"), "value": value}
     market = make_market("capped_outlier", stake=0.04, cap=2, wealth=0.0)
