@@ -151,3 +151,12 @@ def test_a_consensus_slash_experiment_is_refused_before_simulating(tmp_path, cap
     assert captured.err.startswith("infomarket: error: consensus_slash is not on chain: it slashes by the angle")
     assert len(captured.err.strip().splitlines()) == 1 and "Traceback" not in captured.err
     assert "simulated" not in captured.out
+
+
+def test_an_adaptive_outlier_experiment_is_refused_with_its_reason(tmp_path, capsys):
+    _simulator()
+    path = _experiment_file(tmp_path, "adaptive_outlier", "{ theta = 30.0 }")
+    assert main(["chain", "demo", "--experiment", path, "--scheme", "experiment"]) == 2
+    err = capsys.readouterr().err
+    assert err == ("infomarket: error: adaptive_outlier is not on chain: each seller's Theta follows its "
+                   "reputation, which the simulated ledger keeps and the contract does not\n")

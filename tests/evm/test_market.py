@@ -5,11 +5,14 @@ from __future__ import annotations
 import json
 import random
 import math
+from dataclasses import replace
 from fractions import Fraction
 from pathlib import Path
 
 import pytest
+from infomarket.errors import ConfigError
 from infomarket.evm.errors import ContractRevert
+from infomarket.evm.market import ChainMarket, MarketParams
 from infomarket.evm.protocol import FOOD, NEST, PathInfo
 from infomarket.evm.evm_replay import FLOAT_SLACK_UNITS
 from infomarket.evm.units import TOKEN_UNIT, to_units
@@ -296,10 +299,6 @@ def test_contract_reproduces_the_original_simulators_payments(case, vector_marke
 def test_the_cap_is_a_constructor_parameter_validated_like_the_others(chain, artifact, make_market):
     """OutlierCapped needs a cap of at least 1 and every other scheme a cap of 0; under OutlierCapped the
     reward and the stake stay below 2^96 units (so that no payment product overflows)."""
-    from dataclasses import replace
-
-    from infomarket.evm.market import ChainMarket, MarketParams
-
     capped = MarketParams.from_floats("capped_outlier", stake=0.04, cap=2)
     for params, name, value in ((replace(capped, cap=0), "cap", 0),
                                 (replace(MarketParams.from_floats("outlier"), cap=3), "cap", 3),
@@ -318,9 +317,6 @@ def test_the_cap_is_a_constructor_parameter_validated_like_the_others(chain, art
 def test_the_client_encodes_the_rules_cap():
     """The rule counts a record while fewer than ``cap`` of its seller's came before it, so a cap of 2.5
     counts 3; a cap beyond the 512 records a round trip holds is 512; only capped_outlier takes one."""
-    from infomarket.errors import ConfigError
-    from infomarket.evm.market import MarketParams
-
     assert MarketParams.from_floats("capped_outlier").cap == 3  # the rule's default
     assert MarketParams.from_floats("capped_outlier", cap=2.5).cap == 3
     assert MarketParams.from_floats("capped_outlier", cap=1).cap == 1

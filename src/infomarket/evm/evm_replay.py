@@ -252,6 +252,8 @@ OFF_CHAIN = {
                        "angles; an integer arctangent would not reproduce the simulated ledger's floating-point "
                        "angles bit for bit, so the two ledgers could not be checked against each other "
                        "(docs/chain.md, \"Which rules run where\")",
+    "adaptive_outlier": "adaptive_outlier is not on chain: each seller's Theta follows its reputation, which the "
+                        "simulated ledger keeps and the contract does not",
 }
 
 
