@@ -12,8 +12,8 @@ time), and a smaller sample over py-evm (a pure-Python EVM takes about a second 
 Those 80 draw every scheme and expiry that 200 draw, refusals, and long sequences under every scheme; every
 payment-rule mutant of the contract tried fails them within the first few examples (docs/testing.md).
 ``capped_outlier`` (cap 1 or 2, with and without stake) has random sequences of its own, 100 on the
-simulated ledger and 40 on revm, so that adding it left the other schemes' draws as they were; among
-them, sellers over their cap with records expired before their void ones.
+simulated ledger and 40 on revm, so that the other schemes' draws do not depend on it; among them,
+sellers over their cap with records expired before their void ones.
 """
 from __future__ import annotations
 
