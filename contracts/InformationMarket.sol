@@ -56,10 +56,15 @@ contract InformationMarket {
     /// OutlierDistinct: like Outlier, but a transaction weighs the number of distinct sellers with a
     /// same-site transaction within theta (its own seller once), divided by its seller's number of
     /// transactions for that site in the round trip: one seller, one voice (docs/chain.md).
+    /// OutlierCapped: at most `cap` records per seller count in a round trip (its first live ones); a
+    /// later one is void: paid its stake back (scaled as the live records' amount is, when some records
+    /// expired), it earns nothing and counts in nobody's weight. The counted records are weighed as under
+    /// Outlier among themselves and share the rest (docs/defences.md, `capped_outlier`).
     enum Scheme {
         Delayed,
         Outlier,
-        OutlierDistinct
+        OutlierDistinct,
+        OutlierCapped
     }
 
     /// @notice The seller's offer, which the buyer accepts without seeing the information itself.
@@ -116,7 +121,8 @@ contract InformationMarket {
     /// position), x, micro units; a zero vector is stored as (1, 0), direction 0 like atan2(0, 0).
     /// @param dy Same, y.
     /// @param weight The record's weight, written while its round trip is settled (under
-    /// OutlierDistinct scaled by 1e27: distinct sellers * 1e27 / the seller's records for the site).
+    /// OutlierDistinct scaled by 1e27: distinct sellers * 1e27 / the seller's records for the site; under
+    /// OutlierCapped the count of similar counted records, 0 for a void record).
     /// @param prevGap How many records back the same seller's previous record of this round trip lies
     /// (0: none within reach).
     struct Information {
@@ -154,6 +160,7 @@ contract InformationMarket {
     /// `escrow` holds the reward share and the stakes not yet paid out; `amount` is what the records
     /// share (fixed when paying starts); `first` is the round trip's first record, `live` its first
     /// live one: the expired records [first, live) are each paid `perExpired`, the live ones the rest.
+    /// `counted`: under OutlierCapped, how many of the live records weighed so far count (are not void).
     struct Settlement {
         uint64 next;
         uint64 end;
@@ -161,6 +168,7 @@ contract InformationMarket {
         uint64 live;
         uint8 phase;
         uint64 first;
+        uint64 counted;
         uint256 escrow;
         uint256 amount;
         uint256 totalWeight;
@@ -231,7 +239,9 @@ contract InformationMarket {
     /// @param index The record.
     /// @param weight The record's weight (1 under delayed payment, similar-transaction count under
     /// outlier, distinct-seller count * 1e27 / the seller's records for the site under outlier-distinct;
-    /// 0 for an expired record, paid the share over the round trip's records).
+    /// under outlier-capped stake * C for a void record and (share + counted records * stake) * its count
+    /// for a counted one, C the counts' sum; 0 for an expired record, paid the share over the round
+    /// trip's records).
     /// @param amount Share paid, 1e-9 units.
     event RewardShared(address indexed robot, address indexed seller, uint256 index, uint256 weight, uint256 amount);
 
@@ -296,7 +306,7 @@ contract InformationMarket {
     /// @param robot Depositing robot.
     /// @param shared Sum of the shares paid.
     /// @param kept Returned to the robot.
-    /// @param totalWeight Sum of the live records' weights.
+    /// @param totalWeight Sum of the live records' weights (under OutlierCapped, of their counts: C).
     event SettlementCompleted(address indexed robot, uint256 shared, uint256 kept, uint256 totalWeight);
 
     // ------------------------------------------------------------------------------------------------
@@ -466,6 +476,12 @@ contract InformationMarket {
     uint256 private constant _MAX_SETTLEMENT_UNITS = _MAX_TRIP_RECORDS * 15;
     /// @dev Scale of an OutlierDistinct weight (distinct sellers / seller's records, as a fixed point).
     uint256 private constant _DISTINCT_SCALE = 1e27;
+    /// @dev The site code a void OutlierCapped record takes while weighing: no record is of it, so no
+    /// comparison counts it.
+    uint256 private constant _VOID = 2;
+    /// @dev Under OutlierCapped the reward and the stake stay below this, so that no product of the
+    /// payment (amount * (share + 512 stakes) * 512) can overflow.
+    uint256 private constant _MAX_CAPPED_AMOUNT = 2 ** 96;
     uint8 private constant _EXPIRE = 0;
     uint8 private constant _WEIGH = 1;
     uint8 private constant _PAY = 2;
@@ -518,6 +534,7 @@ contract InformationMarket {
     uint64 private immutable _registrarPeriod;
     uint256 private immutable _registrationBond;
     uint64 private immutable _bondDelay;
+    uint256 private immutable _cap;
     uint256 private immutable _cachedChainId;
     bytes32 private immutable _cachedDomainSeparator;
 
@@ -578,6 +595,8 @@ contract InformationMarket {
     /// `maxGrant_`).
     /// @param bondDelay_ Blocks between a robot's `exit` and the return of its bond (>= 1): the time the
     /// registrars have to revoke it.
+    /// @param cap_ Under OutlierCapped, most records per seller that count in a round trip (>= 1; the
+    /// reward and the stake below 2^96 units); 0 under every other scheme.
     constructor(
         address market_,
         Scheme scheme_,
@@ -599,7 +618,8 @@ contract InformationMarket {
         address nest_,
         uint256 settleBounty_,
         uint256 registrationBond_,
-        uint64 bondDelay_
+        uint64 bondDelay_,
+        uint256 cap_
     ) {
         if (market_ == address(0)) revert InfoMarketInvalidParameter("market", 0);
         if (nest_ == address(0)) revert InfoMarketInvalidParameter("nest", 0);
@@ -630,6 +650,12 @@ contract InformationMarket {
             revert InfoMarketInvalidParameter("registrationBond", int256(registrationBond_));
         }
         if (bondDelay_ == 0) revert InfoMarketInvalidParameter("bondDelay", 0);
+        if (scheme_ == Scheme.OutlierCapped ? cap_ == 0 : cap_ != 0) revert InfoMarketInvalidParameter("cap", int256(cap_));
+        if (scheme_ == Scheme.OutlierCapped) {
+            if (reward_ >= _MAX_CAPPED_AMOUNT) revert InfoMarketInvalidParameter("reward", int256(reward_));
+            if (stake_ >= _MAX_CAPPED_AMOUNT) revert InfoMarketInvalidParameter("stake", int256(stake_));
+        }
+        _cap = cap_;
         _registrationBond = registrationBond_;
         _bondDelay = bondDelay_;
         _grantRole(ADMIN_ROLE, market_);
@@ -1131,6 +1157,7 @@ contract InformationMarket {
     /// @return settlementDeadline_ Blocks after a deposit from which its settlement refunds instead.
     /// @return maxGrant_ Most initial wealth per robot.
     /// @return settleBounty_ Bounty per unit of settlement work.
+    /// @return cap_ Most records per seller that count in a round trip under OutlierCapped (0 otherwise).
     function configuration()
         external
         view
@@ -1147,7 +1174,8 @@ contract InformationMarket {
             uint256 settleBatch_,
             uint64 settlementDeadline_,
             uint256 maxGrant_,
-            uint256 settleBounty_
+            uint256 settleBounty_,
+            uint256 cap_
         )
     {
         return (
@@ -1163,7 +1191,8 @@ contract InformationMarket {
             _settleBatch,
             _settlementDeadline,
             _maxGrant,
-            _settleBounty
+            _settleBounty,
+            _cap
         );
     }
 
@@ -1309,7 +1338,9 @@ contract InformationMarket {
             if (next < end && affordable == 0 && budget == _settleBatch) affordable = 1;
             if (next < end && affordable > 0) {
                 uint64 stop = next + uint64(affordable < end - next ? affordable : end - next);
-                s.totalWeight += _weigh(robot, s.live, next, stop, end);
+                (uint256 sum, uint256 counted) = _weigh(robot, s.live, next, stop, end);
+                s.totalWeight += sum;
+                if (_scheme == Scheme.OutlierCapped) s.counted = uint64(counted);
                 uint256 spent = (stop - next) * cost;
                 budget = spent < budget ? budget - spent : 0;
                 next = stop;
@@ -1341,13 +1372,18 @@ contract InformationMarket {
         uint256 perExpired = live > first ? s.perExpired : 0;
         uint256 liveAmount = amount - (live - first) * perExpired;
         bool equal = phase == _EQUAL || _scheme == Scheme.Delayed;
+        bool capped = !equal && _scheme == Scheme.OutlierCapped;
         while (next < end && budget > 0) {
             Information storage record = _records[robot][next];
             uint256 weight;
             uint256 share = perExpired;
             if (next >= live) {
                 weight = equal ? 1 : record.weight;
-                share = (liveAmount * weight) / total;
+                if (capped) {
+                    (weight, share) = _cappedShare(s, weight, liveAmount, end - live);
+                } else {
+                    share = (liveAmount * weight) / total;
+                }
             }
             uint256 cut = rate < share ? rate : share;
             _balances[record.seller] += share - cut;
@@ -1364,6 +1400,22 @@ contract InformationMarket {
             return false;
         }
         return _finish(robot, escrow, first < end ? amount - escrow : 0, total);
+    }
+
+    /// @dev OutlierCapped: what a live record of count `count` (0: void) is paid of `liveAmount`, and its
+    /// weight. A void record weighs its stake, the counted ones share the rest (the share and their own
+    /// stakes) by their counts, C their sum: weights stake * C and (share + counted * stake) * count over
+    /// C * (share + m * stake) for m live records, as the simulated ledger pays them.
+    function _cappedShare(Settlement storage s, uint256 count, uint256 liveAmount, uint256 m)
+        private
+        view
+        returns (uint256 weight, uint256 share)
+    {
+        uint256 shared = (_reward * _informationShare) / _WAD;
+        uint256 sum = s.totalWeight;
+        weight = count == 0 ? _stake * sum : (shared + s.counted * _stake) * count;
+        uint256 total = sum * (shared + m * _stake);
+        share = total == 0 ? 0 : (liveAmount * weight) / total;
     }
 
     /// @dev Stops a settlement call before paying: records where it stands and pays the bounty.
@@ -1405,10 +1457,16 @@ contract InformationMarket {
     /// @dev Weights of records [from, to) of `robot` against the live ones [live, end) of the same site.
     /// Outlier: the number of records (itself included) whose vector lies strictly within theta of its
     /// own. OutlierDistinct: the number of distinct sellers with such a record (its own seller once),
-    /// times 1e27, divided by its seller's live records for the same site. Loads the live records once into memory (one
-    /// storage slot each): O(end - live) storage reads and O((to - from) * (end - live)) comparisons,
-    /// bounded by the caller's batch. Returns the weights' sum.
-    function _weigh(address robot, uint64 live, uint64 from, uint64 to, uint64 end) private returns (uint256 sum) {
+    /// times 1e27, divided by its seller's live records for the same site. OutlierCapped: a record
+    /// preceded by `cap` live records of its seller is void (weight 0, and compared with nothing); the
+    /// others weigh as under Outlier, among the counted records only. Loads the live records once into
+    /// memory (one storage slot each): O(end - live) storage reads and O((to - from) * (end - live))
+    /// comparisons, bounded by the caller's batch. Returns the weights' sum and, under OutlierCapped, how
+    /// many live records count.
+    function _weigh(address robot, uint64 live, uint64 from, uint64 to, uint64 end)
+        private
+        returns (uint256 sum, uint256 counted)
+    {
         uint256 m = end - live;
         int256[] memory xs = new int256[](m);
         int256[] memory ys = new int256[](m);
@@ -1421,6 +1479,10 @@ contract InformationMarket {
         uint256[] memory sales = new uint256[](distinct ? 2 * m : 0);
         uint256[] memory mark = new uint256[](distinct ? m : 0);
         uint256 ranks;
+        // Capped scheme: each record's place among its seller's live records (0 for the first), from the
+        // same chain of gaps; from place `cap` on a record is void.
+        bool capped = _scheme == Scheme.OutlierCapped;
+        uint256[] memory place = new uint256[](capped ? m : 0);
         mapping(uint256 => Information) storage records = _records[robot];
         for (uint256 k; k < m; ++k) {
             Information storage r = records[live + k];
@@ -1431,6 +1493,12 @@ contract InformationMarket {
                 uint256 q = gap != 0 && gap <= k ? rank[k - gap] : ranks++;
                 rank[k] = q;
                 ++sales[2 * q + r.site];
+            } else if (capped) {
+                uint256 gap = r.prevGap;
+                uint256 p = gap != 0 && gap <= k ? place[k - gap] + 1 : 0;
+                place[k] = p;
+                if (p >= _cap) sites[k] = _VOID;
+                else ++counted;
             }
         }
         int256 cosTheta = _cosTheta;
@@ -1449,6 +1517,8 @@ contract InformationMarket {
                     }
                 }
                 w = (w * _DISTINCT_SCALE) / sales[2 * rank[i] + site];
+            } else if (site == _VOID) {
+                w = 0;
             } else {
                 for (uint256 j; j < m; ++j) {
                     if (j == i || sites[j] != site) continue;

@@ -9,6 +9,13 @@ stake-expiry rule: at ``advance(step)``, transactions opened at a step t with t 
 the weighing and their stakes are returned; the buyer's next deposit pays each of them share / n (n:
 every transaction of the round trip, expired or not), and the live ones share the rest, share * live / n
 plus their stakes, by the scheme's weights.
+
+Under ``capped_outlier`` (cap ``cap``) a seller's live records after its first ``cap`` are void, and the
+weights are the simulated rule's (``payments.consensus``): they add up to what the rule reads as the
+round trip's amount, share + pot, a void record weighing its stake and the counted ones the rest by
+eq. 7 among themselves; the ledger pays the live amount in proportion. So without expiry a void record
+gets exactly its stake back, and with expired records in the round trip its stake times
+(share * live / n + pot) / (share + pot).
 """
 from __future__ import annotations
 
@@ -45,6 +52,7 @@ class ExactLedger:
     theta: Fraction
     initial: Fraction
     expiry: int = 0
+    cap: int = 0
     balance: list[Fraction] = field(init=False)
     pot: list[Fraction] = field(init=False)
     open: list[list[tuple[int, int, Fraction, int]]] = field(init=False)
@@ -91,10 +99,18 @@ class ExactLedger:
             self.bound[seller] += 1
         self.bound[robot] += len(expired)
         amount = self.share * self.reward * Fraction(len(txs), n or 1) + self.pot[robot]
-        self.pot[robot] = Fraction(0)
+        pot, self.pot[robot] = self.pot[robot], Fraction(0)
         if txs:
             if self.scheme == "delayed":
                 weights = [1] * len(txs)
+            elif self.scheme == "capped_outlier":
+                counted = [sum(1 for t in txs[:k] if t[0] == seller) < self.cap
+                           for k, (seller, _, _, _) in enumerate(txs)]
+                counts = [sum(1 for c2, (_, s2, d2, _) in zip(counted, txs)
+                              if c2 and s2 == s and circular_distance(d, d2) < self.theta) if c else 0
+                          for c, (_, s, d, _) in zip(counted, txs)]
+                rest = self.share * self.reward + pot - counted.count(False) * self.stake
+                weights = [rest * Fraction(w, sum(counts)) if c else self.stake for c, w in zip(counted, counts)]
             elif self.scheme == "outlier_distinct":
                 # distinct sellers with a same-site transaction within theta, over the seller's sales for the site
                 weights = [Fraction(len({s2 for (s2, site2, d2, _) in txs
@@ -106,9 +122,9 @@ class ExactLedger:
                            for (_, s, d, _) in txs]
             total = sum(weights)
             for (seller, _, _, _), w in zip(txs, weights):
-                self.balance[seller] += amount * w / total
+                self.balance[seller] += amount * w / total if total else 0
                 self.bound[seller] += 1
-            self.balance[robot] -= amount
+            self.balance[robot] -= amount if total else 0
             self.bound[robot] += len(txs)
         self.open[robot] = []
         self.expired[robot] = []

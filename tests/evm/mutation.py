@@ -92,6 +92,10 @@ MUTANTS = [
     ("deposit signed by the robot", "signer == address(0) || signer != robot", ["test_a_deposit_needs_the_robots"]),
     ("deposit acknowledged by a nest", "signer == address(0) || !_roles[NEST_ROLE][signer]",
      ["test_a_deposit_needs_the_robots"]),
+    ("capped: a cap under OutlierCapped only", "scheme_ == Scheme.OutlierCapped ? cap_ == 0 : cap_ != 0",
+     ["test_the_cap_is_a_constructor_parameter"]),
+    ("capped: reward below 2^96", "reward_ >= _MAX_CAPPED_AMOUNT", ["test_the_cap_is_a_constructor_parameter"]),
+    ("capped: stake below 2^96", "stake_ >= _MAX_CAPPED_AMOUNT", ["test_the_cap_is_a_constructor_parameter"]),
 ]
 
 #: (the rule broken, text replaced, its wrong replacement, tests that must then fail)
@@ -157,6 +161,12 @@ REWRITES = [
     ("distinct weighing costs more units",
      "uint256 per = _scheme == Scheme.OutlierDistinct ? _DISTINCT_PAIRS_PER_UNIT : _PAIRS_PER_UNIT;",
      "uint256 per = _PAIRS_PER_UNIT;", ["test_a_distinct_seller_weighing_costs"]),
+    ("capped: records past the cap are void", "if (p >= _cap) sites[k] = _VOID;", "if (p > _cap) sites[k] = _VOID;",
+     ["test_a_capped_round_trip"]),
+    ("capped: a void record weighs its stake", "weight = count == 0 ? _stake * sum :", "weight = count == 0 ? 0 :",
+     ["test_a_capped_round_trip"]),
+    ("capped: counted records over all weighing calls", "s.counted = uint64(counted);",
+     "s.counted += uint64(counted);", ["test_a_capped_round_trip"]),
     ("batch bound 48", "uint256 private constant _MAX_SETTLE_BATCH = 48;",
      "uint256 private constant _MAX_SETTLE_BATCH = 64;", ["test_the_trip_bound_and_the_batch_bound"]),
 ]

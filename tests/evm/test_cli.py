@@ -112,3 +112,51 @@ def test_the_demo_defaults_make_deposits():
     config = demo_config(load_experiment(args.experiment), args.robots, args.steps, args.scheme)
     kinds = simulate(config, seed=args.seed, record_events=True).events["kind"].value_counts()
     assert kinds.get("deposit", 0) >= 10 and kinds.get("purchase", 0) >= 100
+
+
+def _experiment_file(tmp_path, scheme: str, params: str) -> str:
+    """fig4C paying by ``scheme`` with ``params`` (a TOML inline table), as a file the demo can load."""
+    path = tmp_path / f"{scheme}.toml"
+    path.write_text('name = "demo"\nsteps = 4000\n[swarm]\nrobots = 25\n'
+                    '[[swarm.groups]]\nbehaviour = "sceptical"\ncount = 20\n'
+                    '[[swarm.groups]]\nbehaviour = "scaboteur"\ncount = 5\nparams = { rotation_angle = 90.0 }\n'
+                    f'[payment]\nscheme = "{scheme}"\nstake = 0.04\nparams = {params}\n')
+    return str(path)
+
+
+@pytest.mark.parametrize("chain_model, verdict", [
+    ([], "on-chain balances match the simulated ledger (within the fixed-point rounding bound)"),
+    (["--chain-period", "3"], "every robot's balance matches the modelled ledger at all"),
+])
+def test_a_capped_outlier_experiment_is_replayed_on_chain_and_agrees(tmp_path, capsys, chain_model, verdict):
+    """``--scheme experiment`` keeps the experiment's payment: capped_outlier with cap 1 runs on the
+    contract's OutlierCapped scheme, and every balance is within its rounding bound of the simulation's
+    (the instant ledger's at the end, or the chain model's after every block). Five robots meet often:
+    about half of the instant run's purchases are a seller's second or later record in its buyer's round
+    trip, void under the cap."""
+    _simulator()
+    path = _experiment_file(tmp_path, "capped_outlier", "{ cap = 1 }")
+    assert main(["chain", "demo", "--experiment", path, "--scheme", "experiment", "--robots", "5", "--steps",
+                 "4000", "--seed", "2", *chain_model]) == 0
+    out = capsys.readouterr().out
+    assert "scheme capped_outlier (stake 0.04)" in out
+    assert verdict in out.rstrip().splitlines()[-1]
+
+
+def test_a_consensus_slash_experiment_is_refused_before_simulating(tmp_path, capsys):
+    _simulator()
+    path = _experiment_file(tmp_path, "consensus_slash", "{ slash_angle = 60.0 }")
+    assert main(["chain", "demo", "--experiment", path, "--scheme", "experiment"]) == 2
+    captured = capsys.readouterr()
+    assert captured.err.startswith("infomarket: error: consensus_slash is not on chain: it slashes by the angle")
+    assert len(captured.err.strip().splitlines()) == 1 and "Traceback" not in captured.err
+    assert "simulated" not in captured.out
+
+
+def test_an_adaptive_outlier_experiment_is_refused_with_its_reason(tmp_path, capsys):
+    _simulator()
+    path = _experiment_file(tmp_path, "adaptive_outlier", "{ theta = 30.0 }")
+    assert main(["chain", "demo", "--experiment", path, "--scheme", "experiment"]) == 2
+    err = capsys.readouterr().err
+    assert err == ("infomarket: error: adaptive_outlier is not on chain: each seller's Theta follows its "
+                   "reputation, which the simulated ledger keeps and the contract does not\n")

@@ -11,6 +11,9 @@ simulated ledger, 80 on the contract over revm (every transaction signed and sen
 time), and a smaller sample over py-evm (a pure-Python EVM takes about a second per hundred transactions).
 Those 80 draw every scheme and expiry that 200 draw, refusals, and long sequences under every scheme; every
 payment-rule mutant of the contract tried fails them within the first few examples (docs/testing.md).
+``capped_outlier`` (cap 1 or 2, with and without stake) has random sequences of its own, 100 on the
+simulated ledger and 40 on revm, so that the other schemes' draws do not depend on it; among them,
+sellers over their cap with records expired before their void ones.
 """
 from __future__ import annotations
 
@@ -35,7 +38,11 @@ from .node import running_node
 
 CASES = json.loads((Path(__file__).parents[1] / "fixtures" / "payment_vectors.json").read_text())["cases"]
 SCHEMES = {"delayed": ("delayed", 0.0), "outlier": ("outlier", 0.0), "outlier+stake": ("outlier", 0.04),
-           "distinct": ("outlier_distinct", 0.0), "distinct+stake": ("outlier_distinct", 0.04)}
+           "distinct": ("outlier_distinct", 0.0), "distinct+stake": ("outlier_distinct", 0.04),
+           "capped": ("capped_outlier", 0.0), "capped+stake": ("capped_outlier", 0.04),
+           "capped1+stake": ("capped_outlier", 0.04)}
+#: The per-seller cap of each ``capped_outlier`` case (records per seller per round trip that count).
+CAPS = {"capped": 2, "capped+stake": 2, "capped1+stake": 1}
 #: Directions 7.3 k degrees (k < 50): no two differ by Theta = 30 within 0.1 degree, so the
 #: simulation's degrees and the contract's micro-unit vectors cannot decide a pair differently.
 DIRECTIONS = [round(7.3 * k % 360, 6) for k in range(50)]
@@ -54,12 +61,12 @@ def deposit(step, robot):
 
 
 @st.composite
-def scenarios(draw, expiries=(0, 0, 3, 10), longest=1000):
+def scenarios(draw, expiries=(0, 0, 3, 10), longest=1000, schemes=tuple(sorted(set(SCHEMES) - set(CAPS)))):
     """(robots, scheme, wealth, expiry, events): hypothesis draws the sizes and a seed, the events
     come from the seed (1 000 operations drawn one by one would exceed hypothesis' data budget);
     most sequences are short, one in eight is long (up to ``longest`` operations)."""
     robots = draw(st.integers(2, 25))
-    scheme = draw(st.sampled_from(sorted(SCHEMES)))
+    scheme = draw(st.sampled_from(schemes))
     wealth = draw(st.sampled_from([0.05, 0.1, 1.0]))
     expiry = draw(st.sampled_from(expiries))
     length = draw(st.one_of(*[st.integers(0, 40)] * 7, st.integers(40, longest)))
@@ -118,12 +125,77 @@ LATE_CASES = [*_late("delayed", 0, [F(1, 3)] * 3), *_late("outlier", 0, [F(2, 5)
               *_late("distinct+stake", F(1, 25), [F(2, 5), F(2, 5), F(1, 5)])]
 
 
+def simulated_params(scheme: str) -> dict | None:
+    """The simulated ledger's payment parameters for a case's scheme."""
+    name, _ = SCHEMES[scheme]
+    if name == "delayed":
+        return None
+    return {"theta": 30.0, **({"cap": float(CAPS[scheme])} if scheme in CAPS else {})}
+
+
+#: ``capped_outlier`` by hand (share 0.5 of a reward of 1, Theta 30, every robot starting with 1). A void
+#: record gets its stake back; the counted ones share the rest, share + pot - void stakes, by eq. 7 among
+#: themselves (each counted record's count of similar counted records, C their sum).
+CAPPED_CASES = [
+    # cap 2, a seller over it: 1@10, 2@15, 3@100 three times; 3's third record is void. Counts 2, 2 (10 and
+    # 15 agree), 2, 2 (3's two counted ones agree): C = 8. Pot 5 x 0.04 = 0.2, amount 0.7, rest
+    # 0.7 - 0.04 = 0.66, 0.66 x 2/8 = 0.165 per counted record: 1 and 2 end at 1 - 0.04 + 0.165 = 1.125,
+    # 3 at 1 - 0.12 + 2 x 0.165 + 0.04 = 1.25 (under eq. 7 alone it would take 9/13 of 0.7); the buyer
+    # 1 + 1 + 0.2 - 0.7 = 1.5.
+    ("capped+stake", _case([(1, 10.0), (2, 15.0)] + [(3, 100.0)] * 3, 0.04),
+     [F(3, 2), F(9, 8), F(9, 8), F(5, 4)]),
+    # cap 1, the saboteur of _REPEAT sells one vector 5 times: 4 void. Counts 3, 3, 3 (10, 15, 20 agree), 1:
+    # C = 10. Pot 8 x 0.04 = 0.32, amount 0.82, rest 0.82 - 4 x 0.04 = 0.66: the honest 0.66 x 3/10 = 0.198
+    # each, 1 - 0.04 + 0.198 = 1.158; the saboteur 1 - 0.2 + 0.066 + 4 x 0.04 = 1.026.
+    ("capped1+stake", _case(_REPEAT, 0.04), [F(3, 2), F(1158, 1000), F(1158, 1000), F(1158, 1000), F(1026, 1000)]),
+    # cap 2, two sellers with records on both sites (the cap counts both): 1 food@10, 2 food@20, 1 nest@200,
+    # 1 food@15 (1's third: void), 2 nest@210, 2 food@25 (2's third: void), 1 nest@205 (void), 3 food@100.
+    # Counted: food 10, 20 (count 2 each), 100 (1); nest 200, 210 (2 each): C = 9. Pot 8 x 0.04 = 0.32,
+    # amount 0.82, rest 0.82 - 3 x 0.04 = 0.7, 0.7/9 per count. Seller 1: 1 - 4 x 0.04 + 4 x 0.7/9 + 2 x
+    # 0.04 = 0.92 + 14/45; seller 2: 1 - 3 x 0.04 + 4 x 0.7/9 + 0.04 = 0.92 + 14/45; seller 3: 0.96 + 7/90.
+    ("capped+stake", [purchase(1, 0, 1, 0, 10.0, 0), purchase(1, 0, 2, 0, 20.0, 1), purchase(1, 0, 1, 1, 200.0, 2),
+                      purchase(1, 0, 1, 0, 15.0, 3), purchase(1, 0, 2, 1, 210.0, 4), purchase(1, 0, 2, 0, 25.0, 5),
+                      purchase(1, 0, 1, 1, 205.0, 6), purchase(1, 0, 3, 0, 100.0, 7), deposit(2, 0)],
+     [F(3, 2), F(92, 100) + F(14, 45), F(92, 100) + F(14, 45), F(96, 100) + F(7, 90)]),
+    # cap 2, the void record is the one eq. 7 would make the outlier: 1@10, 1@15, 2@20, 1@200 (1's third).
+    # Counts 3, 3, 3: C = 9. Pot 0.16, amount 0.66, rest 0.62. Seller 1: 1 - 0.12 + 6 x 0.62/9 + 0.04 = 4/3
+    # (its far record is not slashed: void, its stake comes back); seller 2: 1 - 0.04 + 3 x 0.62/9 = 7/6.
+    ("capped+stake", _case([(1, 10.0), (1, 15.0), (2, 20.0), (1, 200.0)], 0.04), [F(3, 2), F(4, 3), F(7, 6)]),
+    # without stakes a void record gets nothing: cap 2, 1@10 three times, 2@50: counts 2, 2, 1 (C = 5),
+    # 0.5 x 2/5 = 0.2 for each of 1's counted records, 0.1 for 2.
+    ("capped", _case([(1, 10.0)] * 3 + [(2, 50.0)], 0.0), [F(3, 2), F(14, 10), F(11, 10)]),
+]
+
+
+#: Late deposits under the cap (stake expiry 5, cap 1), by hand.
+LATE_CAPPED = [
+    # 1@10 at step 1 (expired at the start of step 6), then 2@20, 2@25 (2's second: void) and 3@100 at step
+    # 6, and the deposit at step 6. The expired record is paid 0.5/4 = 0.125 (its stake went back). The
+    # rule's weights add up to share + pot = 0.5 + 0.12 = 0.62: 0.04 for the void record, the rest 0.58
+    # split 1 : 1 (counts 1 and 1). The ledger pays the live amount, 0.5 x 3/4 + 0.12 = 0.495, by those
+    # weights: the void record 0.495 x 0.04/0.62 = 99/3100 (not its whole stake: the simulated rule scales
+    # it as the live amount is), each counted one 0.495 x 0.29/0.62 = 2871/12400.
+    ("capped1+stake", [purchase(1, 0, 1, 0, 10.0, 0), purchase(6, 0, 2, 0, 20.0, 1),
+                       purchase(6, 0, 2, 0, 25.0, 2), purchase(6, 0, 3, 0, 100.0, 3), deposit(6, 0)],
+     [F(3, 2), F(9, 8), F(92, 100) + F(2871 + 396, 12400), F(96, 100) + F(2871, 12400)]),
+    # 1@10 and 4@12 at step 1 (both expired at step 6), 2@20 at step 3, 2@25 (void) and 3@100 at step 6,
+    # the deposit at step 6: the void record is the second live one of three, with two records expired
+    # before it. Each expired record 0.5/5 = 0.1 (1 and 4 end at 1.1); weights 0.04 (void) and 0.29, 0.29
+    # of 0.5 + 0.12 = 0.62; the live amount 0.5 x 3/5 + 0.12 = 0.42: the void record 0.42 x 0.04/0.62 =
+    # 21/775, each counted one 0.42 x 0.29/0.62 = 609/3100. Seller 2 ends at 1 - 0.08 + 609/3100 + 21/775,
+    # seller 3 at 0.96 + 609/3100, the buyer at 1 + 1 + 0.12 - 0.2 - 0.42 = 1.5.
+    ("capped1+stake", [purchase(1, 0, 1, 0, 10.0, 0), purchase(1, 0, 4, 0, 12.0, 1), purchase(3, 0, 2, 0, 20.0, 2),
+                       purchase(6, 0, 2, 0, 25.0, 3), purchase(6, 0, 3, 0, 100.0, 4), deposit(6, 0)],
+     [F(3, 2), F(11, 10), F(92, 100) + F(609, 3100) + F(21, 775), F(96, 100) + F(609, 3100), F(11, 10)]),
+]
+
+
 def exact_run(robots, scheme, wealth, expiry, events) -> tuple[ExactLedger, list[bool]]:
     """The rational model, and whether each purchase is accepted (the simulation decides refusals:
     the event kinds fed to the ledgers are taken from this model, as the simulator's log would be)."""
     name, stake = SCHEMES[scheme]
     exact = ExactLedger(robots, name, Fraction(1), Fraction(1, 2), Fraction(str(stake)), Fraction(30),
-                        Fraction(str(wealth)), expiry)
+                        Fraction(str(wealth)), expiry, CAPS.get(scheme, 0))
     accepted = []
     for ev in events:
         exact.advance(ev["step"])
@@ -140,6 +212,8 @@ class LedgerConformance:
     """The behaviour every ledger must show; subclasses implement ``run``."""
 
     examples = 200
+    #: random sequences drawn under ``capped_outlier`` alone (the examples above draw the other schemes)
+    capped_examples = 100
     expiries = (0, 0, 3, 10)
     longest = 1000
 
@@ -185,10 +259,48 @@ class LedgerConformance:
         exact, _ = exact_run(len(expected), scheme, 1.0, 5, [dict(e) for e in events])
         assert exact.balance == expected  # the rational model, checked by hand here too
 
+    @pytest.mark.parametrize(("scheme", "events", "expected"), CAPPED_CASES,
+                             ids=[f"{c[0]}-{k}" for k, c in enumerate(CAPPED_CASES)])
+    def test_the_per_seller_cap_by_hand(self, scheme, events, expected):
+        """``capped_outlier``: a seller over its cap, cap 1, two sellers on both sites, a void outlier."""
+        events = [dict(e) for e in events]
+        balances = self.run(len(expected), scheme, 1.0, 0, events)
+        shares = sum(1 for e in events if e["kind"] == "purchase")
+        for i, value in enumerate(expected):
+            assert balances[i] == pytest.approx(float(value), abs=self.tolerance(shares) + 1e-9), i
+        exact, _ = exact_run(len(expected), scheme, 1.0, 0, [dict(e) for e in events])
+        assert exact.balance == expected  # the rational model, checked by hand here too
+
+    @pytest.mark.parametrize(("scheme", "events", "expected"), LATE_CAPPED, ids=["void-after-expired", "void-among"])
+    def test_a_late_deposit_under_the_cap_by_hand(self, scheme, events, expected):
+        if self.expiries == (0,):
+            pytest.skip("this ledger replays one block per transaction: no stake expiry")
+        balances = self.run(len(expected), scheme, 1.0, 5, [dict(e) for e in events])
+        shares = sum(1 for e in events if e["kind"] == "purchase")
+        for i, value in enumerate(expected):
+            assert balances[i] == pytest.approx(float(value), abs=self.tolerance(shares) + 1e-9), i
+        exact, _ = exact_run(len(expected), scheme, 1.0, 5, [dict(e) for e in events])
+        assert exact.balance == expected
+
     def test_random_event_sequences_agree_with_the_exact_model(self):
         @settings(max_examples=self.examples, deadline=None, derandomize=True,
                   suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
         @given(scenarios(self.expiries, self.longest))
+        def check(scenario):
+            robots, scheme, wealth, expiry, events = scenario
+            exact, _ = exact_run(robots, scheme, wealth, expiry, events)
+            balances = self.run(robots, scheme, wealth, expiry, events)
+            for i in range(robots):
+                assert abs(balances[i] - float(exact.balance[i])) <= self.tolerance(exact.bound[i]), (i, scheme, expiry)
+
+        check()
+
+    def test_random_capped_sequences_agree_with_the_exact_model(self):
+        """The same under the per-seller cap only (cap 1 or 2, with and without stake), so that every
+        variant is drawn, with sellers over their cap, expired records and refusals among them."""
+        @settings(max_examples=self.capped_examples, deadline=None, derandomize=True,
+                  suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+        @given(scenarios(self.expiries, self.longest, tuple(sorted(CAPS))))
         def check(scenario):
             robots, scheme, wealth, expiry, events = scenario
             exact, _ = exact_run(robots, scheme, wealth, expiry, events)
@@ -203,7 +315,7 @@ class TestSimulatedLedger(LedgerConformance):
     def run(self, robots, scheme, wealth, expiry, events):
         name, stake = SCHEMES[scheme]
         replayed = replay_events(events, robots, scheme=name, initial_wealth=wealth, stake=stake,
-                                 params={"theta": 30.0} if name != "delayed" else None, stake_expiry=expiry)
+                                 params=simulated_params(scheme), stake_expiry=expiry)
         # what the simulation would have in pots at the end (stakes of open round trips) is not a balance
         return [float(b) for b in replayed.balances]
 
@@ -217,6 +329,7 @@ class TestSimulatedLedger(LedgerConformance):
 class TestContractLedger(LedgerConformance):
     backend = "revm"
     examples = 80
+    capped_examples = 40
     #: where the replays' markets are kept: None, each replay deploys its own (cheap on revm); else each
     #: market is deployed once on one chain per class and reverted to (``start``)
     kept_on: str | None = None
@@ -248,7 +361,8 @@ class TestContractLedger(LedgerConformance):
 
     def run(self, robots, scheme, wealth, expiry, events):
         name, stake = SCHEMES[scheme]
-        params = MarketParams.from_floats(name, stake=stake, stake_expiry=expiry, max_records_per_seller=1000)
+        params = MarketParams.from_floats(name, stake=stake, stake_expiry=expiry, max_records_per_seller=1000,
+                                          cap=CAPS.get(scheme))
         report = replay_on_chain(events, robots=robots, params=params, initial_wealth=wealth, backend=self.backend,
                                  start=self.start(robots, params, wealth))
         assert not report.disagreements, report.disagreements[:3]
@@ -265,6 +379,7 @@ class TestContractLedgerOnPyEvm(TestContractLedger):
     backend = "py-evm"
     kept_on = "py-evm"
     examples = 4
+    capped_examples = 2
     longest = 150
     expiries = (0,)  # py-evm mines one block per transaction: expiry needs one block per step (revm)
 
@@ -275,6 +390,7 @@ class TestContractLedgerOnNode(TestContractLedger):
     sample. Transactions are signed by the robots' keys and mined one per block, as on a chain."""
 
     examples = 4
+    capped_examples = 2
     longest = 80
     expiries = (0,)  # one block per transaction: the replay's expiry needs one block per step (revm)
 
@@ -294,7 +410,8 @@ class TestContractLedgerOnNode(TestContractLedger):
 
     def run(self, robots, scheme, wealth, expiry, events):
         name, stake = SCHEMES[scheme]
-        params = MarketParams.from_floats(name, stake=stake, stake_expiry=expiry, max_records_per_seller=1000)
+        params = MarketParams.from_floats(name, stake=stake, stake_expiry=expiry, max_records_per_seller=1000,
+                                          cap=CAPS.get(scheme))
         report = replay_on_chain(events, robots=robots, params=params, initial_wealth=wealth, rpc_url=self.rpc_url,
                                  start=self.start(robots, params, wealth))
         assert report.backend == self.rpc_url and report.cold_storage

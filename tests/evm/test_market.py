@@ -5,11 +5,14 @@ from __future__ import annotations
 import json
 import random
 import math
+from dataclasses import replace
 from fractions import Fraction
 from pathlib import Path
 
 import pytest
+from infomarket.errors import ConfigError
 from infomarket.evm.errors import ContractRevert
+from infomarket.evm.market import ChainMarket, MarketParams
 from infomarket.evm.protocol import FOOD, NEST, PathInfo
 from infomarket.evm.evm_replay import FLOAT_SLACK_UNITS
 from infomarket.evm.units import TOKEN_UNIT, to_units
@@ -291,3 +294,63 @@ def test_contract_reproduces_the_original_simulators_payments(case, vector_marke
     pots = sum(market.locked_stake(robots[i].address) for i in range(n))
     bonds = sum(market.bond_of(a.address) for a in robots)  # every robot registered, each locked its bond
     assert sum(chain) + pots + bonds == market.total_supply() == to_units(case["initial_wealth"]) * n + TOKEN_UNIT + bonds
+
+
+def test_the_cap_is_a_constructor_parameter_validated_like_the_others(chain, artifact, make_market):
+    """OutlierCapped needs a cap of at least 1 and every other scheme a cap of 0; under OutlierCapped the
+    reward and the stake stay below 2^96 units (so that no payment product overflows)."""
+    capped = MarketParams.from_floats("capped_outlier", stake=0.04, cap=2)
+    for params, name, value in ((replace(capped, cap=0), "cap", 0),
+                                (replace(MarketParams.from_floats("outlier"), cap=3), "cap", 3),
+                                (replace(capped, reward=2**96), "reward", 2**96),
+                                (replace(capped, stake=2**96), "stake", 2**96)):
+        with pytest.raises(ContractRevert) as refused:
+            ChainMarket.deploy(params, backend=chain, artifact=artifact)
+        assert refused.value.name == "InfoMarketInvalidParameter"
+        assert refused.value.args_by_name == {"parameter": name.encode().ljust(32, b"\0"), "value": value}
+    market = make_market("capped_outlier", stake=0.04, cap=2, wealth=0.0)
+    config = market.view("configuration")
+    assert (config[0], config[3], config[-1]) == (3, 40_000_000, 2)  # Scheme.OutlierCapped, the stake, the cap
+    assert make_market("outlier", wealth=0.0).view("configuration")[-1] == 0
+
+
+def test_the_client_encodes_the_rules_cap():
+    """The rule counts a record while fewer than ``cap`` of its seller's came before it, so a cap of 2.5
+    counts 3; a cap beyond the 512 records a round trip holds is 512; only capped_outlier takes one."""
+    assert MarketParams.from_floats("capped_outlier").cap == 3  # the rule's default
+    assert MarketParams.from_floats("capped_outlier", cap=2.5).cap == 3
+    assert MarketParams.from_floats("capped_outlier", cap=1).cap == 1
+    assert MarketParams.from_floats("capped_outlier", cap=1e12).cap == 512
+    assert MarketParams.from_floats("outlier").cap == 0
+    with pytest.raises(ConfigError, match="cap must be at least 1, not 0.5"):
+        MarketParams.from_floats("capped_outlier", cap=0.5)
+    with pytest.raises(ConfigError, match="cap is a parameter of the capped_outlier scheme, not of 'outlier'"):
+        MarketParams.from_floats("outlier", cap=2)
+
+
+def test_a_capped_round_trip_settles_across_transactions_and_pays_what_the_rules_say(make_market, robots):
+    """60 records of 7 sellers on both sites with cap 3 (39 of them void) and a batch of 8: weighing and
+    paying resume across calls, and the result is the exact ledger's, within the rounding bound."""
+    market = make_market("capped_outlier", stake=0.04, cap=3, settle_batch=8, wealth=10.0)
+    exact = ExactLedger(len(robots), "capped_outlier", Fraction(1), Fraction(1, 2), Fraction(1, 25), Fraction(30),
+                        Fraction(10), cap=3)
+    buyer = 0
+    rng = random.Random(2)
+    for k in range(60):
+        seller, site, direction = 1 + k % 7, k % 2, round(rng.uniform(0.0, 90.0), 3)
+        sell(market, robots[seller], robots[buyer], site, direction, age=k)
+        assert exact.purchase(buyer, seller, site, Fraction(direction))
+    results = market.deposit(robots[buyer].address, batch=8)
+    exact.deposit(buyer)
+    assert len(results) > 2
+    shares = shares_of(results)
+    (done,) = results[-1].of("SettlementCompleted")
+    # the total weight is C, the counted records' counts, and a void record (each seller's records after
+    # its first 3) weighs stake x C
+    c = done["totalWeight"]
+    assert sum(1 for e in shares if e["weight"] == 40_000_000 * c) == 60 - 3 * 7
+    assert sum(e["amount"] for e in shares) == done["shared"]
+    for i, account in enumerate(robots):
+        gap = market.balance_of(account.address) - exact.balance[i] * TOKEN_UNIT
+        assert abs(gap) < max(exact.bound[i], 1)
+    assert market.total_supply() == sum(market.balance_of(a.address) + market.bond_of(a.address) for a in robots)

@@ -1,7 +1,7 @@
 """Property: any sequence of reveals and buys keeps the token supply exact and the ledger sound.
 
-For random sequences (random buyers, sellers, sites, directions, schemes, and initial wealth small
-enough that stakes get refused), after every operation:
+For random sequences (random buyers, sellers, sites, directions, schemes, capped_outlier with cap 1
+beside them, and initial wealth small enough that stakes get refused), after every operation:
 - every token is accounted for: balances + locked stakes + bonds == totalSupply == wealth granted +
   rewards;
 - the contract accepts exactly the sales the model accepts (a refused one fails with
@@ -24,6 +24,8 @@ from .exact_ledger import SELLER_POSITION, ExactLedger, vector_for
 
 N = 4
 SCHEMES = [("delayed", 0.0), ("outlier", 0.0), ("outlier", 0.04)]
+#: capped_outlier with cap 1: a seller's second record to a buyer in a round trip is void
+CAPPED = ("capped_outlier", 0.04)
 WEALTHS = [0.05, 0.1, 1.0]
 
 #: Directions whose pairwise differences stay at least 0.01 degree away from Theta = 30, so that the
@@ -37,20 +39,34 @@ sequences = st.lists(st.one_of(sale, sale, buy), min_size=1, max_size=12)
 @pytest.fixture(scope="module")
 def deployed(chain, make_market):
     """One market per (scheme, wealth), deployed once; each example starts from this snapshot."""
-    markets = {(s, stake, wealth): make_market(s, stake=stake, wealth=[wealth] * N + [0.0] * 4)
-               for s, stake in SCHEMES for wealth in WEALTHS}
+    markets = {(s, stake, wealth): make_market(s, stake=stake, wealth=[wealth] * N + [0.0] * 4,
+                                               **({"cap": 1} if (s, stake) == CAPPED else {}))
+               for s, stake in SCHEMES + [CAPPED] for wealth in WEALTHS}
     return markets, chain, chain.snapshot()
 
 
 @settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(scheme=st.sampled_from(SCHEMES), wealth=st.sampled_from(WEALTHS), ops=sequences)
 def test_random_sequences_conserve_supply_and_never_go_negative(deployed, robots, scheme, wealth, ops):
+    check_sequence(deployed, robots, scheme, wealth, ops)
+
+
+@settings(max_examples=20, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(wealth=st.sampled_from(WEALTHS), ops=st.lists(st.one_of(sale, sale, sale, buy), min_size=6, max_size=12))
+def test_random_capped_sequences_conserve_supply_and_never_go_negative(deployed, robots, wealth, ops):
+    """Longer runs of sales between deposits than above, so that sellers sell a buyer twice (void)."""
+    check_sequence(deployed, robots, CAPPED, wealth, ops, cap=1)
+
+
+def check_sequence(deployed, robots, scheme, wealth, ops, cap=0):
+    """Run ``ops`` on the deployed market of (scheme, wealth) and on the rational model, checking after
+    every operation."""
     markets, chain, snapshot = deployed
     chain.revert(snapshot)
     name, stake = scheme
     market = markets[(name, stake, wealth)]
     exact = ExactLedger(N, name, Fraction(1), Fraction(1, 2), Fraction(str(stake)), Fraction(30),
-                        Fraction(str(wealth)))
+                        Fraction(str(wealth)), cap=cap)
     minted = to_units(wealth) * N
     for age, op in enumerate(ops):
         if op[0] == "buy":

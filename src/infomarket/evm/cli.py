@@ -30,6 +30,8 @@ from ..errors import report as report_error
 from ..payments import MARKETS
 
 DEMO_SCHEMES = MARKETS
+#: ``--scheme`` value that keeps the experiment's own payment section (any scheme the contract implements).
+FROM_EXPERIMENT = "experiment"
 
 
 def _rpc_url(text: str) -> str:
@@ -48,9 +50,10 @@ def add_subcommand(subparsers) -> None:
         description=__doc__.split("\n\n")[1].replace("\n", " "))
     demo.add_argument("--robots", type=at_least(1), default=25, help="swarm size (default 25)")
     demo.add_argument("--steps", type=at_least(1), default=3000, help="simulation steps (default 3000)")
-    demo.add_argument("--scheme", choices=sorted(DEMO_SCHEMES), default="staking",
-                      help="payment scheme: delayed, outlier (no stake) or staking (outlier, stake 0.04); "
-                           "default staking")
+    demo.add_argument("--scheme", choices=sorted(DEMO_SCHEMES) + [FROM_EXPERIMENT], default="staking",
+                      help="payment scheme: delayed, outlier (no stake), staking (outlier, stake 0.04), or "
+                           "experiment (the experiment's own payment section, e.g. capped_outlier); default "
+                           "staking")
     demo.add_argument("--experiment", default="fig4C",
                       help="experiment whose swarm composition is scaled down (default fig4C)")
     demo.add_argument("--seed", type=seed_value, default=0, help="simulation seed (default 0)")
@@ -71,16 +74,18 @@ def add_subcommand(subparsers) -> None:
 
 def demo_config(base, robots: int, steps: int, scheme: str):
     """``base`` with its swarm scaled to ``robots`` (every group keeps at least one robot when there
-    is room), run for ``steps``, paying with ``scheme`` (a key of ``DEMO_SCHEMES``)."""
+    is room), run for ``steps``, paying with ``scheme`` (a key of ``DEMO_SCHEMES``, or ``FROM_EXPERIMENT``:
+    as ``base`` pays)."""
     groups = base.swarm.groups
     counts = [max(1, round(g.count * robots / base.swarm.robots)) if g.count else 0 for g in groups]
     largest = max(range(len(groups)), key=lambda k: counts[k])
     counts[largest] += robots - sum(counts)
     if counts[largest] < 0:  # more groups than robots: keep the first ones
         counts = [1 if k < robots else 0 for k in range(len(groups))]
-    name, stake = DEMO_SCHEMES[scheme]
     payment = base.payment.model_dump()
-    payment.update(scheme=name, stake=stake, params=payment["params"] if base.payment.scheme == name else {})
+    if scheme != FROM_EXPERIMENT:
+        name, stake = DEMO_SCHEMES[scheme]
+        payment.update(scheme=name, stake=stake, params=payment["params"] if base.payment.scheme == name else {})
     return base.with_overrides(
         steps=steps, transitory=0,
         swarm={"robots": robots, "groups": [dict(g.model_dump(), count=c) for g, c in zip(groups, counts)]},
@@ -120,7 +125,7 @@ def run_demo(args: argparse.Namespace) -> int:
         from ..errors import ConfigError
         from .errors import ChainError
         from .market import connect
-        from .evm_replay import replay_result
+        from .evm_replay import market_params, replay_result
     except ImportError as exc:
         return report_error(f"infomarket chain needs the chain extra (pip install 'infomarket[chain]'): {exc}", 1)
     try:
@@ -136,13 +141,15 @@ def run_demo(args: argparse.Namespace) -> int:
             connect(args.rpc)  # fail before simulating if the node is not there
         if config.payment.scheme == "outlier" and config.payment_params()["theta"] > 180:
             raise ConfigError("the contract needs theta in [0, 180] degrees")
+        market_params(config)  # a scheme the contract does not implement is refused before simulating
         too_big = sizes.run_too_big(config, record_events=True)  # the demo keeps the whole event log
         if too_big:
             raise ConfigError(f"--steps {args.steps} --robots {args.robots}: {too_big}")
     except (ConfigError, ValueError, ChainError) as exc:
         return report_error(exc, 2)
     composition = ", ".join(f"{g.count} {g.behaviour}" for g in config.swarm.groups if g.count)
-    print(f"chain demo: {args.robots} robots ({composition}), {args.steps} steps, scheme {args.scheme} "
+    scheme = config.payment.scheme if args.scheme == FROM_EXPERIMENT else args.scheme
+    print(f"chain demo: {args.robots} robots ({composition}), {args.steps} steps, scheme {scheme} "
           f"(stake {config.payment.stake:g}), seed {args.seed}")
     if config.chain.enabled:
         return _run_chain_demo(config, args)

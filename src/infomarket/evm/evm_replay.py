@@ -245,24 +245,40 @@ def _expire(market, accounts, open_steps, step: int, expiry: int, report: Replay
             del opened[:n]
 
 
+#: Why a scheme the simulator has is not on chain (the contract implements ``market.SCHEMES``).
+OFF_CHAIN = {
+    "consensus_slash": "consensus_slash is not on chain: it slashes by the angle between a record and its "
+                       "site's medoid, and the contract compares vectors by exact integer dot products, with no "
+                       "angles; an integer arctangent would not reproduce the simulated ledger's floating-point "
+                       "angles bit for bit, so the two ledgers could not be checked against each other "
+                       "(docs/chain.md, \"Which rules run where\")",
+    "adaptive_outlier": "adaptive_outlier is not on chain: each seller's Theta follows its reputation, which the "
+                        "simulated ledger keeps and the contract does not",
+}
+
+
 def market_params(config) -> MarketParams:
     """The contract's parameters for an experiment's payment section (``config.payment``).
 
-    The contract implements the built-in ``delayed``, ``outlier`` and ``outlier_distinct`` schemes; a
-    plugin scheme, or a fuel cost (money the simulation burns, which the contract has no notion of),
-    cannot be replayed on chain. The simulation's stake expiry 0 (never) becomes, in the replay, one
-    longer than the replay itself (the contract always has one).
+    The contract implements the built-in ``delayed``, ``outlier``, ``outlier_distinct`` and
+    ``capped_outlier`` schemes; another scheme (``consensus_slash``, a plugin's), or a fuel cost (money the
+    simulation burns, which the contract has no notion of), cannot be replayed on chain. The simulation's
+    stake expiry 0 (never) becomes, in the replay, one longer than the replay itself (the contract always
+    has one).
     """
     payment = config.payment
+    if payment.scheme in OFF_CHAIN:
+        raise ChainError(OFF_CHAIN[payment.scheme])
     if payment.scheme not in SCHEMES:
-        raise ChainError(f"the contract implements the {' and '.join(SCHEMES)} schemes, not {payment.scheme!r}")
+        raise ChainError(f"the contract implements the {', '.join(SCHEMES)} schemes, not {payment.scheme!r}")
     if config.robot.fuel_cost:
         raise ChainError("the contract has no fuel cost: replay a configuration with robot.fuel_cost = 0")
-    theta = (config.payment_params().get("theta", default_theta()) if payment.scheme != "delayed"
-             else default_theta())
+    params = config.payment_params()
+    theta = params.get("theta", default_theta()) if payment.scheme != "delayed" else default_theta()
     return MarketParams.from_floats(payment.scheme, reward=payment.reward,
                                     information_share=payment.information_share, stake=payment.stake,
-                                    theta_deg=theta, stake_expiry=int(getattr(payment, "stake_expiry", 0) or 0))
+                                    theta_deg=theta, stake_expiry=int(getattr(payment, "stake_expiry", 0) or 0),
+                                    cap=params.get("cap"))
 
 
 def replay_result(result, *, rpc_url: str | None = None, backend: str | None = None,

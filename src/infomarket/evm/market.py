@@ -29,13 +29,15 @@ from eth_utils.abi import event_abi_to_log_topic, function_abi_to_4byte_selector
 
 from ..errors import ConfigError
 from ..payments import default_theta
+from ..registry import get_payment
 from .backends import Receipt, RevertedCall, make_backend
 from .errors import ChainError, ContractRevert
 from .protocol import (Domain, LightContract, Offer, PathInfo, ProtocolError, accept_offer, checksum, sign_deposit,
                        sign_offer)
 from .units import COS_SCALE, share_to_wad, to_units
 
-SCHEMES = {"delayed": 0, "outlier": 1, "outlier_distinct": 2}
+#: The simulator's payment schemes the contract implements, by their number in its ``Scheme`` enum.
+SCHEMES = {"delayed": 0, "outlier": 1, "outlier_distinct": 2, "capped_outlier": 3}
 #: The contract's roles (docs/chain.md, "Trust model"), by name.
 ROLES = {"admin": bytes(32), **{name: keccak(text=f"{name.upper()}_ROLE")
                                 for name in ("registrar", "depositor", "nest", "pauser")}}
@@ -95,6 +97,20 @@ def cos_theta(theta_deg: float) -> int:
     return round(math.cos(math.radians(theta_deg)) * COS_SCALE)
 
 
+def record_cap(scheme: str, cap: float | None) -> int:
+    """The contract's cap for ``scheme``: 0 unless ``capped_outlier``; there the rule's ``cap`` (its
+    default when None) rounded up, which counts the same records (the rule counts a record while fewer
+    than ``cap`` of its seller's came before it), and no more than any round trip can hold."""
+    if scheme != "capped_outlier":
+        if cap is not None:
+            raise ConfigError(f"cap is a parameter of the capped_outlier scheme, not of {scheme!r}")
+        return 0
+    value = get_payment("capped_outlier").defaults["cap"] if cap is None else cap
+    if not value >= 1:
+        raise ConfigError(f"cap must be at least 1, not {value}")
+    return DEFAULT_MAX_RECORDS_PER_TRIP if value > DEFAULT_MAX_RECORDS_PER_TRIP else math.ceil(value)
+
+
 @dataclass(frozen=True)
 class MarketParams:
     """The contract's constructor arguments, already in fixed point (see ``units``)."""
@@ -119,6 +135,8 @@ class MarketParams:
     settle_bounty: int | None = None
     registration_bond: int = DEFAULT_REGISTRATION_BOND
     bond_delay: int = DEFAULT_BOND_DELAY
+    #: under ``capped_outlier``, most records per seller that count in a round trip; 0 otherwise
+    cap: int = 0
 
     @property
     def bounty(self) -> int:
@@ -134,21 +152,22 @@ class MarketParams:
                     max_records_per_trip: int = DEFAULT_MAX_RECORDS_PER_TRIP,
                     max_validity: int = DEFAULT_MAX_VALIDITY, settle_batch: int = DEFAULT_SETTLE_BATCH,
                     settlement_deadline: int = DEFAULT_SETTLEMENT_DEADLINE,
-                    max_grant: float | None = None, **policy) -> MarketParams:
+                    max_grant: float | None = None, cap: float | None = None, **policy) -> MarketParams:
+        """``cap``: under ``capped_outlier`` (default: the rule's own), most records per seller that count."""
         if scheme not in SCHEMES:
             raise ConfigError(f"scheme must be one of {sorted(SCHEMES)}, not {scheme!r}")
         theta = default_theta() if theta_deg is None else theta_deg  # the outlier rule's own default
         grant = DEFAULT_MAX_GRANT if max_grant is None else to_units(max_grant)
         return cls(scheme, to_units(reward), share_to_wad(information_share), to_units(stake),
                    cos_theta(theta), stake_expiry, max_records_per_seller, max_records_per_trip, max_validity,
-                   settle_batch, settlement_deadline, grant, **policy)
+                   settle_batch, settlement_deadline, grant, **policy, cap=record_cap(scheme, cap))
 
     def constructor_args(self, market: str, registrars: list[str], nest: str) -> tuple:
         return (market, SCHEMES[self.scheme], self.reward, self.information_share, self.stake,
                 self.cos_theta, self.stake_expiry, self.max_records_per_seller, self.max_records_per_trip,
                 self.max_validity, self.settle_batch, self.settlement_deadline, self.max_grant, registrars,
                 self.registrar_threshold, self.registrar_quota, self.registrar_period, nest, self.bounty,
-                self.registration_bond, self.bond_delay)
+                self.registration_bond, self.bond_delay, self.cap)
 
 
 class Event(NamedTuple):

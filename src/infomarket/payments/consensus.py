@@ -23,7 +23,8 @@ def round_trip_amount(market, buyer):
 
 @njit(inline="always")
 def stake_of(market, buyer, x):
-    """The stake locked by the buyer's x-th open transaction."""
+    """The stake locked by the buyer's x-th open transaction.  x counts its expired transactions too
+    (first in its block, stake 0): the k live ones a rule weighs are the last k."""
     return market.tx_stake[market.tx_off[buyer] + x]
 
 
@@ -33,10 +34,11 @@ def payouts(market, buyer, refund, share, weights):
     is left of the round trip's amount in proportion to ``share`` (equally when ``share`` sums to 0):
     they sum to that amount, so the ledger pays each weight as it is."""
     k = weights.shape[0]
+    first = market.tx_count[buyer] - k  # the expired transactions before the live ones weighed
     rest = round_trip_amount(market, buyer)
     total = 0.0
     for x in range(k):
-        weights[x] = refund[x] * stake_of(market, buyer, x)
+        weights[x] = refund[x] * stake_of(market, buyer, first + x)
         rest -= weights[x]
         total += share[x]
     rest = max(rest, 0.0)
