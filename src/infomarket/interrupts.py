@@ -38,9 +38,15 @@ import signal
 import sys
 import tempfile
 import threading
+import time
 from collections.abc import Callable
 from pathlib import Path
 from typing import TypeVar
+
+try:
+    import fcntl
+except ImportError:  # pragma: no cover - not on Windows: compiles are then not coordinated
+    fcntl = None
 
 T = TypeVar("T")
 SIGNALS = (signal.SIGINT, signal.SIGTERM)
@@ -293,9 +299,43 @@ def compiled_apart(compile_: Callable[[], T], marker: Path | None) -> T:
     here (a failed compile is not cached: running it here would compile it all again); an error it
     cannot hand back is left to the call here.  ``marker`` None (not cacheable), outside a command, off
     the main thread or without ``fork``: just ``compile_()``."""
-    if (marker is None or not _state.active or marker.exists() or not hasattr(os, "fork")
-            or threading.current_thread() is not threading.main_thread()):
-        return _here(compile_)
+    with one_compiler(marker):
+        if (marker is None or not _state.active or marker.exists() or not hasattr(os, "fork")
+                or threading.current_thread() is not threading.main_thread()):
+            return _here(compile_)
+        return _in_child(compile_, marker)
+
+
+_COMPILING = threading.local()
+
+
+@contextlib.contextmanager
+def one_compiler(marker: Path | None):
+    """Hold the lock of ``marker``'s generated module while the block compiles it: two processes that meet
+    one kernel at once (test workers, two commands) would both compile it; the second waits and loads what
+    the first cached.  Not nested (a process holding one lock takes no other, so none waits in a circle);
+    the wait polls, so a stop signal ends it (``check``).  Without ``fcntl`` or a marker: no lock."""
+    if marker is None or fcntl is None or getattr(_COMPILING, "held", False):
+        yield
+        return
+    path = marker.with_name(marker.name.split(".", 1)[0] + ".lock")
+    with open(path, "a") as fh:
+        while True:
+            try:
+                fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+                break
+            except BlockingIOError:
+                check()
+                time.sleep(0.05)
+        _COMPILING.held = True
+        try:
+            yield
+        finally:
+            _COMPILING.held = False
+            fcntl.flock(fh, fcntl.LOCK_UN)
+
+
+def _in_child(compile_: Callable[[], T], marker: Path) -> T:
     parent = os.getpid()
     with tempfile.TemporaryFile() as failure:
         pid = os.fork()
