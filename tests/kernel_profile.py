@@ -98,7 +98,7 @@ def summary(path: str, top: int = 40) -> str:
             users[module].add(name)
     kernels = collections.defaultdict(list)  # step kernel -> its compiles (run_steps, or a dispatch alone)
     for c in compiles:
-        if c["module"].startswith("infomarket_kernel"):
+        if (c["module"] or "").startswith("infomarket_kernel"):  # None: a function made at run time
             kernels[c["module"]].append(c)
     files = collections.Counter()
     for name, t in tests.items():
