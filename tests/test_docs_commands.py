@@ -94,7 +94,7 @@ NOT_RUN = {
     "results/chain/chain_fig7_sweep results/chain/chain_partition --out results/chain/report":
         "needs the study's stores; tests/analysis/test_chain_study.py runs it on a synthetic one",
     # docs/attack-search.md
-    "infomarket attack-search attack_search --out results/attack_search": "the full study, about 169 000 runs",
+    "infomarket attack-search attack_search --out results/attack_search": "the full study, about 64 000 runs",
     "infomarket attack-search attack_search --defence staking --byzantines 3 --budget 48 --runs 4 "
     "--confirmation-runs 16 --seed 7 --out /tmp/attack-reduced": "~2 500 full runs; tests/search runs a tiny search",
     "infomarket attack-search attack_search --defence staking,theta20 --byzantines 3 --dask tcp://head:8786 "
