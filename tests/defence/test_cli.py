@@ -115,6 +115,38 @@ def test_the_same_study_on_dask_gives_the_same_frontier(inline, tmp_path):
     _same(inline, out)
 
 
+def _with_counts(tmp_path: Path, every_count: bool) -> list[str]:
+    """TINY at 1 and 3 Byzantines, from a copy of tiny.toml with ``every_count`` set."""
+    q = tmp_path / f"tiny-every-{every_count}.toml"
+    q.write_text(TINY_FILE.read_text().replace("seed = 5\n", f"seed = 5\nevery_count = {str(every_count).lower()}\n", 1))
+    args = list(TINY)
+    args[args.index("--questions") + 1] = str(q)
+    args[args.index("--byzantines") + 1] = "1,3"
+    return args
+
+
+def test_judging_the_target_count_alone_confirms_the_same_numbers_with_fewer_runs(tmp_path):
+    """every_count = false: the outer search judges at the target count (3) only and completes the confirmed
+    candidates at 1 before confirming them; their confirmation is the one every_count = true makes."""
+    full, lean = tmp_path / "full", tmp_path / "lean"
+    assert main(_with_counts(tmp_path, True) + ["--workers", "1", "--quiet", "--out", str(full)]) == 0
+    assert main(_with_counts(tmp_path, False) + ["--workers", "1", "--quiet", "--out", str(lean)]) == 0
+    a, b = (json.loads((d / "defence.json").read_text()) for d in (full, lean))
+    assert [r["label"] for r in a["confirmed"]] == [r["label"] for r in b["confirmed"]]
+    assert all(set(r["losses"]) == {"1", "3"} for r in a["search"])
+    for r in b["search"]:  # 3 candidates, at most 2 confirmed: one at least judged at the target alone
+        assert set(r["losses"]) == ({"1", "3"} if r["confirmed"] else {"3"})
+        assert r["losses"]["3"] == next(x for x in a["search"] if x["label"] == r["label"])["losses"]["3"]
+    assert any(not r["confirmed"] for r in b["search"])
+    assert [r["loss"] for r in a["confirmed"]] == [r["loss"] for r in b["confirmed"]]
+    for name in ("defence_cost.parquet", "defence_attacks.parquet"):
+        pd.testing.assert_frame_equal(pd.read_parquet(full / name), pd.read_parquet(lean / name), check_exact=True)
+    made_full, made_lean = len(_runs(full)), len(_runs(lean))
+    assert made_lean < made_full
+    assert set(map(tuple, _runs(lean)[["experiment", "condition", "run"]].values)) < \
+        set(map(tuple, _runs(full)[["experiment", "condition", "run"]].values))
+
+
 BAD_FAMILY = """
 [defence]
 candidates = 2

@@ -123,28 +123,48 @@ def _undefended(study: Study):
     return ("undefended", study.undefended_config())
 
 
+def outer_counts(study: Study) -> tuple[int, ...]:
+    """The Byzantine counts the outer search judges every candidate at (``Settings.every_count``)."""
+    return study.byzantines if study.settings.every_count else (study.settings.target,)
+
+
+def _judge_count(study: Study, c: Candidate, b: int, store: Store, run: Callable) -> tuple[float, dict, dict, int]:
+    """The inner attack search against ``c`` with ``b`` Byzantines: the mean per-seed loss to the worst attack
+    it chose, that attack and the reference, the search's roles, and the runs it stands on."""
+    r = attack.search_cell(study.inner, cell(study, c, b), store, run=run)
+    conf = r.confirmation
+    worst, ref = r.chosen["worst"], r.chosen["reference"]
+    w = conf[conf.attack == worst].sort_values("run")["items"].to_numpy(float)
+    t = conf[conf.attack == ref].sort_values("run")["items"].to_numpy(float)
+    attacks = {"worst": dict(r.params[worst]), "reference": dict(r.params[ref])}
+    return ratio_loss(w, t), attacks, dict(r.chosen), r.done + r.skipped
+
+
 def judge(study: Study, c: Candidate, store: Store, run: Callable, *, runner: _Runner | None = None) -> Judged:
-    """The candidate's cost and its worst case at every count, on search seeds (module docstring, 1)."""
+    """The candidate's cost and its worst case at the outer search's counts, on search seeds (module
+    docstring, 1)."""
     s = study.settings
     runner = runner or _Runner(run, store)
     before = runner.made + runner.found
     crn = stream(s.seed, "cost", "search")
     mine, undef = runner.items(_cost_conditions(study, [(c.label, study.config(c, 0)), _undefended(study)],
                                                 "search", s.cost_runs, crn))
-    cost = ratio_loss(mine, undef)
-    losses, attacks, chosen, runs = {}, {}, {}, 0
-    for b in study.byzantines:
-        r = attack.search_cell(study.inner, cell(study, c, b), store, run=run)
-        runs += r.done + r.skipped
-        conf = r.confirmation
-        worst, ref = r.chosen["worst"], r.chosen["reference"]
-        w = conf[conf.attack == worst].sort_values("run")["items"].to_numpy(float)
-        t = conf[conf.attack == ref].sort_values("run")["items"].to_numpy(float)
-        losses[b] = ratio_loss(w, t)
-        attacks[b] = {"worst": dict(r.params[worst]), "reference": dict(r.params[ref])}
-        chosen[b] = dict(r.chosen)
-    runs += runner.made + runner.found - before
-    return Judged(c, cost, losses, attacks, chosen, runs)
+    j = Judged(c, ratio_loss(mine, undef), {}, {}, {})
+    complete(study, j, store, run, outer_counts(study))
+    j.runs += runner.made + runner.found - before
+    return j
+
+
+def complete(study: Study, j: Judged, store: Store, run: Callable, counts: tuple[int, ...] | None = None) -> None:
+    """Judge ``j`` at the ``counts`` (default: every count of the study) it was not judged at yet.  The inner
+    search's seeds depend on the candidate and the count alone, so a candidate completed before its
+    confirmation has the numbers it would have had from the outer search."""
+    for b in counts or study.byzantines:
+        if b not in j.losses:
+            j.losses[b], j.attacks[b], j.chosen[b], runs = _judge_count(study, j.candidate, b, store, run)
+            j.runs += runs
+    order = [b for b in study.byzantines if b in j.losses]
+    j.losses, j.attacks, j.chosen = ({b: d[b] for b in order} for d in (j.losses, j.attacks, j.chosen))
 
 
 def pareto(judged: list[Judged], target: int) -> list[Judged]:
@@ -195,6 +215,8 @@ def confirm(study: Study, judged: list[Judged], store: Store, run: Callable) -> 
     """The existing defences and the frontier on the confirmation seeds (module docstring, 2)."""
     s = study.settings
     chosen = [j for j in judged if j.candidate.origin == "existing"] + frontier(study, judged)
+    for j in chosen:  # the counts the outer search left out (Settings.every_count)
+        complete(study, j, store, run)
     runner = _Runner(run, store)
     crn = stream(s.seed, "confirmation")
     n = s.confirmation_runs
@@ -230,7 +252,9 @@ def planned_runs(study: Study) -> int:
     s = study.settings
     per_family = {n: (s.candidates + s.refine if f.params else 1) for n, f in study.families.items()}
     n_candidates = sum(per_family.values()) + len(study.existing)
-    inner = attack.planned_runs(study.inner) * len(study.byzantines)
+    inner = attack.planned_runs(study.inner)
+    outer = len(outer_counts(study))
     confirmed = len(study.existing) + min(s.frontier, sum(per_family.values()))
-    return (n_candidates * (s.cost_runs + inner) + s.cost_runs
+    return (n_candidates * (s.cost_runs + inner * outer) + s.cost_runs
+            + confirmed * inner * (len(study.byzantines) - outer)
             + (confirmed + 1) * s.confirmation_runs + confirmed * len(study.byzantines) * 2 * s.confirmation_runs)

@@ -273,8 +273,11 @@ def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, p
               + " | trade | Pareto | confirmed |", "|---|---|---|" + "---|" * len(counts) + "---|---|---|"]
     for r in a["search"]:
         lines.append(f"| {r['label']} | {r['origin']} | {r['cost']:.1%} | "
-                     + " | ".join(f"{r['losses'][c]:.1%}" for c in counts)
+                     + " | ".join(f"{r['losses'][c]:.1%}" if c in r["losses"] else "–" for c in counts)
                      + f" | {r['trade']:.3f} | {'yes' if r['pareto'] else ''} | {'yes' if r['confirmed'] else ''} |")
+    if any(c not in r["losses"] for r in a["search"] for c in counts):
+        lines += ["", "–: not judged at that count (the outer search judges every candidate at the target count; "
+                  "the confirmed ones at every count, on the same search seeds)."]
     lines += ["", f"Runs: {a['made']} made in the confirmation now, {a['found']} found in the store"
               + (f"; {wall_seconds:.0f} s wall." if wall_seconds is not None else ".")]
     if records:

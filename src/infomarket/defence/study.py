@@ -37,6 +37,10 @@ class Settings:
     frontier: int = 6
     confirmation_runs: int = 128
     seed: int = 71041
+    #: judge every candidate at every Byzantine count in the outer search; when false, at the target count
+    #: only (the trade and the frontier read no other), and the confirmed candidates at the others before
+    #: their confirmation, on the same seeds: the same numbers for them, a third of the inner runs for the rest
+    every_count: bool = True
 
 
 WHOLE = {"candidates": 1, "refine": 0, "cost_runs": 2, "target": 0, "frontier": 0, "confirmation_runs": 2, "seed": 0}
@@ -56,6 +60,8 @@ def settings(table: dict, overrides: dict | None = None,
         v = getattr(s, k)
         if isinstance(v, bool) or not isinstance(v, int) or v < lo:
             raise UsageError(f"{source}: {k} = {v!r}: a whole number of at least {lo} is expected")
+    if not isinstance(s.every_count, bool):
+        raise UsageError(f"{source}: every_count = {s.every_count!r}: true or false is expected")
     for k, lo, hi in (("refine_sigma", 0.0, 1.0), ("max_cost", 0.0, 1.0)):
         v = getattr(s, k)
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not lo < v <= hi:
