@@ -7,6 +7,7 @@ calling test only when node or npm is absent from the machine.
 from __future__ import annotations
 
 import contextlib
+import fcntl
 import shutil
 import socket
 import subprocess
@@ -26,6 +27,16 @@ def _free_port() -> int:
         return sock.getsockname()[1]
 
 
+def _install(procs: Procs, npm: str, binary: Path) -> None:
+    """``npm ci`` once when the node is missing.  Under a file lock: two test processes (pytest -n 2) that
+    both found it missing would otherwise run ``npm ci`` in the same folder at once, and ``npm ci`` first
+    deletes the other's node_modules."""
+    with open(TOOLS / ".install.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
+        if not binary.exists():
+            procs.run([npm, "ci", "--no-audit", "--no-fund"], cwd=TOOLS, check=True)
+
+
 @contextlib.contextmanager
 def running_node():
     """Yield the URL of a fresh Hardhat node; stop it afterwards."""
@@ -34,8 +45,7 @@ def running_node():
         pytest.skip("node and npm are not installed: cannot start the JSON-RPC node")
     binary = TOOLS / "node_modules" / ".bin" / "hardhat"
     with Procs() as procs:  # the node, and whatever it started, killed on leaving
-        if not binary.exists():
-            procs.run([npm, "ci", "--no-audit", "--no-fund"], cwd=TOOLS, check=True)
+        _install(procs, npm, binary)
         port = _free_port()
         url = f"http://127.0.0.1:{port}"
         proc = procs.start([binary, "node", "--hostname", "127.0.0.1", "--port", str(port)], cwd=TOOLS,

@@ -226,6 +226,20 @@ class LedgerConformance:
         """How far (tokens) a balance may be from the exact model, given its rounding bound."""
         raise NotImplementedError
 
+    def check_by_hand(self, scheme, events, expected, *, expiry: int = 0, bound: int | None = None,
+                      exact: bool = True) -> None:
+        """Replay hand-computed ``events`` (copies): every balance is ``expected`` within the ledger's rounding
+        for ``bound`` shares (default: the accepted purchases), and, with ``exact``, the rational model's
+        balances are ``expected`` exactly, so the hand calculation checks the model too."""
+        mine = [dict(e) for e in events]
+        balances = self.run(len(expected), scheme, 1.0, expiry, mine)
+        shares = sum(1 for e in mine if e["kind"] == "purchase") if bound is None else bound
+        for i, value in enumerate(expected):
+            assert balances[i] == pytest.approx(float(value), abs=self.tolerance(shares) + 1e-9), i
+        if exact:
+            model, _ = exact_run(len(expected), scheme, 1.0, expiry, [dict(e) for e in events])
+            assert model.balance == expected
+
     @pytest.mark.parametrize("case", CASES, ids=[f"{i}-{c['scheme']}" for i, c in enumerate(CASES)])
     def test_payment_vectors_of_the_original_simulator(self, case):
         events = [purchase(1, case["buyer"], t["seller"], 0 if t["site"] == "food" else 1, t["direction_deg"], k,
@@ -241,11 +255,7 @@ class LedgerConformance:
                              ids=[f"{c[0]}-{k}" for k, c in enumerate(DISTINCT_CASES)])
     def test_one_seller_one_voice_by_hand(self, scheme, events, expected):
         """Shared hand-computed cases: repetition and copying sellers, under eq. 7 and outlier_distinct."""
-        events = [dict(e) for e in events]
-        balances = self.run(len(expected), scheme, 1.0, 0, events)
-        shares = sum(1 for e in events if e["kind"] == "purchase")
-        for i, value in enumerate(expected):
-            assert balances[i] == pytest.approx(float(value), abs=self.tolerance(shares) + 1e-9), i
+        self.check_by_hand(scheme, events, expected, exact=False)
 
     @pytest.mark.parametrize(("scheme", "events", "expected"), LATE_CASES,
                              ids=[f"{c[0]}-{c[1][-1]['step']}" for c in LATE_CASES])
@@ -253,35 +263,19 @@ class LedgerConformance:
         """Shared hand-computed cases of stake expiry: a deposit after some or all records expired."""
         if self.expiries == (0,):
             pytest.skip("this ledger replays one block per transaction: no stake expiry")
-        events = [dict(e) for e in events]
-        balances = self.run(len(expected), scheme, 1.0, 5, events)
-        for i, value in enumerate(expected):
-            assert balances[i] == pytest.approx(float(value), abs=self.tolerance(5) + 1e-9), i
-        exact, _ = exact_run(len(expected), scheme, 1.0, 5, [dict(e) for e in events])
-        assert exact.balance == expected  # the rational model, checked by hand here too
+        self.check_by_hand(scheme, events, expected, expiry=5, bound=5)
 
     @pytest.mark.parametrize(("scheme", "events", "expected"), CAPPED_CASES,
                              ids=[f"{c[0]}-{k}" for k, c in enumerate(CAPPED_CASES)])
     def test_the_per_seller_cap_by_hand(self, scheme, events, expected):
         """``capped_outlier``: a seller over its cap, cap 1, two sellers on both sites, a void outlier."""
-        events = [dict(e) for e in events]
-        balances = self.run(len(expected), scheme, 1.0, 0, events)
-        shares = sum(1 for e in events if e["kind"] == "purchase")
-        for i, value in enumerate(expected):
-            assert balances[i] == pytest.approx(float(value), abs=self.tolerance(shares) + 1e-9), i
-        exact, _ = exact_run(len(expected), scheme, 1.0, 0, [dict(e) for e in events])
-        assert exact.balance == expected  # the rational model, checked by hand here too
+        self.check_by_hand(scheme, events, expected)
 
     @pytest.mark.parametrize(("scheme", "events", "expected"), LATE_CAPPED, ids=["void-after-expired", "void-among"])
     def test_a_late_deposit_under_the_cap_by_hand(self, scheme, events, expected):
         if self.expiries == (0,):
             pytest.skip("this ledger replays one block per transaction: no stake expiry")
-        balances = self.run(len(expected), scheme, 1.0, 5, [dict(e) for e in events])
-        shares = sum(1 for e in events if e["kind"] == "purchase")
-        for i, value in enumerate(expected):
-            assert balances[i] == pytest.approx(float(value), abs=self.tolerance(shares) + 1e-9), i
-        exact, _ = exact_run(len(expected), scheme, 1.0, 5, [dict(e) for e in events])
-        assert exact.balance == expected
+        self.check_by_hand(scheme, events, expected, expiry=5)
 
     def test_random_event_sequences_agree_with_the_exact_model(self):
         @settings(max_examples=self.examples, deadline=None, derandomize=True,
