@@ -195,8 +195,8 @@ def test_the_search_says_what_is_reduced(tmp_path):
     small = study.load(exp, budget=4, runs=1)
     got = _reductions(small, declared, exp, every[:1], every, Namespace(steps=60, transitory=20))
     assert got == [f"1 of {len(every)} cells", f"--steps 60 (declared {exp.steps})",
-                   f"--transitory 20 (declared {exp.transitory})", "--budget 4 (declared 256)",
-                   "--popsize 4 (declared 8)", "--runs 1 (declared 8)"]
+                   f"--transitory 20 (declared {exp.transitory})", f"--budget 4 (declared {declared.settings.budget})",
+                   f"--popsize 4 (declared {declared.settings.popsize})", f"--runs 1 (declared {declared.settings.runs})"]
 
 
 def test_check_attack_search_shows_the_cells_the_search_runs_as_the_doc_says(capsys):
