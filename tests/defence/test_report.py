@@ -107,3 +107,6 @@ def test_the_figure_draws_exactly_the_table_numbers(st, tmp_path):
     assert {p.name for p in paths} == {"defence.json", "defence.md", "frontier.png"}
     text = (tmp_path / "defence.md").read_text()
     assert "| good | robust_median | 1.0% [" in text and "| 0.10 [" in text and "**Is there a defence" in text
+    # by hand: 5 purchases, 3 of the 24 others lie, so f = 5 x 3 / 24 = 0.625 of n = 6 voices:
+    # 0.625 / (6 - 1.25) = 0.132; staking combines no vectors
+    assert "| yes | 0.132 | vectors 5 |" in text and "| no | – | – |" in text

@@ -255,19 +255,22 @@ def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, p
     lines += [f"Confirmed on {a['runs']} paired runs per defence and count (Hodges-Lehmann estimate [95 % "
               "interval]; loss to the worst attack the inner search found, against truthful Byzantines):", "",
               "| defence | family | cost, none | items lost per robot, none | "
-              + " | ".join(f"loss, {c}" for c in counts) + " | answer | parameters |",
-              "|---|---|---|---|" + "---|" * len(counts) + "---|---|"]
+              + " | ".join(f"loss, {c}" for c in counts) + f" | answer | floor of its voices, {t} | parameters |",
+              "|---|---|---|---|" + "---|" * len(counts) + "---|---|---|"]
     for r in a["confirmed"]:
         vals = ", ".join(f"{k} {v:.4g}" for k, v in r["values"].items()) or "–"
         ci = r["cost_items"]
         items = (f"{ci['hl']:.2f} {_ci(ci['low'], ci['high'], '.2f')}" if math.isfinite(ci["hl"]) else "undefined")
         lines.append(f"| {r['label']} | {r['family']} | {_pct(r['cost'])} | {items} | "
-                     + " | ".join(_pct(r["loss"][c]) for c in counts) + f" | {r['answer']} | {vals} |")
+                     + " | ".join(_pct(r["loss"][c]) for c in counts)
+                     + f" | {r['answer']} | {_voices(r['voices_floor'][t])} | {vals} |")
     lines += ["", "The floor of robust aggregation (Allouah et al. 2023), kappa >= f / (n - 2f): for the swarm "
               f"(n = {a['robots']} voices, f = the Byzantine count) "
               + ", ".join(f"{c}: {_kappa(a['floor'][c])}" for c in counts)
-              + "; for a robust buyer's own voices see `voices_floor` in report.json.  It bounds how close any "
-              "combination of the vectors can stay to the honest ones, not the items lost.", "",
+              + "; for a robust buyer's own voices (its `vectors` purchases and its own entry, the liars among "
+              "them at the Byzantines' share of its neighbours) the table's column, every count in defence.json "
+              "(`voices_floor`).  It bounds how close any combination of the vectors can stay to the honest "
+              "ones, not the items lost.", "",
               "## Search phase (search seeds; what chose the confirmed defences)", "",
               "| candidate | origin | cost | " + " | ".join(f"loss, {c}" for c in counts)
               + " | trade | Pareto | confirmed |", "|---|---|---|" + "---|" * len(counts) + "---|---|---|"]
@@ -283,6 +286,11 @@ def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, p
     if records:
         lines += ["", *records]
     return "\n".join(lines) + "\n"
+
+
+def _voices(v) -> str:
+    """A robust buyer's own-voices floor; "–" for a defence that combines no vectors (NaN)."""
+    return "–" if isinstance(v, float) and math.isnan(v) else _kappa(v)
 
 
 def _kappa(v) -> str:
