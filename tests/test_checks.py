@@ -66,29 +66,47 @@ def test_a_scheme_with_negative_weights_is_caught():
         checks.check_payment("tmp_negative", sequences=3)
 
 
-def test_a_nondeterministic_seller_is_caught():
-    def noisy_sell(w, me, site):
-        return True, np.random.random() * 100.0, 0.0, 0  # numba's own global RNG: not seeded per run
+def noisy_sell(w, me, site):
+    return True, np.random.random() * 100.0, 0.0, 0  # numba's own global RNG: not seeded per run
 
+
+def random_age_liar(w, me, site, rng, spread=3.0):
+    """Sells its entry claiming an age of 1, 2 or 3, drawn at random."""
+    return w.tab_valid[me, site], w.tab_vec[me, site, 0], w.tab_vec[me, site, 1], 1 + int(rng.random() * spread)
+
+
+def past_the_table(w, me, site):
+    n = w.tab_valid.shape[0]
+    return w.tab_valid[n + 3, site], w.tab_vec[me, site, 0], w.tab_vec[me, site, 1], 0
+
+
+#: The sell rules below that the checkers must catch (or pass), compiled into one step kernel per scheme
+#: (``check_behaviour``'s ``alongside``) rather than one per rule: a robot calls only its own rules.
+CAUGHT = ("tmp_noisy", "tmp_past_the_table", "tmp_random_liar")
+
+
+def _register_caught():
     im.register_behaviour("tmp_noisy", buy="naive", sell=noisy_sell, honest=False, replace=True)
+    im.register_behaviour("tmp_past_the_table", buy="naive", sell=past_the_table, honest=False, replace=True)
+    return im.register_behaviour("tmp_random_liar", buy="naive", sell=random_age_liar, honest=False, replace=True)
+
+
+def test_a_nondeterministic_seller_is_caught():
+    _register_caught()
     with pytest.raises(checks.CheckFailed, match="same seed"):
-        checks.check_behaviour("tmp_noisy", steps=300)
+        checks.check_behaviour("tmp_noisy", steps=300, alongside=CAUGHT)
 
 
 def test_a_random_rule_gets_the_runs_generator_and_stays_reproducible():
-    def random_age_liar(w, me, site, rng, spread=3.0):
-        """Sells its entry claiming an age of 1, 2 or 3, drawn at random."""
-        return w.tab_valid[me, site], w.tab_vec[me, site, 0], w.tab_vec[me, site, 1], 1 + int(rng.random() * spread)
-
-    spec = im.register_behaviour("tmp_random_liar", buy="naive", sell=random_age_liar, honest=False, replace=True)
+    spec = _register_caught()
     assert spec.sell.wants_rng and spec.params == ("spread",)
-    checks.check_behaviour("tmp_random_liar", steps=800)  # reproducible from the seed, money conserved
+    checks.check_behaviour("tmp_random_liar", steps=800, alongside=CAUGHT)  # reproducible, money conserved
 
     cfg = im.Experiment.model_validate({"steps": 1500, "swarm": {"robots": 25, "groups": [
         {"behaviour": "naive", "count": 20}, {"behaviour": "tmp_random_liar", "count": 5}]}})
 
     def liar_sales(seed):
-        ev = im.simulate(cfg, seed=seed, record_events=True).events
+        ev = Simulation(cfg, seed, record_events=True, kernel_kinds=("naive", *CAUGHT)).run().events
         return ev[(ev.kind == "purchase") & (ev.seller >= 20)].age.to_numpy()
 
     ages = liar_sales(1)
@@ -155,14 +173,10 @@ def test_the_decorators_take_limits_as_the_docs_say():
 
 
 def test_a_sell_rule_reading_out_of_bounds_is_caught_with_its_file_and_line():
-    # issue 21: compiled without bounds checking this read past `tab_valid` and passed check_behaviour
-    def past_the_table(w, me, site):
-        n = w.tab_valid.shape[0]
-        return w.tab_valid[n + 3, site], w.tab_vec[me, site, 0], w.tab_vec[me, site, 1], 0
-
-    im.register_behaviour("tmp_past_the_table", buy="naive", sell=past_the_table, honest=False, replace=True)
+    # compiled without bounds checking this read past `tab_valid` and passed check_behaviour
+    _register_caught()
     with pytest.raises(checks.CheckFailed) as err:
-        checks.check_behaviour("tmp_past_the_table", steps=300)
+        checks.check_behaviour("tmp_past_the_table", steps=300, alongside=CAUGHT)
     msg = str(err.value)
     assert "behaviour 'tmp_past_the_table': its sell rule past_the_table indexes an array out of bounds" in msg
     assert f"{__file__}:{past_the_table.__code__.co_firstlineno + 2}" in msg

@@ -4,11 +4,12 @@ import pytest
 
 import infomarket as im
 
+from ..shared_kernel import simulate
 from .test_reference import SETUP
 
 
 def deposit_steps(cfg, seed):
-    ev = im.simulate(cfg, seed=seed, record_events=True).events
+    ev = simulate(cfg, seed, record_events=True).events  # the shared kernel (test_reference's mix)
     return ev[ev.kind == "deposit"].step.to_numpy()
 
 
@@ -19,5 +20,5 @@ def test_an_item_deposited_at_the_last_transitory_step_counts():
     # the transitory period changes only what is counted, never the dynamics
     bounded = cfg.with_overrides(transitory=boundary)
     assert np.array_equal(deposit_steps(bounded, 11), steps)
-    items = int(im.simulate(bounded, seed=11).robots.items_collected.sum())
+    items = int(simulate(bounded, 11).robots.items_collected.sum())
     assert items == int((steps >= boundary).sum())

@@ -11,6 +11,7 @@ pytest.importorskip("pettingzoo")
 from infomarket.config import sizes  # noqa: E402
 from infomarket.errors import ArgumentError, InfomarketError, InputTypeError, UsageError  # noqa: E402
 from infomarket.rl import AttackEnv, AttackParallelEnv, AttackVectorEnv  # noqa: E402
+from infomarket.rl.envs import configured  # noqa: E402
 
 SMALL = dict(steps=60, transitory=20, interval=10)
 
@@ -113,5 +114,7 @@ def test_a_parallel_step_needs_an_action_for_every_acting_agent():
 
 
 def test_the_distinct_defence_is_a_cell_of_the_environments():
-    e = AttackEnv(cell={"defence": "distinct", "byzantines": 3}, **SMALL)
-    assert e.runs.config.payment.scheme == "outlier_distinct"
+    # what every environment runs for a cell (``envs.configured``), without compiling a kernel for it
+    cfg = configured("attack_search", {"defence": "distinct", "byzantines": 3}, SMALL["steps"], SMALL["transitory"])
+    assert cfg.payment.scheme == "outlier_distinct"
+    assert cfg.steps == SMALL["steps"] and sum(g.count for g in cfg.swarm.groups if g.behaviour == "attacker") == 3

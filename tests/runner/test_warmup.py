@@ -15,6 +15,8 @@ from infomarket.runner.plan import conditions
 from infomarket.runner.sweep import plan, run_sweep
 from infomarket.store import Store
 
+#: The paper's Fig. 4 mix (sceptical robots, scaboteurs, outlier payment): the suite compiles its step kernels
+#: for other tests too, on the plane and with terrain (tests/store/test_dictionary.py).
 TERRAIN_SWEEP = """
 name = "collide"
 steps = 200
@@ -25,12 +27,15 @@ seed = 4
 robots = 6
 
 [[swarm.groups]]
-behaviour = "naive"
+behaviour = "sceptical"
 count = 5
 
 [[swarm.groups]]
-behaviour = "saboteur"
+behaviour = "scaboteur"
 count = 1
+
+[payment]
+scheme = "outlier"
 
 [sweep.grid]
 "robot.collisions" = [false, true]
@@ -63,7 +68,7 @@ def test_configs_differing_only_in_terrain_are_warmed_separately(tmp_path, monke
     plane = [c.config for c in conds if not c.config.robot.collisions]
     walls = [c.config for c in conds if c.config.robot.collisions]
     # the old key could not tell them apart; the kernel's own digest does
-    assert {(behaviour_kinds(c), c.payment.scheme) for c in plane + walls} == {(("naive", "saboteur"), "delayed")}
+    assert {(behaviour_kinds(c), c.payment.scheme) for c in plane + walls} == {(("sceptical", "scaboteur"), "outlier")}
     assert len({kernel_id(c) for c in plane}) == len({kernel_id(c) for c in walls}) == 1
     assert kernel_id(plane[0]) != kernel_id(walls[0])
 

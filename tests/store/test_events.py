@@ -21,7 +21,8 @@ def test_sweep_events_equal_the_engines_log_of_each_run(tiny, tmp_path):
     pd.testing.assert_frame_equal(mine[list(alone.columns)], alone, check_exact=True, check_categorical=False)
 
 
-#: Close sites in a small arena: deposits within a few hundred steps; staking with outliers weighed out.
+#: Close sites in a small arena: deposits within a few hundred steps; staking with outliers weighed out.  The
+#: paper's Fig. 4 mix, whose step kernel other tests compile too.
 BUSY = """
 name = "busy"
 steps = 1500
@@ -41,10 +42,10 @@ radius = 30
 [swarm]
 robots = 9
 [[swarm.groups]]
-behaviour = "naive"
+behaviour = "sceptical"
 count = 7
 [[swarm.groups]]
-behaviour = "saboteur"
+behaviour = "scaboteur"
 count = 2
 [payment]
 scheme = "outlier"

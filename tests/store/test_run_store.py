@@ -13,6 +13,8 @@ from infomarket.runner.plan import conditions
 from infomarket.runner.sweep import plan, run_sweep
 from infomarket.store import Store, StoreError
 
+#: The paper's Fig. 4 mix (sceptical robots, scaboteurs, outlier payment): the suite compiles its step kernels
+#: for other tests too, on the plane and with terrain (tests/store/test_dictionary.py).
 TERRAIN = """
 name = "two_sites"
 steps = 3000
@@ -21,8 +23,13 @@ seed = 7
 [swarm]
 robots = 10
 [[swarm.groups]]
-behaviour = "naive"
-count = 10
+behaviour = "sceptical"
+count = 9
+[[swarm.groups]]
+behaviour = "scaboteur"
+count = 1
+[payment]
+scheme = "outlier"
 [[food]]
 x = 200.0
 y = 300.0
