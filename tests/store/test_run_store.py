@@ -51,8 +51,8 @@ def test_run_stores_items_per_site_of_a_terrain_setup(tmp_path):
     assert main(["run", str(path), "--runs", "2", "--out", str(out), "--workers", "1", "--quiet"]) == 0
     store = Store(out)
     sites, robots = store.sites(), store.robots()
-    assert sites.columns.tolist()[:5] == ["experiment", "condition", "run", "seed", "site"]
-    assert {"kind", "x", "y", "radius", "items"} <= set(sites.columns)
+    assert sites.columns.tolist() == ["experiment", "condition", "run", "seed", "site", "kind", "x", "y", "radius",
+                                      "items"]
     # two food sites and one nest per run, in the file's order
     assert sites.groupby("run").kind.apply(list).tolist() == [["food", "food", "nest"]] * 2
     assert sites[sites.kind == "food"].x.tolist() == [200.0, 700.0, 200.0, 700.0]

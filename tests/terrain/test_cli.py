@@ -1,4 +1,5 @@
-"""Terrain setups from the command line: bad files exit 2 with one message, `run` writes per-site counts."""
+"""Terrain setups from the command line: bad files exit 2 with one message; a plane run writes no per-site
+counts (a terrain run's: tests/store/test_run_store.py)."""
 import pytest
 
 from infomarket.store.results import Store
@@ -41,22 +42,6 @@ def test_bad_terrain_file_is_one_clear_error_exit_2(tmp_path, capsys, extra, mes
     assert main(["check", str(path)]) == 2
     err = capsys.readouterr().err
     assert message in err and "Traceback" not in err
-
-
-def test_run_writes_items_per_site(tmp_path):
-    path = tmp_path / "t.toml"
-    path.write_text(GOOD.replace("steps = 400", "steps = 3000"))
-    out = tmp_path / "out"
-    assert main(["run", str(path), "--runs", "2", "--out", str(out), "--workers", "1", "--quiet"]) == 0
-    store = Store(out)
-    sites, robots = store.sites(), store.robots()
-    assert sites.columns.tolist() == ["experiment", "condition", "run", "seed", "site", "kind", "x", "y", "radius",
-                                      "items"]
-    assert sites.groupby("run").kind.apply(list).tolist() == [["food", "food", "nest"]] * 2
-    # every deposit is counted at the one nest and in some robot's items (two independent counters)
-    nest = sites[sites.kind == "nest"].set_index("run")["items"]
-    assert nest.to_dict() == robots.groupby("run").items_collected.sum().to_dict()
-    assert nest.sum() > 0
 
 
 def test_plane_run_writes_no_sites_table(tmp_path):
