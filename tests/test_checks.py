@@ -80,7 +80,7 @@ def past_the_table(w, me, site):
     return w.tab_valid[n + 3, site], w.tab_vec[me, site, 0], w.tab_vec[me, site, 1], 0
 
 
-#: The sell rules below that the checkers must catch (or pass), compiled into one step kernel per scheme
+#: The sell rules above, which the checkers must catch (or pass), compiled into one step kernel per scheme
 #: (``check_behaviour``'s ``alongside``) rather than one per rule: a robot calls only its own rules.
 CAUGHT = ("tmp_noisy", "tmp_past_the_table", "tmp_random_liar")
 
