@@ -144,7 +144,7 @@ def robust_combination(xs, ys, wt, method, trim, iterations):
     return geometric_median(xs, ys, wt, iterations)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def remember(w, me, site, seller, x, y, age, vectors):
     """Hold a purchase in the robot's memory for ``site``: it replaces the seller's earlier one (one voice
     per seller), and the oldest purchases go until at most ``vectors`` are held."""
@@ -182,7 +182,7 @@ def install_combination(w, me, site, method, trim, iterations, power):
     install(w, me, site, cx, cy, np.sort(ages)[(k - 1) // 2])
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def robust_site(w, me, nbrs, site, method, vectors, trim, iterations, power, horizon):
     """One site of a robust buy rule.  A robot whose entry is invalid (never known, or it failed it), or
     fresher than every purchase held (it has sensed the site since), forgets its purchases, and it

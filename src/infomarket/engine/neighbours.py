@@ -17,7 +17,7 @@ from ..space.grid import grid_shape  # noqa: F401  (the grid's geometry; re-expo
 ALL_PAIRS_UP_TO = 48
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _link(nbr, nbr_count, cap, i, j):
     """Record that i and j are neighbours (each at the end of the other's list)."""
     c = nbr_count[i]
@@ -43,7 +43,7 @@ def _all_pairs(pos, rc2, nbr, nbr_count, cap):
                 _link(nbr, nbr_count, cap, i, j)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _cell(x, size, cells):
     c = int(x / size)
     return min(max(c, 0), cells - 1)

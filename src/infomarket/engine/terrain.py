@@ -94,7 +94,7 @@ def drop_hidden_pairs(w):
         nbr_count[i] = c
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def containing_site(w, x, y, kind):
     """The first site of ``kind`` (file order) that (x, y) lies strictly inside, else -1."""
     for s in range(w.sites_r.shape[0]):
@@ -103,7 +103,7 @@ def containing_site(w, x, y, kind):
     return -1
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def obstructed(w, i, x, y):
     """A proximity sensor of robot i: would a disc centred at (x, y) leave the arena or touch an
     obstacle (or, with ``sense_robots``, another robot's disc: centres at most 2 r apart)?"""
@@ -123,7 +123,7 @@ def obstructed(w, i, x, y):
     return False
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def blocked(w, i, x, y):
     """Would robot i's disc at (x, y) overlap an obstacle or (with collisions) another robot?"""
     r = w.radius

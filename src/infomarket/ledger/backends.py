@@ -42,12 +42,12 @@ class Operations(NamedTuple):
     end_of_step: Callable
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _nothing(w):
     pass
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _nothing_yet(w, rng):
     pass
 

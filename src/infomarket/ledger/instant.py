@@ -10,7 +10,7 @@ from .pool import reserve
 from .lock import lock_stake_and_gas
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def open_transaction(w, buyer, seller, site, direction):
     """Lock the seller's stake (``lock_stake_and_gas``, no gas) and record the transaction in the
     buyer's block of the pool; False, with nothing recorded, when refused."""

@@ -84,7 +84,7 @@ def _open_transaction(w, buyer, seller, site, direction):
     return lambda w, buyer, seller, site, direction: instant_open(w, buyer, seller, site, direction)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def expired_count(w, buyer):
     """How many of the buyer's open transactions have expired (0 without stake expiry): those opened at
     a step t with t + stake_expiry <= now.  Transactions are in step order, so they are a prefix."""
@@ -99,7 +99,7 @@ def expired_count(w, buyer):
     return m
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def live_count(w, buyer):
     """The buyer's open transactions that have not expired: the ones its deposit weighs."""
     return w.tx_count[buyer] - expired_count(w, buyer)
@@ -132,13 +132,13 @@ def settlement(w, buyer):
     return w.tx_seller[a:b], w.tx_site[a:b], w.tx_dir[a:b]
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def purchase_events(w, ok, buyer, seller, site, direction, x, y, age, sx, sy):
     log_event(w, EV_PURCHASE if ok else EV_REFUSED, buyer, seller, site, direction, x, y, age,
               w.stake if ok else 0.0, sx, sy)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _record_sale(w, seller, weight, top, pay, stake):
     """The seller's reputation record for one settled transaction (ledger.state, REPUTATION): O(1)."""
     unlock(w.rep_settled)[seller] += 1
@@ -227,7 +227,7 @@ def _pay_expired(w, buyer, e, part):
             log_payment(w, buyer, a + x, 0.0, part)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def burn_fuel(w, i):
     """Robot i pays the fuel cost of one move (the caller checked it can): burned, not paid to anyone."""
     fuel = w.fuel_cost

@@ -6,7 +6,7 @@ from numba import njit
 from ..state.view import unlock
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def move_transaction(w, src, dst):
     """Copy pool entry ``src`` (every field of a transaction) to ``dst``."""
     unlock(w.tx_seller)[dst] = w.tx_seller[src]

@@ -14,14 +14,14 @@ from numba import njit
 from ..engine.geometry import angular_distance
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def round_trip_amount(market, buyer):
     """What the ledger shares among the sellers when ``buyer`` deposits: information share of the reward
     plus every stake its open purchases locked."""
     return market.info_share * market.reward + market.pot[buyer]
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def stake_of(market, buyer, x):
     """The stake locked by the buyer's x-th open transaction.  x counts its expired transactions too
     (first in its block, stake 0): the k live ones a rule weighs are the last k."""

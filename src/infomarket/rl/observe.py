@@ -23,7 +23,7 @@ OBSERVATION = (
 PER_SITE = 6
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def _capped(x, scale):
     return min(x / scale, 1.0)
 

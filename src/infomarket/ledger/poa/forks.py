@@ -8,7 +8,7 @@ from .mempool import REVEAL, drop_own, on_branch, refresh_view
 from .states import save_checkpoint, set_current
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def heavier(w, a, b):
     """Is block a heavier than block b: more total difficulty, or as much and a lower hash."""
     wa = w.blk_weight[a]
@@ -16,7 +16,7 @@ def heavier(w, a, b):
     return wa > wb or (wa == wb and w.blk_hash[a] < w.blk_hash[b])
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def ancestor_at(w, b, height):
     """The block on b's branch at ``height`` (b itself when b is not higher)."""
     while w.blk_height[b] > height:

@@ -7,7 +7,7 @@ from .forks import ancestor_at, heavier
 from .mempool import chance, learn, nest_side, partitioned
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def heavier_than_view(w, b, i):
     """Is block b heavier than robot i's head (its cached weight and hash: the head may be dropped)?"""
     return w.blk_weight[b] > w.view_weight[i] or (w.blk_weight[b] == w.view_weight[i]

@@ -23,7 +23,7 @@ DEPOSIT = 1  #: buyItem + settle: a deposit (the depositing robot's; its reward 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def mix(x):
     """splitmix64's finaliser: a bijective scramble of a 64-bit word (``x`` uint64)."""
     x = (x ^ (x >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
@@ -41,18 +41,18 @@ def chance(seed, a, b, c):
     return float(x >> np.uint64(11)) * (1.0 / 9007199254740992.0)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def knows(w, i, tx):
     """Does robot i know pending transaction ``tx`` (its bit in ``mp_known``)?"""
     return (w.mp_known[i, tx >> 6] >> np.uint64(tx & 63)) & np.uint64(1) != np.uint64(0)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def learn(w, i, tx):
     unlock(w.mp_known)[i, tx >> 6] |= np.uint64(1) << np.uint64(tx & 63)
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def on_branch(w, b, tx):
     """Is pending transaction ``tx`` included on block b's branch after the checkpoint (``blk_included``)?
     Nothing is for b = -1 (a dropped head)."""
@@ -81,7 +81,7 @@ def refresh_view(w, i):
     unlock(w.view_avail)[i] = a
 
 
-@njit(inline="always")
+@njit(forceinline=True)
 def partitioned(w, t):
     """Is the chain's network partitioned at step t (``[chain] partition``)?"""
     return w.chn_part_start <= t < w.chn_part_end
