@@ -24,6 +24,7 @@ _OUT: list = []
 
 
 def _emit(record: dict) -> None:
+    record["worker"] = os.environ.get("PYTEST_XDIST_WORKER", "main")  # which xdist worker (or none) ran it
     if not _OUT:
         _OUT.append(open(os.environ.get("KERNEL_PROFILE", "kernel-profile.jsonl"), "a"))
     _OUT[0].write(json.dumps(record) + "\n")
@@ -100,14 +101,19 @@ def summary(path: str, top: int = 40) -> str:
     for c in compiles:
         if (c["module"] or "").startswith("infomarket_kernel"):  # None: a function made at run time
             kernels[c["module"]].append(c)
-    files = collections.Counter()
+    files, workers, worker_compiles = collections.Counter(), collections.Counter(), collections.Counter()
     for name, t in tests.items():
         files[name.split("::")[0]] += t["cpu"] + t["children_cpu"]
+        workers[t.get("worker", "?")] += t["cpu"] + t["children_cpu"]
+    for c in compiles:
+        worker_compiles[c.get("worker", "?")] += c["cpu"]
     kernel_cpu = sum(c["cpu"] for cs in kernels.values() for c in cs)
     lines = [f"{len(tests)} tests, {sum(t['cpu'] for t in tests.values()):.0f} CPU s in the test process, "
              f"{sum(t['children_cpu'] for t in tests.values()):.0f} in processes they started",
              f"{len(compiles)} compiles, {sum(c['cpu'] for c in compiles):.0f} CPU s; {len(kernels)} step kernels, "
-             f"{kernel_cpu:.0f} CPU s", "",
+             f"{kernel_cpu:.0f} CPU s",
+             "per worker (CPU s, its processes included; of which compiling): "
+             + ", ".join(f"{w} {cpu:.0f} ({worker_compiles[w]:.0f})" for w, cpu in sorted(workers.items())), "",
              "step kernels (CPU s compiling it, tests that loaded it where recorded, the first test that compiled it):"]
     for module, cs in sorted(kernels.items(), key=lambda kv: -sum(c["cpu"] for c in kv[1])):
         used = f"{len(users[module]):4d}" if users else "   ?"

@@ -19,7 +19,7 @@ from .errors import EXIT_FAILED, EXIT_USAGE, ConfigWarning, InfomarketError, rep
 
 SUBCOMMAND_MODULES = ("infomarket.runner.cli", "infomarket.analysis.cli", "infomarket.viewer.cli",
                       "infomarket.evm.cli", "infomarket.analysis.sensitivity_cli")
-SUBCOMMAND_MODULES += ("infomarket.analysis.terrain",)  # terrain-report (docs/terrain.md)
+SUBCOMMAND_MODULES += ("infomarket.analysis.terrain_cli",)  # terrain-report (docs/terrain.md)
 SUBCOMMAND_MODULES += ("infomarket.search.cli",)  # attack-search (docs/attack-search.md)
 SUBCOMMAND_MODULES += ("infomarket.rl.cli",)  # rl-train (docs/rl.md)
 SUBCOMMAND_MODULES += ("infomarket.search.adaptive_cli",)  # adaptive-attack (docs/rl.md)

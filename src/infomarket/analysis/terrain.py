@@ -14,7 +14,6 @@ p-value reported beside it; the crowd's ratio is read from its bootstrap interva
 """
 from __future__ import annotations
 
-import argparse
 import json
 from pathlib import Path
 
@@ -375,30 +374,12 @@ def markdown(a: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _jsonable(a):
+def jsonable(a):
+    """``a`` (the answers) with numpy numbers as Python ones and keys as strings, for ``json.dumps``."""
     if isinstance(a, dict):
-        return {str(k): _jsonable(v) for k, v in a.items()}
+        return {str(k): jsonable(v) for k, v in a.items()}
     if isinstance(a, (list, tuple)):
-        return [_jsonable(v) for v in a]
+        return [jsonable(v) for v in a]
     if isinstance(a, (np.floating, np.integer)):
         return a.item()
     return a
-
-
-def add_subcommand(subparsers) -> None:
-    p = subparsers.add_parser("terrain-report", help="answer the terrain questions (corridor, two_food, crowd) "
-                              "from their stores, with a figure")
-    p.add_argument("results", help="folder holding the stores corridor/, two_food/, crowd/ (optionally corridor_waypoints/, crowd_sensing/)")
-    p.add_argument("--out", required=True, help="folder for terrain.md, terrain.json, terrain.png")
-    p.set_defaults(func=cmd_terrain_report)
-
-
-def cmd_terrain_report(args: argparse.Namespace) -> int:
-    out = study.out_dir(args.out)
-    a = answer(Path(args.results))
-    text = markdown(a)
-    files = study.write(out, "terrain", text, extra=[("terrain.json", json.dumps(_jsonable(a), indent=1))],
-                        figure=lambda p: figure(a, p))
-    print(text)
-    print(f"wrote {', '.join(str(f) for f in files)}")
-    return 0
