@@ -127,12 +127,29 @@ def uses_paths(behaviour_names: tuple[str, ...]) -> bool:
     return any(get_behaviour(b).paths for b in behaviour_names)
 
 
+#: ``_kernel_parts`` already worked out in this process: (the specs' ids, terrain, ledger) -> (the specs,
+#: the parts).  Every run asks for its kernel's key (a study's runs, thousands of times), and reading the
+#: rules' source and hashing it took 4 ms each time.
+_PARTS: dict = {}
+
+
 def _kernel_parts(behaviour_names: tuple[str, ...], payment_name: str, terrain: bool,
                   ledger: str | bool = "instant") -> tuple[str, str, bool]:
     """(source, key, cacheable) of the kernel for these rules: the key hashes everything its machine code
-    depends on (template, engine source, every rule's source, versions)."""
-    behaviours = [get_behaviour(b) for b in behaviour_names]
-    payment = get_payment(payment_name)
+    depends on (template, engine source, every rule's source, versions).  Worked out once per set of
+    registered rules: a rule registered again under its name (a new spec) is worked out again."""
+    specs = tuple(get_behaviour(b) for b in behaviour_names) + (get_payment(payment_name),)
+    memo = (tuple(map(id, specs)), bool(terrain), ledger_name(ledger))
+    known = _PARTS.get(memo)
+    if known is not None and all(a is b for a, b in zip(known[0], specs)):  # the same objects, not reused ids
+        return known[1]
+    parts = _work_out_parts(list(specs[:-1]), specs[-1], terrain, ledger)
+    _PARTS[memo] = (specs, parts)
+    return parts
+
+
+def _work_out_parts(behaviours: list[BehaviourSpec], payment: PaymentSpec, terrain: bool,
+                    ledger: str | bool) -> tuple[str, str, bool]:
     source = generate_source(behaviours, payment, terrain, any(b.paths for b in behaviours), ledger)
     digest = generated_digest(source)
     cacheable = True

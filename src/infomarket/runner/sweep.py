@@ -104,7 +104,12 @@ def _frames(task: Task, outputs: list[RunOutput]) -> dict[str, pd.DataFrame | No
         return {t: _concat([p[t] for p in parts if p[t] is not None]) for t in parts[0]}
     c = task.condition
 
-    def label(df: pd.DataFrame, keys: bool) -> pd.DataFrame:
+    def labelled(frames: list[pd.DataFrame], keys: bool) -> pd.DataFrame | None:
+        """The runs' frames as one, with the condition's columns: labelled once, after concatenating (a
+        column set on each run's frame cost more than the run itself for short runs)."""
+        df = _concat(frames)
+        if df is None:
+            return None
         df.insert(0, "experiment", c.experiment)
         df.insert(1, "condition", c.id)
         if keys:
@@ -115,18 +120,18 @@ def _frames(task: Task, outputs: list[RunOutput]) -> dict[str, pd.DataFrame | No
     robots, hists, events, payments, sites, chains, rows = [], [], [], [], [], [], []
     for o, run in zip(outputs, task.runs):
         if o.error is None:
-            robots.append(label(o.robots, True))
+            robots.append(o.robots)
             if len(o.history):
                 meta = o.robots[["robot", "honest", "behaviour"]]
-                hists.append(label(o.history.merge(meta, on="robot", how="left"), False))
+                hists.append(o.history.merge(meta, on="robot", how="left"))
             if len(o.events):
-                events.append(label(o.events, True))
+                events.append(o.events)
             if len(o.payments):
-                payments.append(label(o.payments, True))
+                payments.append(o.payments)
             if len(o.sites):
-                sites.append(label(o.sites, True))
+                sites.append(o.sites)
             if len(o.chain):
-                chains.append(label(o.chain, True))
+                chains.append(o.chain)
         rows.append({"experiment": c.experiment, "condition": c.id, "run": np.int64(run),
                      "seed": np.uint64(c.seed(run)), "master_seed": np.int64(c.master_seed),
                      "config_hash": c.config.config_hash(), "package_version": __version__,
@@ -134,9 +139,9 @@ def _frames(task: Task, outputs: list[RunOutput]) -> dict[str, pd.DataFrame | No
                      "status": OK if o.error is None else FAILED, "error": o.error or "", **c.keys})
     configs = pd.DataFrame([{"experiment": c.experiment, "condition": c.id, "config_hash": c.config.config_hash(),
                              "config": config_json(c.config)}])
-    return {"robots": _concat(robots), "history": _concat(hists), "events": _concat(events),
-            "payments": _concat(payments), "sites": _concat(sites), "configs": configs, "chain": _concat(chains),
-            "runs": pd.DataFrame(rows)}
+    return {"robots": labelled(robots, True), "history": labelled(hists, False), "events": labelled(events, True),
+            "payments": labelled(payments, True), "sites": labelled(sites, True), "configs": configs,
+            "chain": labelled(chains, True), "runs": pd.DataFrame(rows)}
 
 
 def config_json(cfg: Experiment) -> str:
