@@ -260,3 +260,29 @@ def test_only_ledger_operations_write_ledger_arrays():
             offenders[str(rel)] = lines
     assert offenders == {}
     assert _ledger_writes(ast.parse((PACKAGE / "ledger" / "kernels.py").read_text()))  # where they are
+
+
+def _njit_inlined_by_numba(source: str) -> list[str]:
+    """Functions of ``source`` decorated ``@njit(inline="always")`` (or ``'always'``)."""
+    found = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            for d in node.decorator_list:
+                if (isinstance(d, ast.Call) and ast.unparse(d.func).split(".")[-1] == "njit"
+                        and any(k.arg == "inline" and ast.unparse(k.value).strip("'\"") == "always" for k in d.keywords)):
+                    found.append(node.name)
+    return found
+
+
+def test_the_inlined_finder():
+    assert _njit_inlined_by_numba("@njit(inline='always')\ndef f(w):\n    pass\n\n@njit(forceinline=True)\ndef g(w):\n"
+                                  "    pass\n\n@numba.njit(inline=\"always\")\ndef h(w):\n    pass\n") == ["f", "h"]
+
+
+def test_compiled_helpers_are_inlined_by_llvm_not_by_numba():
+    """``@njit(forceinline=True)``: numba types a helper once per process and LLVM inlines its machine code
+    into each kernel; ``inline="always"`` made numba type it again inside every kernel that calls it, and
+    compiling took twice the CPU (docs/testing.md, "A fourth round").  The ``@overload``s and the generated
+    dispatch functions stay inlined by numba, where it measured faster."""
+    offenders = {m: names for m, p in MODULES.items() if (names := _njit_inlined_by_numba(p.read_text()))}
+    assert not offenders, offenders

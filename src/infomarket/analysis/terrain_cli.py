@@ -18,7 +18,7 @@ def add_subcommand(subparsers) -> None:
 def cmd_terrain_report(args: argparse.Namespace) -> int:
     # the analysis (scipy.stats, pandas) loads when the command runs, not when the CLI starts
     from . import study
-    from .terrain import jsonable, answer, figure, markdown
+    from .terrain import answer, figure, jsonable, markdown
 
     out = study.out_dir(args.out)
     a = answer(Path(args.results))
