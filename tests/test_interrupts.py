@@ -96,6 +96,70 @@ def test_a_compile_in_a_child_is_killed_at_once_and_a_finished_one_is_loaded_her
 
 
 
+def test_kernels_compiled_together_share_one_child_and_are_then_loaded_here(tmp_path):
+    """A command's new kernels are compiled in one child (which types the step's helpers once for all of
+    them), each leaving its marker; the calls here then load them without another child.  Outside a
+    command, or with every marker there, nothing is forked."""
+    parent = os.getpid()
+    calls = tmp_path / "calls"
+    calls.mkdir()
+    markers = [tmp_path / f"kernel{k}.simulation.compiled" for k in range(3)]
+
+    def compile_(k):
+        return lambda: (calls / f"{k}-{os.getpid()}").touch() or f"kernel {k}"
+
+    def each():
+        return [interrupts.compiled_apart(compile_(k), m) for k, m in enumerate(markers)]
+
+    interrupts.compiled_together(each, markers)  # outside a command: nothing
+    assert not list(calls.iterdir())
+    with interrupts.handling():
+        interrupts.compiled_together(each, markers)
+        seen = [p.name.split("-") for p in calls.iterdir()]
+        assert sorted(k for k, _ in seen) == ["0", "1", "2"] and len({pid for _, pid in seen}) == 1
+        child = int(seen[0][1])
+        assert child != parent and not Path(f"/proc/{child}").exists()  # one child, reaped
+        assert all(m.exists() for m in markers)
+        for p in calls.iterdir():
+            p.unlink()
+        assert each() == ["kernel 0", "kernel 1", "kernel 2"]
+        assert sorted(p.name for p in calls.iterdir()) == [f"{k}-{parent}" for k in range(3)]  # loaded here
+        for p in calls.iterdir():
+            p.unlink()
+        interrupts.compiled_together(each, markers)  # every marker there: no child
+        assert not list(calls.iterdir())
+
+
+def test_a_stop_while_kernels_compile_together_kills_their_child_at_once(tmp_path):
+    parent = os.getpid()
+    started = tmp_path / "started"
+    marker = tmp_path / "kernel.simulation.compiled"
+    child_started = threading.Event()
+
+    def forever():
+        (tmp_path / "pid").write_text(str(os.getpid()))
+        os.replace(tmp_path / "pid", started)  # whole, or not there: the watcher never reads half of it
+        while True:
+            time.sleep(1)
+
+    def watch():
+        deadline = time.monotonic() + HANG
+        while not started.exists() and time.monotonic() < deadline:
+            time.sleep(0.01)
+        child_started.set()
+
+    threading.Thread(target=watch, daemon=True).start()
+    _signal_when(child_started)
+    try:
+        with interrupts.handling(), pytest.raises(KeyboardInterrupt):
+            interrupts.compiled_together(lambda: interrupts.compiled_apart(forever, marker), [marker])
+        child = int(started.read_text())
+        assert child != parent and not Path(f"/proc/{child}").exists() and not marker.exists()
+    finally:
+        if started.exists() and Path(f"/proc/{started.read_text()}").exists():
+            os.kill(int(started.read_text()), signal.SIGKILL)
+
+
 class _Unpicklable(ValueError):
     def __reduce__(self):
         raise TypeError("not picklable")

@@ -300,10 +300,64 @@ def compiled_apart(compile_: Callable[[], T], marker: Path | None) -> T:
     cannot hand back is left to the call here.  ``marker`` None (not cacheable), outside a command, off
     the main thread or without ``fork``: just ``compile_()``."""
     with one_compiler(marker):
+        if _TOGETHER.child:  # in compiled_together's child: compile here, and say it is in the cache
+            out = _here(compile_)
+            if marker is not None:
+                marker.touch()
+            return out
         if (marker is None or not _state.active or marker.exists() or not hasattr(os, "fork")
                 or threading.current_thread() is not threading.main_thread()):
             return _here(compile_)
         return _in_child(compile_, marker)
+
+
+class _Together:
+    child = False  # this process is compiled_together's child
+
+
+_TOGETHER = _Together()
+
+
+def compiled_together(work: Callable[[], object], markers) -> None:
+    """Run ``work`` (calls that reach ``compiled_apart``, e.g. building each of a command's kernels) first in
+    one forked child, in which each of them compiles in place and leaves its marker; the calls made here
+    afterwards then load from the cache.  One child for all: the step's helpers are typed once per process
+    (docs/testing.md), and a child per kernel typed them again for every kernel.  Nothing happens outside a
+    command (``handling``), off the main thread, without ``fork``, or when every one of ``markers`` (the
+    kernels' ``generated.compile_marker``) exists; what failed in the child is met again by the calls here,
+    each in a child of its own as before.  A stop signal kills the child at once and is raised here."""
+    if (not _state.active or not hasattr(os, "fork") or threading.current_thread() is not threading.main_thread()
+            or all(m is None or m.exists() for m in markers)):
+        return
+    parent = os.getpid()
+    pid = os.fork()
+    if pid == 0:  # pragma: no cover - the child (its coverage is not collected)
+        code = 1
+        try:
+            detach(parent)
+            _TOGETHER.child = True
+            work()
+            code = 0
+        except BaseException:  # noqa: BLE001 - the parent meets it again
+            pass
+        finally:
+            os._exit(code)
+    try:
+        _wait(pid)  # a signal raises KeyboardInterrupt here, at once
+    except BaseException:
+        kill_group(pid)
+        with contextlib.suppress(ChildProcessError):
+            os.waitpid(pid, 0)
+        raise
+    check()
+
+
+def _wait(pid: int) -> None:
+    """Wait for the child ``pid`` to end, polling: a stop signal raises here within 50 ms whichever thread of
+    this process it landed on.  A blocking ``waitpid`` missed one that another thread (a progress bar's, a
+    notice's timer) took while this one held the signals for the fork: it then waited for the whole compile."""
+    while os.waitpid(pid, os.WNOHANG) == (0, 0):
+        time.sleep(0.05)
 
 
 _COMPILING = threading.local()
@@ -353,7 +407,7 @@ def _in_child(compile_: Callable[[], T], marker: Path) -> T:
             finally:
                 os._exit(code)
         try:
-            os.waitpid(pid, 0)  # a signal raises KeyboardInterrupt here, at once
+            _wait(pid)  # a signal raises KeyboardInterrupt here, at once
         except BaseException:
             kill_group(pid)
             with contextlib.suppress(ChildProcessError):

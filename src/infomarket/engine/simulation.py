@@ -329,6 +329,18 @@ def quiet_compiles():
         yield
 
 
+def kernel_marker(config: Experiment) -> Path | None:
+    """The marker (``generated.compile_marker``) that says the kernel ``Simulation(config)`` runs on is
+    compiled and in the cache; None where it cannot say (a kernel outside the cache folder, or one whose
+    module does not load: ``Simulation`` then meets the error)."""
+    try:
+        kernel = specialise.kernel_module(behaviour_kinds(config), config.payment.scheme, config.terrain,
+                                          config.chain.enabled)
+    except Exception:  # noqa: BLE001 - Simulation(config) reports it, named
+        return None
+    return compile_marker(kernel, "simulation")
+
+
 @contextmanager
 def compile_notice(kinds, scheme: str, after: float | None = None):
     """Say on stderr, once ``after`` seconds have gone by inside the block, that the step kernel is being

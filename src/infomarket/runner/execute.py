@@ -32,7 +32,7 @@ import pandas as pd
 from .. import interrupts, plugins
 from ..config.schema import Experiment
 from ..engine.batch import Simulations
-from ..engine.simulation import Simulation
+from ..engine.simulation import Simulation, kernel_marker
 from ..engine.specialise import kernel_id
 from ..checks import explain, explain_compile_failure
 from ..errors import InfomarketError, RuleRunError
@@ -302,19 +302,44 @@ def warm(cfg: Experiment) -> None:
     Simulations(cfg, [0, 1]).advance(0)
 
 
+def _distinct_kernels(configs: Iterable[Experiment]) -> dict[str, Experiment]:
+    """Kernel id (``kernel_id``) -> the first configuration that runs on it; a configuration whose id fails
+    is left out (the runs themselves report it)."""
+    seen: dict[str, Experiment] = {}
+    for cfg in configs:
+        try:
+            seen.setdefault(kernel_id(cfg), cfg)
+        except Exception:  # noqa: BLE001 - the runs themselves report it
+            continue
+    return seen
+
+
+def _warm_each(configs: list[Experiment]) -> None:
+    """``warm`` every configuration, whatever fails (compiled_together's child: the parent meets it)."""
+    for cfg in configs:
+        try:
+            for entry in cfg.plugins:
+                plugins.load(entry)
+            warm(cfg)
+        except Exception:  # noqa: BLE001 - met again where it is reported
+            continue
+
+
+def _compile_together(configs: list[Experiment]) -> None:
+    """In a command, the kernels of ``configs`` not yet in the cache and their batch drivers compiled in
+    one child (``interrupts.compiled_together``), which types the step's helpers once for all of them;
+    the calls here then load them."""
+    interrupts.compiled_together(lambda: _warm_each(configs), [kernel_marker(cfg) for cfg in configs])
+
+
 def preflight(configs: Iterable[Experiment]) -> None:
     """Compile (or load) each distinct kernel in this process before anything is written or run: a kernel
     that cannot compile because of a user's rule is a RuleRunError naming the rule and what is wrong with
-    it (numba's own error points into the generated kernel).  Other errors are left to the runs."""
-    seen: set[str] = set()
-    for cfg in configs:
-        try:
-            key = kernel_id(cfg)
-        except Exception:  # noqa: BLE001 - the runs themselves report it
-            continue
-        if key in seen:
-            continue
-        seen.add(key)
+    it (numba's own error points into the generated kernel).  Other errors are left to the runs.  New
+    kernels are compiled together first (``_compile_together``)."""
+    distinct = list(_distinct_kernels(configs).values())
+    _compile_together(distinct)
+    for cfg in distinct:
         try:
             Simulation(cfg, 0)  # compiles or loads the kernel (what a warm-up then finds done)
         except InfomarketError:
@@ -329,15 +354,14 @@ def warm_up(configs: Iterable[Experiment]) -> dict[str, float]:
     """Load the kernel of each configuration in this process, once per distinct
     ``engine.specialise.kernel_id`` (behaviours, scheme and terrain: the kernel's real key); returns the
     seconds spent per kernel id.  A configuration whose warm-up raises is left to its runs, which record
-    the error as failed runs."""
+    the error as failed runs.  New kernels are compiled together first (``_compile_together``; its seconds
+    shared equally among the kernels)."""
+    t0 = time.perf_counter()
+    distinct = _distinct_kernels(configs)
+    _compile_together(list(distinct.values()))
+    shared = (time.perf_counter() - t0) / max(len(distinct), 1)
     seconds: dict[str, float] = {}
-    for cfg in configs:
-        try:
-            key = kernel_id(cfg)
-        except Exception:  # noqa: BLE001 - the runs themselves report it
-            continue
-        if key in seconds:
-            continue
+    for key, cfg in distinct.items():
         t0 = time.perf_counter()
         try:
             for entry in cfg.plugins:
@@ -345,7 +369,7 @@ def warm_up(configs: Iterable[Experiment]) -> dict[str, float]:
             warm(cfg)
         except Exception:  # noqa: BLE001 - the runs themselves report it, as failed runs
             pass
-        seconds[key] = time.perf_counter() - t0
+        seconds[key] = shared + time.perf_counter() - t0
     return seconds
 
 
