@@ -342,22 +342,23 @@ def compiled_together(work: Callable[[], object], markers) -> None:
             pass
         finally:
             os._exit(code)
-    try:
-        _wait(pid)  # a signal raises KeyboardInterrupt here, at once
-    except BaseException:
-        kill_group(pid)
-        with contextlib.suppress(ChildProcessError):
-            os.waitpid(pid, 0)
-        raise
+    _wait(pid)  # a signal raises KeyboardInterrupt here, at once
     check()
 
 
 def _wait(pid: int) -> None:
     """Wait for the child ``pid`` to end, polling: a stop signal raises here within 50 ms whichever thread of
     this process it landed on.  A blocking ``waitpid`` missed one that another thread (a progress bar's, a
-    notice's timer) took while this one held the signals for the fork: it then waited for the whole compile."""
-    while os.waitpid(pid, os.WNOHANG) == (0, 0):
-        time.sleep(0.05)
+    notice's timer) took while this one held the signals for the fork: it then waited for the whole compile.
+    On any exception the child is killed with its group and reaped before it propagates."""
+    try:
+        while os.waitpid(pid, os.WNOHANG) == (0, 0):
+            time.sleep(0.05)
+    except BaseException:
+        kill_group(pid)
+        with contextlib.suppress(ChildProcessError):
+            os.waitpid(pid, 0)
+        raise
 
 
 _COMPILING = threading.local()
@@ -406,13 +407,7 @@ def _in_child(compile_: Callable[[], T], marker: Path) -> T:
                     failure.flush()
             finally:
                 os._exit(code)
-        try:
-            _wait(pid)  # a signal raises KeyboardInterrupt here, at once
-        except BaseException:
-            kill_group(pid)
-            with contextlib.suppress(ChildProcessError):
-                os.waitpid(pid, 0)
-            raise
+        _wait(pid)  # a signal raises KeyboardInterrupt here, at once
         failure.seek(0)
         error = _unpickled(failure.read())
     if error is not None:
