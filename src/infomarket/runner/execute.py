@@ -314,22 +314,23 @@ def _distinct_kernels(configs: Iterable[Experiment]) -> dict[str, Experiment]:
     return seen
 
 
-def _warm_each(configs: list[Experiment]) -> None:
-    """``warm`` every configuration, whatever fails (compiled_together's child: the parent meets it)."""
-    for cfg in configs:
-        try:
-            for entry in cfg.plugins:
-                plugins.load(entry)
-            warm(cfg)
-        except Exception:  # noqa: BLE001 - met again where it is reported
-            continue
+def _try_warm(cfg: Experiment) -> None:
+    """``warm`` with the configuration's plugins loaded; an error is left to where it is reported (the runs,
+    or the calls after ``compiled_together``'s child)."""
+    try:
+        for entry in cfg.plugins:
+            plugins.load(entry)
+        warm(cfg)
+    except Exception:  # noqa: BLE001 - met again where it is reported
+        pass
 
 
 def _compile_together(configs: list[Experiment]) -> None:
     """In a command, the kernels of ``configs`` not yet in the cache and their batch drivers compiled in
     one child (``interrupts.compiled_together``), which types the step's helpers once for all of them;
     the calls here then load them."""
-    interrupts.compiled_together(lambda: _warm_each(configs), [kernel_marker(cfg) for cfg in configs])
+    interrupts.compiled_together(lambda: [_try_warm(cfg) for cfg in configs],
+                                 [kernel_marker(cfg) for cfg in configs])
 
 
 def preflight(configs: Iterable[Experiment]) -> None:
@@ -363,12 +364,7 @@ def warm_up(configs: Iterable[Experiment]) -> dict[str, float]:
     seconds: dict[str, float] = {}
     for key, cfg in distinct.items():
         t0 = time.perf_counter()
-        try:
-            for entry in cfg.plugins:
-                plugins.load(entry)
-            warm(cfg)
-        except Exception:  # noqa: BLE001 - the runs themselves report it, as failed runs
-            pass
+        _try_warm(cfg)
         seconds[key] = shared + time.perf_counter() - t0
     return seconds
 
