@@ -55,9 +55,10 @@ def test_pyproject_pins_numba_to_the_range():
 
 
 PRIVATE_MODULES = ("numba.core.ir_utils", "numba.core.registry", "numba.np.random.generator_core",
-                   "numba.np.random.distributions")
+                   "numba.np.random.distributions", "numba.core.caching")
 PRIVATE_NAMES = ("_add_alias", "alias_func_extensions", "_numba_box_", "_meminfo", "CPUDispatcher", "ir_utils",
-                 "generator_core", "next_double", "random_normal")
+                 "generator_core", "next_double", "random_normal", "caching", "_CacheLocator", "IndexDataCacheFile",
+                 "CacheImpl", "_locator_classes", "_load_index", "_save_index", "_save_data", "_data_name")
 
 
 def _private_uses(source: str) -> list[int]:

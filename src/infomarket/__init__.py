@@ -13,6 +13,12 @@ New behaviours and payment schemes: ``im.register_behaviour`` / ``im.register_pa
 #: compiled-kernel cache, stores and the command line take it from here, so it holds in a fresh clone too.
 __version__ = "0.1.0"
 
+# First: numba caches the package's own compiled functions by its source (compiled_cache), so each must be
+# decorated after this.
+from .compiled_cache import install as _install_compiled_cache  # noqa: E402
+
+_install_compiled_cache()
+
 from .config import Experiment, load_experiment  # noqa: E402
 from .engine import Result, Simulation, simulate  # noqa: E402
 from .errors import ConfigError, InfomarketError, SimulationError  # noqa: E402
@@ -25,7 +31,7 @@ from .engine.simulation import explain_errors_with as _explain_errors_with  # no
 # Python API as from the command line (the engine cannot import the checkers, which import it).
 _explain_errors_with(_explain)
 
-# The engine is imported: fix the digest of the code this process runs (generated kernels are cached by it).
+# Fix the digest of the code this process runs (kernels are cached by it), had nothing compiled been imported.
 from .generated import freeze_package_digest as _freeze  # noqa: E402
 
 _freeze()

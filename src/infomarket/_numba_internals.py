@@ -1,15 +1,18 @@
 """Every private numba API infomarket uses, checked once, here.
 
-The compiled view (``state.view``), the engine's draws (``engine.draws``) and the rule registry
-(``registry``) lean on numba internals that numba may rename or drop in any release.  They are taken from
+The compiled view (``state.view``), the engine's draws (``engine.draws``), the rule registry
+(``registry``) and the disk cache of the package's compiled functions (``compiled_cache``) lean on numba
+internals that numba may rename or drop in any release.  They are taken from
 this module only, which checks the installed numba against the range the tests cover and that each
 internal is there, so an unsupported numba fails at import with one message naming the numba version and
 what is missing, instead of a compile error deep in a kernel.  pyproject.toml pins numba to ``SUPPORTED``.
 """
 from __future__ import annotations
 
+import itertools
+
 import numba
-from numba.core import ir_utils
+from numba.core import caching, ir_utils
 from numba.core import registry as _registry
 from numba.experimental import structref
 from numba.np.random import distributions, generator_core
@@ -70,10 +73,64 @@ random_normal = require(distributions, "random_normal", "numba.np.random.distrib
 #: the type of an ``@njit`` function (registry): a rule already compiled is taken as it is
 CPUDispatcher = require(_registry, "CPUDispatcher", "numba.core.registry")
 
+#: numba's disk cache (compiled_cache): the base of a locator (which must keep its function's file as
+#: ``_py_file``: numba's warning that a function cannot be cached reads it), the list of locators a cached
+#: function is offered to, and the index-and-data files of one function's cache (saved in order below)
+CacheLocator = require(caching, "_CacheLocator", "numba.core.caching")
+IndexDataCacheFile = require(caching, "IndexDataCacheFile", "numba.core.caching")
+_locators = require(require(caching, "CacheImpl", "numba.core.caching"), "_locator_classes",
+                    "numba.core.caching.CacheImpl")
+_INDEX_METHODS = ("_load_index", "_save_index", "_save_data", "_data_name")
+for _method in _INDEX_METHODS:
+    require(IndexDataCacheFile, _method, "numba.core.caching.IndexDataCacheFile")
+
+
+class _OrderedIndex(IndexDataCacheFile):
+    """numba's index and data files of one function, whose ``save`` (where ``_LOCK(cache_path)`` gives a
+    lock) runs under that lock and writes the code before the index entry that names it; elsewhere
+    exactly numba's.  numba's own reads the index, writes it back with the new entry, then writes the code:
+    two processes saving two signatures at once could both take one file name, and leave an index that
+    names a file holding the other's code."""
+
+    def __init__(self, cache_path, filename_base, source_stamp):
+        super().__init__(cache_path, filename_base, source_stamp)
+        self._folder = cache_path
+
+    def save(self, key, data):
+        lock = _LOCK[0](self._folder)
+        if lock is None:
+            return super().save(key, data)
+        with lock:
+            overloads = self._load_index()
+            name = overloads.get(key)
+            if name is None:
+                taken = set(overloads.values())
+                name = next(n for n in map(self._data_name, itertools.count(1)) if n not in taken)
+            self._save_data(name, data)
+            overloads[key] = name
+            self._save_index(overloads)
+
+
+_LOCK = [lambda cache_path: None]
+
+
+def install_cache(locator, lock) -> None:
+    """Offer every function cached from now on to ``locator`` first (a ``CacheLocator``), and save each
+    cache whose folder ``lock(folder)`` gives a lock for (a context manager; None: numba's save) in order,
+    under that lock (``_OrderedIndex``: numba's ``Cache`` makes its index by the module-level name)."""
+    if locator not in _locators:
+        _locators.insert(0, locator)
+    _LOCK[0] = lock
+    caching.IndexDataCacheFile = _OrderedIndex
+
+
 #: each internal as (owner, name, where), for the tests
 USES = ((ir_utils, "_add_alias", "numba.core.ir_utils"), (ir_utils, "alias_func_extensions", "numba.core.ir_utils"),
         (structref.StructRefProxy, "_numba_box_", "numba.experimental.structref.StructRefProxy"),
         (structref.StructRefProxy, "_meminfo", "numba.experimental.structref.StructRefProxy"),
         (generator_core, "next_double", "numba.np.random.generator_core"),
         (distributions, "random_normal", "numba.np.random.distributions"),
-        (_registry, "CPUDispatcher", "numba.core.registry"))
+        (_registry, "CPUDispatcher", "numba.core.registry"), (caching, "_CacheLocator", "numba.core.caching"),
+        (caching, "IndexDataCacheFile", "numba.core.caching"), (caching, "CacheImpl", "numba.core.caching"),
+        (caching.CacheImpl, "_locator_classes", "numba.core.caching.CacheImpl"),
+        *((IndexDataCacheFile, m, "numba.core.caching.IndexDataCacheFile") for m in _INDEX_METHODS))

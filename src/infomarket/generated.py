@@ -38,10 +38,10 @@ def _digest_now() -> str:
 
 
 def freeze_package_digest() -> str:
-    """Hash of the source that compiled code comes from, taken once, when ``import infomarket`` has
-    imported the engine (the code this process runs): the generated kernel inlines engine code from many
-    modules, and numba only checks the generated file itself for staleness, so any change there must
-    change the kernel's name."""
+    """Hash of the source that compiled code comes from, taken once, while ``import infomarket`` imports it
+    (at its first compiled function, ``compiled_cache``): the code this process runs.  The generated kernel
+    inlines engine code from many modules, and numba only checks the generated file itself for staleness,
+    so any change there must change the kernel's name."""
     if not _PACKAGE_DIGEST:
         _PACKAGE_DIGEST.append(_digest_now())
     return _PACKAGE_DIGEST[0]
@@ -54,11 +54,15 @@ def source_changed_since_import() -> bool:
     return _digest_now() != freeze_package_digest()
 
 
-def cache_dir() -> Path:
-    """Where generated kernels live (``INFOMARKET_CACHE_DIR``, else ~/.cache/infomarket/kernels)."""
+def cache_root() -> Path:
+    """The folder of everything infomarket caches (``INFOMARKET_CACHE_DIR``, else ~/.cache/infomarket)."""
     root = os.environ.get("INFOMARKET_CACHE_DIR")
-    base = Path(root) if root else Path.home() / ".cache" / "infomarket"
-    return base / "kernels"
+    return Path(root) if root else Path.home() / ".cache" / "infomarket"
+
+
+def cache_dir() -> Path:
+    """Where generated kernels live (``cache_root()/kernels``)."""
+    return cache_root() / "kernels"
 
 
 def load_generated(prefix: str, key: str, source: str, cacheable: bool = True) -> ModuleType:

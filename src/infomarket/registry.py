@@ -19,6 +19,7 @@ from typing import Callable
 import numba
 
 from ._numba_internals import CPUDispatcher
+from .compiled_cache import in_package
 from .errors import ConfigError, RegistrationError, RuleError
 
 #: Fixed leading arguments of each kind of rule (everything after them is a parameter).
@@ -100,7 +101,7 @@ def _jit(func: Callable) -> Callable:
         return func
     if not inspect.isfunction(func):  # a builtin, a class, a number...: numba compiles only Python functions
         raise RuleError(f"a rule must be a Python function (def ...), got {_shown(func)}")
-    return numba.njit(func)
+    return numba.njit(func, cache=in_package(func))
 
 
 #: What a behaviour's or a payment scheme's name may be: it is written in experiment files, stored in the

@@ -18,25 +18,25 @@ from ..ledger.kernels import open_transaction, purchase_events
 DIFF_OF_ZERO = 1000.0
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def own_entry(w, me, site):
     """The robot's own table entry as it was at the start of the step: (valid, x, y, age)."""
     return w.tab_valid[me, site], w.tab_vec[me, site, 0], w.tab_vec[me, site, 1], w.tab_age[me, site]
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def current(w, me, site):
     """The robot's table entry including this step's purchases: (valid, x, y, age)."""
     return w.new_valid[me, site], w.new_vec[me, site, 0], w.new_vec[me, site, 1], w.new_age[me, site]
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def offer(w, seller, site):
     """What a buyer sees of a seller's offer before buying: (valid, age)."""
     return w.off_valid[seller, site], w.off_age[seller, site]
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def next_candidate(w, nbrs, site, after_age, after_id):
     """The neighbour with a valid offer that comes next after (after_age, after_id) in (age, id) order,
     or -1.  Start with (-1, -1) to get the freshest offer; ties go to the lower id."""
@@ -56,7 +56,7 @@ def next_candidate(w, nbrs, site, after_age, after_id):
     return best
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def next_younger(w, me, nbrs, site, after):
     """The candidate after ``after`` (-1 to start) in (offered age, id) order whose offer is younger than
     the robot's current entry for ``site``, or -1: the walk every buy rule makes (``next_candidate``,
@@ -67,7 +67,7 @@ def next_younger(w, me, nbrs, site, after):
     return s
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def buy(w, me, seller, site):
     """Buy the seller's offer for ``site``: (ok, x, y, age), the vector in the buyer's frame.
 
@@ -94,7 +94,7 @@ def buy(w, me, seller, site):
     return True, rx + ox, ry + oy, age
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def weighted(ax, ay, a_age, bx, by, b_age):
     """Age-weighted average of eqs. (4)-(5): the younger information gets the larger weight.
     Returns (x, y, age) with age floor((a + b) / 2); equal weights when both ages are 0."""
@@ -106,7 +106,7 @@ def weighted(ax, ay, a_age, bx, by, b_age):
     return wa * bx + wb * ax, wa * by + wb * ay, total // 2
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def install(w, me, site, x, y, age):
     """Make (x, y, age) the robot's valid entry for ``site`` (takes effect when it moves)."""
     w.new_vec[me, site, 0] = x
@@ -115,7 +115,7 @@ def install(w, me, site, x, y, age):
     w.new_valid[me, site] = True
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def combine(w, me, site, x, y, age):
     """Combine bought information with the robot's current entry (eqs. 4-5) and install the result;
     an invalid entry is replaced by the bought vector (its age still averaged, as the original does)."""
@@ -126,7 +126,7 @@ def combine(w, me, site, x, y, age):
     install(w, me, site, nx, ny, nage)
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def diff(ax, ay, bx, by):
     """Difference score of eq. (6): |a - b| / |a|, and 1000 when |a| = 0."""
     na = norm(ax, ay)
@@ -135,19 +135,19 @@ def diff(ax, ay, bx, by):
     return norm(ax - bx, ay - by) / na
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def pending_count(w, me, site):
     return w.pend_count[me, site]
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def pending_get(w, me, site, j):
     """The j-th pending entry (insertion order): (seller, x, y, age)."""
     return (w.pend_seller[me, site, j], w.pend_vec[me, site, j, 0], w.pend_vec[me, site, j, 1],
             w.pend_age[me, site, j])
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def pending_has(w, me, site, seller):
     for j in range(w.pend_count[me, site]):
         if w.pend_seller[me, site, j] == seller:
@@ -155,7 +155,7 @@ def pending_has(w, me, site, seller):
     return False
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def pending_add(w, me, site, seller, x, y, age):
     """Append a purchase to the pending list; the list holds at most one entry per seller."""
     k = w.pend_count[me, site]
@@ -169,12 +169,12 @@ def pending_add(w, me, site, seller, x, y, age):
     return True
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def pending_clear(w, me, site):
     w.pend_count[me, site] = 0
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def pending_find(w, me, site, seller):
     """Index of the seller's pending entry for ``site``, or -1."""
     for j in range(w.pend_count[me, site]):
@@ -183,7 +183,7 @@ def pending_find(w, me, site, seller):
     return -1
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def pending_remove(w, me, site, j):
     """Drop the j-th pending entry, keeping the others in insertion order (the list doubles as a memory
     of recent purchases: the engine dead-reckons and ages its entries like table entries)."""
@@ -196,7 +196,7 @@ def pending_remove(w, me, site, j):
     w.pend_count[me, site] = k - 1
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def confirm_or_wait(w, me, site, seller, x, y, age, threshold):
     """The sceptic's second chance for a purchase that disagrees with its own entry: if a pending
     purchase agrees with it (diff < threshold), install their age-weighted average and clear the

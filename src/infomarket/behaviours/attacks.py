@@ -62,13 +62,13 @@ KNOWN = (("theta", 30.0), ("theta_min", 10.0), ("adaptive", 0.0), ("threshold", 
 NO_ENTRY_AGE = 1000000
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def sceptic_angle(threshold):
     """The largest rotation (degrees) a sceptic accepts against an accurate own entry: diff = 2 sin(a/2)."""
     return 2.0 * math.degrees(math.asin(min(threshold / 2.0, 1.0)))
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def applied_theta(w, me, theta, theta_min, adaptive):
     """The outlier threshold the contract applies to ``me`` now (adaptive: by its reputation)."""
     if adaptive > 0.5:
@@ -76,7 +76,7 @@ def applied_theta(w, me, theta, theta_min, adaptive):
     return theta
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def in_range(w, me, site, my_age):
     """(other sellers with a valid entry for ``site``, potential buyers, their mean reputation, the oldest
     buyer age) among the robots in range of ``me``, from their start-of-step tables."""
@@ -93,7 +93,7 @@ def in_range(w, me, site, my_age):
     return sellers, buyers, (rep / buyers if buyers else 0.5), oldest
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def policy_offer(w, me, site, rot_base, rot_rep, rot_buyer_rep, rot_age, cap_theta, cap_sceptic, lie_from_rep,
                  lie_min_record, fresh_record, max_confirmers, buyer_age_min, lie_site, withhold, collude, theta,
                  theta_min, adaptive, threshold):
@@ -138,7 +138,7 @@ def policy_sell(w, me, site, rot_base=20.0, rot_rep=0.0, rot_buyer_rep=0.0, rot_
                         withhold, collude, theta, theta_min, adaptive, threshold)
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def holds(w, me, seller, site):
     """Whether ``me`` has an open transaction (since its last deposit) buying ``site`` from ``seller``."""
     start = w.tx_off[me]
@@ -148,7 +148,7 @@ def holds(w, me, seller, site):
     return False
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def sceptical_or_colluding(w, me, nbrs, threshold, collude):
     """The sceptical rule (``behaviours.sceptical``) that, when colluding, first buys each partner's offer
     (same behaviour) for each site once per round trip (whatever its age), without using it, and never

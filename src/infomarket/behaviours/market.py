@@ -14,13 +14,13 @@ Under delayed payment every weight is equal, so nothing is ever reduced.
 from numba import njit
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def wealth(w, j):
     """Robot j's balance (its wealth, as the robots table reports it)."""
     return w.balance[j]
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def wealth_share(w, j):
     """Robot j's balance as a fraction of all balances (0 when there is no money)."""
     total = w.money[0]
@@ -29,19 +29,19 @@ def wealth_share(w, j):
     return w.balance[j] / total
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def sales_settled(w, j):
     """How many transactions in which j sold information have been settled."""
     return w.rep_settled[j]
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def sales_reduced(w, j):
     """How many of j's settled sales were weighed as outliers (0, or below half the best of their site)."""
     return w.rep_reduced[j]
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def seller_reputation(w, j):
     """The fraction of j's settled sales that were not outliers, with one good and one bad sale added
     (Laplace's rule), so a seller nobody has judged yet scores 0.5 and one sale cannot make 0 or 1.
@@ -53,19 +53,19 @@ def seller_reputation(w, j):
     return (w.rep_settled[j] - w.rep_reduced[j] + 1.0) / (w.rep_settled[j] + 2.0)
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def earnings(w, j):
     """Money j has been paid for its settled sales (stakes returned with the payment included)."""
     return w.rep_earned[j]
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def stake_lost(w, j):
     """Stake j locked in settled sales and did not get back (stake minus payment, where positive)."""
     return w.rep_stake_lost[j]
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def deposits(w, j):
     """How many items j has deposited (every deposit, the transitory period included)."""
     return w.rep_deposits[j]

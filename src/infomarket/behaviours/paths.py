@@ -23,26 +23,26 @@ from ..engine.world import PATH_POINTS
 from .api import buy
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def was_blocked(w, me, site):
     """Did the robot bump into something while seeking ``site`` since it was last at such a site?"""
     return w.blocked[me, site]
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def path_length(w, me, site):
     """Number of waypoints after the entry in the robot's current path for ``site`` (this step's
     purchases included); 0 means the entry is one straight vector."""
     return w.new_path_count[me, site]
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def offered_path_length(w, seller, site):
     """Number of waypoints after the first leg in what ``seller`` offers for ``site`` this step."""
     return w.path_count[seller, site]
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def path_point(w, me, site, j):
     """Point j (0 = the entry, the first waypoint) of the robot's current path for ``site``: (x, y)."""
     if j == 0:
@@ -50,13 +50,13 @@ def path_point(w, me, site, j):
     return w.new_path_vec[me, site, j - 1, 0], w.new_path_vec[me, site, j - 1, 1]
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def detour(ax, ay, bx, by, cx, cy):
     """How much longer a -> b -> c is than a -> c (0 when b lies on the segment)."""
     return norm(bx - ax, by - ay) + norm(cx - bx, cy - by) - norm(cx - ax, cy - ay)
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def shorten(pts, m, keep):
     """Drop interior points of the polyline (0, 0) -> pts[0] -> ... -> pts[m - 1] until at most
     ``keep`` remain: each time the one whose removal shortens the path least (the straightest corner).
@@ -77,7 +77,7 @@ def shorten(pts, m, keep):
     return m
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def install_points(w, me, site, pts, m, age):
     """Make the polyline pts[:m] (robot frame, m <= PATH_POINTS) the robot's entry for ``site``."""
     w.new_vec[me, site, 0] = pts[0, 0]
@@ -90,7 +90,7 @@ def install_points(w, me, site, pts, m, age):
     w.new_valid[me, site] = True
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def buy_path(w, me, seller, site):
     """Buy the seller's path for ``site`` and make it the robot's entry: (ok, age).
 
@@ -119,7 +119,7 @@ def buy_path(w, me, seller, site):
     return True, age
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def clear_path(w, me, site):
     """Make the robot's current entry for ``site`` one straight vector again (its waypoints dropped)."""
     w.new_path_count[me, site] = 0

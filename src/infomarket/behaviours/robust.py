@@ -26,7 +26,7 @@ MEDIAN, TRIMMED, GEOMETRIC = 0, 1, 2
 COINCIDENT = 1e-12
 
 
-@njit
+@njit(cache=True)
 def weighted_median(v, wt):
     """The weighted median of ``v``: the smallest value at which the cumulative weight (values in
     increasing order, ties in index order) reaches half the total; halfway between it and the next value
@@ -51,7 +51,7 @@ def weighted_median(v, wt):
     return v[order[k - 1]]
 
 
-@njit
+@njit(cache=True)
 def trimmed_mean(v, wt, trim):
     """Mean of ``v`` after dropping the ``trim`` smallest and ``trim`` largest values (at most
     (k - 1) // 2 from each end, so something is always left), the kept values weighed by ``wt`` (equally
@@ -72,19 +72,19 @@ def trimmed_mean(v, wt, trim):
     return num / den
 
 
-@njit
+@njit(cache=True)
 def coordinate_median(xs, ys, wt):
     """Coordinate-wise (weighted) median of the vectors (xs[i], ys[i])."""
     return weighted_median(xs, wt), weighted_median(ys, wt)
 
 
-@njit
+@njit(cache=True)
 def coordinate_trimmed_mean(xs, ys, wt, trim):
     """Coordinate-wise trimmed mean: each coordinate trimmed by ``trim`` at both ends (Yin et al. 2018)."""
     return trimmed_mean(xs, wt, trim), trimmed_mean(ys, wt, trim)
 
 
-@njit
+@njit(cache=True)
 def geometric_median(xs, ys, wt, iterations):
     """The (weighted) geometric median, the point minimising sum_i wt_i |p - x_i|: ``iterations`` steps
     of Weiszfeld's algorithm in Vardi and Zhang's form (which handles an iterate on a data point: it
@@ -134,7 +134,7 @@ def geometric_median(xs, ys, wt, iterations):
     return px, py
 
 
-@njit
+@njit(cache=True)
 def robust_combination(xs, ys, wt, method, trim, iterations):
     """The combination ``method`` (MEDIAN, TRIMMED or GEOMETRIC) of the vectors."""
     if method == MEDIAN:
@@ -144,7 +144,7 @@ def robust_combination(xs, ys, wt, method, trim, iterations):
     return geometric_median(xs, ys, wt, iterations)
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def remember(w, me, site, seller, x, y, age, vectors):
     """Hold a purchase in the robot's memory for ``site``: it replaces the seller's earlier one (one voice
     per seller), and the oldest purchases go until at most ``vectors`` are held."""
@@ -156,7 +156,7 @@ def remember(w, me, site, seller, x, y, age, vectors):
     pending_add(w, me, site, seller, x, y, age)
 
 
-@njit
+@njit(cache=True)
 def install_combination(w, me, site, method, trim, iterations, power):
     """Install the robust combination of the held purchases and the robot's own start-of-step entry (one
     more voice, weight 1, when valid); each purchase weighs its seller's reputation ** ``power``.  The
@@ -182,7 +182,7 @@ def install_combination(w, me, site, method, trim, iterations, power):
     install(w, me, site, cx, cy, np.sort(ages)[(k - 1) // 2])
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def robust_site(w, me, nbrs, site, method, vectors, trim, iterations, power, horizon):
     """One site of a robust buy rule.  A robot whose entry is invalid (never known, or it failed it), or
     fresher than every purchase held (it has sensed the site since), forgets its purchases, and it

@@ -13,7 +13,7 @@ def sceptical_buy(w, me, nbrs, threshold=0.25):
         sceptical_site(w, me, nbrs, site, threshold, -1)
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def sceptical_site(w, me, nbrs, site, threshold, ignore_kind):
     """The sceptical rule for one site, never buying from sellers of behaviour kind ``ignore_kind`` (-1:
     none; colluders pass their own, ``behaviours.attacks``)."""

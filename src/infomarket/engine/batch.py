@@ -48,7 +48,7 @@ def step_all(views, rngs, t_end, status, clocks, extra):
 #: ``step_all``'s status of a run whose world has an error bit set (the kernel's own are 0 and 1).
 FLAGGED = 2
 _NO_FINISH = """
-@njit
+@njit(cache=True)
 def finish(views, extra):
     return None
 """

@@ -7,7 +7,7 @@ from numba import njit
 DEG = math.pi / 180.0
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def rotate(x, y, deg):
     """Rotate (x, y) counter-clockwise by ``deg`` degrees."""
     a = deg * DEG
@@ -16,7 +16,7 @@ def rotate(x, y, deg):
     return c * x - s * y, s * x + c * y
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def direction(x, y):
     """Direction of (x, y) in degrees, in [0, 360)."""
     d = math.atan2(y, x) / DEG
@@ -27,12 +27,12 @@ def direction(x, y):
     return d
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def norm(x, y):
     return math.sqrt(x * x + y * y)
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def wrap360(d):
     """``d % 360`` for ``d >= 0``, bit for bit, without ``%``.
 
@@ -53,7 +53,7 @@ def wrap360(d):
     return d
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def angular_distance(a, b):
     """Smallest absolute difference between two directions in degrees, in [0, 180]."""
     d = wrap360(abs(a - b))  # directions outside [0, 360) only: within, the reduction is one test
@@ -62,7 +62,7 @@ def angular_distance(a, b):
     return d
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def within(x, y, cx, cy, r):
     """Strictly inside the circle of centre (cx, cy) and radius r."""
     dx = x - cx
@@ -70,13 +70,13 @@ def within(x, y, cx, cy, r):
     return dx * dx + dy * dy < r * r
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def outside(x, y, r, width, height):
     """Would a robot disc centred at (x, y) leave the arena?"""
     return x + r >= width or x - r < 0.0 or y + r >= height or y - r < 0.0
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def to_frame(w, i, x, y):
     """A world-frame vector in robot i's frame (rotated by -heading)."""
     c = w.hdir[i, 0]
@@ -84,7 +84,7 @@ def to_frame(w, i, x, y):
     return c * x + s * y, c * y - s * x
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def to_world(w, i, x, y):
     """A vector in robot i's frame in the world frame (rotated by +heading)."""
     c = w.hdir[i, 0]

@@ -17,7 +17,7 @@ from ..space.grid import grid_shape  # noqa: F401  (the grid's geometry; re-expo
 ALL_PAIRS_UP_TO = 48
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def _link(nbr, nbr_count, cap, i, j):
     """Record that i and j are neighbours (each at the end of the other's list)."""
     c = nbr_count[i]
@@ -30,7 +30,7 @@ def _link(nbr, nbr_count, cap, i, j):
     nbr_count[j] = c + 1
 
 
-@njit
+@njit(cache=True)
 def _all_pairs(pos, rc2, nbr, nbr_count, cap):
     n = pos.shape[0]
     for i in range(n):
@@ -43,13 +43,13 @@ def _all_pairs(pos, rc2, nbr, nbr_count, cap):
                 _link(nbr, nbr_count, cap, i, j)
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def _cell(x, size, cells):
     c = int(x / size)
     return min(max(c, 0), cells - 1)
 
 
-@njit
+@njit(cache=True)
 def _grid(pos, rc2, nbr, nbr_count, cap, size, nx, ny, start, items):
     n = pos.shape[0]
     ncell = nx * ny
@@ -94,7 +94,7 @@ def _grid(pos, rc2, nbr, nbr_count, cap, size, nx, ny, start, items):
             nbr[i, b + 1] = v
 
 
-@njit
+@njit(cache=True)
 def find_all_neighbours(w):
     """Fill ``nbr`` / ``nbr_count`` for the current positions (idempotent: depends on positions only)."""
     nbr = w.nbr

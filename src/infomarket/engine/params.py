@@ -101,7 +101,7 @@ def turn_tables() -> tuple[np.ndarray, np.ndarray]:
     return c, s
 
 
-@njit
+@njit(cache=True)
 def fill_turn_tables(cos_out, sin_out, deg):
     """cos and sin of every whole-degree turn (``turn_tables``), with compiled code's libm."""
     for k in range(cos_out.shape[0]):

@@ -27,7 +27,7 @@ from .geometry import norm
 from .params import FOOD, NEST
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def path_odometry(w, i, dx, dy):
     """Move robot i's waypoints by its intended move (dx, dy) in its frame, as ``odometry_update``
     moves its table entries."""
@@ -42,7 +42,7 @@ def path_odometry(w, i, dx, dy):
             w.path_vec[i, k, j, 1] = s * x + c * y
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def advance(w, i):
     """A robot at its first waypoint (closer than its radius) of a valid path takes the next one."""
     for k in range(2):
@@ -56,14 +56,14 @@ def advance(w, i):
             w.path_count[i, k] = m - 1
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def at_site(w, i, k):
     """Robot i senses a site of kind k: its entry is now one exact vector."""
     w.path_count[i, k] = 0
     w.blocked[i, k] = False
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def bumped(w, i, front, was_food, was_nest):
     """After the state machine: an entry it dropped while FRONT fired (the model's "blocked while
     seeking") marks that site blocked.  ``was_*``: the entries' validity before the state machine."""
@@ -74,7 +74,7 @@ def bumped(w, i, front, was_food, was_nest):
             w.blocked[i, NEST] = True
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def drop_invalid(w, i):
     """A path lives only as long as its entry is valid (arrival at a final point empties it too)."""
     for k in range(2):
@@ -82,7 +82,7 @@ def drop_invalid(w, i):
             w.path_count[i, k] = 0
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def begin_paths(w, i):
     """Robot i is about to buy: its purchases go to a new path, a copy of the one it sells."""
     for k in range(2):
@@ -93,7 +93,7 @@ def begin_paths(w, i):
             w.new_path_vec[i, k, j, 1] = w.path_vec[i, k, j, 1]
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def install_path(w, i):
     """The robot moves: what it bought becomes its path (with ``install_table`` for the entry)."""
     for k in range(2):

@@ -34,7 +34,7 @@ from .terrain import blocked, containing_site, drop_hidden_pairs, obstructed
 
 # ---- the behaviour step's shared pieces ----------------------------------------------------------------
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def walls(x, y, c, s, r, width, height):
     """Wall sensors FRONT, RIGHT, BACK, LEFT: would a move of (c, s) (the heading times the speed),
     turned by 0, -90, 180, +90 degrees, put the robot's disc outside the arena?
@@ -43,7 +43,7 @@ def walls(x, y, c, s, r, width, height):
             outside(x - c, y - s, r, width, height), outside(x - s, y + c, r, width, height))
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def update_state(w, i, front):
     """The three-state machine (EXPLORING, SEEKING_FOOD, SEEKING_NEST)."""
     st = w.state[i]
@@ -71,7 +71,7 @@ def update_state(w, i, front):
     w.state[i] = st
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def draw_index(cdf, guide, u):
     """Inverse-CDF sampling on a table: the first index whose cumulative probability exceeds u.
 
@@ -84,7 +84,7 @@ def draw_index(cdf, guide, u):
     return k
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def intended_move(w, i, rng):
     """The movement the robot wants, in its own frame: towards the sought site, or a random-walk step."""
     st = w.state[i]
@@ -108,7 +108,7 @@ def intended_move(w, i, rng):
     return w.speed * w.turn_cos[turn], w.speed * w.turn_sin[turn]
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def odometry_update(w, i, dx, dy):
     """Dead reckoning: every table and pending entry moves by -dr, turns by -heading(dr), ages by one.
     Turning by -heading(dr) is multiplying by dr's conjugate unit vector, so no trigonometry is needed."""
@@ -152,7 +152,7 @@ def variant(terrain: bool, paths: bool) -> Step:
 @functools.cache
 def _variant(terrain: bool, paths: bool) -> Step:
     # ---- neighbours and the communication phase
-    @njit
+    @njit(cache=True)
     def find_neighbours(w):
         """Every pair strictly closer than the communication range (``engine.neighbours``); with terrain and
         line of sight, pairs whose straight line an obstacle cuts are dropped."""
@@ -160,7 +160,7 @@ def _variant(terrain: bool, paths: bool) -> Step:
         if terrain:
             drop_hidden_pairs(w)
 
-    @njit(forceinline=True)
+    @njit(forceinline=True, cache=True)
     def begin_communication(w, i):
         """Robot i is about to buy: its purchases go to a new table (and path), a copy of the one it sells.
         Only robot i reads or writes its new table, and nobody writes its table before it moves, so the
@@ -173,7 +173,7 @@ def _variant(terrain: bool, paths: bool) -> Step:
         if paths:
             begin_paths(w, i)
 
-    @njit(forceinline=True)
+    @njit(forceinline=True, cache=True)
     def install_table(w, i):
         """The robot moves: what it bought becomes its table (and path); called for a robot whose
         ``begin_communication`` ran this step (for any other, the new table is not this step's)."""
@@ -185,7 +185,7 @@ def _variant(terrain: bool, paths: bool) -> Step:
         if paths:
             install_path(w, i)
 
-    @njit(forceinline=True)
+    @njit(forceinline=True, cache=True)
     def site_of(w, x, y, kind):
         """The site of ``kind`` that (x, y) lies strictly inside (the first in file order), else -1."""
         if terrain:
@@ -194,7 +194,7 @@ def _variant(terrain: bool, paths: bool) -> Step:
             return kind
         return -1
 
-    @njit(forceinline=True)
+    @njit(forceinline=True, cache=True)
     def forage(w, i, rng):
         """Pick-up and drop spots (docs/model.md §6), at whichever site of the needed kind the robot is in.
         Returns True when robot i deposits an item this step (the caller then pays and shares the reward)."""
@@ -228,7 +228,7 @@ def _variant(terrain: bool, paths: bool) -> Step:
             w.items[i] += 1
         return True
 
-    @njit(forceinline=True)
+    @njit(forceinline=True, cache=False)  # captures compiled functions: see compiled_cache
     def sense_sites(w, i):
         """A robot inside a site knows exactly where its target point there is (its spot if the spot lies in
         that site, else the centre); for each kind, the first site containing it sets that kind's entry."""
@@ -251,7 +251,7 @@ def _variant(terrain: bool, paths: bool) -> Step:
             w.tab_valid[i, k] = True
             w.last_site[i] = k
 
-    @njit(forceinline=True)
+    @njit(forceinline=True, cache=True)
     def sensors(w, i):
         """FRONT, RIGHT, BACK, LEFT (docs/model.md §3); with terrain, obstacles (and, with sense_robots,
         other robots) are sensed like the arena's walls."""
@@ -264,7 +264,7 @@ def _variant(terrain: bool, paths: bool) -> Step:
                     obstructed(w, i, x - s, y + c))
         return walls(x, y, c, s, w.radius, w.width, w.height)
 
-    @njit(forceinline=True)
+    @njit(forceinline=True, cache=False)  # captures compiled functions: see compiled_cache
     def behaviour_step(w, i, rng):
         """Sensors, sites, state machine, intended movement with wall reflection, dead reckoning
         (docs/model.md §3); with paths, a site sensed clears that kind's path and mark, the legs are followed,
@@ -295,7 +295,7 @@ def _variant(terrain: bool, paths: bool) -> Step:
                 path_odometry(w, i, dx, dy)
         return dx, dy
 
-    @njit(forceinline=True)
+    @njit(forceinline=True, cache=True)
     def move(w, i, dx, dy, rng):
         """Execute the movement with odometry noise: the robot turns by N(bias, noise_sd) more than it
         thinks; its new heading is the direction it actually moved; positions are clamped to the arena.
@@ -320,7 +320,7 @@ def _variant(terrain: bool, paths: bool) -> Step:
 
 # ---- the log -----------------------------------------------------------------------------------------
 
-@njit
+@njit(cache=True)
 def record_history(w):
     """Wealth of every robot every ``hist_every`` steps (row k holds step (k + 1) * hist_every)."""
     if w.hist_every > 0 and w.clock[0] % w.hist_every == 0:

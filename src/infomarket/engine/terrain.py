@@ -68,7 +68,7 @@ def place_clear(world, rng) -> None:
                               f" after {PLACEMENT_TRIES} tries: the arena has too little free space")
 
 
-@njit
+@njit(cache=True)
 def drop_hidden_pairs(w):
     """With line of sight, drop the neighbour pairs whose straight line an obstacle cuts (lists stay in
     increasing id order).  Lists that overflowed are left alone: the step does not begin (``has_room``)
@@ -94,7 +94,7 @@ def drop_hidden_pairs(w):
         nbr_count[i] = c
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def containing_site(w, x, y, kind):
     """The first site of ``kind`` (file order) that (x, y) lies strictly inside, else -1."""
     for s in range(w.sites_r.shape[0]):
@@ -103,7 +103,7 @@ def containing_site(w, x, y, kind):
     return -1
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def obstructed(w, i, x, y):
     """A proximity sensor of robot i: would a disc centred at (x, y) leave the arena or touch an
     obstacle (or, with ``sense_robots``, another robot's disc: centres at most 2 r apart)?"""
@@ -123,7 +123,7 @@ def obstructed(w, i, x, y):
     return False
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def blocked(w, i, x, y):
     """Would robot i's disc at (x, y) overlap an obstacle or (with collisions) another robot?"""
     r = w.radius

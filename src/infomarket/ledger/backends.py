@@ -42,17 +42,17 @@ class Operations(NamedTuple):
     end_of_step: Callable
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def _nothing(w):
     pass
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def _nothing_yet(w, rng):
     pass
 
 
-@njit
+@njit(cache=True)
 def _send_deposit(w, i, rng):
     send_deposit(w, i)
 

@@ -45,7 +45,7 @@ def gas_schedule(scheme: str, stake: float) -> tuple[float, tuple[int, ...]]:
     return float(GAS_REVEAL[name]), GAS_DEPOSIT[name]
 
 
-@njit
+@njit(cache=True)
 def table_gas(xs, ys, n):
     """Gas of a deposit that settles n reveals by the table (xs reveals, ys gas): linear between its points;
     n below the first point costs the first point's gas, n beyond the last the last point's.  The last

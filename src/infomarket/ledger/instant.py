@@ -10,7 +10,7 @@ from .pool import reserve
 from .lock import lock_stake_and_gas
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def open_transaction(w, buyer, seller, site, direction):
     """Lock the seller's stake (``lock_stake_and_gas``, no gas) and record the transaction in the
     buyer's block of the pool; False, with nothing recorded, when refused."""
@@ -34,7 +34,7 @@ def open_transaction(w, buyer, seller, site, direction):
     return True
 
 
-@njit
+@njit(cache=True)
 def has_room(w):
     """Can the next step's transactions fit?  A buy rule may make one purchase per neighbour and site;
     the log gets at most one event per purchase plus a deposit, and the payments log one row per

@@ -26,7 +26,7 @@ from .poa.spec import runs_poa
 OUTLIER_FRACTION = 0.5
 
 
-@njit
+@njit(cache=True)
 def log_event(w, kind, buyer, seller, site, direction, x, y, age, stake, sx=0.0, sy=0.0):
     """Append one event to the log when recording; the host keeps enough room for a whole step."""
     if not w.record:
@@ -50,7 +50,7 @@ def log_event(w, kind, buyer, seller, site, direction, x, y, age, stake, sx=0.0,
     unlock(w.ev_count)[0] = k + 1
 
 
-@njit
+@njit(cache=True)
 def log_payment(w, buyer, tx, weight, amount):
     """Append one row to the payments log: what the seller of pool transaction ``tx`` received."""
     k = w.pay_count[0]
@@ -84,7 +84,7 @@ def _open_transaction(w, buyer, seller, site, direction):
     return lambda w, buyer, seller, site, direction: instant_open(w, buyer, seller, site, direction)
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def expired_count(w, buyer):
     """How many of the buyer's open transactions have expired (0 without stake expiry): those opened at
     a step t with t + stake_expiry <= now.  Transactions are in step order, so they are a prefix."""
@@ -99,13 +99,13 @@ def expired_count(w, buyer):
     return m
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def live_count(w, buyer):
     """The buyer's open transactions that have not expired: the ones its deposit weighs."""
     return w.tx_count[buyer] - expired_count(w, buyer)
 
 
-@njit
+@njit(cache=True)
 def expire_stakes(w, buyer):
     """The stake-expiry rule (docs/chain.md): at the start of step s, each open transaction of the
     buyer opened at a step t with t + stake_expiry <= s gives its stake back to its seller.  It stays
@@ -123,7 +123,7 @@ def expire_stakes(w, buyer):
         stake[a + x] = 0.0
 
 
-@njit
+@njit(cache=True)
 def settlement(w, buyer):
     """The buyer's live (unexpired) open transactions as (sellers, sites, directions): views of its pool
     block, what the scheme weighs."""
@@ -132,13 +132,13 @@ def settlement(w, buyer):
     return w.tx_seller[a:b], w.tx_site[a:b], w.tx_dir[a:b]
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def purchase_events(w, ok, buyer, seller, site, direction, x, y, age, sx, sy):
     log_event(w, EV_PURCHASE if ok else EV_REFUSED, buyer, seller, site, direction, x, y, age,
               w.stake if ok else 0.0, sx, sy)
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def _record_sale(w, seller, weight, top, pay, stake):
     """The seller's reputation record for one settled transaction (ledger.state, REPUTATION): O(1)."""
     unlock(w.rep_settled)[seller] += 1
@@ -154,7 +154,7 @@ def _record_sale(w, seller, weight, top, pay, stake):
         unlock(w.rep_stake_lost)[seller] += stake - pay
 
 
-@njit
+@njit(cache=True)
 def distribute(w, buyer, weights):
     """Settle a deposit: reward and pot to the buyer, then from the buyer to the sellers of its n open
     transactions: each expired one (its stake already returned) ``info_share * reward / n``, an equal
@@ -212,7 +212,7 @@ def distribute(w, buyer, weights):
     log_event(w, EV_DEPOSIT, buyer, -1, -1, 0.0, 0.0, 0.0, 0, 0.0, 0.0, 0.0)
 
 
-@njit
+@njit(cache=True)
 def _pay_expired(w, buyer, e, part):
     """The buyer pays each of its ``e`` expired transactions (the first of its block) ``part``."""
     balance = unlock(w.balance)
@@ -227,7 +227,7 @@ def _pay_expired(w, buyer, e, part):
             log_payment(w, buyer, a + x, 0.0, part)
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def burn_fuel(w, i):
     """Robot i pays the fuel cost of one move (the caller checked it can): burned, not paid to anyone."""
     fuel = w.fuel_cost

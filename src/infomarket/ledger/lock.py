@@ -13,7 +13,7 @@ from numba import njit
 STAKE_TOLERANCE = 1e-9
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def lock_stake_and_gas(funds, seller, stake, gas):
     """Take ``gas`` and then the stake from ``funds[seller]`` if they cover ``stake + gas`` (within
     ``STAKE_TOLERANCE``): (True, the stake locked, never more than what is left) or (False, 0.0) with

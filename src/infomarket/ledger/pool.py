@@ -6,7 +6,7 @@ from numba import njit
 from ..state.view import unlock
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def move_transaction(w, src, dst):
     """Copy pool entry ``src`` (every field of a transaction) to ``dst``."""
     unlock(w.tx_seller)[dst] = w.tx_seller[src]
@@ -16,7 +16,7 @@ def move_transaction(w, src, dst):
     unlock(w.tx_stake)[dst] = w.tx_stake[src]
 
 
-@njit
+@njit(cache=True)
 def reserve(w, buyer, need):
     """Make the buyer's block of the transaction pool hold at least ``need`` transactions, moving it to
     a bigger block at the top of the pool if needed; False when the pool is full (the host grows it)."""

@@ -14,21 +14,21 @@ from numba import njit
 from ..engine.geometry import angular_distance
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def round_trip_amount(market, buyer):
     """What the ledger shares among the sellers when ``buyer`` deposits: information share of the reward
     plus every stake its open purchases locked."""
     return market.info_share * market.reward + market.pot[buyer]
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def stake_of(market, buyer, x):
     """The stake locked by the buyer's x-th open transaction.  x counts its expired transactions too
     (first in its block, stake 0): the k live ones a rule weighs are the last k."""
     return market.tx_stake[market.tx_off[buyer] + x]
 
 
-@njit
+@njit(cache=True)
 def payouts(market, buyer, refund, share, weights):
     """Weights that pay seller x back ``refund[x]`` (a fraction in [0, 1]) of its stake, and share what
     is left of the round trip's amount in proportion to ``share`` (equally when ``share`` sums to 0):
@@ -46,7 +46,7 @@ def payouts(market, buyer, refund, share, weights):
         weights[x] += rest * (share[x] / total if total > 0.0 else 1.0 / k)
 
 
-@njit
+@njit(cache=True)
 def consensus_directions(sites, directions):
     """Per transaction, the settled consensus of its site: the direction among the site's records that
     lies nearest to all of them (the smallest sum of angular distances; ties to the earliest record), a

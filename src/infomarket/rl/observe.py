@@ -23,14 +23,12 @@ OBSERVATION = (
 PER_SITE = 6
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def _capped(x, scale):
     return min(x / scale, 1.0)
 
 
-@njit  # not cached on its own: numba would not see a change in the helpers it calls (behaviours.*); the
-# engine's generated ``step_all`` (``observe_all`` its finish), whose file name hashes the package's source
-# and this file, caches it with itself
+@njit(cache=True)
 def observe_run(w, agents, known, honest, steps, obs, shares):
     """Fill ``obs[a]`` (float32, len(OBSERVATION)) and ``shares[a]`` (the wealth share) for each agent
     robot ``agents[a]``; ``known`` = the attacker's columns of theta, theta_min, adaptive in ``w.bparams``.
@@ -66,7 +64,7 @@ def observe_run(w, agents, known, honest, steps, obs, shares):
     return total
 
 
-@njit
+@njit(cache=True)
 def observe_all(views, extra):
     """Observe every run (the engine's batch driver calls it once all B runs reached their step):
     ``extra`` = (agents, known, honest, steps, obs [B, A, O], items [B], shares [B, A])."""

@@ -17,7 +17,7 @@ SEGMENT = 2
 SHAPES = ("rect", "circle", "segment")
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def segment_distance(x, y, ax, ay, bx, by):
     """Distance from (x, y) to the segment from (ax, ay) to (bx, by)."""
     ux = bx - ax
@@ -29,7 +29,7 @@ def segment_distance(x, y, ax, ay, bx, by):
     return math.sqrt(dx * dx + dy * dy)
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def distance(kind, g0, g1, g2, g3, x, y):
     """Distance from (x, y) to one obstacle (0 inside a rectangle or a circle)."""
     if kind == RECT:
@@ -41,7 +41,7 @@ def distance(kind, g0, g1, g2, g3, x, y):
     return segment_distance(x, y, g0, g1, g2, g3)
 
 
-@njit
+@njit(cache=True)
 def nearest(kinds, geom, x, y):
     """Distance from (x, y) to the nearest obstacle (inf when there is none)."""
     best = np.inf
@@ -52,18 +52,18 @@ def nearest(kinds, geom, x, y):
     return best
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def _cross(ax, ay, bx, by, cx, cy):
     return (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def _on(ax, ay, bx, by, cx, cy):
     """c (collinear with a-b) lies within the bounding box of a-b."""
     return min(ax, bx) <= cx <= max(ax, bx) and min(ay, by) <= cy <= max(ay, by)
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def segments_meet(ax, ay, bx, by, cx, cy, dx, dy):
     """Do the closed segments a-b and c-d share a point?"""
     d1 = _cross(cx, cy, dx, dy, ax, ay)
@@ -76,7 +76,7 @@ def segments_meet(ax, ay, bx, by, cx, cy, dx, dy):
             or (d3 == 0.0 and _on(ax, ay, bx, by, cx, cy)) or (d4 == 0.0 and _on(ax, ay, bx, by, dx, dy)))
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def cuts(kind, g0, g1, g2, g3, ax, ay, bx, by):
     """Does the obstacle cut the segment a-b (share a point with it)?  Touching counts as cutting."""
     if kind == CIRCLE:
@@ -101,7 +101,7 @@ def cuts(kind, g0, g1, g2, g3, ax, ay, bx, by):
     return t0 <= t1
 
 
-@njit
+@njit(cache=True)
 def sight_blocked(kinds, geom, ax, ay, bx, by):
     """Is the straight line between two points cut by any obstacle?"""
     for k in range(kinds.shape[0]):

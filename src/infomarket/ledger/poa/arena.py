@@ -333,7 +333,7 @@ def chain_needs(w):
     return mp, live + due + 1, pool, events, payments, lists, entries
 
 
-@njit
+@njit(cache=True)
 def room_fits(w):
     """Does the next step fit in the chain's arrays (and, when recording, the logs)?"""
     mp, blocks, pool, events, payments, lists, entries = chain_needs(w)
@@ -344,7 +344,7 @@ def room_fits(w):
     return not w.record or (events <= w.ev_step.shape[0] and payments <= w.pay_step.shape[0])
 
 
-@njit
+@njit(cache=True)
 def can_make(w):
     """Is there room for one more block this step (a free slot, room for its transactions and its
     buyers' lists, log rows for its settlements)?  A signer that finds none makes its block in a later

@@ -17,14 +17,14 @@ from .mempool import DEPOSIT, mix
 from .states import ledger_at, save_state, set_current
 
 
-@njit
+@njit(cache=True)
 def in_turn(w, height):
     """The signer whose turn block ``height`` is."""
     s = w.chn_signers
     return s[height % s.shape[0]]
 
 
-@njit
+@njit(cache=True)
 def due(w, signer, t):
     """Does ``signer`` make a block on its head at step t: P steps after the head's block when in turn,
     P + delay when out of turn."""
@@ -47,7 +47,7 @@ _GAPS = np.array([1, 4, 10, 23, 57, 132, 301, 701, 1577, 3548, 7983, 17961, 4041
                   1035711], np.int64)
 
 
-@njit
+@njit(cache=True)
 def sort_by_seq(w, txs, k):
     """Put the first k mempool slots of ``txs`` in sending order (``mp_seq``, all distinct), in place:
     an insertion sort (a block's transactions come mostly in slot order, which is mostly sending order),
@@ -69,7 +69,7 @@ def sort_by_seq(w, txs, k):
         g -= 1
 
 
-@njit
+@njit(cache=True)
 def new_block(w, signer, t):
     """``signer`` makes a block on its head at step t, holding every pending transaction it knows that
     its branch does not include yet, in sending order.  Returns its slot (the ledger is not touched)."""
@@ -130,7 +130,7 @@ def new_block(w, signer, t):
     return b
 
 
-@njit
+@njit(cache=True)
 def include_tx(w, b, tx):
     """Apply transaction ``tx`` of block b to the ledger arrays.  A reveal: the seller pays the gas and
     locks the stake if the branch's balance covers both (the view's check, on the branch), and the
@@ -162,13 +162,13 @@ def include_tx(w, b, tx):
     return False
 
 
-@njit
+@njit(cache=True)
 def deposit_gas(w, n):
     """Gas of a deposit that settles n reveals (the world's deposit-gas table)."""
     return table_gas(w.chn_gas_n, w.chn_gas_deposit, n)
 
 
-@njit
+@njit(cache=True)
 def finish_deposit(w, b, tx):
     """After a deposit's settlement: the depositor pays the deposit's gas (never below a zero balance),
     and its delay from sending to this block is measured (first application only)."""
@@ -189,7 +189,7 @@ def end_of_step(settle):
     """The chain's end of a step (``make_blocks``) around ``settle(w, buyer, rng)``, the kernel's
     settlement (its payment rule's weights, then ``ledger.kernels.distribute``)."""
 
-    @njit
+    @njit(cache=False)  # captures compiled functions: see compiled_cache
     def apply_block(w, b, rng):
         """Apply block b's transactions, in order, to the ledger arrays (which hold its parent's state)."""
         for k in range(w.blk_ntx[b]):
@@ -198,7 +198,7 @@ def end_of_step(settle):
                 settle(w, w.mp_buyer[tx], rng)
                 finish_deposit(w, b, tx)
 
-    @njit
+    @njit(cache=False)  # captures compiled functions: see compiled_cache
     def make_blocks(w, rng):
         """Every signer whose turn has come (in signer-set order) makes a block on its head and applies it
         (logged, measured); the heaviest block is the canonical head, whose state the ledger arrays hold

@@ -8,7 +8,7 @@ from .mempool import REVEAL, drop_own, on_branch, refresh_view
 from .states import save_checkpoint, set_current
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def heavier(w, a, b):
     """Is block a heavier than block b: more total difficulty, or as much and a lower hash."""
     wa = w.blk_weight[a]
@@ -16,7 +16,7 @@ def heavier(w, a, b):
     return wa > wb or (wa == wb and w.blk_hash[a] < w.blk_hash[b])
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def ancestor_at(w, b, height):
     """The block on b's branch at ``height`` (b itself when b is not higher)."""
     while w.blk_height[b] > height:
@@ -24,7 +24,7 @@ def ancestor_at(w, b, height):
     return b
 
 
-@njit
+@njit(cache=True)
 def new_canonical(w, b):
     """Block b was made: if it is heavier than the canonical head it becomes the canonical head; when the
     old head is not on b's branch that is a reorganisation, and the old branch's transactions that b's
@@ -47,7 +47,7 @@ def new_canonical(w, b):
     return b
 
 
-@njit
+@njit(cache=True)
 def next_checkpoint(w):
     """The block after the checkpoint on the canonical branch if it is final: every robot's head
     descends from it, or it lies ``chn_final`` blocks or more below the canonical head.  Else -1."""
@@ -70,7 +70,7 @@ def next_checkpoint(w):
     return c
 
 
-@njit
+@njit(cache=True)
 def move_checkpoint(w, c):
     """Block c (whose state the ledger arrays hold) becomes the checkpoint: its state is saved, its
     transactions leave the mempool, and every block not descending from it is dropped; a robot whose

@@ -7,14 +7,14 @@ from .forks import ancestor_at, heavier
 from .mempool import chance, learn, nest_side, partitioned
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def heavier_than_view(w, b, i):
     """Is block b heavier than robot i's head (its cached weight and hash: the head may be dropped)?"""
     return w.blk_weight[b] > w.view_weight[i] or (w.blk_weight[b] == w.view_weight[i]
                                                    and w.blk_hash[b] < w.view_hash[i])
 
 
-@njit
+@njit(cache=True)
 def set_head(w, i, b):
     """Robot i's head becomes block b (a view reorganisation when its old head is not on b's branch)."""
     h = w.view_head[i]
@@ -28,7 +28,7 @@ def set_head(w, i, b):
     unlock(w.view_stale)[i] = True
 
 
-@njit
+@njit(cache=True)
 def adopt(w, i, b):
     """Robot i takes block b as its head if b is heavier than its head; True when it did."""
     if b == w.view_head[i] or not heavier_than_view(w, b, i):
@@ -37,7 +37,7 @@ def adopt(w, i, b):
     return True
 
 
-@njit
+@njit(cache=True)
 def deliver_block(w, b):
     """The backbone brings block b to every robot; during a partition only to the robots on its signer's
     side, and to the others once it ends (``gossip``)."""
@@ -52,7 +52,7 @@ def deliver_block(w, b):
         adopt(w, i, b)
 
 
-@njit
+@njit(cache=True)
 def gossip(w):
     """One gossip round at the start of a step: every robot hears each neighbour's head and pending
     transactions as they were when the round began (so news travels one hop per step), each message

@@ -10,7 +10,7 @@ from ...state.view import unlock
 from ..pool import reserve
 
 
-@njit
+@njit(cache=True)
 def append_node(w, buyer, prev, seq, seller, site, direction, step, stake):
     """The list node after ``prev`` (-1: a first one) of buyer's list recording reveal ``seq``: an
     existing one with the same content, else a new one (``ls_top``; the host keeps room).  A list is
@@ -43,14 +43,14 @@ def append_node(w, buyer, prev, seq, seller, site, direction, step, stake):
     return top
 
 
-@njit
+@njit(cache=True)
 def cached_weights(w, v, k):
     """The k weights cached for list node v (``cache_weights``), as the same array type a fresh weighing
     gives (the settlement reads them; only ledger operations may unlock ledger arrays)."""
     return unlock(w.weight_store)[w.ls_weights_at[v]:w.ls_weights_at[v] + k]
 
 
-@njit
+@njit(cache=True)
 def cache_weights(w, v, weights):
     """Keep the weights of list v (its ls_len[v] transactions) for the next settlement of the same list, if
     the cache has room (the host packs it with the lists)."""
@@ -65,7 +65,7 @@ def cache_weights(w, v, weights):
     unlock(w.weight_top)[0] = top + k
 
 
-@njit
+@njit(cache=True)
 def weighed_before(w, buyer):
     """Has the buyer's list in the state being applied (``state_list``) been weighed on some branch, with a
     scheme that reads nothing but the list (``chn_cache``)?"""
@@ -73,13 +73,13 @@ def weighed_before(w, buyer):
     return w.chn_cache and v >= 0 and w.ls_weights_at[v] >= 0
 
 
-@njit
+@njit(cache=True)
 def weights_of(w, buyer):
     """The weights kept for the buyer's list (``weighed_before``)."""
     return cached_weights(w, w.state_list[buyer], w.tx_count[buyer])
 
 
-@njit
+@njit(cache=True)
 def keep_weights(w, buyer, weights):
     """Keep the weights the scheme gave the buyer's list, when it reads nothing but the list."""
     v = w.state_list[buyer]
@@ -87,7 +87,7 @@ def keep_weights(w, buyer, weights):
         cache_weights(w, v, weights)
 
 
-@njit
+@njit(cache=True)
 def materialise(w, i):
     """Buyer i's open transactions in the ledger arrays' pool are its list in the current state
     (``state_list``): nothing to do if the pool holds that list; only the nodes after it if the pool holds a
@@ -121,7 +121,7 @@ def materialise(w, i):
     unlock(w.pool_list)[i] = v
 
 
-@njit
+@njit(cache=True)
 def materialise_all(w):
     """Every buyer's list of the current state in the pool (nothing to do unless a list changed since the
     last call: ``pool_stale``)."""

@@ -23,7 +23,7 @@ DEPOSIT = 1  #: buyItem + settle: a deposit (the depositing robot's; its reward 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def mix(x):
     """splitmix64's finaliser: a bijective scramble of a 64-bit word (``x`` uint64)."""
     x = (x ^ (x >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
@@ -31,7 +31,7 @@ def mix(x):
     return x ^ (x >> np.uint64(31))
 
 
-@njit
+@njit(cache=True)
 def chance(seed, a, b, c):
     """A uniform draw in [0, 1) that depends only on (seed, a, b, c), all non-negative integers."""
     x = mix(np.uint64(seed) + _GOLDEN)
@@ -41,25 +41,25 @@ def chance(seed, a, b, c):
     return float(x >> np.uint64(11)) * (1.0 / 9007199254740992.0)
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def knows(w, i, tx):
     """Does robot i know pending transaction ``tx`` (its bit in ``mp_known``)?"""
     return (w.mp_known[i, tx >> 6] >> np.uint64(tx & 63)) & np.uint64(1) != np.uint64(0)
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def learn(w, i, tx):
     unlock(w.mp_known)[i, tx >> 6] |= np.uint64(1) << np.uint64(tx & 63)
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def on_branch(w, b, tx):
     """Is pending transaction ``tx`` included on block b's branch after the checkpoint (``blk_included``)?
     Nothing is for b = -1 (a dropped head)."""
     return b >= 0 and (w.blk_included[b, tx >> 6] >> np.uint64(tx & 63)) & np.uint64(1) != np.uint64(0)
 
 
-@njit
+@njit(cache=True)
 def refresh_view(w, i):
     """Robot i's spendable money at its head: its balance there, less the gas and stakes of its own
     reveals that its head's branch does not include yet (in sending order; all of them when its branch
@@ -81,13 +81,13 @@ def refresh_view(w, i):
     unlock(w.view_avail)[i] = a
 
 
-@njit(forceinline=True)
+@njit(forceinline=True, cache=True)
 def partitioned(w, t):
     """Is the chain's network partitioned at step t (``[chain] partition``)?"""
     return w.chn_part_start <= t < w.chn_part_end
 
 
-@njit
+@njit(cache=True)
 def nest_side(w, i):
     """Is robot i on the nest's side of the perpendicular bisector of the first food site and the first
     nest (on it counts as the nest's side)?"""
@@ -103,7 +103,7 @@ def nest_side(w, i):
     return ((w.pos[i, 0] - 0.5 * (fx + nx)) * (nx - fx) + (w.pos[i, 1] - 0.5 * (fy + ny)) * (ny - fy)) >= 0.0
 
 
-@njit
+@njit(cache=True)
 def new_tx(w, kind, origin, buyer, seller, site, direction, stake, gas):
     """Put a transaction in the mempool, known to its sender (and to everyone at once through a backbone
     of zero latency).  The host keeps a free slot for every transaction a step can make."""
@@ -158,7 +158,7 @@ def new_tx(w, kind, origin, buyer, seller, site, direction, stake, gas):
     return x
 
 
-@njit
+@njit(cache=True)
 def drop_own(w, tx):
     """Take reveal ``tx`` out of its sender's list of own pending reveals."""
     i = w.mp_origin[tx]
@@ -173,7 +173,7 @@ def drop_own(w, tx):
         unlock(w.own_last)[i] = p
 
 
-@njit
+@njit(cache=True)
 def reveal(w, buyer, seller, site, direction):
     """A purchase in a chain world (``ledger.kernels.open_transaction``).  The seller signs the light
     contract only if its own view can pay: ``lock_stake_and_gas`` on its spendable money at its head
@@ -189,7 +189,7 @@ def reveal(w, buyer, seller, site, direction):
     return True
 
 
-@njit
+@njit(cache=True)
 def send_deposit(w, i):
     """Robot i deposited an item: a deposit transaction (buyItem, then settle) goes to the mempool; the
     reward and the payments move when a block includes it."""

@@ -6,7 +6,7 @@ from numba import njit
 from ...state.view import unlock
 
 
-@njit
+@njit(cache=True)
 def save_checkpoint(w):
     """The ledger arrays' state becomes the checkpoint's (``ck_*``).  Its buyers' lists of open
     transactions are not copied: the checkpoint is a live block, whose state keeps them (``bs_list``)."""
@@ -18,7 +18,7 @@ def save_checkpoint(w):
                  unlock(w.ck_rep_stake_lost), unlock(w.ck_rep_deposits), unlock(w.ck_gas_paid))
 
 
-@njit
+@njit(cache=True)
 def _copy_ledger(balance, pot, burned, tx_off, tx_cap, tx_count, pool_top, money, rep_settled, rep_reduced,
                  rep_earned, rep_stake_lost, rep_deposits, gas_paid, o_balance, o_pot, o_burned, o_tx_off, o_tx_cap,
                  o_tx_count, o_pool_top, o_money, o_rep_settled, o_rep_reduced, o_rep_earned, o_rep_stake_lost,
@@ -39,20 +39,20 @@ def _copy_ledger(balance, pot, burned, tx_off, tx_cap, tx_count, pool_top, money
     o_gas_paid[:] = gas_paid
 
 
-@njit
+@njit(cache=True)
 def same_state(w, a, b):
     """Do blocks a and b have the same state (the same row: one of them, or a block between, includes no
     transaction)?"""
     return w.blk_state[a] == w.blk_state[b]
 
 
-@njit
+@njit(cache=True)
 def set_current(w, b):
     """The ledger arrays now hold the state after block b."""
     unlock(w.state_block)[0] = b
 
 
-@njit
+@njit(cache=True)
 def save_state(w, b):
     """Block b's state (its row of ``blk_bal`` and ``bs_*``, ``blk_state``): the ledger arrays' (they hold the
     state after b), with each buyer's list as its node (``state_list``: nothing is copied)."""
@@ -76,7 +76,7 @@ def save_state(w, b):
     unlock(w.bs_money)[b] = w.money[0]
 
 
-@njit
+@njit(cache=True)
 def load_state(w, b):
     """The ledger arrays get block b's state (``save_state``), except the buyers' lists of open
     transactions, which ``materialise`` copies when they are needed.  ``state_block`` is then b."""
@@ -103,7 +103,7 @@ def load_state(w, b):
     unlock(w.state_block)[0] = b
 
 
-@njit
+@njit(cache=True)
 def ledger_at(w, target):
     """Make the ledger arrays hold the state after block ``target``: a copy of the state it keeps
     (``save_state``); nothing is applied again."""

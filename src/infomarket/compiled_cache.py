@@ -1,0 +1,112 @@
+"""numba's disk cache for infomarket's own compiled functions, keyed by the package's source.
+
+A step kernel inlines a few hundred helpers (the step's pieces, the ledgers, the built-in rules).  numba
+types and compiles each once per process, so a fresh process paid 8 to 12 CPU s before its first kernel of
+the plane, and 20 s more for the chain model's, whatever its kernel cache held.  With ``cache=True`` a
+helper is loaded instead: its signature and machine code, and its LLVM bitcode, which a new kernel still
+inlines.  numba's own locator stamps a function's cache with its file's time and size only, but a helper
+inlines helpers of other files; an edit there would leave it stale.  So a function of this package is cached
+in a folder named by the digest of every compiled part (``generated.freeze_package_digest``), numba's and
+Python's versions, and its file's own hash: any edit gives a fresh cache and never a stale one.
+
+Saving is one process at a time (``save_lock``, ``_numba_internals``): numba reads a function's index, adds its entry and writes
+it back, then writes the code. Two processes compiling one helper for two view types at once (two test
+workers, a sweep's) could then leave an index that names a file holding the other signature's code.
+
+Every ``@njit`` of the package says ``cache=``.  A closure that captures compiled functions says
+``cache=False``: numba keys a closure's cache by its captured values, pickled, and a compiled function
+pickles differently in every process, so each process would add an entry and none would find one.
+"""
+from __future__ import annotations
+
+import contextlib
+import functools
+import hashlib
+import sys
+from pathlib import Path
+
+import numba
+
+from . import _numba_internals as ni
+from .generated import cache_root, freeze_package_digest
+
+try:
+    import fcntl
+except ImportError:  # pragma: no cover - Windows: numba's saves as they are
+    fcntl = None
+
+_PACKAGE = Path(__file__).resolve().parent
+
+
+@functools.cache
+def compiled_root() -> Path:
+    """The folder of this code's cached functions: one per digest of the package and versions (an older one
+    is never read again: deleting it frees its space).  Fixed at the first function decorated: the code of
+    a process does not change."""
+    key = hashlib.sha256(f"{freeze_package_digest()} {numba.__version__} {sys.version}".encode()).hexdigest()
+    return cache_root() / "compiled" / key[:20]
+
+
+def _file_hash(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()[:16]
+
+
+def in_package(func) -> bool:
+    """Is ``func`` written in this package (a built-in rule), so cached here?  A user's rule is not cached:
+    numba's own cache would not see an edit of the helpers it calls."""
+    code = getattr(func, "__code__", None)
+    return code is not None and _PACKAGE in Path(code.co_filename).resolve().parents
+
+
+class PackageLocator(ni.CacheLocator):
+    """Where numba caches a function of this package (``compiled_root``), under its file's path in the package;
+    other functions (a user's rules, generated kernels) are left to numba's own locators."""
+
+    def __init__(self, py_file: Path, line: int):
+        self._py_file = str(py_file)  # numba's warning that a function cannot be cached names it
+        self._relative = py_file.relative_to(_PACKAGE)
+        self._root = compiled_root()
+        self._name = f"{line}-{_file_hash(py_file)}"
+
+    @classmethod
+    def from_function(cls, py_func, py_file):
+        path = Path(py_file).resolve()
+        if _PACKAGE not in path.parents or not path.is_file():
+            return None
+        return cls(path, py_func.__code__.co_firstlineno)
+
+    def get_cache_path(self) -> str:
+        return str(self._root / self._relative.parent)
+
+    def get_source_stamp(self) -> str:
+        return freeze_package_digest()  # the folder is named by it already: a fresh index is never stale
+
+    def get_disambiguator(self) -> str:
+        return self._name  # its line, and its file's own hash (for files outside the digest's compiled parts)
+
+
+@contextlib.contextmanager
+def _saving(root: Path):
+    """Hold the lock of ``root`` while a save reads and writes an index there (a few milliseconds)."""
+    root.mkdir(parents=True, exist_ok=True)
+    with open(root / "save.lock", "a") as fh:
+        fcntl.flock(fh, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(fh, fcntl.LOCK_UN)
+
+
+def save_lock(cache_path):
+    """The lock a save into ``cache_path`` takes: this package's cache's (one for all its functions), or None
+    (a cache elsewhere, or no ``fcntl``: numba's save as it is)."""
+    root, path = compiled_root(), Path(cache_path)
+    if fcntl is None or not (path == root or root in path.parents):
+        return None
+    return _saving(root)
+
+
+def install() -> None:
+    """Use ``PackageLocator`` and ``save_lock`` for every function decorated from now on (``cache=True``);
+    called by ``import infomarket`` before any of its compiled modules is imported."""
+    ni.install_cache(PackageLocator, save_lock)
