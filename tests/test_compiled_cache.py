@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import ast
 import fcntl
+import os
 import shutil
 import sys
 from pathlib import Path
@@ -13,7 +14,7 @@ import infomarket
 from infomarket import compiled_cache
 from infomarket import _numba_internals as ni
 from infomarket._numba_internals import CPUDispatcher
-from infomarket.compiled_cache import PackageLocator, in_package
+from infomarket.compiled_cache import KEPT, PackageLocator, in_package
 from infomarket.engine import step
 from infomarket.ledger.poa import blocks
 from infomarket.ledger import kernels
@@ -160,3 +161,20 @@ def test_no_cached_closure_captures_a_compiled_function():
                  if f.stats.cache_path is not None
                  and any(isinstance(c.cell_contents, CPUDispatcher) for c in f.py_func.__closure__)}
     assert offenders == set()
+
+
+def test_a_new_version_keeps_the_latest_used_folders_and_deletes_the_rest(tmp_path):
+    """Every edit of the package starts a folder of about 130 MB: the ``KEPT`` most recently used stay."""
+    parent = tmp_path / "compiled"
+    for k in range(6):
+        (parent / f"v{k}").mkdir(parents=True)
+        (parent / f"v{k}" / "used").touch()
+        os.utime(parent / f"v{k}" / "used", (1000 + k, 1000 + k))  # v5 used last
+    (parent / "v0" / "used").unlink()  # never marked: the oldest
+    root = compiled_cache.opened(parent / "new")
+    assert root == parent / "new" and (root / "used").exists()
+    assert sorted(p.name for p in parent.iterdir()) == sorted(["new", *(f"v{k}" for k in range(6 - KEPT + 1, 6))])
+    compiled_cache.opened(parent / "v3")  # a kept version's process comes back: marked used, nothing deleted
+    assert sorted(p.name for p in parent.iterdir()) == ["new", "v3", "v4", "v5"]
+    compiled_cache.opened(parent / "v1")  # a deleted one's: made again, and the least recently used goes
+    assert sorted(p.name for p in parent.iterdir()) == ["new", "v1", "v3", "v5"]

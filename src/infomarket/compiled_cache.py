@@ -22,6 +22,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import hashlib
+import shutil
 import sys
 from pathlib import Path
 
@@ -38,13 +39,39 @@ except ImportError:  # pragma: no cover - Windows: numba's saves as they are
 _PACKAGE = Path(__file__).resolve().parent
 
 
+#: How many versions of the package's compiled functions are kept (about 130 MB each), the most recently
+#: used: every edit of the package starts a new one.
+KEPT = 4
+
+
 @functools.cache
 def compiled_root() -> Path:
-    """The folder of this code's cached functions: one per digest of the package and versions (an older one
-    is never read again: deleting it frees its space).  Fixed at the first function decorated: the code of
-    a process does not change."""
+    """The folder of this code's cached functions: one per digest of the package and versions.  Fixed at the
+    first function decorated (the code of a process does not change); marked used, and on its creation all
+    but the ``KEPT`` most recently used folders beside it are deleted (an older version's is never read
+    again; a process still running one would compile again what it misses)."""
     key = hashlib.sha256(f"{freeze_package_digest()} {numba.__version__} {sys.version}".encode()).hexdigest()
-    return cache_root() / "compiled" / key[:20]
+    return opened(cache_root() / "compiled" / key[:20])
+
+
+def opened(root: Path) -> Path:
+    """``root``, marked used now; when it is new, the folders beside it pruned to the ``KEPT`` latest used."""
+    new = not root.exists()
+    with contextlib.suppress(OSError):  # a read-only cache: numba then finds it cannot write there
+        root.mkdir(parents=True, exist_ok=True)
+        (root / "used").touch()
+        if new:
+            folders = [p for p in root.parent.iterdir() if p.is_dir()]
+            for old in sorted(folders, key=_last_used, reverse=True)[KEPT:]:
+                shutil.rmtree(old, ignore_errors=True)
+    return root
+
+
+def _last_used(folder: Path) -> float:
+    try:
+        return (folder / "used").stat().st_mtime
+    except OSError:
+        return 0.0
 
 
 def _file_hash(path: Path) -> str:
