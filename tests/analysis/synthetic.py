@@ -22,23 +22,27 @@ RUNS_FIG7 = 8    # per condition: Holm over 6 angles needs p < 0.05 / 6; 8 vs 8 
 
 def _robots(name: str, groups: list[tuple[str, bool, int]], runs: int, rng, *, items, wealth,
             drift_sd: float = 0.05, condition: str = "base", keys: dict | None = None) -> pd.DataFrame:
-    """One row per robot per run; ``items(honest, n)`` and ``wealth(honest, n, drift)`` draw the values."""
-    frames = []
-    for run in range(runs):
-        behaviour = [b for b, _, c in groups for _ in range(c)]
-        honest = np.array([h for _, h, c in groups for _ in range(c)])
+    """One row per robot per run; ``items(honest, n)`` and ``wealth(honest, n, drift)`` draw the values
+    (run by run, in that order; the table is made once: a frame per run cost most of the tests' time)."""
+    behaviour = [b for b, _, c in groups for _ in range(c)]
+    honest = np.array([h for _, h, c in groups for _ in range(c)])
+    drifts, wealths, counts = [], [], []
+    for _ in range(runs):
         drift = rng.normal(0.0, drift_sd, ROBOTS)
-        w = np.where(honest, wealth(True, ROBOTS, drift), wealth(False, ROBOTS, drift))
-        df = pd.DataFrame({
-            "experiment": name, "condition": condition, "run": run, "seed": np.uint64(1000 + run),
-            "robot": np.arange(ROBOTS), "behaviour": behaviour, "honest": honest, "drift": drift,
-            "items_collected": np.where(honest, items(True, ROBOTS), items(False, ROBOTS)).astype(int),
-            "wealth": w, "wealth_share": w / w.sum(),
-        })
-        for k, v in (keys or {}).items():
-            df[k] = v
-        frames.append(df)
-    return pd.concat(frames, ignore_index=True)
+        drifts.append(drift)
+        wealths.append(np.where(honest, wealth(True, ROBOTS, drift), wealth(False, ROBOTS, drift)))
+        counts.append(np.where(honest, items(True, ROBOTS), items(False, ROBOTS)).astype(int))
+    w = np.concatenate(wealths)
+    df = pd.DataFrame({
+        "experiment": name, "condition": condition, "run": np.repeat(np.arange(runs), ROBOTS),
+        "seed": np.repeat(np.arange(1000, 1000 + runs, dtype=np.uint64), ROBOTS),
+        "robot": np.tile(np.arange(ROBOTS), runs), "behaviour": behaviour * runs, "honest": np.tile(honest, runs),
+        "drift": np.concatenate(drifts), "items_collected": np.concatenate(counts), "wealth": w,
+        "wealth_share": np.concatenate([x / x.sum() for x in wealths]),
+    })
+    for k, v in (keys or {}).items():
+        df[k] = v
+    return df
 
 
 def _runs(robots: pd.DataFrame, steps: int, transitory: int = 0, keys: tuple[str, ...] = ()) -> pd.DataFrame:
@@ -67,15 +71,16 @@ def _normal_wealth(rng, honest_mean, byz_mean, sd=0.3):
 def _fig5_history(robots: pd.DataFrame, rng) -> pd.DataFrame:
     """Wealth every 100 steps over 10 000 steps: honest robots gain ~1 per 100 steps, scaboteurs ~0."""
     steps = np.arange(0, 10_001, 100)
-    rows = []
-    for run, g in robots.groupby("run"):
-        for _, r in g.iterrows():
-            rate = 0.01 if r.honest else 0.0001
-            wealth = 1.0 + rate * steps * rng.uniform(0.8, 1.2)
-            rows.append(pd.DataFrame({"experiment": "fig5", "condition": "base", "run": run, "seed": r.seed,
-                                      "step": steps, "robot": r.robot, "wealth": wealth,
-                                      "honest": r.honest, "behaviour": r.behaviour}))
-    return pd.concat(rows, ignore_index=True)
+    rows = robots.sort_values(["run", "robot"], kind="stable")
+    rate = np.where(rows.honest, 0.01, 0.0001)
+    factor = rng.uniform(0.8, 1.2, len(rows))  # one draw per robot, run by run (the order of the old loop)
+    n = len(steps)
+    return pd.DataFrame({"experiment": "fig5", "condition": "base", "run": np.repeat(rows.run.to_numpy(), n),
+                         "seed": np.repeat(rows.seed.to_numpy().astype(np.int64), n), "step": np.tile(steps, len(rows)),
+                         "robot": np.repeat(rows.robot.to_numpy(), n),
+                         "wealth": (1.0 + rate[:, None] * steps * factor[:, None]).ravel(),
+                         "honest": np.repeat(rows.honest.to_numpy(), n),
+                         "behaviour": np.repeat(rows.behaviour.to_numpy(), n)})
 
 
 def _fig6_wealth(rng, noise: float):

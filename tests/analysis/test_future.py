@@ -18,33 +18,34 @@ ANGLES = (5.0, 10.0, 20.0, 25.0, 40.0, 90.0)
 RUNS = 8
 
 
-def _run_rows(experiment, defence, byz, angle, run, total, rng):
-    per = np.full(25, total // 25)
-    per[0] += total - per.sum()
-    condition = f"byzantines={byz},defence={defence}" + ("" if angle is None else f",rotation_angle={angle}")
-    return pd.DataFrame({
-        "experiment": experiment, "condition": condition, "run": run, "seed": np.uint64(run + 1),
-        "robot": np.arange(25), "behaviour": ["sceptical"] * (25 - byz) + ["scaboteur"] * byz,
-        "honest": [True] * (25 - byz) + [False] * byz, "drift": rng.normal(0, 0.05, 25),
-        "items_collected": per.astype(int), "wealth": 1.0, "wealth_share": 0.04,
-        "byzantines": byz, "defence": defence, "rotation_angle": np.nan if angle is None else angle})
-
-
 def sweep(items, runs: int = RUNS) -> pd.DataFrame:
     """``items(experiment, defence, byzantines, angle)`` -> the runs' swarm items around that value, with
-    the same spread (-3 .. +3) in every condition, so equal values give equal samples, never a p < 0.05."""
-    rng = np.random.default_rng(0)
-    rows = []
+    the same spread (-3 .. +3) in every condition, so equal values give equal samples, never a p < 0.05.
+    One row per robot per run; robot 0 carries the remainder of the swarm's items."""
+    cells = []  # (experiment, defence, byzantines, angle, run, swarm items)
     for d in future.DEFENCES:
-        for r in range(runs):
-            rows.append(_run_rows(future.HONEST, d, 0, None, r, items(future.HONEST, d, 0, None) + r % 7 - 3, rng))
+        cells += [(future.HONEST, d, 0, None, r, items(future.HONEST, d, 0, None) + r % 7 - 3) for r in range(runs)]
         for exp in future.ATTACKS:
             for byz in (1, 3):
                 for a in ANGLES:
-                    for r in range(runs):
-                        total = items(exp, d, byz, a) + r % 7 - 3
-                        rows.append(_run_rows(exp, d, byz, a, r, total, rng))
-    return pd.concat(rows, ignore_index=True)
+                    cells += [(exp, d, byz, a, r, items(exp, d, byz, a) + r % 7 - 3) for r in range(runs)]
+    rng = np.random.default_rng(0)
+    drift = np.concatenate([rng.normal(0, 0.05, 25) for _ in cells])
+    exp, defence, byz, angle, run, total = (np.array(c, dtype=object) for c in zip(*cells))
+    byz, total = byz.astype(int), total.astype(int)
+    per = np.repeat(total // 25, 25).reshape(-1, 25)
+    per[:, 0] += total - per.sum(axis=1)
+    robot = np.tile(np.arange(25), len(cells))
+    honest = robot < np.repeat(25 - byz, 25)
+    condition = [f"byzantines={b},defence={d}" + ("" if a is None else f",rotation_angle={a}")
+                 for b, d, a in zip(byz, defence, angle)]
+    return pd.DataFrame({
+        "experiment": np.repeat(exp, 25), "condition": np.repeat(np.array(condition, dtype=object), 25),
+        "run": np.repeat(run.astype(int), 25), "seed": np.repeat(run.astype(int) + 1, 25).astype(np.uint64),
+        "robot": robot, "behaviour": np.where(honest, "sceptical", "scaboteur").astype(object), "honest": honest,
+        "drift": drift, "items_collected": per.ravel(), "wealth": 1.0, "wealth_share": 0.04,
+        "byzantines": np.repeat(byz, 25), "defence": np.repeat(defence, 25),
+        "rotation_angle": np.repeat(np.array([np.nan if a is None else a for a in angle]), 25)})
 
 
 def hopeless(exp, d, byz, a):

@@ -122,6 +122,7 @@ def _with_counts(tmp_path: Path, every_count: bool) -> list[str]:
     args = list(TINY)
     args[args.index("--questions") + 1] = str(q)
     args[args.index("--byzantines") + 1] = "1,3"
+    args[args.index("--steps") + 1], args[args.index("--transitory") + 1] = "800", "300"  # runs' length: not the point
     return args
 
 

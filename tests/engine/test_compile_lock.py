@@ -3,7 +3,7 @@ lock (``interrupts.one_compiler``) and loads what the first cached, as two test 
 one machine would."""
 import sys
 
-from infomarket import interrupts
+from infomarket import compiled_cache, interrupts
 
 #: A child: waits for the start file (so both meet the kernel at once), builds a simulation of a small
 #: experiment, and prints how many times numba compiled its step loop in this process (0: loaded).
@@ -36,7 +36,10 @@ print(len(compiled))
 
 
 def test_two_processes_compile_a_new_kernel_once(procs, tmp_path):
-    env = {"INFOMARKET_CACHE_DIR": str(tmp_path / "cache")}  # an empty kernel cache: the kernel is new
+    cache = tmp_path / "cache"  # an empty kernel cache: the kernel is new; the step's pieces as cached already
+    cache.mkdir()
+    (cache / "compiled").symlink_to(compiled_cache.compiled_root().parent, target_is_directory=True)
+    env = {"INFOMARKET_CACHE_DIR": str(cache)}
     go = tmp_path / "go"
     children = [procs.start([sys.executable, "-c", CHILD, go], env=env, stdout=-1, stderr=-1, text=True)
                 for _ in range(2)]
