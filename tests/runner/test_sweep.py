@@ -4,6 +4,7 @@ import signal
 import sys
 import time
 from pathlib import Path
+from types import SimpleNamespace
 
 import pandas as pd
 import pytest
@@ -12,7 +13,7 @@ import infomarket as im
 from infomarket.cli import main
 from infomarket.errors import ConfigError
 from infomarket.runner.plan import conditions
-from infomarket.runner.sweep import plan, run_sweep
+from infomarket.runner.sweep import _alike, plan, run_sweep
 from infomarket.store import Store
 
 from ..procs import HANG
@@ -172,3 +173,56 @@ def test_killed_sweep_resumes_with_every_run_exactly_once(tmp_path, procs):
     robots = Store(out).robots()
     assert len(robots) == 48 * 10 and not robots.duplicated(["condition", "run", "robot"]).any()
     assert not list(out.rglob("*.tmp"))
+
+
+def test_conditions_are_labelled_together_only_when_one_column_types_their_keys_as_each_alone():
+    """A part's conditions get their key columns by repetition when their keys are the same and each key
+    has values of one type; otherwise (an int beside a float, a key one lacks) each is labelled alone and
+    pandas reconciles the columns, as it did."""
+    def members(*keys):
+        return [(SimpleNamespace(keys=k), (0,)) for k in keys]
+
+    assert _alike(members({"a": 1, "m": "x"}, {"a": 2, "m": "y"}))
+    assert not _alike(members({"a": 1}, {"a": 2.5}))
+    assert not _alike(members({"a": 1}, {"b": 1}))
+    assert not _alike(members({"a": 1, "b": 2}, {"b": 2, "a": 1}))  # another column order
+
+
+SAMPLED = """
+name = "sampled"
+steps = 2
+runs = 1
+seed = 4
+
+[swarm]
+robots = 6
+
+[[swarm.groups]]
+behaviour = "naive"
+count = 6
+
+[sweep.sample]
+method = "sobol"
+samples = 2
+outputs = ["items"]
+
+[sweep.sample.bounds]
+"payment.stake" = [0.0, 0.1]
+"robot.noise_sd" = [0.0, 0.1]
+"""
+
+
+def test_a_sampled_design_labels_each_run_with_its_own_point(tmp_path):
+    """Many conditions in one part: every robot row carries its own condition's id and sampled value."""
+    p = tmp_path / "sampled.toml"
+    p.write_text(SAMPLED)
+    out = tmp_path / "s"
+    assert main(["sweep", str(p), "--out", str(out), "--workers", "1", "--quiet"]) == 0
+    store = Store(out)
+    runs, robots = store.runs(), store.robots()
+    assert len(runs) == 12 and len(list((out / "runs").glob("*.parquet"))) < len(runs)  # grouped into parts
+    for _, r in runs.iterrows():
+        mine = robots[(robots.condition == r.condition) & (robots.run == r.run)]
+        assert len(mine) == 6 and (mine.experiment == "sampled").all()
+        assert ((mine.point == r.point) & (mine.stake == r.stake) & (mine.noise_sd == r.noise_sd)).all()
+    assert runs.point.nunique() == 12 and runs.stake.nunique() > 2 and runs.noise_sd.nunique() > 2

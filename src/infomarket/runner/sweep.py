@@ -93,55 +93,67 @@ def _concat(frames: list[pd.DataFrame]) -> pd.DataFrame | None:
     return pd.concat(frames, ignore_index=True) if frames else None
 
 
+#: The part's tables that hold one frame per run (``_frames``), and whether they take the condition's keys.
+_PER_RUN = {"robots": True, "history": False, "events": True, "payments": True, "sites": True, "chain": True}
+
+
 def _frames(task: Task, outputs: list[RunOutput]) -> dict[str, pd.DataFrame | None]:
     """The part's tables (None when empty): robots, history, events, payments, sites, the configurations
-    the runs used (one row per condition: ``Store.config`` rebuilds them) and the runs record."""
-    if task.more:
+    the runs used (one row per condition: ``Store.config`` rebuilds them) and the runs record.  The runs'
+    frames of each table are concatenated once and labelled with their conditions' columns by repetition
+    (labelling each run's frame, or each condition's, cost more than a short run itself)."""
+    members = task.members
+    if not _alike(members):  # conditions with other keys or key types: each labelled alone, as pandas types it
         parts, k = [], 0
-        for c, runs in task.members:
+        for c, runs in members:
             parts.append(_frames(Task(c, runs), outputs[k:k + len(runs)]))
             k += len(runs)
         return {t: _concat([p[t] for p in parts if p[t] is not None]) for t in parts[0]}
-    c = task.condition
+    frames = {t: ([], []) for t in _PER_RUN}  # table -> (the runs' frames, the condition of each)
+    rows, configs, k = [], [], 0
+    for c, runs in members:
+        for o, run in zip(outputs[k:k + len(runs)], runs):
+            if o.error is None:
+                history = o.history
+                if len(history):
+                    history = history.merge(o.robots[["robot", "honest", "behaviour"]], on="robot", how="left")
+                for t, df in (("robots", o.robots), ("history", history), ("events", o.events),
+                              ("payments", o.payments), ("sites", o.sites), ("chain", o.chain)):
+                    if len(df):
+                        frames[t][0].append(df)
+                        frames[t][1].append(c)
+            rows.append({"experiment": c.experiment, "condition": c.id, "run": np.int64(run),
+                         "seed": np.uint64(c.seed(run)), "master_seed": np.int64(c.master_seed),
+                         "config_hash": c.config.config_hash(), "package_version": __version__,
+                         "duration_s": o.run_seconds, "steps": o.steps, "transitory": c.config.transitory,
+                         "status": OK if o.error is None else FAILED, "error": o.error or "", **c.keys})
+        configs.append({"experiment": c.experiment, "condition": c.id, "config_hash": c.config.config_hash(),
+                        "config": config_json(c.config)})
+        k += len(runs)
+    out = {t: _labelled(*frames[t], keys) for t, keys in _PER_RUN.items()}
+    return {**out, "configs": pd.DataFrame(configs), "runs": pd.DataFrame(rows)}
 
-    def labelled(frames: list[pd.DataFrame], keys: bool) -> pd.DataFrame | None:
-        """The runs' frames as one, with the condition's columns: labelled once, after concatenating (a
-        column set on each run's frame cost more than the run itself for short runs)."""
-        df = _concat(frames)
-        if df is None:
-            return None
-        df.insert(0, "experiment", c.experiment)
-        df.insert(1, "condition", c.id)
-        if keys:
-            for k, v in c.keys.items():
-                df[k] = v
-        return df
 
-    robots, hists, events, payments, sites, chains, rows = [], [], [], [], [], [], []
-    for o, run in zip(outputs, task.runs):
-        if o.error is None:
-            robots.append(o.robots)
-            if len(o.history):
-                meta = o.robots[["robot", "honest", "behaviour"]]
-                hists.append(o.history.merge(meta, on="robot", how="left"))
-            if len(o.events):
-                events.append(o.events)
-            if len(o.payments):
-                payments.append(o.payments)
-            if len(o.sites):
-                sites.append(o.sites)
-            if len(o.chain):
-                chains.append(o.chain)
-        rows.append({"experiment": c.experiment, "condition": c.id, "run": np.int64(run),
-                     "seed": np.uint64(c.seed(run)), "master_seed": np.int64(c.master_seed),
-                     "config_hash": c.config.config_hash(), "package_version": __version__,
-                     "duration_s": o.run_seconds, "steps": o.steps, "transitory": c.config.transitory,
-                     "status": OK if o.error is None else FAILED, "error": o.error or "", **c.keys})
-    configs = pd.DataFrame([{"experiment": c.experiment, "condition": c.id, "config_hash": c.config.config_hash(),
-                             "config": config_json(c.config)}])
-    return {"robots": labelled(robots, True), "history": labelled(hists, False), "events": labelled(events, True),
-            "payments": labelled(payments, True), "sites": labelled(sites, True), "configs": configs,
-            "chain": labelled(chains, True), "runs": pd.DataFrame(rows)}
+def _alike(members) -> bool:
+    """Do these conditions have the same keys, each with values of one type (so one column types them all
+    as pandas typed each condition's)?"""
+    names = [tuple(c.keys) for c, _ in members]
+    return all(n == names[0] for n in names) and all(
+        len({type(c.keys[k]) for c, _ in members}) == 1 for k in names[0])
+
+
+def _labelled(frames: list[pd.DataFrame], conditions: list, keys: bool) -> pd.DataFrame | None:
+    """``frames`` as one, with the experiment, condition and (``keys``) key columns of each frame's condition."""
+    if not frames:
+        return None
+    df = pd.concat(frames, ignore_index=True)
+    counts = [len(f) for f in frames]
+    df.insert(0, "experiment", np.repeat(np.array([c.experiment for c in conditions], dtype=object), counts))
+    df.insert(1, "condition", np.repeat(np.array([c.id for c in conditions], dtype=object), counts))
+    if keys:
+        for k in conditions[0].keys:
+            df[k] = np.repeat(np.array([c.keys[k] for c in conditions]), counts)
+    return df
 
 
 def config_json(cfg: Experiment) -> str:
