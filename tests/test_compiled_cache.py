@@ -22,14 +22,45 @@ from infomarket.ledger import kernels
 
 PACKAGE = Path(infomarket.__file__).parent
 
-_OUTER = "from numba import njit\n\nfrom ._probe_inner import inner\n\n\n@njit(cache=True)\ndef outer(x):\n    return 2 * inner(x)\n"
-_INNER = "from numba import njit\n\n\n@njit(forceinline=True, cache=True)\ndef inner(x):\n    return x + {}\n"
-#: a function numba cannot cache (it calls C through ctypes): numba warns, naming its file, and runs it
-_UNCACHEABLE = ("import ctypes\n\nfrom numba import njit\n\n_labs = ctypes.CDLL(None).labs\n_labs.restype = ctypes.c_long\n"
-                "_labs.argtypes = [ctypes.c_long]\n\n\n@njit(cache=True)\ndef absolute(x):\n    return _labs(x)\n")
-_RUN = ("import sys\nsys.path.insert(0, {!r})\nimport infomarket\nassert infomarket.__file__.startswith(sys.path[0])\n"
-        "from infomarket.engine._probe_outer import outer\nfrom infomarket.engine._probe_uncacheable import absolute\n"
-        "print(outer(1), sum(outer.stats.cache_hits.values()), absolute(-3))\n")
+#: Two files of the package copied for the test: ``outer`` inlines ``inner``, which the test edits.
+_OUTER = """from numba import njit
+
+from ._probe_inner import inner
+
+
+@njit(cache=True)
+def outer(x):
+    return 2 * inner(x)
+"""
+_INNER = """from numba import njit
+
+
+@njit(forceinline=True, cache=True)
+def inner(x):
+    return x + {}
+"""
+#: A function numba cannot cache (it calls C through ctypes): numba warns, naming its file, and runs it.
+_UNCACHEABLE = """import ctypes
+
+from numba import njit
+
+_labs = ctypes.CDLL(None).labs
+_labs.restype = ctypes.c_long
+_labs.argtypes = [ctypes.c_long]
+
+
+@njit(cache=True)
+def absolute(x):
+    return _labs(x)
+"""
+_RUN = """import sys
+sys.path.insert(0, {!r})
+import infomarket
+assert infomarket.__file__.startswith(sys.path[0])
+from infomarket.engine._probe_outer import outer
+from infomarket.engine._probe_uncacheable import absolute
+print(outer(1), sum(outer.stats.cache_hits.values()), absolute(-3))
+"""
 
 
 def test_an_edited_helper_is_not_loaded_stale_through_a_function_of_another_file(procs, tmp_path):

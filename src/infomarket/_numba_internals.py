@@ -86,7 +86,7 @@ for _method in _INDEX_METHODS:
 
 
 class _OrderedIndex(IndexDataCacheFile):
-    """numba's index and data files of one function, whose ``save`` (where ``_LOCK(cache_path)`` gives a
+    """numba's index and data files of one function, whose ``save`` (where ``_save_lock(cache_path)`` gives a
     lock) runs under that lock and writes the code before the index entry that names it; elsewhere
     exactly numba's.  numba's own reads the index, writes it back with the new entry, then writes the code:
     two processes saving two signatures at once could both take one file name, and leave an index that
@@ -97,7 +97,7 @@ class _OrderedIndex(IndexDataCacheFile):
         self._folder = cache_path
 
     def save(self, key, data):
-        lock = _LOCK[0](self._folder)
+        lock = _save_lock(self._folder) if _save_lock is not None else None
         if lock is None:
             return super().save(key, data)
         with lock:
@@ -111,16 +111,18 @@ class _OrderedIndex(IndexDataCacheFile):
             self._save_index(overloads)
 
 
-_LOCK = [lambda cache_path: None]
+#: ``install_cache``'s ``lock``
+_save_lock = None
 
 
 def install_cache(locator, lock) -> None:
     """Offer every function cached from now on to ``locator`` first (a ``CacheLocator``), and save each
     cache whose folder ``lock(folder)`` gives a lock for (a context manager; None: numba's save) in order,
     under that lock (``_OrderedIndex``: numba's ``Cache`` makes its index by the module-level name)."""
+    global _save_lock
     if locator not in _locators:
         _locators.insert(0, locator)
-    _LOCK[0] = lock
+    _save_lock = lock
     caching.IndexDataCacheFile = _OrderedIndex
 
 

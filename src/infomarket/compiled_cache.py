@@ -1,17 +1,18 @@
 """numba's disk cache for infomarket's own compiled functions, keyed by the package's source.
 
 A step kernel inlines a few hundred helpers (the step's pieces, the ledgers, the built-in rules).  numba
-types and compiles each once per process, so a fresh process paid 8 to 12 CPU s before its first kernel of
-the plane, and 20 s more for the chain model's, whatever its kernel cache held.  With ``cache=True`` a
-helper is loaded instead: its signature and machine code, and its LLVM bitcode, which a new kernel still
-inlines.  numba's own locator stamps a function's cache with its file's time and size only, but a helper
-inlines helpers of other files; an edit there would leave it stale.  So a function of this package is cached
-in a folder named by the digest of every compiled part (``generated.freeze_package_digest``), numba's and
-Python's versions, and its file's own hash: any edit gives a fresh cache and never a stale one.
+types and compiles each once per process: most of what a fresh process spent on its first kernel, whatever
+its kernel cache held (docs/testing.md, "A fifth round").  With ``cache=True`` a helper is loaded instead:
+its signature and machine code, and its LLVM bitcode, which a new kernel still inlines.  numba's own locator
+stamps a function's cache with its file's time and size only, but a helper inlines helpers of other files;
+an edit there would leave it stale.  So a function of this package is cached in a folder named by the
+digest of every compiled part (``generated.freeze_package_digest``), numba's and Python's versions, and its
+file's own hash: any edit gives a fresh cache and never a stale one.
 
-Saving is one process at a time (``save_lock``, ``_numba_internals``): numba reads a function's index, adds its entry and writes
-it back, then writes the code. Two processes compiling one helper for two view types at once (two test
-workers, a sweep's) could then leave an index that names a file holding the other signature's code.
+Saving is one process at a time (``save_lock``; the ordered save is in ``_numba_internals``): numba reads a
+function's index, adds its entry and writes it back, then writes the code. Two processes compiling one
+helper for two view types at once (two test workers, a sweep's) could then leave an index that names a
+file holding the other signature's code.
 
 Every ``@njit`` of the package says ``cache=``.  A closure that captures compiled functions says
 ``cache=False``: numba keys a closure's cache by its captured values, pickled, and a compiled function
@@ -39,8 +40,8 @@ except ImportError:  # pragma: no cover - Windows: numba's saves as they are
 _PACKAGE = Path(__file__).resolve().parent
 
 
-#: How many versions of the package's compiled functions are kept (about 130 MB each), the most recently
-#: used: every edit of the package starts a new one.
+#: How many versions of the package's compiled functions are kept, the most recently used: every edit of the
+#: package starts a new one, which holds every piece compiled for that version.
 KEPT = 4
 
 
