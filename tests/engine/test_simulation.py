@@ -195,3 +195,20 @@ def test_seeds_have_one_range_in_files_the_api_and_the_command_line(capsys):
     with pytest.raises(SystemExit) as exc:
         main(["run", "fig2A", "--seed", str(2**63), "--runs", "1"])
     assert exc.value.code == 2 and "2**63 - 1" in capsys.readouterr().err
+
+
+def test_a_results_tables_are_its_own_when_the_runs_record_nothing():
+    """Runs that record no events share the empty tables' making (``simulation._empty``) and the behaviour
+    column's (``_categories``): what one result's owner does to them reaches no other result."""
+    cfg = im.load_experiment("fig2B").with_overrides(steps=50)
+    first = im.simulate(cfg, seed=1)
+    assert first.events.empty and first.payments.empty and first.history.empty
+    for table in (first.events, first.payments, first.history):
+        table.insert(0, "run", np.int64(0))  # as the runner labels a table
+    first.robots.loc[0, "behaviour"] = "saboteur"  # robot 0 is naive
+    second = im.simulate(cfg, seed=1)
+    assert "run" not in second.events and "run" not in second.payments and "run" not in second.history
+    assert second.robots.behaviour.iloc[0] == "naive"
+    assert list(second.events.columns) == ["step", "kind", "buyer", "seller", "site", "direction_deg", "x", "y",
+                                           "age", "stake", "seller_x", "seller_y"]
+    assert str(second.events.kind.dtype) == "category" and second.events.step.dtype == np.int64

@@ -8,6 +8,7 @@ robot per step: the kernel advances the whole swarm for as many steps as asked i
 from __future__ import annotations
 
 import copy
+import functools
 import os
 import sys
 import threading
@@ -39,6 +40,25 @@ from ..config.load import validate
 #: Robot-steps one kernel call may run (``Simulation.advance_to``): a bound on the work between two
 #: moments when Python can act on a signal, small beside a run and large beside a call's own cost.
 CALL_ROBOT_STEPS = 1 << 17
+
+
+#: Empty tables of a run that recorded nothing, made once per table and world type (whose spec fixes the
+#: dtypes) and copied: most runs of a study record no events or history, and making an empty DataFrame
+#: cost more than copying one.
+_EMPTY: dict = {}
+
+
+def _empty(key, make) -> pd.DataFrame:
+    if key not in _EMPTY:
+        _EMPTY[key] = make()
+    return _EMPTY[key].copy()
+
+
+@functools.lru_cache(maxsize=64)
+def _categories(names: tuple[str, ...]) -> pd.Categorical:
+    """The robots' behaviours as a categorical column, made once per swarm (the same run after run); a
+    DataFrame made from a dict copies it, so no result shares it."""
+    return pd.Categorical(list(names))
 
 
 @dataclass
@@ -202,15 +222,15 @@ class Simulation:
         robots = pd.DataFrame({
             "seed": np.full(len(honest), self.seed, dtype=np.uint64),
             "robot": np.arange(len(honest), dtype=np.int64),
-            "behaviour": pd.Categorical(self.behaviour_names),
+            "behaviour": _categories(tuple(self.behaviour_names)),
             "honest": honest,
             "drift": w.bias.copy(),
             "items_collected": w.items.copy(),
             "wealth": w.balance.copy(),
             "wealth_share": w.balance / total if total > 0 else np.zeros(len(honest)),
         })
-        history = pd.DataFrame(columns=["step", "robot", "wealth"])
         rows = min(w.hist.shape[0], self.clock // w.hist_every) if w.hist_every else 0
+        history = _empty("history", lambda: pd.DataFrame(columns=["step", "robot", "wealth"]))
         if rows:
             n = w.pos.shape[0]
             history = pd.DataFrame({
@@ -218,18 +238,24 @@ class Simulation:
                 "robot": np.tile(np.arange(n), rows),
                 "wealth": w.hist[:rows].ravel(),
             })
-        k = int(w.ev_count[0])
-        events = pd.DataFrame({
-            "step": w.ev_step[:k], "kind": pd.Categorical.from_codes(w.ev_kind[:k], EVENT_NAMES),
-            "buyer": w.ev_buyer[:k], "seller": w.ev_seller[:k], "site": w.ev_site[:k],
-            "direction_deg": w.ev_dir[:k], "x": w.ev_x[:k], "y": w.ev_y[:k], "age": w.ev_age[:k],
-            "stake": w.ev_stake[:k], "seller_x": w.ev_sx[:k], "seller_y": w.ev_sy[:k],
-        })
-        k = int(w.pay_count[0])
-        payments = pd.DataFrame({
-            "step": w.pay_step[:k], "buyer": w.pay_buyer[:k], "seller": w.pay_seller[:k],
-            "site": w.pay_site[:k], "weight": w.pay_weight[:k], "amount": w.pay_amount[:k],
-        })
+
+        def events_of(k: int) -> pd.DataFrame:
+            return pd.DataFrame({
+                "step": w.ev_step[:k], "kind": pd.Categorical.from_codes(w.ev_kind[:k], EVENT_NAMES),
+                "buyer": w.ev_buyer[:k], "seller": w.ev_seller[:k], "site": w.ev_site[:k],
+                "direction_deg": w.ev_dir[:k], "x": w.ev_x[:k], "y": w.ev_y[:k], "age": w.ev_age[:k],
+                "stake": w.ev_stake[:k], "seller_x": w.ev_sx[:k], "seller_y": w.ev_sy[:k],
+            })
+
+        def payments_of(k: int) -> pd.DataFrame:
+            return pd.DataFrame({
+                "step": w.pay_step[:k], "buyer": w.pay_buyer[:k], "seller": w.pay_seller[:k],
+                "site": w.pay_site[:k], "weight": w.pay_weight[:k], "amount": w.pay_amount[:k],
+            })
+
+        k, j = int(w.ev_count[0]), int(w.pay_count[0])
+        events = events_of(k) if k else _empty(("events", type(w)), lambda: events_of(0))
+        payments = payments_of(j) if j else _empty(("payments", type(w)), lambda: payments_of(0))
         totals = {"wealth": total, "pots": float(w.pot.sum()), "burned": float(w.burned[0]),
                   "items": int(w.items.sum())}
         if self.config.terrain:
