@@ -75,6 +75,7 @@ def _last_used(folder: Path) -> float:
         return 0.0
 
 
+@functools.cache
 def _file_hash(path: Path) -> str:
     return hashlib.sha256(path.read_bytes()).hexdigest()[:16]
 

@@ -110,8 +110,7 @@ class Simulation:
         t0 = time.perf_counter()
         try:
             with compile_notice(self.kinds, config.payment.scheme):
-                self._kernel = specialise.kernel_module(self.kinds, config.payment.scheme, config.terrain,
-                                                        config.chain.enabled)
+                self._kernel = _kernel_for(self.kinds, config)
                 self._view = interrupts.compiled_apart(self._load, compile_marker(self._kernel, "simulation"))
         except Exception as exc:  # a rule that keeps the kernel from compiling: named
             raise _explained(config, self.seed, exc) from exc
@@ -230,14 +229,12 @@ class Simulation:
             "wealth_share": w.balance / total if total > 0 else np.zeros(len(honest)),
         })
         rows = min(w.hist.shape[0], self.clock // w.hist_every) if w.hist_every else 0
-        history = _empty("history", lambda: pd.DataFrame(columns=["step", "robot", "wealth"]))
-        if rows:
-            n = w.pos.shape[0]
-            history = pd.DataFrame({
-                "step": np.repeat((np.arange(rows) + 1) * w.hist_every, n),
-                "robot": np.tile(np.arange(n), rows),
-                "wealth": w.hist[:rows].ravel(),
-            })
+        n = w.pos.shape[0]
+        history = pd.DataFrame({
+            "step": np.repeat((np.arange(rows) + 1) * w.hist_every, n),
+            "robot": np.tile(np.arange(n), rows),
+            "wealth": w.hist[:rows].ravel(),
+        }) if rows else _empty("history", lambda: pd.DataFrame(columns=["step", "robot", "wealth"]))
 
         def events_of(k: int) -> pd.DataFrame:
             return pd.DataFrame({
@@ -355,13 +352,17 @@ def quiet_compiles():
         yield
 
 
+def _kernel_for(kinds: tuple[str, ...], config: Experiment):
+    """The generated kernel module that runs ``config`` with these behaviours in kind order."""
+    return specialise.kernel_module(kinds, config.payment.scheme, config.terrain, config.chain.enabled)
+
+
 def kernel_marker(config: Experiment) -> Path | None:
     """The marker (``generated.compile_marker``) that says the kernel ``Simulation(config)`` runs on is
     compiled and in the cache; None where it cannot say (a kernel outside the cache folder, or one whose
     module does not load: ``Simulation`` then meets the error)."""
     try:
-        kernel = specialise.kernel_module(behaviour_kinds(config), config.payment.scheme, config.terrain,
-                                          config.chain.enabled)
+        kernel = _kernel_for(behaviour_kinds(config), config)
     except Exception:  # noqa: BLE001 - Simulation(config) reports it, named
         return None
     return compile_marker(kernel, "simulation")
