@@ -329,35 +329,43 @@ def compiled_together(work: Callable[[], object], markers) -> None:
     if (not _state.active or not hasattr(os, "fork") or threading.current_thread() is not threading.main_thread()
             or all(m is None or m.exists() for m in markers)):
         return
-    parent = os.getpid()
-    pid = os.fork()
-    if pid == 0:  # pragma: no cover - the child (its coverage is not collected)
-        code = 1
-        try:
-            detach(parent)
-            _TOGETHER.child = True
-            work()
-            code = 0
-        except BaseException:  # noqa: BLE001 - the parent meets it again
-            pass
-        finally:
-            os._exit(code)
-    _wait(pid)  # a signal raises KeyboardInterrupt here, at once
+
+    def child() -> None:
+        _TOGETHER.child = True
+        work()
+
+    _forked(child)
     check()
 
 
-def _wait(pid: int) -> None:
-    """Wait for the child ``pid`` to end, polling: a stop signal raises here within 50 ms whichever thread of
-    this process it landed on.  A blocking ``waitpid`` missed one that another thread (a progress bar's, a
-    notice's timer) took while this one held the signals for the fork: it then waited for the whole compile.
-    On any exception the child is killed with its group and reaped before it propagates."""
+def _forked(work: Callable[[], object]) -> None:
+    """Run ``work`` in a forked child (``detach``ed; it exits 0, or 1 on any exception) and wait for it,
+    polling: a stop signal raises here within 50 ms whichever thread of this process it landed on (a
+    blocking ``waitpid`` missed one that another thread, a progress bar's or a notice's timer, took while
+    this one held the signals for the fork).  On any exception the child is killed with its group and
+    reaped before it propagates; a stop is held back from the fork until then (``held``): let through
+    between the fork and the wait, it left the child running, its pid lost."""
+    parent, pid = os.getpid(), 0
     try:
+        with held():
+            pid = os.fork()
+            if pid == 0:  # pragma: no cover - the child (its coverage is not collected)
+                code = 1
+                try:
+                    detach(parent)
+                    work()
+                    code = 0
+                except BaseException:  # noqa: BLE001 - the parent meets it again
+                    pass
+                finally:
+                    os._exit(code)
         while os.waitpid(pid, os.WNOHANG) == (0, 0):
             time.sleep(0.05)
     except BaseException:
-        kill_group(pid)
-        with contextlib.suppress(ChildProcessError):
-            os.waitpid(pid, 0)
+        if pid:
+            kill_group(pid)
+            with contextlib.suppress(ChildProcessError):
+                os.waitpid(pid, 0)
         raise
 
 
@@ -391,23 +399,18 @@ def one_compiler(marker: Path | None):
 
 
 def _in_child(compile_: Callable[[], T], marker: Path) -> T:
-    parent = os.getpid()
     with tempfile.TemporaryFile() as failure:
-        pid = os.fork()
-        if pid == 0:  # pragma: no cover - the child (its coverage is not collected)
-            code = 1
+        def work() -> None:
             try:
-                detach(parent)
                 compile_()
                 marker.touch()
-                code = 0
-            except Exception as exc:  # noqa: BLE001 - handed to the parent, which raises it
+            except Exception as exc:  # handed to the parent, which raises it
                 with contextlib.suppress(Exception):
                     failure.write(pickle.dumps(exc))
                     failure.flush()
-            finally:
-                os._exit(code)
-        _wait(pid)  # a signal raises KeyboardInterrupt here, at once
+                raise
+
+        _forked(work)
         failure.seek(0)
         error = _unpickled(failure.read())
     if error is not None:
