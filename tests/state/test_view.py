@@ -4,6 +4,8 @@ and the one reference the host holds is not leaked by calls."""
 import re
 
 import numba
+import numpy as np
+import pytest
 from numba import njit
 
 from infomarket.engine.step import variant
@@ -11,7 +13,7 @@ from infomarket.engine.step import variant
 STEP = variant(terrain=False, paths=False)
 find_neighbours, begin_communication, install_table, forage, behaviour_step, move = (
     STEP.find_neighbours, STEP.begin_communication, STEP.install_table, STEP.forage, STEP.behaviour_step, STEP.move)
-from infomarket.state.view import BorrowedArray, GuardedArray, WorldType, layout_type
+from infomarket.state.view import BorrowedArray, GuardedArray, WorldType, layout_type, view_module
 
 from ..conftest import Handle, make_config
 
@@ -138,3 +140,19 @@ def test_a_rule_that_writes_a_balance_does_not_compile():
         njit(thief_buy)(h.view, 0, nbrs)
     njit(honest_buy)(h.view, 0, nbrs)
     assert not h.world.new_valid[0, 0]
+
+
+def test_a_view_is_the_hosts_own_memory_and_scalars_and_a_field_of_another_kind_is_refused():
+    @njit
+    def read(w):
+        w.items[1] = 9  # written through the view: the host's array
+        return w.pos[2, 1], w.nbr.shape[1], w.width, w.transitory
+
+    h = Handle(make_config(3))
+    h.world.pos[2, 1] = 4.25
+    y, cols, width, transitory = read(h.view)
+    assert (y, cols, width, transitory) == (4.25, h.world.nbr.shape[1], h.world.width, h.world.transitory)
+    assert h.world.items[1] == 9
+    wrong = h.world._replace(pos=h.world.pos.astype(np.float32))
+    with pytest.raises(TypeError, match=r"'pos' is array\(float32"):
+        view_module("world").make_view(wrong)
