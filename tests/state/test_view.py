@@ -2,6 +2,7 @@
 line (an atomic add behind a call), so reading a field or passing the handle to a rule must emit none;
 and the one reference the host holds is not leaked by calls."""
 import re
+from collections import namedtuple
 
 import numba
 import numpy as np
@@ -13,7 +14,7 @@ from infomarket.engine.step import variant
 STEP = variant(terrain=False, paths=False)
 find_neighbours, begin_communication, install_table, forage, behaviour_step, move = (
     STEP.find_neighbours, STEP.begin_communication, STEP.install_table, STEP.forage, STEP.behaviour_step, STEP.move)
-from infomarket.state.view import BorrowedArray, GuardedArray, WorldType, layout_type, view_module
+from infomarket.state.view import BorrowedArray, GuardedArray, WorldType, layout_type, make_view
 
 from ..conftest import Handle, make_config
 
@@ -155,4 +156,9 @@ def test_a_view_is_the_hosts_own_memory_and_scalars_and_a_field_of_another_kind_
     assert h.world.items[1] == 9
     wrong = h.world._replace(pos=h.world.pos.astype(np.float32))
     with pytest.raises(TypeError, match=r"'pos' is array\(float32"):
-        view_module("world").make_view(wrong)
+        make_view("world", wrong)
+    names = list(type(h.world)._fields)
+    names[:2] = names[1::-1]
+    swapped = namedtuple("Swapped", names)(**h.world._asdict())
+    with pytest.raises(TypeError, match="does not hold the fields of layout 'world' in its order"):
+        make_view("world", swapped)
