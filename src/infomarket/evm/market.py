@@ -203,36 +203,32 @@ def connect(rpc_url: str | None = None, backend: str | None = None):
 
 
 class _Codec:
-    """The contract's ABI: calldata encoding, result, event and error decoding."""
+    """The contract's ABI: calldata encoding, result, event and error decoding.  Each function's selector and
+    types, and each event's layout, are worked out once: a replay encodes and decodes tens of thousands."""
 
     def __init__(self, abi: list):
         self.abi = abi
-        self.functions = {e["name"]: e for e in abi if e["type"] == "function"}
-        self.events = {event_abi_to_log_topic(e): e for e in abi if e["type"] == "event"}
+        self.functions = {e["name"]: (function_abi_to_4byte_selector(e), get_abi_input_types(e),
+                                      get_abi_output_types(e)) for e in abi if e["type"] == "function"}
+        self.events = {event_abi_to_log_topic(e): _EventLayout.of(e) for e in abi if e["type"] == "event"}
         self.errors = _error_table(abi)
 
     def calldata(self, name: str, args: tuple) -> bytes:
-        fn = self.functions[name]
-        return function_abi_to_4byte_selector(fn) + abi_encode(get_abi_input_types(fn), list(args))
+        selector, inputs, _ = self.functions[name]
+        return selector + abi_encode(inputs, list(args))
 
     def result(self, name: str, data: bytes) -> Any:
-        fn = self.functions[name]
-        values = abi_decode(get_abi_output_types(fn), data)
+        values = abi_decode(self.functions[name][2], data)
         return values[0] if len(values) == 1 else values
 
     def decode_event(self, topics: list[bytes], data: bytes) -> Event | None:
-        abi = self.events.get(topics[0]) if topics else None
-        if abi is None:
+        layout = self.events.get(topics[0]) if topics else None
+        if layout is None:
             return None
-        indexed = [i for i in abi["inputs"] if i["indexed"]]
-        plain = [i for i in abi["inputs"] if not i["indexed"]]
-        args = {}
-        for inp, topic in zip(indexed, topics[1:]):
-            args[inp["name"]] = abi_decode([inp["type"]], topic)[0]
-        for inp, value in zip(plain, abi_decode([i["type"] for i in plain], data)):
-            args[inp["name"]] = value
-        names = [i["name"] for i in abi["inputs"]]
-        return Event(abi["name"], {k: _checksum(args[k]) for k in names})
+        # each topic is one 32-byte word: together, the encoding of the indexed inputs as one static tuple
+        args = dict(zip(layout.indexed_names, abi_decode(layout.indexed_types, b"".join(topics[1:]))))
+        args.update(zip(layout.plain_names, abi_decode(layout.plain_types, data)))
+        return Event(layout.name, {k: _checksum(args[k]) for k in layout.names})
 
     def refusal(self, data: bytes) -> ContractRevert | None:
         if len(data) < 4 or data[:4] not in self.errors:
@@ -240,6 +236,25 @@ class _Codec:
         name, names, types = self.errors[data[:4]]
         values = [_checksum(v) for v in abi_decode(types, data[4:])]
         return ContractRevert(name, dict(zip(names, values)), data)
+
+
+class _EventLayout(NamedTuple):
+    """An event's name, its indexed and its other inputs' names and types, and the order of all its
+    inputs.  The contract indexes value types only, each a topic word as it is."""
+
+    name: str
+    indexed_names: list[str]
+    indexed_types: list[str]
+    plain_names: list[str]
+    plain_types: list[str]
+    names: list[str]
+
+    @classmethod
+    def of(cls, abi: dict) -> "_EventLayout":
+        plain = [i for i in abi["inputs"] if not i["indexed"]]
+        indexed = [i for i in abi["inputs"] if i["indexed"]]
+        return cls(abi["name"], [i["name"] for i in indexed], [i["type"] for i in indexed],
+                   [i["name"] for i in plain], [i["type"] for i in plain], [i["name"] for i in abi["inputs"]])
 
 
 def _checksum(value):

@@ -185,7 +185,9 @@ def _separator(domain: Domain) -> bytes:
                               domain.chain_id, checksum(domain.verifying_contract)]))
 
 
+@functools.lru_cache(maxsize=256)
 def _offer_hash(offer: Offer) -> bytes:
+    """The offer's struct hash; remembered, as the seller signs it, the buyer checks it and signs over it."""
     return keccak(abi_encode(["bytes32", "address", "uint8", "uint32", "uint64", "bytes32"],
                              [_OFFER_TYPEHASH, *offer.as_abi()]))
 
@@ -203,9 +205,15 @@ def acceptance_digest(domain: Domain, offer: Offer, buyer: str, seller_x: int, s
     return keccak(b"\x19\x01" + _separator(domain) + struct)
 
 
+@functools.lru_cache(maxsize=1024)
+def _private_key(key: bytes) -> keys.PrivateKey:
+    """The key object (it derives its public key when made: once per robot, not once per signature)."""
+    return keys.PrivateKey(key)
+
+
 def _sign(key: bytes, digest: bytes) -> tuple[int, bytes, bytes]:
     """(v, r, s) of a low-s signature of ``digest`` (v is 27 or 28)."""
-    sig = keys.PrivateKey(bytes(key)).sign_msg_hash(digest)
+    sig = _private_key(bytes(key)).sign_msg_hash(digest)
     return sig.v + 27, sig.r.to_bytes(32, "big"), sig.s.to_bytes(32, "big")
 
 
