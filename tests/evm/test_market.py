@@ -354,3 +354,17 @@ def test_a_capped_round_trip_settles_across_transactions_and_pays_what_the_rules
         gap = market.balance_of(account.address) - exact.balance[i] * TOKEN_UNIT
         assert abs(gap) < max(exact.bound[i], 1)
     assert market.total_supply() == sum(market.balance_of(a.address) + market.bond_of(a.address) for a in robots)
+
+
+def test_funding_on_py_evm_tops_an_account_up_and_sends_nothing_to_one_funded_already():
+    from infomarket.evm.market import connect, derived_account
+
+    chain = connect(backend="py-evm")
+    account = derived_account("fund-check", 0).address
+    chain.fund([account], 5)
+    assert chain.w3.eth.get_balance(account) == 5
+    block = chain.block_number
+    chain.fund([account], 5)
+    assert chain.block_number == block and chain.w3.eth.get_balance(account) == 5
+    chain.fund([account], 7)
+    assert chain.block_number == block + 1 and chain.w3.eth.get_balance(account) == 7

@@ -115,10 +115,15 @@ class Web3Backend:
                     self.w3.provider.make_request("evm_mine", [])
 
     def fund(self, addresses: list[str], amount: int = GAS_ALLOWANCE_WEI) -> None:
+        """Top each address up to ``amount`` wei from the node's first unlocked account (an address that
+        holds as much already costs no transaction: a market redeployed on the same chain funds the
+        same accounts again)."""
         accounts = self.w3.eth.accounts
         if not accounts:
             raise ChainError("the node has no unlocked account to pay the robots' gas")
-        hashes = [self.w3.eth.send_transaction({"from": accounts[0], "to": a, "value": amount}) for a in addresses]
+        missing = [(a, amount - self.w3.eth.get_balance(a)) for a in addresses]
+        hashes = [self.w3.eth.send_transaction({"from": accounts[0], "to": a, "value": value})
+                  for a, value in missing if value > 0]
         for h in hashes:
             self.w3.eth.wait_for_transaction_receipt(h)
 
