@@ -14,6 +14,7 @@ from infomarket.engine.step import variant
 STEP = variant(terrain=False, paths=False)
 find_neighbours, begin_communication, install_table, forage, behaviour_step, move = (
     STEP.find_neighbours, STEP.begin_communication, STEP.install_table, STEP.forage, STEP.behaviour_step, STEP.move)
+from infomarket.errors import InternalError
 from infomarket.state.view import BorrowedArray, GuardedArray, WorldType, layout_type, make_view
 
 from ..conftest import Handle, make_config
@@ -155,10 +156,10 @@ def test_a_view_is_the_hosts_own_memory_and_scalars_and_a_field_of_another_kind_
     assert (y, cols, width, transitory) == (4.25, h.world.nbr.shape[1], h.world.width, h.world.transitory)
     assert h.world.items[1] == 9
     wrong = h.world._replace(pos=h.world.pos.astype(np.float32))
-    with pytest.raises(TypeError, match=r"'pos' is array\(float32"):
+    with pytest.raises(InternalError, match=r"'pos' is array\(float32"):
         make_view("world", wrong)
     names = list(type(h.world)._fields)
     names[:2] = names[1::-1]
     swapped = namedtuple("Swapped", names)(**h.world._asdict())
-    with pytest.raises(TypeError, match="does not hold the fields of layout 'world' in its order"):
+    with pytest.raises(InternalError, match="does not hold the fields of layout 'world' in its order"):
         make_view("world", swapped)

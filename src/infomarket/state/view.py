@@ -37,6 +37,7 @@ from numba.core import cgutils
 from numba.extending import NativeValue, box, intrinsic, register_model, unbox
 
 from .._numba_internals import BOX, MEMINFO, add_alias, alias_func_extensions
+from ..errors import InternalError
 from .spec import Spec
 
 
@@ -205,12 +206,12 @@ def fill_view(typingctx, view, part, start):
         return None
     fields = list(view.field_dict.items())[start.literal_value:start.literal_value + len(part)]
     if len(fields) != len(part):
-        raise TypeError(f"fill_view: {len(part)} values from field {start.literal_value} of a view of "
+        raise InternalError(f"fill_view: {len(part)} values from field {start.literal_value} of a view of "
                         f"{len(view.field_dict)}")
     for (name, field_type), given in zip(fields, part.types):
         if isinstance(field_type, BorrowedArray) != isinstance(given, types.Array) or (
                 isinstance(given, types.Array) and (given.dtype, given.ndim) != (field_type.dtype, field_type.ndim)):
-            raise TypeError(f"fill_view: the state's {name!r} is {given}, the view's is {field_type}")
+            raise InternalError(f"fill_view: the state's {name!r} is {given}, the view's is {field_type}")
 
     def codegen(context, builder, sig, args):
         st, tup, _ = args
@@ -279,7 +280,7 @@ def view_module(name: str):
 def _in_layout_order(name: str, state_type: type) -> bool:
     names = [f.name for spec in _LAYOUTS[name] for f in spec.fields]
     if list(state_type._fields) != names:
-        raise TypeError(f"a {state_type.__name__} does not hold the fields of layout {name!r} in its order")
+        raise InternalError(f"a {state_type.__name__} does not hold the fields of layout {name!r} in its order")
     return True
 
 
