@@ -368,3 +368,20 @@ def test_funding_on_py_evm_tops_an_account_up_and_sends_nothing_to_one_funded_al
     assert chain.block_number == block and chain.w3.eth.get_balance(account) == 5
     chain.fund([account], 7)
     assert chain.block_number == block + 1 and chain.w3.eth.get_balance(account) == 7
+
+
+def test_a_refused_transaction_or_deployment_spends_no_block_and_names_the_error(make_market, chain, artifact):
+    market = make_market("outlier")
+    block = chain.block_number
+    with pytest.raises(ContractRevert) as refused:
+        market.settle(market.market.address, 1)
+    assert refused.value.name == "InfoMarketNothingToSettle"
+    assert chain.block_number == block
+    refused_params = MarketParams.from_floats("delayed", stake=0.04)
+    with pytest.raises(ContractRevert):  # its accounts are topped up with gas money first
+        ChainMarket.deploy(refused_params, backend=chain, artifact=artifact)
+    block = chain.block_number
+    with pytest.raises(ContractRevert) as refused:
+        ChainMarket.deploy(refused_params, backend=chain, artifact=artifact)
+    assert refused.value.name == "InfoMarketInvalidParameter"
+    assert chain.block_number == block

@@ -127,9 +127,14 @@ class Web3Backend:
         for h in hashes:
             self.w3.eth.wait_for_transaction_receipt(h)
 
-    def call(self, sender: str, to: str, data: bytes, static: bool = False) -> bytes:
+    def call(self, sender: str, to: str | None, data: bytes, static: bool = False) -> bytes:
+        """Execute without keeping anything (``to=None``: ``data`` is code to deploy); a revert is raised
+        as ``RevertedCall`` with its data."""
+        message = {"from": sender, "data": data, "gas": self.gas_limit}
+        if to is not None:
+            message["to"] = to
         try:
-            return bytes(self.w3.eth.call({"from": sender, "to": to, "data": data, "gas": self.gas_limit}, "pending"))
+            return bytes(self.w3.eth.call(message, "pending"))
         except Exception as exc:  # noqa: BLE001 - anything that is not a revert is re-raised as it came
             raw = revert_data(exc)
             if raw is None:
@@ -137,10 +142,14 @@ class Web3Backend:
             raise RevertedCall(raw) from exc
 
     def transact(self, sender, to: str | None, data: bytes) -> Receipt:
-        """Dry-run (which yields the revert data on every backend), then sign with ``sender``'s key
-        and send with the block's gas limit: an estimate would cost a dozen executions on py-evm."""
-        if to is not None:
+        """Sign with ``sender``'s key and send with the block's gas limit (an estimate would cost a dozen
+        executions on py-evm).  A node is sent a call first, a dry run that yields the revert data.  The
+        in-process py-evm runs each transaction once: one that fails is undone (the chain goes back to
+        the block before it, so no nonce or block is spent) and then called for its revert data."""
+        tester = getattr(self.w3.provider, "ethereum_tester", None)
+        if tester is None:
             self.call(sender.address, to, data)
+        before = tester.take_snapshot() if tester is not None else None
         tx = {"from": sender.address, "data": data, "chainId": self.chain_id, "gas": self.gas_limit,
               "nonce": self.w3.eth.get_transaction_count(sender.address, "pending"),
               "gasPrice": self.w3.eth.gas_price}
@@ -149,19 +158,15 @@ class Web3Backend:
         signed = sender.sign_transaction(tx)
         receipt = self.w3.eth.wait_for_transaction_receipt(self.w3.eth.send_raw_transaction(signed.raw_transaction))
         if receipt.status != 1:
-            raise ChainError(f"transaction {receipt.transactionHash.hex()} failed after a successful dry run")
+            if before is not None:
+                tester.revert_to_snapshot(before)
+                self.call(sender.address, to, data)  # raises RevertedCall, with the data
+            raise ChainError(f"transaction {receipt.transactionHash.hex()} failed where a call of it did not")
         self.last_address = receipt.contractAddress
         logs = [Log(lg.address, [bytes(t) for t in lg.topics], bytes(lg.data)) for lg in receipt.logs]
         return Receipt(receipt.gasUsed, receipt.blockNumber, logs)
 
     def deploy(self, sender, code: bytes) -> tuple[str, Receipt]:
-        try:
-            self.w3.eth.call({"from": sender.address, "data": code, "gas": self.gas_limit}, "pending")
-        except Exception as exc:  # noqa: BLE001
-            raw = revert_data(exc)
-            if raw is None:
-                raise
-            raise RevertedCall(raw) from exc
         receipt = self.transact(sender, None, code)
         return checksum(self.last_address), receipt
 
