@@ -362,12 +362,12 @@ def test_funding_on_py_evm_tops_an_account_up_and_sends_nothing_to_one_funded_al
     chain = connect(backend="py-evm")
     account = derived_account("fund-check", 0).address
     chain.fund([account], 5)
-    assert chain.w3.eth.get_balance(account) == 5
+    assert chain.balance(account) == 5
     block = chain.block_number
     chain.fund([account], 5)
-    assert chain.block_number == block and chain.w3.eth.get_balance(account) == 5
+    assert chain.block_number == block and chain.balance(account) == 5
     chain.fund([account], 7)
-    assert chain.block_number == block + 1 and chain.w3.eth.get_balance(account) == 7
+    assert chain.block_number == block + 1 and chain.balance(account) == 7
 
 
 def test_a_refused_transaction_or_deployment_spends_no_block_and_names_the_error(make_market, chain, artifact):

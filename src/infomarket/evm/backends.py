@@ -2,10 +2,11 @@
 
 ``ChainMarket`` (market.py) never talks to a node itself; it hands ABI-encoded calldata to a backend:
 
-- ``Web3Backend`` over web3.py: the in-process py-evm (``EthereumTesterProvider``, the reference EVM,
-  nothing to install or run) or any JSON-RPC node (``--rpc``; its first unlocked account pays the
-  robots' gas). Every transaction is signed by its sender's own key, as on a real swarm; every block
-  holds one transaction (automining), so ``advance_to`` can only move the chain forward.
+- ``PyEvmBackend`` (the in-process py-evm through eth-tester, the reference EVM, nothing to install or
+  run) and ``Web3Backend`` (any JSON-RPC node, ``--rpc``, through web3.py; its first unlocked account
+  pays the robots' gas), in signed_chains.py. Every transaction is signed by its sender's own key, as
+  on a real swarm; every block holds one transaction (automining), so ``advance_to`` can only move the
+  chain forward.
 - ``RevmBackend`` over pyrevm (revm, the Rust EVM, through its Python bindings): hundreds of times
   faster than py-evm, with blocks set explicitly (``advance_to(n)`` makes every following transaction
   land in block ``n`` until the next call), which is what the replay of a simulation needs: one block
@@ -42,149 +43,15 @@ from typing import NamedTuple
 
 from eth_utils import keccak
 
-from .errors import ChainError, revert_data
+from .errors import ChainError
 from .protocol import checksum
+from .signed_chains import PyEvmBackend, Web3Backend
+from .transactions import ETH_TESTER_CHAIN_ID, GAS_ALLOWANCE_WEI, Log, Receipt, RevertedCall
 
-#: Gas money given to every robot and to the market account (wei); far above what a demo spends.
-GAS_ALLOWANCE_WEI = 10**20
 #: Block gas limit of the revm chain (Ethereum mainnet's in 2024).
 REVM_BLOCK_GAS = 30_000_000
-REVM_CHAIN_ID = 131_277_322_940_537  # eth-tester's, so that both in-process chains sign alike
-
-
-class Log(NamedTuple):
-    """One raw event log."""
-
-    address: str
-    topics: list[bytes]
-    data: bytes
-
-
-class Receipt(NamedTuple):
-    """What a mined transaction cost, where it landed, and what it logged."""
-
-    gas_used: int
-    block_number: int
-    logs: list[Log]
-
-
-class RevertedCall(ChainError):
-    """A call or transaction reverted with ``data`` (the revert bytes; decoded by the market)."""
-
-    def __init__(self, data: bytes):
-        self.data = data
-        super().__init__(f"reverted with 0x{data.hex()}")
-
-
-class Web3Backend:
-    """py-evm in process (``rpc_url=None``) or a JSON-RPC node, through web3.py."""
-
-    name = "py-evm"
-    #: gas as a chain charges it: every transaction starts with cold accounts and storage (EIP-2929)
-    cold_storage = True
-
-    def __init__(self, rpc_url: str | None = None):
-        from web3 import Web3
-
-        if rpc_url is None:
-            from web3 import EthereumTesterProvider
-
-            self.w3 = Web3(EthereumTesterProvider())
-        else:
-            self.w3 = Web3(Web3.HTTPProvider(rpc_url))
-            if not self.w3.is_connected():
-                raise ChainError(f"no JSON-RPC node answers at {rpc_url}")
-            self.name = rpc_url
-        self.chain_id = self.w3.eth.chain_id
-        self.gas_limit = self.w3.eth.get_block("latest")["gasLimit"]
-
-    @property
-    def block_number(self) -> int:
-        """The block the next transaction lands in."""
-        return self.w3.eth.block_number + 1
-
-    def advance_to(self, block: int) -> None:
-        """Mine empty blocks until the next transaction lands in ``block`` or later."""
-        missing = block - self.block_number
-        if missing > 0:
-            tester = getattr(self.w3.provider, "ethereum_tester", None)
-            if tester is not None:
-                tester.mine_blocks(missing)
-            else:
-                for _ in range(missing):
-                    self.w3.provider.make_request("evm_mine", [])
-
-    def fund(self, addresses: list[str], amount: int = GAS_ALLOWANCE_WEI) -> None:
-        """Top each address up to ``amount`` wei from the node's first unlocked account (an address that
-        holds as much already costs no transaction: a market redeployed on the same chain funds the
-        same accounts again)."""
-        accounts = self.w3.eth.accounts
-        if not accounts:
-            raise ChainError("the node has no unlocked account to pay the robots' gas")
-        missing = [(a, amount - self.w3.eth.get_balance(a)) for a in addresses]
-        hashes = [self.w3.eth.send_transaction({"from": accounts[0], "to": a, "value": value})
-                  for a, value in missing if value > 0]
-        for h in hashes:
-            self.w3.eth.wait_for_transaction_receipt(h)
-
-    def call(self, sender: str, to: str | None, data: bytes, static: bool = False) -> bytes:
-        """Execute without keeping anything (``to=None``: ``data`` is code to deploy); a revert is raised
-        as ``RevertedCall`` with its data."""
-        message = {"from": sender, "data": data, "gas": self.gas_limit}
-        if to is not None:
-            message["to"] = to
-        try:
-            return bytes(self.w3.eth.call(message, "pending"))
-        except Exception as exc:  # noqa: BLE001 - anything that is not a revert is re-raised as it came
-            raw = revert_data(exc)
-            if raw is None:
-                raise
-            raise RevertedCall(raw) from exc
-
-    def transact(self, sender, to: str | None, data: bytes) -> Receipt:
-        """Sign with ``sender``'s key and send with the block's gas limit (an estimate would cost a dozen
-        executions on py-evm).  A node is sent a call first, a dry run that yields the revert data.  The
-        in-process py-evm runs each transaction once: one that fails is undone (the chain goes back to
-        the block before it, so no nonce or block is spent) and then called for its revert data."""
-        tester = getattr(self.w3.provider, "ethereum_tester", None)
-        if tester is None:
-            self.call(sender.address, to, data)
-        before = tester.take_snapshot() if tester is not None else None
-        tx = {"from": sender.address, "data": data, "chainId": self.chain_id, "gas": self.gas_limit,
-              "nonce": self.w3.eth.get_transaction_count(sender.address, "pending"),
-              "gasPrice": self.w3.eth.gas_price}
-        if to is not None:
-            tx["to"] = to
-        signed = sender.sign_transaction(tx)
-        receipt = self.w3.eth.wait_for_transaction_receipt(self.w3.eth.send_raw_transaction(signed.raw_transaction))
-        if receipt.status != 1:
-            if before is not None:
-                tester.revert_to_snapshot(before)
-                self.call(sender.address, to, data)  # raises RevertedCall, with the data
-            raise ChainError(f"transaction {receipt.transactionHash.hex()} failed where a call of it did not")
-        self.last_address = receipt.contractAddress
-        logs = [Log(lg.address, [bytes(t) for t in lg.topics], bytes(lg.data)) for lg in receipt.logs]
-        return Receipt(receipt.gasUsed, receipt.blockNumber, logs)
-
-    def deploy(self, sender, code: bytes) -> tuple[str, Receipt]:
-        receipt = self.transact(sender, None, code)
-        return checksum(self.last_address), receipt
-
-    def snapshot(self):
-        """A handle to the current state for ``revert``: py-evm's, or a node's ``evm_snapshot`` (which a
-        node lets be reverted to once, dropping every later one)."""
-        tester = getattr(self.w3.provider, "ethereum_tester", None)
-        if tester is not None:
-            return tester.take_snapshot()
-        return self.w3.provider.make_request("evm_snapshot", [])["result"]
-
-    def revert(self, snapshot) -> None:
-        tester = getattr(self.w3.provider, "ethereum_tester", None)
-        if tester is not None:
-            tester.revert_to_snapshot(snapshot)
-        elif not self.w3.provider.make_request("evm_revert", [snapshot]).get("result"):
-            raise ChainError(f"the node could not go back to its snapshot {snapshot}")
-
+#: eth-tester's, so that both in-process chains sign alike
+REVM_CHAIN_ID = ETH_TESTER_CHAIN_ID
 
 _REVERT_OUTPUT = re.compile(r"output: 0x([0-9a-fA-F]*)")
 #: The pyrevm whose journal print ``journal_accounts`` reads.
@@ -428,5 +295,5 @@ def make_backend(name: str | None = None, rpc_url: str | None = None):
     if name in (None, "revm"):
         return RevmBackend()
     if name == "py-evm":
-        return Web3Backend()
+        return PyEvmBackend()
     raise ChainError(f"unknown chain backend {name!r}: choose revm or py-evm")
