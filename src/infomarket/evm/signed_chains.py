@@ -55,7 +55,7 @@ class _SignedChain:
         nonce, and is raised as ``RevertedCall``."""
         if self.dry_run_first:
             self.call(sender.address, to, data)
-        before = None if self.dry_run_first else self._snapshot()
+        before = None if self.dry_run_first else self._undo_point()
         tx = {"data": data, "chainId": self.chain_id, "gas": self.gas_limit, "nonce": self._nonce(sender.address),
               "gasPrice": self._gas_price()}
         if to is not None:
@@ -63,7 +63,7 @@ class _SignedChain:
         mined = self._send_signed(sender.sign_transaction(tx).raw_transaction)
         if mined.status != 1:
             if before is not None:
-                self._revert(before)
+                self._undo_to(before)
                 self.call(sender.address, to, data)  # raises RevertedCall, with the data
             raise ChainError(f"transaction {mined.hash} failed where a call of it did not")
         self.last_address = mined.contract
@@ -158,6 +158,14 @@ class PyEvmBackend(_SignedChain):
 
     def _revert(self, snapshot) -> None:
         self.tester.revert_to_snapshot(snapshot)
+
+    def _undo_point(self):
+        """The chain's head (its backend's snapshot, a block hash): eth-tester keeps every snapshot id it
+        hands out, one per transaction here, for good."""
+        return self.tester.backend.take_snapshot()
+
+    def _undo_to(self, head) -> None:
+        self.tester.backend.revert_to_snapshot(head)
 
 
 class Web3Backend(_SignedChain):
