@@ -96,9 +96,10 @@ def _raw(value: str | bytes) -> bytes:
 
 
 class PyEvmBackend(_SignedChain):
-    """py-evm in process, through eth-tester's own interface (web3.py's provider around it cost about as
+    """py-evm in process, through eth-tester's own interface (web3.py's provider around it cost nearly as
     much per call as py-evm's execution of a short one).  Each transaction runs once: one that fails is
-    undone with eth-tester's snapshot, so it spends no block and no nonce, and then called for its error."""
+    undone (the chain's head set back to the block before it), so it spends no block and no nonce, and
+    then called for its error."""
 
     name = "py-evm"
     dry_run_first = False

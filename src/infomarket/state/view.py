@@ -207,7 +207,7 @@ def fill_view(typingctx, view, part, start):
     fields = list(view.field_dict.items())[start.literal_value:start.literal_value + len(part)]
     if len(fields) != len(part):
         raise InternalError(f"fill_view: {len(part)} values from field {start.literal_value} of a view of "
-                        f"{len(view.field_dict)}")
+                            f"{len(view.field_dict)}")
     for (name, field_type), given in zip(fields, part.types):
         if isinstance(field_type, BorrowedArray) != isinstance(given, types.Array) or (
                 isinstance(given, types.Array) and (given.dtype, given.ndim) != (field_type.dtype, field_type.ndim)):
