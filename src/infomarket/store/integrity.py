@@ -18,11 +18,14 @@ def _rel(root: Path, path: Path) -> str:
     return str(path.relative_to(root))
 
 
-def data_part_problem(store, table: str, path: Path, record: pd.DataFrame) -> str | None:
-    """Why the ``table`` part at ``path`` does not match its commit record ``record``, or None."""
+def data_part_problem(store, table: str, path: Path, record: pd.DataFrame, exists: bool | None = None) -> str | None:
+    """Why the ``table`` part at ``path`` does not match its commit record ``record``, or None.  ``exists``:
+    whether the file exists, where the caller knows (None: look)."""
+    if exists is None:
+        exists = path.exists()
     sha_col, rows_col = f"{table}_sha256", f"{table}_rows"
     if sha_col not in record.columns:  # a store written before checksums: readable is all we know
-        if not path.exists():
+        if not exists:
             return None
         if table in OPTIONAL_TABLES and store._record_checksums():
             return "exists but its commit record does not list it"
@@ -33,8 +36,8 @@ def data_part_problem(store, table: str, path: Path, record: pd.DataFrame) -> st
         return None
     sha, rows = str(record[sha_col].iloc[0]), int(record[rows_col].iloc[0])
     if not sha:
-        return "exists but its commit record says it has no rows" if path.exists() else None
-    if not path.exists():
+        return "exists but its commit record says it has no rows" if exists else None
+    if not exists:
         return f"missing (the commit record says {rows} rows)"
     if store._cached("sha256", path, lambda: sha256_file(path)) != sha:
         return f"checksum mismatch: truncated or altered (the commit record says {rows} rows)"
@@ -47,6 +50,7 @@ def inspect(store) -> Inspection:
     if store.exists():
         store.meta()  # an unreadable store.json is a StoreError, not a store of no parts
     runs_parts = store._parts("runs")
+    present = {t: store._part_ids(t) for t in DATA_TABLES}
     for pid, path in sorted(runs_parts.items()):
         found.parts += 1
         try:
@@ -59,11 +63,11 @@ def inspect(store) -> Inspection:
                                          f"unreadable commit record ({type(exc).__name__}: {exc})"))
             continue
         for t in DATA_TABLES:
-            why = store._check_data_part(t, pid, record)
+            why = store._check_data_part(t, pid, record, present=pid in present[t])
             if why:
                 found.damaged.append(Problem(pid, _rel(store.root, store.part_path(t, pid)), why))
     for t in DATA_TABLES:
-        found.orphans += [_rel(store.root, p) for pid, p in sorted(store._parts(t).items())
+        found.orphans += [_rel(store.root, store.part_path(t, pid)) for pid in sorted(present[t])
                           if pid not in runs_parts]
     found.orphans += sorted(_rel(store.root, p) for p in store.root.glob("*/.part-*.tmp"))
     return found

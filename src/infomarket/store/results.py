@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 import json
+import os
 import time
 from contextlib import contextmanager
 from pathlib import Path
@@ -23,6 +24,7 @@ from .query import run_sql
 from .dictionary import TABLES as TABLES_DICT
 from .dictionary import annotate
 from .files import sha256_file, write_atomic, write_text_atomic
+from .read_cache import ReadCache, sort_rows
 from ..config.load import validate
 
 FORMAT = 1
@@ -57,40 +59,23 @@ def _rel(root: Path, path: Path) -> str:
     return str(path.relative_to(root))
 
 
-def _signature(path: Path) -> tuple[int, int, int, int] | None:
-    """What identifies a file's content for the read cache: a committed part is written once, through a
-    rename (a new inode), so inode, size and change times tell a rewritten or altered file from the one read."""
-    try:
-        st = path.stat()
-    except OSError:
-        return None
-    return st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns
-
-
 class Store:
     """A results store rooted at ``root`` (created on first write).
 
-    ``cache=True``: remember what this object has read and verified (commit records, checksums of data
-    parts, data frames), keyed by each file's signature (``_signature``), so a long-lived reader of a
-    growing store (the attack search reads its store after every generation) reads each part once
-    instead of the whole store each time.  A file replaced or changed on disk is read and verified again;
-    a same-size edit within one clock tick would go unseen, hence off by default."""
+    ``cache=True``: remember what this object has read, verified and written (commit records, checksums
+    of data parts, data frames, each table's rows), keyed by each file's signature (``store.read_cache``),
+    so a long-lived reader of a growing store (the attack search sweeps into its store every generation)
+    reads each part once instead of the whole store each time.  A file replaced or changed on disk is read
+    and verified again; a same-size edit within one clock tick would go unseen, hence off by default."""
 
     def __init__(self, root: str | Path, *, cache: bool = False):
         self.root = Path(root)
-        self._cache: dict | None = {} if cache else None
+        self._cache: ReadCache | None = ReadCache() if cache else None
+        self._paths: dict[tuple[str, str], Path] = {}
 
     def _cached(self, kind: str, path: Path, compute):
         """``compute()``, remembered under (kind, path, the file's signature) when caching."""
-        if self._cache is None:
-            return compute()
-        sig = _signature(path)
-        if sig is None:
-            return compute()
-        hit = self._cache.get((kind, path))
-        if hit is None or hit[0] != sig:
-            hit = self._cache[(kind, path)] = (sig, compute())
-        return hit[1]
+        return compute() if self._cache is None else self._cache.get(kind, path, compute)
 
     # ------------------------------------------------------------------ creation and checks
     @property
@@ -190,27 +175,34 @@ class Store:
     def seeds(self) -> dict[str, int]:
         return {k: int(v) for k, v in self.meta().get("seeds", {}).items()} if self.exists() else {}
 
+    def _part_ids(self, table: str) -> set[str]:
+        """The ids of the ``table`` folder's part files (one listing: no file is looked at)."""
+        try:
+            names = os.listdir(self.root / table)
+        except FileNotFoundError:
+            return set()
+        return {n[5:-8] for n in names if n.startswith("part-") and n.endswith(".parquet")}
+
     def _parts(self, table: str) -> dict[str, Path]:
-        folder = self.root / table
-        if not folder.exists():
-            return {}
-        return {p.stem.removeprefix("part-"): p for p in folder.glob("part-*.parquet")}
+        return {pid: self.part_path(table, pid) for pid in self._part_ids(table)}
 
     def part_path(self, table: str, part_id: str) -> Path:
-        return self.root / table / f"part-{part_id}.parquet"
+        path = self._paths.get((table, part_id))
+        if path is None:  # remembered: a store's checks name every part of every table each time
+            path = self._paths[(table, part_id)] = self.root / table / f"part-{part_id}.parquet"
+        return path
 
     def committed(self) -> list[str]:
         return sorted(self._parts("runs"))
 
     def remove_orphans(self) -> int:
         """Delete data parts (robots, history, events, payments) without a runs part (left by a crash); returns how many."""
-        done = set(self._parts("runs"))
+        done = self._part_ids("runs")
         removed = 0
         for t in DATA_TABLES:
-            for pid, path in self._parts(t).items():
-                if pid not in done:
-                    path.unlink(missing_ok=True)
-                    removed += 1
+            for pid in self._part_ids(t) - done:
+                self.part_path(t, pid).unlink(missing_ok=True)
+                removed += 1
         for tmp in self.root.glob("*/.part-*.tmp"):
             tmp.unlink(missing_ok=True)
         return removed
@@ -227,9 +219,9 @@ class Store:
         keys = list(keys)
         if self.part_path("runs", part_id).exists():
             raise StoreError(f"{self.root}: part {part_id} is already committed")
-        runs = runs.copy()
         tables = {"robots": robots, "history": history, "events": events, "payments": payments,
                   "sites": sites, "configs": configs, "chain": chain}
+        sums: dict[str, str | int] = {}
         for t in DATA_TABLES:
             df = tables[t]
             if t in OPTIONAL_TABLES and (df is None or not len(df)):
@@ -240,18 +232,25 @@ class Store:
                 path.parent.mkdir(exist_ok=True)
                 write_atomic(path, lambda tmp, df=df, t=t: write_table(t, df, tmp, keys))
                 sha, rows = sha256_file(path), len(df)
-            runs[f"{t}_sha256"] = sha
-            runs[f"{t}_rows"] = rows
-        self._write_runs(part_id, runs, keys)
+                if self._cache is not None:  # the bytes it hashed are the file's: no need to read them again
+                    self._cache.put("sha256", path, sha)
+            sums[f"{t}_sha256"], sums[f"{t}_rows"] = sha, rows
+        self._write_runs(part_id, runs.assign(**sums), keys)
 
     def _write_runs(self, part_id: str, runs: pd.DataFrame, keys: Iterable[str]) -> None:
+        written = []
+
         def write(tmp: Path) -> None:
             write_table("runs", runs, tmp, keys, write_page_checksum=True)
             table = pq.read_table(tmp)  # the digest is of what a reader gets back
             meta = {**(table.schema.metadata or {}), RECORD_SHA: record_digest(table).encode()}
-            pq.write_table(table.replace_schema_metadata(meta), tmp, write_page_checksum=True)
+            table = table.replace_schema_metadata(meta)
+            pq.write_table(table, tmp, write_page_checksum=True)
+            written.append(table)
 
-        write_atomic(self.part_path("runs", part_id), write)
+        path = write_atomic(self.part_path("runs", part_id), write)
+        if self._cache is not None:  # the record as a reader gets it back, verified: what was just written
+            self._cache.put("record", path, written[0].to_pandas())
 
     # ------------------------------------------------------------------ integrity
     def _repair_hint(self) -> str:
@@ -279,20 +278,15 @@ class Store:
                 self._sums = False
         return self._sums
 
-    def _check_data_part(self, table: str, part_id: str, record: pd.DataFrame) -> str | None:
-        """Why the ``table`` part of ``part_id`` does not match its commit record, or None (when caching,
-        a verdict stands while the record is the same object and the part's file the same file)."""
+    def _check_data_part(self, table: str, part_id: str, record: pd.DataFrame, present: bool | None = None) -> str | None:
+        """Why the ``table`` part of ``part_id`` does not match its commit record, or None.  ``present``:
+        whether its file exists, where the caller listed the folder (a part that is not there needs no
+        look).  When caching, a verdict stands while the record is the same object and the file the same."""
         path = self.part_path(table, part_id)
         if self._cache is None:
-            return self._check_data_part_now(table, path, record)
-        key, sig = ("verdict", path), (id(record), _signature(path))
-        hit = self._cache.get(key)
-        if hit is None or hit[0] != sig:
-            hit = self._cache[key] = (sig, self._check_data_part_now(table, path, record), record)
-        return hit[1]
-
-    def _check_data_part_now(self, table: str, path: Path, record: pd.DataFrame) -> str | None:
-        return integrity.data_part_problem(self, table, path, record)
+            return integrity.data_part_problem(self, table, path, record, exists=False if present is False else None)
+        return self._cache.verdict(path, record, lambda exists: integrity.data_part_problem(
+            self, table, path, record, exists=exists), exists=False if present is False else None)
 
     def verify(self) -> Inspection:
         """Check every committed part against its commit record; list damaged and orphan parts."""
@@ -338,32 +332,23 @@ class Store:
     def _read(self, table: str) -> pd.DataFrame:
         records = self._records()
         frames = []
+        present = self._part_ids(table) if table != "runs" else set()
         for pid, record in records.items():
             if table == "runs":
-                frames.append(record)
+                frames.append((pid, record))
                 continue
-            why = self._check_data_part(table, pid, record)
+            why = self._check_data_part(table, pid, record, present=pid in present)
             if why:
                 raise StoreDamaged(f"{self.root}: part {_rel(self.root, self.part_path(table, pid))} is damaged: "
                                    f"{why}; {self._repair_hint()}")
             path = self.part_path(table, pid)
-            if path.exists():
-                frames.append(self._cached("frame", path, lambda path=path: pd.read_parquet(path)))
-        frames = [f for f in frames if len(f)]
-        if not frames:
+            if pid in present:
+                frames.append((pid, self._cached("frame", path, lambda path=path: pd.read_parquet(path))))
+        if not any(len(f) for _, f in frames):
             return pd.DataFrame()
-        if self._cache is not None:  # the same part objects as last time (kept alive below): that table again
-            parts = tuple(id(f) for f in frames)
-            last = self._cache.get(("table", table))
-            if last is not None and last[0] == parts:
-                return last[2].copy()
-        df = pd.concat(frames, ignore_index=True)
-        sort = [c for c in KEY + ["step", "robot"] if c in df.columns]
-        df = df.sort_values(sort, kind="stable").reset_index(drop=True)
         if self._cache is not None:
-            self._cache[("table", table)] = (parts, frames, df)
-            return df.copy()
-        return df
+            return self._cache.table(table, [(pid, f) for pid, f in frames if len(f)])
+        return sort_rows(pd.concat([f for _, f in frames if len(f)], ignore_index=True))
 
     def sql(self, query: str, *, skip_damaged: bool = False) -> pd.DataFrame:
         """Run a DuckDB SQL ``query`` over the store's verified parts; returns a pandas DataFrame.
