@@ -52,7 +52,7 @@ def far_starts(s: study.Settings, cell: study.Cell) -> np.ndarray:
 def run_planted(tmp_path, **overrides) -> driver.CellSearch:
     st = planted_study(**{**SETTINGS, **overrides})
     cell = study.cells(st)[0]
-    store = Store(tmp_path / "store")
+    store = Store(tmp_path / "store", cache=True)  # as the search command makes it: each part read once
     starts = far_starts(st.settings, cell)
     assert min(space.to_params(x)["rot_base"] for x in starts) > 120.0
     return driver.search_cell(st, cell, store, run=driver.store_runner(store), steps=3000, transitory=1000,
