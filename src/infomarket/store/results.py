@@ -235,22 +235,18 @@ class Store:
                 if self._cache is not None:  # the bytes it hashed are the file's: no need to read them again
                     self._cache.put("sha256", path, sha)
             sums[f"{t}_sha256"], sums[f"{t}_rows"] = sha, rows
-        self._write_runs(part_id, runs.assign(**sums), keys)
+        columns = pd.DataFrame({name: [value] * len(runs) for name, value in sums.items()}, index=runs.index)
+        self._write_runs(part_id, pd.concat([runs, columns], axis=1), keys)  # at once: assign inserts one by one
 
     def _write_runs(self, part_id: str, runs: pd.DataFrame, keys: Iterable[str]) -> None:
-        written = []
-
-        def write(tmp: Path) -> None:
-            write_table("runs", runs, tmp, keys, write_page_checksum=True)
-            table = pq.read_table(tmp)  # the digest is of what a reader gets back
-            meta = {**(table.schema.metadata or {}), RECORD_SHA: record_digest(table).encode()}
-            table = table.replace_schema_metadata(meta)
-            pq.write_table(table, tmp, write_page_checksum=True)
-            written.append(table)
-
-        path = write_atomic(self.part_path("runs", part_id), write)
+        """The commit record, its content's digest in its metadata: the digest of the table written, which is
+        the table a reader gets back (the file keeps the Arrow schema; every read checks the digest)."""
+        table = annotate("runs", pa.Table.from_pandas(runs, preserve_index=False), keys)
+        table = table.replace_schema_metadata({**(table.schema.metadata or {}), RECORD_SHA: record_digest(table).encode()})
+        path = write_atomic(self.part_path("runs", part_id),
+                            lambda tmp: pq.write_table(table, tmp, write_page_checksum=True))
         if self._cache is not None:  # the record as a reader gets it back, verified: what was just written
-            self._cache.put("record", path, written[0].to_pandas())
+            self._cache.put("record", path, table.to_pandas())
 
     # ------------------------------------------------------------------ integrity
     def _repair_hint(self) -> str:
