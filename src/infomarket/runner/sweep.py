@@ -71,7 +71,8 @@ def check_compatible(store: Store, conds: list[Condition]) -> None:
             raise StoreError(f"{c.experiment}: conditions with two master seeds in one sweep")
     store.claim_seeds(seeds, record=False)  # the recorded seeds first: the clearest message
     existing = store.runs()
-    if not existing.empty:
+    if not existing.empty:  # the first run of each of these conditions (a search's store holds thousands)
+        existing = existing[existing.condition.isin({c.id for c in conds})]
         first = existing.groupby(["experiment", "condition"]).first()
         for c in conds:
             if (c.experiment, c.id) not in first.index:

@@ -449,7 +449,7 @@ class Store:
         runs = self.runs()
         if runs.empty:
             return set()
-        return set(zip(runs.experiment, runs.condition, runs.run.astype(int)))
+        return set(zip(runs.experiment.tolist(), runs.condition.tolist(), runs.run.astype(int).tolist()))
 
     def uncommit_failed(self) -> int:
         """Remove failed runs from their commit records (their parts hold no rows of them), so the next
