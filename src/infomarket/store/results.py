@@ -193,7 +193,7 @@ class Store:
         return path
 
     def committed(self) -> list[str]:
-        return sorted(self._parts("runs"))
+        return sorted(self._part_ids("runs"))
 
     def remove_orphans(self) -> int:
         """Delete data parts (robots, history, events, payments) without a runs part (left by a crash); returns how many."""
@@ -278,11 +278,11 @@ class Store:
         """Why the ``table`` part of ``part_id`` does not match its commit record, or None.  ``present``:
         whether its file exists, where the caller listed the folder (a part that is not there needs no
         look).  When caching, a verdict stands while the record is the same object and the file the same."""
-        path = self.part_path(table, part_id)
+        path, known = self.part_path(table, part_id), (False if present is False else None)
         if self._cache is None:
-            return integrity.data_part_problem(self, table, path, record, exists=False if present is False else None)
+            return integrity.data_part_problem(self, table, path, record, exists=known)
         return self._cache.verdict(path, record, lambda exists: integrity.data_part_problem(
-            self, table, path, record, exists=exists), exists=False if present is False else None)
+            self, table, path, record, exists=exists), exists=known)
 
     def verify(self) -> Inspection:
         """Check every committed part against its commit record; list damaged and orphan parts."""
