@@ -1,5 +1,8 @@
 """engine.batch.Simulations: B runs stepped together in one compiled call are the runs Simulation
 makes one at a time, and fresh worlds start with the room earlier runs of the same kernel grew to."""
+import json
+import sys
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -133,3 +136,44 @@ def test_the_step_length_tables_are_the_plain_formula_bit_for_bit(alpha, steps):
     guide = np.searchsorted(cdf, np.arange(len(cdf)) / len(cdf), side="right").astype(np.int64)
     assert params.levy_cdf(alpha, steps).tobytes() == cdf.tobytes()
     assert params.guide_table(cdf).tobytes() == guide.tobytes()
+
+
+#: A child: steps a small batch of fig4C runs (build, advance, reset one, advance) and prints every
+#: function numba compiled meanwhile (``numba:compile`` fires on a compile, not on a load from the cache).
+_BATCH_CHILD = r"""
+import json
+from numba.core import event
+
+compiled = set()
+
+
+class Compiles(event.Listener):
+    def on_start(self, ev):
+        pass
+
+    def on_end(self, ev):
+        f = ev.data["dispatcher"].py_func
+        compiled.add(f"{f.__module__}.{f.__qualname__}")
+
+
+event.register("numba:compile", Compiles())
+from infomarket.config import load_experiment
+from infomarket.engine.batch import Simulations
+
+runs = Simulations(load_experiment("fig4C").with_overrides(steps=40, transitory=10), [3, 41])
+runs.advance(20)
+runs.reset(1, 5)
+runs.advance(40)
+print(json.dumps(sorted(compiled)))
+"""
+
+
+def test_a_batch_in_a_process_that_finds_its_code_cached_compiles_nothing(procs):
+    """Every pool worker and command steps its runs in batches: what a batch needs beyond the kernel (the
+    driver, its typed lists of views and generators) must load from the disk cache, not compile again in
+    every process (numba compiled a typed list's methods per process and item type, uncached)."""
+    first = procs.run([sys.executable, "-c", _BATCH_CHILD])  # compiles what no earlier process cached
+    assert first.returncode == 0, first.stderr[-2000:]
+    again = procs.run([sys.executable, "-c", _BATCH_CHILD])
+    assert again.returncode == 0, again.stderr[-2000:]
+    assert json.loads(again.stdout.splitlines()[-1]) == []

@@ -10,7 +10,7 @@ import time
 from pathlib import Path
 
 import numpy as np
-from numba import typed
+from numba import njit, typed
 
 from .. import interrupts
 from ..errors import ArgumentError, SimulationError
@@ -54,6 +54,35 @@ def finish(views, extra):
 """
 
 
+# A typed list built or changed from Python has numba compile its methods (make, append, set item) for
+# its item type in every process, uncached: about a quarter of a second each, paid by every pool worker and
+# command process for its views and generators.  Built and changed here, in functions cached on disk, the
+# first process compiles them and the others load them.
+@njit(cache=True)
+def _list_of(item):
+    out = typed.List()
+    out.append(item)
+    return out
+
+
+@njit(cache=True)
+def _append(items, item):
+    items.append(item)
+
+
+@njit(cache=True)
+def _put(items, i, item):
+    items[i] = item
+
+
+def typed_list(items: list) -> typed.List:
+    """A numba typed list of ``items`` (one type, at least one), made by the cached functions above."""
+    out = _list_of(items[0])
+    for item in items[1:]:
+        _append(out, item)
+    return out
+
+
 def batch_module(kernel, finish: str | None = None):
     """The generated ``step_all`` for ``kernel``; ``finish``: ``"module:function"``, a compiled
     ``function(views, extra)`` run once every world is done (the RL interface's observation), whose
@@ -86,8 +115,8 @@ class Simulations:
         self.config = first.config
         self.sims = [first] + [first.another(s) for s in seeds[1:]]
         self._batch = batch_module(first._kernel, finish)
-        self._views = typed.List([s._view for s in self.sims])
-        self._rngs = typed.List([s.rng for s in self.sims])
+        self._views = typed_list([s._view for s in self.sims])
+        self._rngs = typed_list([s.rng for s in self.sims])
         self._status = np.zeros(len(self.sims), np.int64)
         self._clocks = np.zeros(len(self.sims), np.int64)
         self._seconds = np.zeros(len(self.sims))  # each run's share of the calls' seconds (``run``)
@@ -109,8 +138,8 @@ class Simulations:
         """Start run ``b`` afresh with ``seed`` (``Simulation.reset``)."""
         sim = self.sims[b]
         sim.reset(seed, into)
-        self._views[b] = sim._view
-        self._rngs[b] = sim.rng
+        _put(self._views, b, sim._view)
+        _put(self._rngs, b, sim.rng)
         self._clocks[b] = sim.clock
         self._seconds[b] = 0.0
 
@@ -144,7 +173,7 @@ class Simulations:
                     except SimulationError as exc:
                         raise _explained(sim.config, sim.seed, exc, sim) from exc
                 sim.grow()
-                self._views[b] = sim._view
+                _put(self._views, b, sim._view)
         made = self._clocks - before
         for b in np.flatnonzero((self._clocks >= self.config.steps) & (before < self.config.steps)):
             self.sims[b].remember_room()  # a run just ended: keep its room for the next ones
