@@ -28,7 +28,6 @@ from .read_cache import ReadCache, sort_rows
 from ..config.load import validate
 
 FORMAT = 1
-KEY = ["experiment", "condition", "run"]
 OK, FAILED = "ok", "failed"
 
 
@@ -340,11 +339,12 @@ class Store:
             path = self.part_path(table, pid)
             if pid in present:
                 frames.append((pid, self._cached("frame", path, lambda path=path: pd.read_parquet(path))))
-        if not any(len(f) for _, f in frames):
+        frames = [(pid, f) for pid, f in frames if len(f)]
+        if not frames:
             return pd.DataFrame()
         if self._cache is not None:
-            return self._cache.table(table, [(pid, f) for pid, f in frames if len(f)])
-        return sort_rows(pd.concat([f for _, f in frames if len(f)], ignore_index=True))
+            return self._cache.table(table, frames)
+        return sort_rows(pd.concat([f for _, f in frames], ignore_index=True))
 
     def sql(self, query: str, *, skip_damaged: bool = False) -> pd.DataFrame:
         """Run a DuckDB SQL ``query`` over the store's verified parts; returns a pandas DataFrame.
