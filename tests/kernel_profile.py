@@ -97,7 +97,7 @@ def summary(path: str, top: int = 40) -> str:
     for name, t in tests.items():
         for module in t.get("uses", ()):
             users[module].add(name)
-    kernels = collections.defaultdict(list)  # step kernel -> its compiles (run_steps, or a dispatch alone)
+    kernels = collections.defaultdict(list)  # step kernel -> its compiles (step_all, or a dispatch alone)
     for c in compiles:
         if (c["module"] or "").startswith("infomarket_kernel"):  # None: a function made at run time
             kernels[c["module"]].append(c)

@@ -19,7 +19,7 @@ class Compiles(event.Listener):
         pass
 
     def on_end(self, ev):
-        if ev.data["dispatcher"].py_func.__name__ == "run_steps":
+        if ev.data["dispatcher"].py_func.__name__ == "step_all":
             compiled.append(1)
 
 

@@ -86,9 +86,9 @@ class _Counted:
     def __init__(self, module, robots: int):
         self.module, self.robots, self.work = module, robots, []
 
-    def step_all(self, views, rngs, t_end, status, clocks, extra):
+    def step_all(self, views, rngs, t_end, status, clocks, *extra):
         before = clocks.copy()
-        short = self.module.step_all(views, rngs, t_end, status, clocks, extra)
+        short = self.module.step_all(views, rngs, t_end, status, clocks, *extra)
         self.work.append(int((clocks - before).sum()) * self.robots)
         return short
 

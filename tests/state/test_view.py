@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from numba import njit
 
+from infomarket.engine.lists import typed_list
 from infomarket.engine.step import variant
 
 STEP = variant(terrain=False, paths=False)
@@ -66,7 +67,10 @@ def test_calls_leave_the_hosts_one_reference():
     h = Handle(make_config(3))
     assert h.view._meminfo.refcount == 1
     _steps(h.view, h.rng, 50)
-    h.kernel.run_steps(h.view, h.rng, 20)
+    views = typed_list([h.view])  # the kernel steps a batch (of one here)
+    h.kernel.step_all(views, typed_list([h.rng]), np.array([20]), np.zeros(1, np.int64), np.zeros(1, np.int64))
+    assert h.view._meminfo.refcount == 1
+    del views
     assert h.view._meminfo.refcount == 1
     assert h.world.items.sum() == 150  # the writes went to the host's arrays
 

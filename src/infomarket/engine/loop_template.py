@@ -22,7 +22,7 @@ same operations on either (``ledger.backends.operations``), chosen before anythi
 kernel compiles none of the other ledger's code.
 
 Before a step changes anything, ``has_room`` checks that the step cannot outgrow a capacity (neighbour
-lists, pending lists, the transaction pool, the event log); if it could, the loop returns NEED_ROOM
+lists, pending lists, the transaction pool, the event log); if it could, the world's status is NEED_ROOM
 with the step not begun, the host grows the arrays (``build.make_room``) and calls again.
 """
 import numpy as np
@@ -36,6 +36,7 @@ from infomarket.state.view import unlock
 
 DONE = 0
 NEED_ROOM = 1
+FLAGGED = 2
 
 # ---- provided by the generator (engine.specialise) --------------------------------------------------
 #: TERRAIN, PATHS (bools), LEDGER (a name of ledger.backends.LEDGERS): the step options, written above this
@@ -97,58 +98,74 @@ ledger_has_room, begin_step, deposit, end_of_step = operations(LEDGER, settle)
 
 
 @njit(cache=True)
-def run_steps(w, rng, t_end):
-    """Advance the world until step ``t_end`` (or until the host must grow an array): DONE or NEED_ROOM."""
-    n = w.pos.shape[0]
-    clock, kind, balance = unlock(w.clock), w.kind, w.balance
-    cool, stop = w.cool_timer, w.stop_timer
-    off_valid, off_vec, off_age = w.off_valid, w.off_vec, w.off_age
-    nbr, nbr_count = w.nbr, w.nbr_count
-    fuel = w.fuel_cost
-    bits = rng.bit_generator  # the engine's own draws (engine.draws); rules get the Generator
-    opened = np.zeros(n, np.bool_)  # this step, robot i's buy rule ran (so it has a new table to install)
-    while clock[0] < t_end:
-        find_neighbours(w)
-        if not has_room(w):
-            return NEED_ROOM
-        clock[0] += 1
-        begin_step(w)
-        if w.stake_expiry > 0:
+def step_all(views, rngs, t_end, status, clocks):
+    """Advance world b (``views[b]``, drawing from ``rngs[b]``) until step ``t_end[b]``, one world after
+    the other, and write its clock in ``clocks[b]`` and in ``status[b]`` DONE, NEED_ROOM (the host must
+    grow an array first: the step is not begun) or FLAGGED (an error bit is set); -1 is left on the world
+    whose step raised.  Returns the count of worlds that are not DONE.  A single run is a batch of one:
+    the kernel's code is compiled once, into this one function, whether its runs go alone or together."""
+    short = 0
+    for b in range(len(views)):
+        status[b] = -1
+        w = views[b]
+        rng = rngs[b]
+        status[b] = DONE
+        n = w.pos.shape[0]
+        clock, kind, balance = unlock(w.clock), w.kind, w.balance
+        cool, stop = w.cool_timer, w.stop_timer
+        off_valid, off_vec, off_age = w.off_valid, w.off_vec, w.off_age
+        nbr, nbr_count = w.nbr, w.nbr_count
+        fuel = w.fuel_cost
+        bits = rng.bit_generator  # the engine's own draws (engine.draws); rules get the Generator
+        opened = np.zeros(n, np.bool_)  # this step, robot i's buy rule ran (so it has a new table to install)
+        while clock[0] < t_end[b]:
+            find_neighbours(w)
+            if not has_room(w):
+                status[b] = NEED_ROOM
+                break
+            clock[0] += 1
+            begin_step(w)
+            if w.stake_expiry > 0:
+                for i in range(n):
+                    expire_stakes(w, i)
             for i in range(n):
-                expire_stakes(w, i)
-        for i in range(n):
-            if nbr_count[i] == 0 and not SELL_DRAWS[kind[i]]:
-                continue  # no neighbour can buy its offer this step, and asking for it draws nothing
-            for site in range(2):
-                if cool[i] == 0:
-                    valid, x, y, age = sell_dispatch(kind[i], w, i, site, rng)
-                    off_valid[i, site] = valid
-                    off_vec[i, site, 0] = x
-                    off_vec[i, site, 1] = y
-                    off_age[i, site] = age
+                if nbr_count[i] == 0 and not SELL_DRAWS[kind[i]]:
+                    continue  # no neighbour can buy its offer this step, and asking for it draws nothing
+                for site in range(2):
+                    if cool[i] == 0:
+                        valid, x, y, age = sell_dispatch(kind[i], w, i, site, rng)
+                        off_valid[i, site] = valid
+                        off_vec[i, site, 0] = x
+                        off_vec[i, site, 1] = y
+                        off_age[i, site] = age
+                    else:
+                        off_valid[i, site] = False
+            for i in range(n):
+                opened[i] = cool[i] == 0 and (nbr_count[i] > 0 or BUY_ALONE[kind[i]])
+                if opened[i]:
+                    begin_communication(w, i)
+                    buy_dispatch(kind[i], w, i, nbr[i, :nbr_count[i]], rng)
+            for i in range(n):
+                if forage(w, i, bits):
+                    deposit(w, i, rng)
+                if opened[i]:
+                    install_table(w, i)
+                if stop[i] > 0:
+                    stop[i] -= 1
+                elif fuel > 0.0 and balance[i] < fuel:
+                    pass
                 else:
-                    off_valid[i, site] = False
-        for i in range(n):
-            opened[i] = cool[i] == 0 and (nbr_count[i] > 0 or BUY_ALONE[kind[i]])
-            if opened[i]:
-                begin_communication(w, i)
-                buy_dispatch(kind[i], w, i, nbr[i, :nbr_count[i]], rng)
-        for i in range(n):
-            if forage(w, i, bits):
-                deposit(w, i, rng)
-            if opened[i]:
-                install_table(w, i)
-            if stop[i] > 0:
-                stop[i] -= 1
-            elif fuel > 0.0 and balance[i] < fuel:
-                pass
-            else:
-                if fuel > 0.0:
-                    burn_fuel(w, i)
-                dx, dy = behaviour_step(w, i, bits)
-                move(w, i, dx, dy, bits)
-            if cool[i] > 0:
-                cool[i] -= 1
-        end_of_step(w, rng)
-        record_history(w)
-    return DONE
+                    if fuel > 0.0:
+                        burn_fuel(w, i)
+                    dx, dy = behaviour_step(w, i, bits)
+                    move(w, i, dx, dy, bits)
+                if cool[i] > 0:
+                    cool[i] -= 1
+            end_of_step(w, rng)
+            record_history(w)
+        clocks[b] = clock[0]
+        if w.flags[0] != 0:
+            status[b] = FLAGGED
+        if status[b] != DONE:
+            short += 1
+    return short

@@ -32,6 +32,7 @@ from ..generated import compile_marker
 from ..seeds import MAX_SEED
 from ..state.flags import ErrorFlags
 from .build import build_world, make_room, room_of, with_room
+from .lists import typed_list
 from .params import behaviour_kinds, behaviour_table, build_params
 from .world import EVENT_NAMES, SITE_NAMES, STATE_NAMES, headings, kernel_view
 from ..config.load import validate
@@ -147,8 +148,16 @@ class Simulation:
         """The world's kernel view, with the view constructor and the step loop compiled or loaded from
         the cache (a call that runs no step); a stop signal meanwhile stops it (``interrupts``)."""
         view = kernel_view(self.world)
-        self._kernel.run_steps(view, self.rng, 0)
+        self._step_kernel(view, 0)
         return view
+
+    def _step_kernel(self, view, t_end: int) -> int:
+        """One call of the kernel's ``step_all`` on this world alone (a batch of one): its status (DONE,
+        NEED_ROOM, or FLAGGED: ``check_flags`` names the error bit)."""
+        status = np.zeros(1, np.int64)
+        self._kernel.step_all(typed_list([view]), typed_list([self.rng]), np.array([t_end], np.int64), status,
+                              np.zeros(1, np.int64))
+        return int(status[0])
 
     @property
     def kernel_source(self) -> Path:
@@ -174,7 +183,7 @@ class Simulation:
         while True:
             stop = min(t_end, self.clock + per_call)
             try:
-                status = self._kernel.run_steps(self._view, self.rng, stop)
+                status = self._step_kernel(self._view, stop)
                 self.check_flags()
             except Exception as exc:  # a rule's error, or an error bit a rule set: named with the step
                 raise _explained(self.config, self.seed, exc, self) from exc

@@ -164,7 +164,7 @@ def _work_out_parts(behaviours: list[BehaviourSpec], payment: PaymentSpec, terra
 
 def kernel_module(behaviour_names: tuple[str, ...], payment_name: str, terrain: bool = False,
                   ledger: str | bool = "instant") -> ModuleType:
-    """The specialised kernel module (``run_steps``) for these behaviours (kind order) and scheme, on
+    """The specialised kernel module (``step_all``) for these behaviours (kind order) and scheme, on
     the paper's plane or (``terrain``) with obstacles, several sites, line of sight and collisions;
     behaviours registered with ``paths=True`` add the paths variant (waypoint paths, engine.paths) to the
     terrain one; ``ledger`` as ``generate_source``."""
