@@ -167,3 +167,29 @@ def test_a_view_is_the_hosts_own_memory_and_scalars_and_a_field_of_another_kind_
     swapped = namedtuple("Swapped", names)(**h.world._asdict())
     with pytest.raises(InternalError, match="does not hold the fields of layout 'world' in its order"):
         make_view("world", swapped)
+
+
+def test_a_function_of_a_view_has_a_short_symbol_and_the_payload_type_is_built_once(monkeypatch):
+    # numba names a StructRef type by all its fields; a symbol or payload type built from that name for
+    # every function and field access was a large share of a chain kernel's compile
+    world, chain = layout_type("world"), layout_type("chainworld")
+    assert len(world.name) > 5000 and len(chain.name) > len(world.name)  # numba's own name: every field
+
+    @njit(cache=False)
+    def clock_of(w):
+        return w.clock[0]
+
+    h = Handle(make_config(3))
+    clock_of(h.view)
+    (compiled,) = clock_of.overloads.values()
+    assert len(compiled.fndesc.mangled_name) < 300, compiled.fndesc.mangled_name[:300]
+    assert world.mangling_args != chain.mangling_args  # two layouts, two symbols
+
+    built = []
+    init = numba.types.StructRefPayload.__init__
+    monkeypatch.setattr(numba.types.StructRefPayload, "__init__",
+                        lambda self, *a, **k: built.append(1) or init(self, *a, **k))
+    first = world.get_data_type()
+    for _ in range(3):
+        assert world.get_data_type() is first
+    assert len(built) <= 1

@@ -27,6 +27,7 @@ With ``NUMBA_DISABLE_JIT=1`` the named tuple itself is passed: attribute access 
 from __future__ import annotations
 
 import functools
+import hashlib
 
 import numba
 import numpy as np
@@ -121,8 +122,27 @@ unlock = _identity if config.DISABLE_JIT else _unlock
 
 
 class WorldType(types.StructRef):
+    """numba names a StructRef type by every field it holds, and writes that name into the symbol of
+    each function that takes one and into its payload type, which it builds again at every field access:
+    for a layout of hundreds of fields, string work that took a large share of a chain kernel's compile.
+    So the symbol carries a digest of the name (``mangling_args``, which numba leaves to subclasses), and
+    the payload type is made once per view type."""
+
     def preprocess_fields(self, fields):
         return tuple((name, types.unliteral(t)) for name, t in fields)
+
+    @property
+    def mangling_args(self):
+        short = self.__dict__.get("_short_name")
+        if short is None:
+            short = self.__dict__["_short_name"] = f"WorldType_{hashlib.sha256(self.name.encode()).hexdigest()[:24]}"
+        return short, ()
+
+    def get_data_type(self):
+        payload = self.__dict__.get("_payload")
+        if payload is None:
+            payload = self.__dict__["_payload"] = super().get_data_type()
+        return payload
 
 
 @register_model(WorldType)
