@@ -15,6 +15,7 @@ import numpy as np
 from .config import validate
 from .engine.simulation import Simulation, quiet_compiles
 from .errors import InfomarketError, RuleRunError
+from .jit import njit
 from .ledger import LedgerEvent, replay_events
 from .ledger.replay import Ledger
 from .payments import MARKETS, PAPER_STAKE
@@ -52,7 +53,7 @@ def _with_bounds_check(py):
     behaviours compiles once), or None where it does not compile here (the runs report it)."""
     if py not in _BOUNDS_CHECKED:
         try:
-            _BOUNDS_CHECKED[py] = numba.njit(boundscheck=True)(py)
+            _BOUNDS_CHECKED[py] = njit(boundscheck=True)(py)
         except Exception:  # noqa: BLE001
             _BOUNDS_CHECKED[py] = None
     return _BOUNDS_CHECKED[py]
@@ -174,7 +175,7 @@ def _bounds_checked(name: str, events: list, robots: int, stake: float) -> None:
     rule = spec.weights
     py = rule.py_func
     try:
-        checked = numba.njit(boundscheck=True)(py)
+        checked = njit(boundscheck=True)(py)
     except Exception:  # not a compilable function: the ordinary replay reports it
         return
 

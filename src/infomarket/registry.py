@@ -1,7 +1,7 @@
 """Registry of market rules: behaviours (a buy rule and a sell rule) and payment schemes.
 
 A rule is a plain Python function over the world tuple, robot ids and numbers, written in the
-numba-compatible subset.  Registering it wraps it in ``numba.njit``; the engine then generates a
+numba-compatible subset.  Registering it wraps it in ``numba.njit`` (``infomarket.jit``); the engine then generates a
 step kernel that calls the configured rules directly (see ``engine.specialise``), so a user's rule
 runs at the same compiled speed as the built-ins, which are registered through this very module.
 
@@ -16,11 +16,10 @@ import re
 from dataclasses import dataclass, field
 from typing import Callable
 
-import numba
-
 from ._numba_internals import CPUDispatcher
 from .compiled_cache import in_package
 from .errors import ConfigError, RegistrationError, RuleError
+from .jit import njit
 
 #: Fixed leading arguments of each kind of rule (everything after them is a parameter).
 BUY_ARGS = ("w", "me", "nbrs")
@@ -101,7 +100,7 @@ def _jit(func: Callable) -> Callable:
         return func
     if not inspect.isfunction(func):  # a builtin, a class, a number...: numba compiles only Python functions
         raise RuleError(f"a rule must be a Python function (def ...), got {_shown(func)}")
-    return numba.njit(func, cache=in_package(func))
+    return njit(func, cache=in_package(func))
 
 
 #: What a behaviour's or a payment scheme's name may be: it is written in experiment files, stored in the

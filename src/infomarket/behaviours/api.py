@@ -8,7 +8,7 @@ Timing (docs/model.md §3): during the communication phase sellers sell from the
 of the step (``own_entry``), while a buyer's purchases go into its new table (``current`` / ``install``
 / ``combine``), which it starts using when it moves.  Stakes and the pending list change at once.
 """
-from numba import njit
+from ..jit import njit
 
 from ..engine.geometry import direction, norm
 from ..engine.geometry import to_frame, to_world

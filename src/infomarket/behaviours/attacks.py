@@ -31,7 +31,7 @@ The damage of an unbounded reset is therefore at least this policy's (docs/attac
 """
 import math
 
-from numba import njit
+from ..jit import njit
 
 from ..engine.geometry import rotate
 from .api import buy, own_entry

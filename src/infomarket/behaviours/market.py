@@ -11,7 +11,7 @@ weight given to a transaction of the same site in that settlement (an outlier, u
 penalisation).
 Under delayed payment every weight is equal, so nothing is ever reduced.
 """
-from numba import njit
+from ..jit import njit
 
 
 @njit(forceinline=True, cache=True)

@@ -15,7 +15,7 @@ The transaction is recorded, and weighed by the payment schemes, with the direct
 exactly as ``api.buy`` records the direction of a bought vector.
 """
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from ..engine.geometry import norm
 from ..engine.geometry import to_frame, to_world

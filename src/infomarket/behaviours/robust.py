@@ -14,7 +14,7 @@ The combination functions (``weighted_median``, ``trimmed_mean``, ``coordinate_m
 import math
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from .api import buy, install, next_candidate, own_entry, pending_add, pending_clear, pending_count, pending_find
 from .api import pending_get, pending_remove

@@ -1,6 +1,6 @@
 """Sceptical robots: use bought information only when something confirms it (eq. 6, pending list).
 (Registered as ``sceptical`` by ``infomarket.builtins``.)"""
-from numba import njit
+from ..jit import njit
 
 from .api import buy, combine, confirm_or_wait, current, diff, next_younger, pending_clear, pending_has
 

@@ -12,7 +12,7 @@ import statistics
 import time
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from ..engine.neighbours import ALL_PAIRS_UP_TO, _all_pairs, _grid, grid_shape
 

@@ -2,7 +2,7 @@
 and a robot's own frame."""
 import math
 
-from numba import njit
+from ..jit import njit
 
 DEG = math.pi / 180.0
 

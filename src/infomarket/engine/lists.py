@@ -1,6 +1,8 @@
 """Numba typed lists of views and generators, the ``step_all`` kernels' arguments (``engine.batch``,
 ``engine.simulation``), built and changed by functions cached on disk."""
-from numba import njit, typed
+from numba import typed
+
+from ..jit import njit
 
 
 # A typed list built or changed from Python has numba compile its methods (make, append, set item) for

@@ -26,9 +26,9 @@ lists, pending lists, the transaction pool, the event log); if it could, the wor
 with the step not begun, the host grows the arrays (``build.make_room``) and calls again.
 """
 import numpy as np
-from numba import njit
 
 from infomarket.engine.step import record_history, variant
+from infomarket.jit import njit
 from infomarket.ledger.backends import operations
 from infomarket.ledger.kernels import burn_fuel, distribute, expire_stakes, live_count, settlement
 from infomarket.ledger.poa.lists import keep_weights, weighed_before, weights_of

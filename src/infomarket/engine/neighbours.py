@@ -9,7 +9,7 @@ they find exactly the same neighbours.
 A robot may have more neighbours than ``nbr`` has columns: the count is still exact, nothing beyond
 the capacity is written, and ``has_room`` sends the host to grow the table before the step goes on.
 """
-from numba import njit
+from ..jit import njit
 
 from ..space.grid import grid_shape  # noqa: F401  (the grid's geometry; re-exported for the engine)
 

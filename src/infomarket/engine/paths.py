@@ -21,7 +21,7 @@ is.  The engine only keeps paths consistent; what is bought and sold is up to ru
 when a configured behaviour was registered with ``paths=True`` (on the plane too, with the terrain
 variant), so neither the paper's kernel nor a terrain run without path rules pays for paths.
 """
-from numba import njit
+from ..jit import njit
 
 from .geometry import norm
 from .params import FOOD, NEST

@@ -20,7 +20,7 @@ import functools
 import math
 from typing import Callable, NamedTuple
 
-from numba import njit
+from ..jit import njit
 
 from ..state.view import unlock
 from .draws import normal, uniform

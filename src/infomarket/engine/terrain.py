@@ -35,7 +35,7 @@ from __future__ import annotations
 
 import math
 
-from numba import njit
+from ..jit import njit
 
 from ..errors import ConfigError
 from ..space.obstacles import nearest, sight_blocked

@@ -21,7 +21,7 @@ from __future__ import annotations
 import functools
 from typing import Callable, NamedTuple
 
-from numba import njit
+from ..jit import njit
 
 from ..errors import InternalError
 from . import instant

@@ -2,7 +2,7 @@
 once.  Its operations for the step kernel (``ledger.backends``): open a transaction, deposit (the
 kernel's settlement itself), and the room a step needs; it has no end of step.
 """
-from numba import njit
+from ..jit import njit
 
 from ..state import flags
 from ..state.view import unlock

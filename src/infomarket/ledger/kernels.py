@@ -9,7 +9,7 @@ the reward issued on a deposit, and (optionally) fuel burned by moving robots.
 """
 import math
 
-from numba import njit
+from ..jit import njit
 
 from numba.extending import overload
 

@@ -6,7 +6,7 @@ twice, on the seller's own view when it signs (``ledger.poa.mempool``) and on th
 a block includes the reveal (``ledger.poa.blocks``).  Only the funds array differs, so the rule and its
 float rounding are the same everywhere.
 """
-from numba import njit
+from ..jit import njit
 
 #: A seller whose money falls short of the stake by less than this (float rounding of sums of stakes,
 #: e.g. 1 - 24 x 0.04) can still lock it: the exact on-chain ledger would accept it.

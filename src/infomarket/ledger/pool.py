@@ -1,7 +1,7 @@
 """The transaction pool's compiled housekeeping (``ledger.state``: each buyer's open transactions are a
 block of the pool): move an entry, make a buyer's block big enough.  Both ledgers use it; only ledger
 operations call it."""
-from numba import njit
+from ..jit import njit
 
 from ..state.view import unlock
 

@@ -9,7 +9,7 @@ the ledger will share: ``info_share * reward + pot`` in proportion to the weight
 ``payouts`` turns "give back this fraction of each stake, share the rest by these weights" into them.
 """
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 from ..engine.geometry import angular_distance
 

@@ -3,7 +3,7 @@ same public API the rules use (``behaviours.market``, ``behaviours.attacks.in_ra
 batch in one call.  ``OBSERVATION`` names the columns (docs/rl.md lists them with their scales)."""
 from __future__ import annotations
 
-from numba import njit
+from ..jit import njit
 
 from ..behaviours.attacks import NO_ENTRY_AGE, applied_theta, in_range
 from ..behaviours.market import sales_settled, seller_reputation, wealth_share

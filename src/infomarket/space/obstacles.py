@@ -9,7 +9,7 @@ when the probed position's distance is at most ``r`` (as ``x + r >= width`` does
 import math
 
 import numpy as np
-from numba import njit
+from ..jit import njit
 
 RECT = 0
 CIRCLE = 1

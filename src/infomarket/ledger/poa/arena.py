@@ -11,7 +11,7 @@ array and untouched room takes no memory.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from ...jit import njit
 
 from ..state import TX_POOL
 from .spec import _LEDGER_KINDS, BLOCK_STATE, CHECKPOINTED, SPEC

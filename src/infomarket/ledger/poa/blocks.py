@@ -4,7 +4,7 @@ kept (``ledger.poa.states``).  ``end_of_step`` is the chain's end of a step (``l
 import functools
 
 import numpy as np
-from numba import njit
+from ...jit import njit
 
 from ...state.view import unlock
 from ..gas import table_gas

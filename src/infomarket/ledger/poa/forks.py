@@ -1,7 +1,7 @@
 """Fork choice and the checkpoint: which block is heavier, the canonical head, and when a block becomes
 final (the checkpoint moves up, its transactions leave the mempool, blocks off its branch are dropped)."""
 import numpy as np
-from numba import njit
+from ...jit import njit
 
 from ...state.view import unlock
 from .mempool import REVEAL, drop_own, on_branch, refresh_view

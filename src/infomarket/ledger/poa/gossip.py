@@ -1,6 +1,6 @@
 """Gossip: how heads and pending transactions travel between robots (one hop a step between neighbours,
 messages lost at random, a backbone with a latency, a partition), and a robot adopting a heavier head."""
-from numba import njit
+from ...jit import njit
 
 from ...state.view import unlock
 from .forks import ancestor_at, heavier

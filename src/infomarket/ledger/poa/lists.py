@@ -4,7 +4,7 @@ every branch, so a settled list's weights are kept by its node.  The ledger arra
 only when it is read (``materialise``)."""
 import math
 
-from numba import njit
+from ...jit import njit
 
 from ...state.view import unlock
 from ..pool import reserve

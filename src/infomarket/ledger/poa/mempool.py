@@ -11,7 +11,7 @@ robots (``chance``): the engine's random streams are never touched, so turning t
 a single draw of the swarm's.
 """
 import numpy as np
-from numba import njit
+from ...jit import njit
 
 from ...state.view import unlock
 from ..lock import lock_stake_and_gas

@@ -1,7 +1,7 @@
 """Block states: the ledger after a block, kept as a row (``blk_state``) of ``blk_bal`` and ``bs_*`` that
 blocks without transactions share with their parent, and the checkpoint's copy (``ck_*``); saving the
 ledger arrays into them and loading them back (the invariants they keep: ``ledger.poa``)."""
-from numba import njit
+from ...jit import njit
 
 from ...state.view import unlock
 
