@@ -81,14 +81,14 @@ def test_room_of_keeps_the_largest_capacities():
 
 
 class _Counted:
-    """A batch module whose ``step_all`` records each call's robot-steps."""
+    """A kernel module whose ``step_all`` records each call's robot-steps."""
 
     def __init__(self, module, robots: int):
         self.module, self.robots, self.work = module, robots, []
 
-    def step_all(self, views, rngs, t_end, status, clocks, *extra):
+    def step_all(self, views, rngs, t_end, status, clocks):
         before = clocks.copy()
-        short = self.module.step_all(views, rngs, t_end, status, clocks, *extra)
+        short = self.module.step_all(views, rngs, t_end, status, clocks)
         self.work.append(int((clocks - before).sum()) * self.robots)
         return short
 
@@ -106,7 +106,7 @@ def test_a_batch_is_stepped_in_calls_of_bounded_work_that_do_not_change_its_runs
     cap = world_steps * robots
     monkeypatch.setattr(batch, "CALL_ROBOT_STEPS", cap)
     parts = Simulations(cfg, seeds)
-    parts._batch = counted = _Counted(parts._batch, robots)
+    parts._kernel = counted = _Counted(parts._kernel, robots)
     parts.advance([100, 700, 1500, 20])
     parts.advance(cfg.steps)
     assert max(counted.work) <= cap and sum(counted.work) == len(seeds) * cfg.steps * robots

@@ -1,5 +1,7 @@
 """rl.runs: B runs stepped in one compiled call are the engine's own runs, actions reach the compiled
 rules, and the observation is what the world holds (checked against simulate() and plain Python)."""
+import sys
+
 import numpy as np
 import pytest
 
@@ -124,3 +126,30 @@ def test_chain_runs_are_simulate_bit_for_bit(cfg):
         ref = simulate(chain, seed)
         np.testing.assert_array_equal(runs.worlds[b].balance, ref.robots.wealth.to_numpy())
         assert int(runs.worlds[b].chn_blocks[0]) == ref.totals["chain"]["blocks"] > 0
+
+
+def test_the_vector_runs_step_on_the_kernels_own_entry_and_compile_no_second_one(cfg):
+    # the kernel's code is compiled once, into its step_all, whether runs go alone or through the RL
+    # interface (whose observation is a call of its own): a driver linking the kernel would compile again
+    from numba.core import event
+
+    simulate(cfg.with_overrides(steps=300, transitory=100), SEEDS[0])  # this process has the kernel now
+    compiled = []
+
+    class Compiles(event.Listener):
+        def on_start(self, ev):
+            pass
+
+        def on_end(self, ev):
+            compiled.append(ev.data["dispatcher"].py_func.__name__)
+
+    listener = Compiles()
+    event.register("numba:compile", listener)
+    try:
+        runs = Runs(cfg, 2)
+        play(runs, SEEDS[:2], 3)
+    finally:
+        event.unregister("numba:compile", listener)
+    assert not [m for m in sys.modules if m.startswith("infomarket_batch")]  # no driver module of its own
+    assert "step_all" not in compiled, compiled
+    assert runs.sims.kernel.__name__.startswith("infomarket_kernel_")

@@ -1,4 +1,5 @@
-"""B runs of one experiment stepped together in one compiled call: the core of every RL interface.
+"""B runs of one experiment stepped together in one compiled call, then observed in another: the core
+of every RL interface.
 
 The agents are the robots whose behaviour is ``attacker`` (``behaviours.attacks``).  An action is a row of
 the attacker's own parameters (``ACTIONS`` picks which, default the lie's rotation and whether to collude):
@@ -9,8 +10,8 @@ sets every agent of every run.
 
 The runs are the engine's own (``engine.batch.Simulations``, the driver sweeps use): ``advance``
 steps each world to its ``t_end``, grows the worlds that ran short and names a rule's error as
-``Simulation`` does; its finishing call (``observe.observe_all``, compiled with it) computes every
-observation, the honest robots' items and every agent's wealth share.  A run built here with seed s is
+``Simulation`` does; its finishing call (``observe.observe_all``, one compiled call after the kernel's)
+computes every observation, the honest robots' items and every agent's wealth share.  A run built here with seed s is
 the run ``simulate(config, seed=s)`` makes, step for step, as long as the actions equal the
 configuration's parameters (tests/rl/test_runs.py); chain runs included.
 """
@@ -99,9 +100,9 @@ class Runs:
         self.items = np.zeros(self.size, np.int64)
         self.shares = np.zeros((self.size, a))
         self.seeds = np.zeros(self.size, np.int64)
-        # the first observation compiles (or loads) step_all: in a child a signal can stop at once
+        # the first observation compiles (or loads) observe_all: in a child a signal can stop at once
         interrupts.compiled_apart(lambda: self.reset(np.arange(self.size), np.arange(self.size)),
-                                  compile_marker(self.sims.batch, "runs"))
+                                  compile_marker(self.sims.kernel, "runs"))
 
     @property
     def worlds(self) -> list:
