@@ -254,3 +254,17 @@ def test_the_python_api_names_the_rule_and_the_step_too(tmp_path, shared):
     plugins.load(str(shared / "three.py"))
     with pytest.raises(RuleRunError, match="three_values_sell.*returns 3 values"):
         im.Simulation(exp, seed=3)
+
+
+
+def test_a_rule_raising_in_one_run_of_a_batch_leaves_that_run_marked(tmp_path, shared):
+    # the kernel's step_all leaves -1 on the world whose step raised (Simulations names that run): the
+    # first world stops at step 30, before the rule divides, the second reaches step 37
+    from infomarket.engine.batch import Simulations
+
+    cfg = im.load_experiment(experiment(tmp_path, "late", LATE, "late_divider", plugins=shared))
+    sims = Simulations(cfg, [11, 12])
+    status, clocks = np.zeros(2, np.int64), np.zeros(2, np.int64)
+    with pytest.raises(ZeroDivisionError):
+        sims.kernel.step_all(sims._views, sims._rngs, np.array([30, 40]), status, clocks)
+    assert status.tolist() == [sims.kernel.DONE, -1] and clocks[0] == 30

@@ -106,10 +106,10 @@ def step_all(views, rngs, t_end, status, clocks):
     the kernel's code is compiled once, into this one function, whether its runs go alone or together."""
     short = 0
     for b in range(len(views)):
-        status[b] = -1
+        status[b] = -1  # left there if a rule raises: the host names this run
         w = views[b]
         rng = rngs[b]
-        status[b] = DONE
+        done = DONE
         n = w.pos.shape[0]
         clock, kind, balance = unlock(w.clock), w.kind, w.balance
         cool, stop = w.cool_timer, w.stop_timer
@@ -121,7 +121,7 @@ def step_all(views, rngs, t_end, status, clocks):
         while clock[0] < t_end[b]:
             find_neighbours(w)
             if not has_room(w):
-                status[b] = NEED_ROOM
+                done = NEED_ROOM
                 break
             clock[0] += 1
             begin_step(w)
@@ -164,8 +164,7 @@ def step_all(views, rngs, t_end, status, clocks):
             end_of_step(w, rng)
             record_history(w)
         clocks[b] = clock[0]
-        if w.flags[0] != 0:
-            status[b] = FLAGGED
+        status[b] = FLAGGED if w.flags[0] != 0 else done
         if status[b] != DONE:
             short += 1
     return short
