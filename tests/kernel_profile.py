@@ -52,7 +52,7 @@ _USES: dict = {}
 
 
 def _record_uses(module) -> None:
-    """Note every generated module (step kernel, batch kernel, state view) a test loads, compiled or loaded
+    """Note every generated module (step kernel, state view) a test loads, compiled or loaded
     from a cache: its callers look ``load_generated`` up as a global, so it is wrapped in each."""
     inner = module.load_generated
 
@@ -65,10 +65,10 @@ def _record_uses(module) -> None:
 
 def pytest_configure(config):
     from infomarket import generated  # the package only once pytest runs with this plugin
-    from infomarket.engine import batch, specialise
+    from infomarket.engine import specialise
 
     event.register("numba:compile", _Compiles())
-    for module in (generated, specialise, batch):
+    for module in (generated, specialise):
         _record_uses(module)
 
 
