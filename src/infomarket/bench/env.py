@@ -1,12 +1,12 @@
 """The RL interface's throughput (``infomarket bench --env``): the vector environment
 (``rl.AttackVectorEnv``, B runs stepped K engine steps per ``step`` in one compiled call) against the
-engine alone (``Simulation.run``) on the same setup, in the same process.
+engine alone (``Simulation``, stepping only) on the same runs, in the same process.
 
 Rates, each a median over ``repeats``, per second of this process's CPU time (``time.process_time``: the
 machine may be shared, and CPU time charges each side only for what it did):
 
-- engine env-steps/s: the episode's own B runs (its seeds), each ``Simulation.run`` alone (world building
-  excluded), B x ``steps`` over their CPU time: the engine's rate for the same runs, so the ratio compares
+- engine env-steps/s: the episode's own B runs (its seeds), each stepped alone by ``Simulation`` (world
+  building and result tables excluded), B x ``steps`` over their CPU time: the engine's rate for the same runs, so the ratio compares
   like with like and does not hang on one short run's timing;
 - vector env-steps/s: B x ``steps`` over the CPU time of ``reset(seed=...)`` plus the ``steps / K`` calls
   of ``step`` of one episode, through the Gymnasium API (worlds built, actions written, observations and
@@ -66,13 +66,13 @@ def run_env_bench(*, steps: int = 3000, batch: int = 64, interval: int = 10, rep
 
 
 def _engine_seconds(cfg, seeds) -> float:
-    """CPU seconds of ``Simulation.run`` over the runs of ``seeds``, one after the other (each world built
-    before its clock starts): the vector episode's runs, which the constant default action leaves as the
+    """CPU seconds of stepping the runs of ``seeds`` to their end, one after the other (each world built
+    before its clock starts, and no result tables made after it): the vector episode's runs, which the constant default action leaves as the
     configuration makes them (tests/rl/test_runs.py)."""
     total = 0.0
     for seed in seeds:
         sim = Simulation(cfg, int(seed))
         t = time.process_time()
-        sim.run()
+        sim.advance_to(cfg.steps)  # the steps alone: the vector env makes no result tables
         total += time.process_time() - t
     return total
