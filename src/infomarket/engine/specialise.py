@@ -129,7 +129,7 @@ def uses_paths(behaviour_names: tuple[str, ...]) -> bool:
 
 #: ``_kernel_parts`` already worked out in this process: (the specs' ids, terrain, ledger) -> (the specs,
 #: the parts).  Every run asks for its kernel's key (a study's runs, thousands of times), and reading the
-#: rules' source and hashing it took 4 ms each time.
+#: rules' source and hashing it each time cost more than a short run's steps (docs/performance.md, "Short runs").
 _PARTS: dict = {}
 
 
