@@ -58,21 +58,28 @@ def floor_kernel(pos, hdir, tab, bias, nbr, nbr_count, cell_start, cell_items, r
     return links
 
 
+def floor_arguments(seed: int, robots: int = 25, width: float = 1200.0, height: float = 600.0,
+                    comm_range: float = 50.0) -> tuple:
+    """``floor_kernel``'s arguments but ``steps``: a swarm of ``robots`` scattered over a ``width`` x
+    ``height`` arena from ``seed``, at the paper's speed, noise and radius."""
+    rng = np.random.default_rng(seed)
+    pos = np.column_stack([rng.uniform(8, width - 8, robots), rng.uniform(8, height - 8, robots)])
+    ang = rng.uniform(0, 2 * math.pi, robots)
+    hdir = np.column_stack([np.cos(ang), np.sin(ang)])
+    tab = rng.normal(0, 100, (robots, 2, 2))
+    bias = rng.normal(0.05, 0.05, robots)
+    cell, nx, ny = grid_shape(width, height, comm_range, robots)
+    nbr = np.zeros((robots, 64), np.int64)
+    return (pos, hdir, tab, bias, nbr, np.zeros(robots, np.int64), np.zeros(nx * ny + 1, np.int64),
+            np.zeros(robots, np.int64), comm_range, cell, nx, ny, 2.5, 0.05, 8.0, width, height, rng)
+
+
 def floor_steps_per_second(robots: int = 25, steps: int = 15000, repeats: int = 7, width: float = 1200.0,
                            height: float = 600.0, comm_range: float = 50.0, seed: int = 0) -> dict:
     """Median env-steps/s of the floor kernel for ``robots`` robots in a ``width`` x ``height`` arena."""
     times = []
     for rep in range(repeats + 1):  # the first call compiles or loads the kernel and is not timed
-        rng = np.random.default_rng(seed + rep)
-        pos = np.column_stack([rng.uniform(8, width - 8, robots), rng.uniform(8, height - 8, robots)])
-        ang = rng.uniform(0, 2 * math.pi, robots)
-        hdir = np.column_stack([np.cos(ang), np.sin(ang)])
-        tab = rng.normal(0, 100, (robots, 2, 2))
-        bias = rng.normal(0.05, 0.05, robots)
-        cell, nx, ny = grid_shape(width, height, comm_range, robots)
-        nbr = np.zeros((robots, 64), np.int64)
-        args = (pos, hdir, tab, bias, nbr, np.zeros(robots, np.int64), np.zeros(nx * ny + 1, np.int64),
-                np.zeros(robots, np.int64), comm_range, cell, nx, ny, 2.5, 0.05, 8.0, width, height, rng)
+        args = floor_arguments(seed + rep, robots, width, height, comm_range)
         t0 = time.perf_counter()
         floor_kernel(*args, steps if rep else 1)
         if rep:
