@@ -59,3 +59,33 @@ def test_scaling_runs_the_same_sweep_on_each_executor():
         assert r[k]["env_steps_per_second"] == pytest.approx(2 * 200 / r[k]["wall_seconds"])
     assert r["speedup_2_vs_1"] == pytest.approx(r["local_2"]["env_steps_per_second"]
                                                 / r["local_1"]["env_steps_per_second"])
+
+
+def test_the_floor_is_timed_once_a_round_before_that_rounds_setups(monkeypatch):
+    """Interleaved, so a change in the machine's speed during the bench moves the floor and the setups
+    alike: the order of the timed runs is floor, every setup, floor, every setup, ..."""
+    from types import SimpleNamespace
+
+    from infomarket.bench import setups
+
+    order = []
+
+    class FakeSimulation:  # records its timed runs; the kernel looks loaded from the disk cache
+        def __init__(self, cfg, seed):
+            self.name = cfg.name
+            self._kernel = SimpleNamespace(step_all=SimpleNamespace(stats=SimpleNamespace(cache_hits={"x": 1})))
+            self.run_seconds = 0.5
+
+        def run(self):
+            order.append(self.name)
+
+    def floor_seconds(seed, steps):
+        order.append(("floor", seed, steps))
+        return 0.25
+
+    monkeypatch.setattr(setups, "Simulation", FakeSimulation)
+    monkeypatch.setattr(setups, "floor_seconds", floor_seconds)
+    report = setups.run_bench(["fig2A", "fig4C"], steps=100, repeats=3)
+    assert order == [("floor", 0, 1)] + [x for i in (1, 2, 3) for x in (("floor", i, 100), "fig2A", "fig4C")]
+    assert report["floor"]["steps_per_second"] == 400 and report["floor"]["repeats"] == 3
+    assert report["setups"]["fig2A"]["ratio_to_floor"] == 2  # 0.5 s a run against the floor's 0.25

@@ -74,6 +74,21 @@ def floor_arguments(seed: int, robots: int = 25, width: float = 1200.0, height: 
             np.zeros(robots, np.int64), comm_range, cell, nx, ny, 2.5, 0.05, 8.0, width, height, rng)
 
 
+def floor_seconds(seed: int, steps: int, robots: int = 25) -> float:
+    """Seconds (wall clock, as the setups' ``run_seconds``) of one floor run of ``steps`` steps."""
+    args = floor_arguments(seed, robots)
+    t0 = time.perf_counter()
+    floor_kernel(*args, steps)
+    return time.perf_counter() - t0
+
+
+def floor_summary(times: list[float], robots: int, steps: int) -> dict:
+    """The floor's rates from its runs' seconds (the median run)."""
+    med = statistics.median(times)
+    return {"steps_per_second": steps / med, "robot_steps_per_second": robots * steps / med,
+            "seconds_per_run": med, "robots": robots, "steps": steps, "repeats": len(times)}
+
+
 def floor_steps_per_second(robots: int = 25, steps: int = 15000, repeats: int = 7, width: float = 1200.0,
                            height: float = 600.0, comm_range: float = 50.0, seed: int = 0) -> dict:
     """Median env-steps/s of the floor kernel for ``robots`` robots in a ``width`` x ``height`` arena."""
@@ -84,6 +99,4 @@ def floor_steps_per_second(robots: int = 25, steps: int = 15000, repeats: int = 
         floor_kernel(*args, steps if rep else 1)
         if rep:
             times.append(time.perf_counter() - t0)
-    med = statistics.median(times)
-    return {"steps_per_second": steps / med, "robot_steps_per_second": robots * steps / med,
-            "seconds_per_run": med, "robots": robots, "steps": steps, "repeats": repeats}
+    return floor_summary(times, robots, steps)

@@ -9,7 +9,7 @@ from .. import __version__
 from ..config import load_experiment
 from ..seeds import run_seed
 from ..engine.simulation import Simulation
-from .floor import floor_steps_per_second
+from .floor import floor_seconds, floor_summary
 
 
 #: A setup named ``NAME+chain`` is the shipped setup NAME with every robot a blockchain node
@@ -41,8 +41,13 @@ def bench_config(name: str, steps: int):
 def run_bench(setups, *, steps: int = 15000, repeats: int = 7) -> dict:
     """Per setup: env-steps per second (median over ``repeats`` runs) and the time to get the compiled
     kernel ready in this process: a compilation, or a load from numba's disk cache (then
-    ``kernel_from_disk_cache`` is true; a kernel already loaded in this process counts as cached)."""
-    out = {}
+    ``kernel_from_disk_cache`` is true; a kernel already loaded in this process counts as cached).
+
+    The runs go in rounds: each round times the floor once, then one run of every setup.  A change in the
+    machine's speed during the bench (another process starting, a clock stepping down) then moves the
+    floor and the setups alike, and the ratios stay comparable; timed one after the other, the floor
+    after all the setups, a load change between them moved a run's ratios by up to 20 %."""
+    out, cfgs = {}, {}
     for name in setups:
         cfg = bench_config(name, steps)
         t0 = time.perf_counter()
@@ -50,17 +55,23 @@ def run_bench(setups, *, steps: int = 15000, repeats: int = 7) -> dict:
         compile_seconds = time.perf_counter() - t0
         loaded_from_disk = bool(sum(first._kernel.step_all.stats.cache_hits.values()))
         del first
-        times = []
-        for i in range(repeats):
+        cfgs[name] = cfg
+        out[name] = {"compile_seconds": compile_seconds, "kernel_from_disk_cache": loaded_from_disk,
+                     "robots": cfg.swarm.robots, "steps": steps, "repeats": repeats}
+    floor_seconds(0, 1)  # compiles or loads the floor kernel; not timed
+    floor_times: list[float] = []
+    times: dict[str, list[float]] = {name: [] for name in setups}
+    for i in range(repeats):
+        floor_times.append(floor_seconds(i + 1, steps))
+        for name, cfg in cfgs.items():
             sim = Simulation(cfg, run_seed(cfg.seed, i))
             sim.run()
-            times.append(sim.run_seconds)
-        med = statistics.median(times)
-        out[name] = {"steps_per_second": steps / med, "seconds_per_run": med,
-                     "compile_seconds": compile_seconds, "kernel_from_disk_cache": loaded_from_disk,
-                     "robots": cfg.swarm.robots, "steps": steps,
-                     "repeats": repeats, "min_seconds": min(times), "max_seconds": max(times)}
-    floor = floor_steps_per_second(robots=25, steps=steps, repeats=repeats)
+            times[name].append(sim.run_seconds)
+    for name, r in out.items():
+        med = statistics.median(times[name])
+        r.update({"steps_per_second": steps / med, "seconds_per_run": med,
+                  "min_seconds": min(times[name]), "max_seconds": max(times[name])})
+    floor = floor_summary(floor_times, 25, steps)
     for r in out.values():
         r["ratio_to_floor"] = floor["steps_per_second"] / r["steps_per_second"]
     for name, r in out.items():
