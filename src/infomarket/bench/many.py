@@ -7,7 +7,9 @@ runs in this process (the inline executor), so the CPU time counts the whole pat
 world building, stepping, results, store writes and checksums, and (the search) reading the store back
 between generations.  Kernels are loaded and the optimiser's libraries imported before any clock starts.
 
-- engine: ``Simulation.run`` alone, world building excluded (the median of ``repeats`` runs);
+- engine: ``Simulation.run`` alone, world building excluded: the same ``repeats`` runs before the first
+  path and after each one; a path's ratio is against the median of the engine's runs just before and just
+  after it (the machine's speed may drift over a bench of minutes), ``engine`` reports all of them;
 - sweep: ``run_sweep`` of ``runs`` runs of the same configuration into a fresh store;
 - search: ``search.driver.search_cell`` of one cell (the start runs of every baseline, the CMA-ES and
   random-search generations, the race, the confirmation), reduced to ``budget`` evaluations of
@@ -45,18 +47,23 @@ CELL = ("staking", 3)
 GOALS = {"sweep": 0.8, "search": 0.8}
 
 
-def engine_rate(cfg, repeats: int) -> dict:
-    """The engine alone: env-steps per CPU second of ``Simulation.run`` (median of ``repeats`` runs)."""
-    Simulation(cfg, 0)  # load the kernel
+def engine_seconds(cfg, repeats: int) -> list[float]:
+    """CPU seconds of ``Simulation.run`` alone (world building excluded) for the runs of seeds 0 to
+    ``repeats`` - 1: the same runs every time it is called, so two calls differ by the machine alone."""
     seconds = []
     for i in range(repeats):
         sim = Simulation(cfg, run_seed(cfg.seed, i))
         t0 = time.process_time()
         sim.run()
         seconds.append(time.process_time() - t0)
+    return seconds
+
+
+def engine_rate(cfg, seconds: list[float]) -> dict:
+    """The engine's rates from its runs' CPU seconds (the median run)."""
     med = statistics.median(seconds)
     return {"env_steps_per_second": cfg.steps / med, "runs_per_second": 1.0 / med, "cpu_seconds_per_run": med,
-            "repeats": repeats}
+            "repeats": len(seconds)}
 
 
 def sweep_rate(cfg, runs: int, folder: Path) -> dict:
@@ -115,21 +122,30 @@ def run_many_bench(*, steps: int = 30000, repeats: int = 5, sweep_runs: int = 32
     st = study_mod.load(load_experiment(SETUP))
     cfg = study_mod.cells(st, [CELL[0]], [CELL[1]])[0].with_attack({}, steps=steps, transitory=transitory)
     out = {"setup": f"{SETUP} [defence={CELL[0]}, byzantines={CELL[1]}]", "steps": steps,
-           "clock": "process CPU time", "engine": engine_rate(cfg, repeats)}
+           "clock": "process CPU time"}
+    Simulation(cfg, 0)  # load the kernel
+    brackets = [engine_seconds(cfg, repeats)]  # the engine before the first path and after each one
+    paths = ["sweep", "search"] + (["search_pool"] if workers > 1 else [])
     with tempfile.TemporaryDirectory(prefix="infomarket-bench-") as tmp:
         search_rate(min(steps, 50), 10, Path(tmp) / "warm", budget=2, popsize=2, runs=1)  # loads what a search loads
-        out["sweep"] = sweep_rate(cfg, sweep_runs, Path(tmp))
-        out["search"] = search_rate(steps, transitory, Path(tmp), budget=budget, popsize=popsize, runs=runs)
-        if workers > 1:
-            out["search_pool"] = search_rate(steps, transitory, Path(tmp), budget=budget, popsize=popsize,
-                                             runs=runs, workers=workers)
-    e = out["engine"]["env_steps_per_second"]
-    for k in ("sweep", "search", "search_pool"):
-        if k in out:
-            out[k]["ratio_to_engine"] = out[k]["env_steps_per_second"] / e
-            out[k]["engine_runs_per_second"] = out["engine"]["runs_per_second"]
-            out[k]["goal"] = GOALS["search" if k == "search_pool" else k]
+        for k in paths:
+            if k == "sweep":
+                out[k] = sweep_rate(cfg, sweep_runs, Path(tmp))
+            else:
+                out[k] = search_rate(steps, transitory, Path(tmp), budget=budget, popsize=popsize, runs=runs,
+                                     workers=workers if k == "search_pool" else 1)
+            brackets.append(engine_seconds(cfg, repeats))
+    out["engine"] = engine_rate(cfg, [s for b in brackets for s in b])
+    for j, k in enumerate(paths):
+        # against the engine's runs just before and just after it: the machine's speed may drift during a
+        # bench of minutes, and a path's ratio should not carry what it did in another path's minute
+        e = engine_rate(cfg, brackets[j] + brackets[j + 1])
+        out[k].update(ratio_to_engine=out[k]["env_steps_per_second"] / e["env_steps_per_second"],
+                      engine_env_steps_per_second=e["env_steps_per_second"],
+                      engine_runs_per_second=e["runs_per_second"],
+                      goal=GOALS["search" if k == "search_pool" else k])
     if "search_pool" in out:  # wall time on a quiet machine: against the engine on every worker at once
         p = out["search_pool"]
-        p["wall_ratio_to_engine_per_worker"] = p["wall_env_steps_per_second"] / (workers * e)
+        p["wall_ratio_to_engine_per_worker"] = (p["wall_env_steps_per_second"]
+                                                / (workers * p["engine_env_steps_per_second"]))
     return out
