@@ -43,24 +43,19 @@ def without_market(source: str) -> str:
 
 def measure(setups: list[str], rounds: int, steps: int) -> dict:
     """In this process: each setup's least CPU seconds a run and the floor's, interleaved."""
-    from infomarket.bench.floor import floor_arguments, floor_kernel
+    from infomarket.bench.floor import floor_seconds
     from infomarket.config import load_experiment
     from infomarket.engine.simulation import Simulation
     from infomarket.seeds import run_seed
 
-    def floor_once(seed: int) -> float:  # the swarm bench.floor.floor_steps_per_second times
-        start = time.process_time()
-        floor_kernel(*floor_arguments(seed), steps)
-        return time.process_time() - start
-
     cfgs = {name: load_experiment(name).with_overrides(steps=steps) for name in setups}
-    floor_once(0)
+    floor_seconds(0, 1)  # compiles or loads the floor kernel
     for cfg in cfgs.values():  # compile or load every kernel before any clock runs
         Simulation(cfg, run_seed(cfg.seed, 0)).run()
     best = dict.fromkeys(setups, math.inf)
     best_floor = math.inf
     for r in range(rounds):
-        best_floor = min(best_floor, floor_once(r + 1))
+        best_floor = min(best_floor, floor_seconds(r + 1, steps, clock=time.process_time))
         for name, cfg in cfgs.items():
             sim = Simulation(cfg, run_seed(cfg.seed, r))
             start = time.process_time()

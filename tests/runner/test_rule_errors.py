@@ -256,7 +256,6 @@ def test_the_python_api_names_the_rule_and_the_step_too(tmp_path, shared):
         im.Simulation(exp, seed=3)
 
 
-
 def test_a_rule_raising_in_one_run_of_a_batch_leaves_that_run_marked(tmp_path, shared):
     # the kernel's step_all leaves -1 on the world whose step raised (Simulations names that run): the
     # first world stops at step 30, before the rule divides, the second reaches step 37

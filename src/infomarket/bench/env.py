@@ -6,8 +6,8 @@ Rates, each a median over ``repeats``, per second of this process's CPU time (``
 machine may be shared, and CPU time charges each side only for what it did):
 
 - engine env-steps/s: the episode's own B runs (its seeds), each stepped alone by ``Simulation`` (world
-  building and result tables excluded), B x ``steps`` over their CPU time: the engine's rate for the same runs, so the ratio compares
-  like with like and does not hang on one short run's timing;
+  building and result tables excluded), B x ``steps`` over their CPU time: the engine's rate for the
+  same runs, so the ratio compares like with like and does not hang on one short run's timing;
 - vector env-steps/s: B x ``steps`` over the CPU time of ``reset(seed=...)`` plus the ``steps / K`` calls
   of ``step`` of one episode, through the Gymnasium API (worlds built, actions written, observations and
   rewards computed: everything an RL loop pays, except the policy);
@@ -67,8 +67,8 @@ def run_env_bench(*, steps: int = 3000, batch: int = 64, interval: int = 10, rep
 
 def _engine_seconds(cfg, seeds) -> float:
     """CPU seconds of stepping the runs of ``seeds`` to their end, one after the other (each world built
-    before its clock starts, and no result tables made after it): the vector episode's runs, which the constant default action leaves as the
-    configuration makes them (tests/rl/test_runs.py)."""
+    before its clock starts, and no result tables made after it): the vector episode's runs, which the
+    constant default action leaves as the configuration makes them (tests/rl/test_runs.py)."""
     total = 0.0
     for seed in seeds:
         sim = Simulation(cfg, int(seed))

@@ -74,12 +74,14 @@ def floor_arguments(seed: int, robots: int = 25, width: float = 1200.0, height: 
             np.zeros(robots, np.int64), comm_range, cell, nx, ny, 2.5, 0.05, 8.0, width, height, rng)
 
 
-def floor_seconds(seed: int, steps: int, robots: int = 25) -> float:
-    """Seconds (wall clock, as the setups' ``run_seconds``) of one floor run of ``steps`` steps."""
-    args = floor_arguments(seed, robots)
-    t0 = time.perf_counter()
+def floor_seconds(seed: int, steps: int, robots: int = 25, width: float = 1200.0, height: float = 600.0,
+                  comm_range: float = 50.0, clock=time.perf_counter) -> float:
+    """Seconds of one floor run of ``steps`` steps on ``floor_arguments(seed, ...)``: wall clock by
+    default, as the setups' ``run_seconds``; ``clock=time.process_time`` for CPU time."""
+    args = floor_arguments(seed, robots, width, height, comm_range)
+    t0 = clock()
     floor_kernel(*args, steps)
-    return time.perf_counter() - t0
+    return clock() - t0
 
 
 def floor_summary(times: list[float], robots: int, steps: int) -> dict:
@@ -92,11 +94,6 @@ def floor_summary(times: list[float], robots: int, steps: int) -> dict:
 def floor_steps_per_second(robots: int = 25, steps: int = 15000, repeats: int = 7, width: float = 1200.0,
                            height: float = 600.0, comm_range: float = 50.0, seed: int = 0) -> dict:
     """Median env-steps/s of the floor kernel for ``robots`` robots in a ``width`` x ``height`` arena."""
-    times = []
-    for rep in range(repeats + 1):  # the first call compiles or loads the kernel and is not timed
-        args = floor_arguments(seed + rep, robots, width, height, comm_range)
-        t0 = time.perf_counter()
-        floor_kernel(*args, steps if rep else 1)
-        if rep:
-            times.append(time.perf_counter() - t0)
+    floor_seconds(seed, 1, robots, width, height, comm_range)  # compiles or loads the kernel; not timed
+    times = [floor_seconds(seed + rep, steps, robots, width, height, comm_range) for rep in range(1, repeats + 1)]
     return floor_summary(times, robots, steps)
