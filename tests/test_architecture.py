@@ -286,3 +286,20 @@ def test_compiled_helpers_are_inlined_by_llvm_not_by_numba():
     dispatch functions stay inlined by numba, where it measured faster."""
     offenders = {m: names for m, p in MODULES.items() if (names := _njit_inlined_by_numba(p.read_text()))}
     assert not offenders, offenders
+
+
+#: Most lines a Python file of the project may hold: a longer one mixes jobs that want modules of their own.
+MAX_LINES = 500
+
+
+def _python_files() -> list[Path]:
+    repo = PACKAGE.parent.parent
+    return [p for folder in ("src", "tests", "tools") for p in (repo / folder).rglob("*.py")
+            if "node_modules" not in p.parts]
+
+
+def test_no_file_is_over_500_lines():
+    files = _python_files()
+    assert PACKAGE / "evm" / "market.py" in files and Path(__file__) in files  # the files are really found
+    long = {str(p): n for p in files if (n := len(p.read_text().splitlines())) > MAX_LINES}
+    assert long == {}, f"split these files (most {MAX_LINES} lines each): {long}"
