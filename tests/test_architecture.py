@@ -303,3 +303,44 @@ def test_no_file_is_over_500_lines():
     assert PACKAGE / "evm" / "market.py" in files and Path(__file__) in files  # the files are really found
     long = {str(p): n for p in files if (n := len(p.read_text().splitlines())) > MAX_LINES}
     assert long == {}, f"split these files (most {MAX_LINES} lines each): {long}"
+
+
+def private_names_taken(text: str, module: str, is_package: bool = False) -> list[str]:
+    """``module``'s uses of another package's private names (``_name``, not a dunder): imported from it, or
+    read as an attribute of a module of it imported here.  A private module (``_numba_internals``) is a
+    module, not a name, and may be imported."""
+    def unit(name: str) -> str:
+        return name.split(".")[1] if name.count(".") else ""
+
+    private = (lambda n: n.startswith("_") and not n.startswith("__"))
+    tree, found, modules = ast.parse(text), [], {}
+    for node, _ in _imports(tree):
+        for alias, target in zip(node.names, _targets(module, is_package, node) if isinstance(node, ast.ImportFrom)
+                                 else [a.name for a in node.names]):
+            if not target.startswith("infomarket"):
+                continue
+            bound = alias.asname or alias.name.split(".")[0]
+            if isinstance(node, ast.ImportFrom) and f"{target}" != f"{target.rsplit('.', 1)[0]}.{alias.name}":
+                if private(alias.name) and unit(target) != unit(module):  # a name of module ``target``
+                    found.append(f"{target}.{alias.name}")
+            else:
+                modules[bound] = target
+    for node in ast.walk(tree):
+        if (isinstance(node, ast.Attribute) and private(node.attr) and isinstance(node.value, ast.Name)
+                and node.value.id in modules and unit(modules[node.value.id]) != unit(module)):
+            found.append(f"{modules[node.value.id]}.{node.attr}")
+    return found
+
+
+def test_the_private_name_finder():
+    text = ("from ..search.report import _ci, json_ready\nfrom . import _helper\nfrom .. import _numba_internals\n"
+            "from ..analysis import stats as st\nx = st._fmt_p(1) + st.fmt(2)\n")
+    assert private_names_taken(text, "infomarket.defence.report") == [
+        "infomarket.search.report._ci", "infomarket.analysis.stats._fmt_p"]
+    assert private_names_taken(text, "infomarket.search.other") == ["infomarket.analysis.stats._fmt_p"]
+
+
+def test_no_module_takes_a_private_name_of_another_package():
+    taken = {m: names for m, p in MODULES.items()
+             if (names := private_names_taken(p.read_text(), m, p.name == "__init__.py"))}
+    assert taken == {}

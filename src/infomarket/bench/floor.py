@@ -14,7 +14,7 @@ import time
 import numpy as np
 from ..jit import njit
 
-from ..engine.neighbours import ALL_PAIRS_UP_TO, _all_pairs, _grid, grid_shape
+from ..engine.neighbours import ALL_PAIRS_UP_TO, grid_shape, neighbours_by_all_pairs, neighbours_by_grid
 
 DEG = math.pi / 180.0
 
@@ -30,9 +30,9 @@ def floor_kernel(pos, hdir, tab, bias, nbr, nbr_count, cell_start, cell_items, r
         for i in range(n):
             nbr_count[i] = 0
         if n <= ALL_PAIRS_UP_TO:
-            _all_pairs(pos, rc * rc, nbr, nbr_count, cap)
+            neighbours_by_all_pairs(pos, rc * rc, nbr, nbr_count, cap)
         else:
-            _grid(pos, rc * rc, nbr, nbr_count, cap, cell, nx, ny, cell_start, cell_items)
+            neighbours_by_grid(pos, rc * rc, nbr, nbr_count, cap, cell, nx, ny, cell_start, cell_items)
         for i in range(n):
             links += nbr_count[i]
             a = rng.normal(bias[i], noise_sd) * DEG

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..analysis import paired_runs as pr
 from ..analysis import stats
-from ..search.report import _ci, _clean
+from ..search.report import interval_text, json_ready
 from ..store.files import write_atomic, write_parquet_atomic, write_text_atomic
 from .driver import Judged, Result, pareto
 from .study import Study, floor
@@ -226,7 +226,7 @@ def _growth(ax, a: dict, matplotlib) -> None:
 def _pct(v: dict) -> str:
     if not math.isfinite(v.get("hl", math.nan)):
         return "undefined"
-    return f"{v['hl']:.1%} {_ci(v['low'], v['high'], '.1%')}"
+    return f"{v['hl']:.1%} {interval_text(v['low'], v['high'], '.1%')}"
 
 
 def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, provenance: dict | None = None,
@@ -247,7 +247,7 @@ def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, p
     e = a["beats_existing"]
     if "new" in e:
         lines += [f"Best new trade `{e['new']}` against the best existing defence `{e['existing']}` at {t} "
-                  f"Byzantines: loss difference {e['hl']:+.1%} {_ci(e['low'], e['high'], '+.1%')}, p = "
+                  f"Byzantines: loss difference {e['hl']:+.1%} {interval_text(e['low'], e['high'], '+.1%')}, p = "
                   f"{e['p']:.3g}, power {e['power']:.2f} at {-e['min_effect']:+.0%}: **{e['answer']}**.", ""]
     else:
         lines += [f"Best new against best existing: {e['answer']} ({e.get('note', '')}).", ""]
@@ -260,7 +260,8 @@ def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, p
     for r in a["confirmed"]:
         vals = ", ".join(f"{k} {v:.4g}" for k, v in r["values"].items()) or "–"
         ci = r["cost_items"]
-        items = (f"{ci['hl']:.2f} {_ci(ci['low'], ci['high'], '.2f')}" if math.isfinite(ci["hl"]) else "undefined")
+        items = (f"{ci['hl']:.2f} {interval_text(ci['low'], ci['high'], '.2f')}" if math.isfinite(ci["hl"])
+                 else "undefined")
         lines.append(f"| {r['label']} | {r['family']} | {_pct(r['cost'])} | {items} | "
                      + " | ".join(_pct(r["loss"][c]) for c in counts)
                      + f" | {r['answer']} | {_voices(r['voices_floor'][t])} | {vals} |")
@@ -309,7 +310,7 @@ def write(out: Path, a: dict, *, reduced: str = "", wall_seconds: float | None =
     """``defence.json``, ``defence.md`` and ``frontier.png`` into ``out``, each written whole or not at all."""
     out = Path(out)
     meta = {"reduced": reduced, "wall_seconds": wall_seconds, "provenance": provenance or {}}
-    text = json.dumps(_clean({**meta, **a}), indent=2) + "\n"
+    text = json.dumps(json_ready({**meta, **a}), indent=2) + "\n"
     paths = [write_text_atomic(text, out / "defence.json")]
     md = markdown(a, reduced=reduced, wall_seconds=wall_seconds, provenance=provenance, records=records)
     paths.append(write_text_atomic(md, out / "defence.md"))

@@ -31,7 +31,7 @@ def _link(nbr, nbr_count, cap, i, j):
 
 
 @njit(cache=True)
-def _all_pairs(pos, rc2, nbr, nbr_count, cap):
+def neighbours_by_all_pairs(pos, rc2, nbr, nbr_count, cap):
     n = pos.shape[0]
     for i in range(n):
         xi = pos[i, 0]
@@ -50,7 +50,7 @@ def _cell(x, size, cells):
 
 
 @njit(cache=True)
-def _grid(pos, rc2, nbr, nbr_count, cap, size, nx, ny, start, items):
+def neighbours_by_grid(pos, rc2, nbr, nbr_count, cap, size, nx, ny, start, items):
     n = pos.shape[0]
     ncell = nx * ny
     for c in range(ncell + 1):
@@ -106,7 +106,7 @@ def find_all_neighbours(w):
     if rc <= 0.0:
         return
     if n <= ALL_PAIRS_UP_TO:
-        _all_pairs(w.pos, rc * rc, nbr, nbr_count, nbr.shape[1])
+        neighbours_by_all_pairs(w.pos, rc * rc, nbr, nbr_count, nbr.shape[1])
     else:
-        _grid(w.pos, rc * rc, nbr, nbr_count, nbr.shape[1], w.grid_cell, w.grid_nx, w.grid_ny,
+        neighbours_by_grid(w.pos, rc * rc, nbr, nbr_count, nbr.shape[1], w.grid_cell, w.grid_nx, w.grid_ny,
               w.cell_start, w.cell_items)

@@ -267,7 +267,7 @@ def write(out: Path, analysis: dict, *, reduced: str = "", wall_seconds: float |
     paths = [out / "report.json", out / "report.md"]
     meta = {"reduced": reduced, "wall_seconds": wall_seconds, "steps": steps, "transitory": transitory,
             "provenance": provenance or {}}
-    paths[0].write_text(json.dumps(_clean({**meta, **analysis}), indent=2) + "\n")
+    paths[0].write_text(json.dumps(json_ready({**meta, **analysis}), indent=2) + "\n")
     paths[1].write_text(markdown(analysis, reduced=reduced, wall_seconds=wall_seconds, steps=steps,
                                  transitory=transitory, provenance=provenance))
     if analysis["cells"]:
@@ -280,14 +280,14 @@ def write(out: Path, analysis: dict, *, reduced: str = "", wall_seconds: float |
     return paths
 
 
-def _clean(v):
+def json_ready(v):
     """JSON-ready: numpy scalars as Python numbers, NaN and infinities as null."""
     if isinstance(v, dict):
-        return {str(k): _clean(x) for k, x in v.items()}
+        return {str(k): json_ready(x) for k, x in v.items()}
     if isinstance(v, (list, tuple)):
-        return [_clean(x) for x in v]
+        return [json_ready(x) for x in v]
     if isinstance(v, np.ndarray):
-        return _clean(v.tolist())
+        return json_ready(v.tolist())
     if isinstance(v, (np.integer, np.bool_)):
         return v.item()
     if isinstance(v, (float, np.floating)):
@@ -295,7 +295,8 @@ def _clean(v):
     return v
 
 
-def _ci(lo: float, hi: float, fmt: str) -> str:
+def interval_text(lo: float, hi: float, fmt: str) -> str:
+    """An interval as a report prints it: ``[lo, hi]`` in ``fmt``, or why it has no bounds."""
     if math.isnan(lo) or math.isnan(hi):
         return "undefined"
     return "unbounded" if not (math.isfinite(lo) and math.isfinite(hi)) else f"[{lo:{fmt}}, {hi:{fmt}}]"
@@ -312,8 +313,8 @@ def _duel_cell(a: dict | None) -> str:
     if not a:
         return "–"
     share = ("share undefined" if math.isnan(a["percent"]) else
-             f"{a['percent']:+.1%} {_ci(a['percent_low'], a['percent_high'], '+.1%')}")
-    return f"{a['hl']:+.2f} {_ci(a['low'], a['high'], '.2f')} ({share})"
+             f"{a['percent']:+.1%} {interval_text(a['percent_low'], a['percent_high'], '+.1%')}")
+    return f"{a['hl']:+.2f} {interval_text(a['low'], a['high'], '.2f')} ({share})"
 
 
 def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, steps: int | None = None,
@@ -345,7 +346,7 @@ def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, s
     for c in a["cells"]:
         b = c.get("worst_case_bounded")
         loss_txt = "–" if not b else ("undefined" if math.isnan(b["loss"]) else
-                                      f"{b['loss']:.1%} {_ci(b['low'], b['high'], '.1%')}")
+                                      f"{b['loss']:.1%} {interval_text(b['low'], b['high'], '.1%')}")
         m, ch = c["medians"], c["chosen"]
         worst = f"{ch.get('worst', '–')} ({m['worst']:.2f})" if "worst" in m else "–"
         ref = f"{m['reference']:.2f}" if "reference" in m else "–"
