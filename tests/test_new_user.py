@@ -181,7 +181,7 @@ def test_a_slow_kernel_load_is_announced_on_stderr_unless_quiet(capsys, monkeypa
         while not err:  # however long the notice's thread takes to be scheduled
             time.sleep(0.01)
             err += capsys.readouterr().err
-    assert err == ("compiling the step kernel for naive+saboteur / delayed (the first time, ~15 s; "
+    assert err == ("compiling the step kernel for naive+saboteur / delayed (once on this machine: "
                    "later runs load it from the cache)...\n")
     with compile_notice(("naive",), "delayed", after=3600.0):
         pass  # loaded from the cache before the notice was due: nothing to say

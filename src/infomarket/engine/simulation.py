@@ -395,7 +395,7 @@ def _notice(kinds, scheme: str, after: float):
     names = "+".join(str(k) for k in dict.fromkeys(kinds))
 
     def say() -> None:
-        print(f"compiling the step kernel for {names} / {scheme} (the first time, ~15 s; later runs load it "
+        print(f"compiling the step kernel for {names} / {scheme} (once on this machine: later runs load it "
               f"from the cache)...", file=sys.stderr, flush=True)
 
     timer = threading.Timer(after, say)
