@@ -319,18 +319,17 @@ def private_names_taken(text: str, module: str, is_package: bool = False) -> lis
         return name.split(".")[1] if name.count(".") else ""
 
     private = (lambda n: n.startswith("_") and not n.startswith("__"))
-    tree, found, modules = ast.parse(text), [], {}
+    tree, found, modules = ast.parse(text), [], {}  # modules: local name -> the project module it is bound to
     for node, _ in _imports(tree):
-        for alias, target in zip(node.names, _targets(module, is_package, node) if isinstance(node, ast.ImportFrom)
-                                 else [a.name for a in node.names]):
-            if not target.startswith("infomarket"):
-                continue
-            bound = alias.asname or alias.name.split(".")[0]
-            if isinstance(node, ast.ImportFrom) and f"{target}" != f"{target.rsplit('.', 1)[0]}.{alias.name}":
-                if private(alias.name) and unit(target) != unit(module):  # a name of module ``target``
-                    found.append(f"{target}.{alias.name}")
-            else:
-                modules[bound] = target
+        if isinstance(node, ast.Import):
+            modules |= {a.asname or "infomarket": a.name if a.asname else "infomarket"
+                        for a in node.names if a.name.split(".")[0] == "infomarket"}
+            continue
+        for alias, target in zip(node.names, _targets(module, is_package, node)):
+            if target.endswith(f".{alias.name}"):  # the name is a module of the project
+                modules[alias.asname or alias.name] = target
+            elif private(alias.name) and unit(target) != unit(module):
+                found.append(f"{target}.{alias.name}")
     for node in ast.walk(tree):
         if (isinstance(node, ast.Attribute) and private(node.attr) and isinstance(node.value, ast.Name)
                 and node.value.id in modules and unit(modules[node.value.id]) != unit(module)):

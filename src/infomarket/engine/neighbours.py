@@ -109,4 +109,4 @@ def find_all_neighbours(w):
         neighbours_by_all_pairs(w.pos, rc * rc, nbr, nbr_count, nbr.shape[1])
     else:
         neighbours_by_grid(w.pos, rc * rc, nbr, nbr_count, nbr.shape[1], w.grid_cell, w.grid_nx, w.grid_ny,
-              w.cell_start, w.cell_items)
+                           w.cell_start, w.cell_items)

@@ -431,4 +431,3 @@ class ChainMarket:
     def contributors(self, buyer: str) -> list[tuple]:
         """The open round trip's records: (seller, openedAt, site, dx, dy, weight, prevGap)."""
         return [(checksum(r[0]),) + tuple(r[1:]) for r in self.view("contributors", buyer)]
-
