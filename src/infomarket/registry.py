@@ -40,6 +40,8 @@ class Rule:
 
     @property
     def py_func(self) -> Callable:
+        """The rule's plain Python function (numba keeps it as ``py_func``), for reading its source and running it
+        uncompiled."""
         return getattr(self.func, "py_func", self.func)
 
 
@@ -84,10 +86,12 @@ class PaymentSpec:
 
     @property
     def params(self) -> tuple[str, ...]:
+        """The scheme's parameter names, in call order (those of its weights rule)."""
         return self.weights.params
 
     @property
     def defaults(self) -> dict[str, float]:
+        """The scheme's parameter defaults by name (an experiment's ``payment_params`` overrides them)."""
         return self.weights.defaults
 
 
@@ -294,6 +298,23 @@ def _load_entry_points() -> None:
 
 
 def get_behaviour(name: str) -> BehaviourSpec:
+    """The registered behaviour called ``name`` (plug-ins' entry points are loaded first).
+
+    Args:
+        name: the name it was registered under, as an experiment file writes it.
+
+    Returns:
+        Its spec: the compiled buy and sell rules, their parameters and whether the robot is honest.
+
+    Raises:
+        ConfigError: no behaviour has that name (the message lists those that do).
+
+    Example:
+        >>> from infomarket.registry import get_behaviour
+        >>> spec = get_behaviour("sceptical")
+        >>> spec.honest
+        True
+    """
     _load_entry_points()
     try:
         return _BEHAVIOURS[name]
@@ -302,6 +323,22 @@ def get_behaviour(name: str) -> BehaviourSpec:
 
 
 def get_payment(name: str) -> PaymentSpec:
+    """The registered payment scheme called ``name`` (plug-ins' entry points are loaded first).
+
+    Args:
+        name: the name it was registered under, as an experiment file's ``payment`` writes it.
+
+    Returns:
+        Its spec: the compiled weights rule, its parameters and their defaults.
+
+    Raises:
+        ConfigError: no scheme has that name (the message lists those that do).
+
+    Example:
+        >>> from infomarket.registry import get_payment
+        >>> get_payment("outlier").defaults
+        {'theta': 30.0}
+    """
     _load_entry_points()
     try:
         return _PAYMENTS[name]
@@ -310,11 +347,27 @@ def get_payment(name: str) -> PaymentSpec:
 
 
 def behaviours() -> dict[str, BehaviourSpec]:
+    """Every registered behaviour by name: the built-ins, plug-ins' and those this process registered.
+
+    A copy, so a caller cannot register or remove one by editing it.
+
+    Example:
+        >>> from infomarket.registry import behaviours
+        >>> "naive" in behaviours() and "saboteur" in behaviours()
+        True
+    """
     _load_entry_points()
     return dict(_BEHAVIOURS)
 
 
 def payments() -> dict[str, PaymentSpec]:
+    """Every registered payment scheme by name (a copy; see ``behaviours``).
+
+    Example:
+        >>> from infomarket.registry import payments
+        >>> "outlier" in payments()
+        True
+    """
     _load_entry_points()
     return dict(_PAYMENTS)
 

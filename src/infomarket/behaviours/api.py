@@ -137,6 +137,7 @@ def diff(ax, ay, bx, by):
 
 @njit(forceinline=True, cache=True)
 def pending_count(w, me, site):
+    """How many offers for ``site`` robot ``me`` holds pending (bought but not yet used)."""
     return w.pend_count[me, site]
 
 
@@ -149,6 +150,8 @@ def pending_get(w, me, site, j):
 
 @njit(forceinline=True, cache=True)
 def pending_has(w, me, site, seller):
+    """Whether robot ``me`` holds a pending offer for ``site`` from ``seller`` (a buy rule asks before buying
+    twice)."""
     for j in range(w.pend_count[me, site]):
         if w.pend_seller[me, site, j] == seller:
             return True
@@ -171,6 +174,7 @@ def pending_add(w, me, site, seller, x, y, age):
 
 @njit(forceinline=True, cache=True)
 def pending_clear(w, me, site):
+    """Forget all of robot ``me``'s pending offers for ``site`` (e.g. once it has acted on them)."""
     w.pend_count[me, site] = 0
 
 

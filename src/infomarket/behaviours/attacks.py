@@ -171,6 +171,8 @@ def policy_buy(w, me, nbrs, threshold=0.25, collude=0.0):
 # ---- the hand-written threats (each a point of the family, with the parameters that matter to it) ----
 
 def colluder_buy(w, me, nbrs, threshold=0.25):
+    """The colluder's buy rule: sceptical buying at ``threshold`` plus the record-inflating purchases from
+    partners."""
     sceptical_or_colluding(w, me, nbrs, threshold, 1.0)
 
 

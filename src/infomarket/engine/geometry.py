@@ -29,6 +29,7 @@ def direction(x, y):
 
 @njit(forceinline=True, cache=True)
 def norm(x, y):
+    """Length of the vector (x, y), compiled inline into the step."""
     return math.sqrt(x * x + y * y)
 
 

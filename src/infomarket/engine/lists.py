@@ -23,6 +23,8 @@ def _append(items, item):
 
 @njit(cache=True)
 def put(items, i, item):
+    """``items[i] = item`` on a typed list, compiled once and cached so that building lists compiles nothing per
+    run."""
     items[i] = item
 
 

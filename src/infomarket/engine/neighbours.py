@@ -32,6 +32,15 @@ def _link(nbr, nbr_count, cap, i, j):
 
 @njit(cache=True)
 def neighbours_by_all_pairs(pos, rc2, nbr, nbr_count, cap):
+    """Fill the neighbour lists by testing every pair: O(n²), the fastest for small swarms.
+
+    Args:
+        pos: robot positions, ``[n, 2] float64``.
+        rc2: the squared communication range; a pair strictly closer is linked.
+        nbr: ``[n, cap] int`` lists to append to; ids past ``cap`` are counted but not stored.
+        nbr_count: ``[n] int`` each robot's neighbour count so far (the caller zeroes it), updated in place.
+        cap: the lists' capacity.
+    """
     n = pos.shape[0]
     for i in range(n):
         xi = pos[i, 0]
@@ -51,6 +60,18 @@ def _cell(x, size, cells):
 
 @njit(cache=True)
 def neighbours_by_grid(pos, rc2, nbr, nbr_count, cap, size, nx, ny, start, items):
+    """Fill the neighbour lists via a cell grid (cells at least the range wide): O(n) for large swarms.
+
+    Lists the same neighbours in the same increasing order as ``neighbours_by_all_pairs``, so a run does not
+    depend on which of the two the engine picks.
+
+    Args:
+        pos, rc2, nbr, nbr_count, cap: as ``neighbours_by_all_pairs``.
+        size: a cell's side.
+        nx, ny: the number of cells along x and y.
+        start: ``[nx * ny + 1] int`` scratch: where each cell's robots begin in ``items``.
+        items: ``[n] int`` scratch: robot ids sorted by cell.
+    """
     n = pos.shape[0]
     ncell = nx * ny
     for c in range(ncell + 1):

@@ -81,6 +81,7 @@ class Result:
 
     @property
     def steps_per_second(self) -> float:
+        """Simulated steps per wall-clock second of running (compilation excluded); infinite for an instant run."""
         return self.steps / self.run_seconds if self.run_seconds > 0 else float("inf")
 
 
@@ -166,6 +167,7 @@ class Simulation:
 
     @property
     def clock(self) -> int:
+        """The number of steps simulated so far."""
         return int(self.world.clock[0])
 
     def step(self, k: int = 1) -> None:
@@ -218,11 +220,27 @@ class Simulation:
             _ROOM[self._room_key] = room
 
     def run(self, steps: int | None = None) -> Result:
+        """Advance to step ``steps`` (default: the experiment's ``steps``) and return the result.
+
+        Args:
+            steps: the step to stop at, counted from the start of the run (not from the current clock).
+
+        Returns:
+            The run's ``Result``, as ``result()`` gives it.
+        """
         self.advance_to(self.config.steps if steps is None else steps)
         return self.result()
 
     # ------------------------------------------------------------------ results
     def result(self) -> Result:
+        """What the run has produced so far, as a ``Result``.
+
+        ``robots`` holds one row per robot (its behaviour, honesty, items, wealth and wealth share);
+        ``history``,
+        ``events`` and ``payments`` are filled only if the run was asked to record them.  It can be called at
+        any
+        clock, so a caller stepping the swarm can read it part way.
+        """
         w = self.world
         specs = behaviours()
         honest = np.array([specs[b].honest for b in self.behaviour_names])

@@ -10,6 +10,13 @@ class ErrorFlags(IntFlag):
     EVENT_OVERFLOW = 4  #: the event log reserve was exceeded within one step
 
     def describe(self) -> str:
+        """The raised flags in words, joined by "; " (what the engine's error message says went wrong).
+
+        Example:
+            >>> from infomarket.state.flags import ErrorFlags
+            >>> ErrorFlags.BAD_WEIGHTS.describe()
+            'a payment rule returned a negative or non-finite weight'
+        """
         text = {
             ErrorFlags.TX_OVERFLOW: "a buy rule made more than 2 purchases per neighbour in one step",
             ErrorFlags.BAD_WEIGHTS: "a payment rule returned a negative or non-finite weight",

@@ -43,6 +43,7 @@ class Field:
 
     @property
     def ndim(self) -> int:
+        """The field's number of dimensions, from its shape text (0 for a scalar)."""
         return len(self.shape.split(",")) if self.shape else 0
 
 
@@ -68,6 +69,7 @@ class Spec:
         return name in self.names
 
     def writer(self, name: str) -> str:
+        """Who writes the field ``name`` (one of ``WRITERS``: the host, the engine, the ledger or the event log)."""
         return next(f.writer for f in self.fields if f.name == name)
 
     def check(self, values: Mapping) -> None:

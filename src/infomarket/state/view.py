@@ -56,6 +56,7 @@ class BorrowedArray(types.Array):
 
     @classmethod
     def of(cls, t: types.Array, readonly: bool) -> "BorrowedArray":
+        """The borrowed twin of the array type ``t`` (read-only if asked, or if ``t`` is)."""
         return cls(t.dtype, t.ndim, t.layout, readonly=readonly or not t.mutable, aligned=t.aligned)
 
 
@@ -81,6 +82,7 @@ class GuardedArray(BorrowedArray):
 
     @classmethod
     def of(cls, t: types.Array, readonly: bool = True) -> "GuardedArray":
+        """The guarded twin of the array type ``t`` (same dtype, dimensions and layout)."""
         return cls(t.dtype, t.ndim, t.layout, aligned=t.aligned)
 
 
@@ -129,16 +131,20 @@ class WorldType(types.StructRef):
     the payload type is made once per view type."""
 
     def preprocess_fields(self, fields):
+        """Drop literal types from the fields, so that views built from different values share one type."""
         return tuple((name, types.unliteral(t)) for name, t in fields)
 
     @property
     def mangling_args(self):
+        """A short, stable symbol name (a hash of the type's name): the full one lists every field and is too long
+        for a linker symbol."""
         short = self.__dict__.get("_short_name")
         if short is None:
             short = self.__dict__["_short_name"] = f"WorldType_{hashlib.sha256(self.name.encode()).hexdigest()[:24]}"
         return short, ()
 
     def get_data_type(self):
+        """The payload type, made once per view type and remembered (numba would rebuild it at each call)."""
         payload = self.__dict__.get("_payload")
         if payload is None:
             payload = self.__dict__["_payload"] = super().get_data_type()
@@ -283,6 +289,7 @@ def register_layout(name: str, specs: tuple[Spec, ...]) -> None:
 
 
 def layout_type(name: str) -> WorldType:
+    """The numba type of the world view for the layout called ``name``."""
     return view_type(_LAYOUTS[name])
 
 

@@ -22,6 +22,7 @@ from ..errors import InternalError
 
 @dataclass(frozen=True)
 class Column:
+    """One column of a store table as the data dictionary documents it: name, type, unit and meaning."""
     name: str
     type: str  # the Arrow/pandas type as written (int64, uint64, float64, string, bool, category)
     unit: str  # "" when the column has no unit (an id, a code, a text)
@@ -30,6 +31,7 @@ class Column:
 
 @dataclass(frozen=True)
 class Table:
+    """One store table as documented: where its parts live, what a row is, its key and its columns."""
     name: str
     path: str  # where in the store
     rows: str  # what one row is
@@ -38,6 +40,7 @@ class Table:
     condition_keys: bool  # whether the table also carries the condition keys
 
     def column(self, name: str) -> Column | None:
+        """The column called ``name``, or None if the table has none."""
         for c in self.columns:
             if c.name == name:
                 return c

@@ -42,4 +42,5 @@ class Inspection:
 
     @property
     def ok(self) -> bool:
+        """True when the inspection found nothing damaged."""
         return not self.damaged

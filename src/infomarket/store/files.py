@@ -38,6 +38,8 @@ def write_parquet_atomic(df: pd.DataFrame, path: str | Path) -> Path:
 
 
 def write_text_atomic(text: str, path: str | Path) -> Path:
+    """Write ``text`` to ``path`` atomically (a temporary file, then a rename): a reader sees the old or the new
+    file, never part of one."""
     return write_atomic(path, lambda tmp: tmp.write_text(text))
 
 

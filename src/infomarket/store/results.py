@@ -79,12 +79,31 @@ class Store:
     # ------------------------------------------------------------------ creation and checks
     @property
     def meta_path(self) -> Path:
+        """The store's ``store.json``: format, package version, seeds claimed and declarations recorded."""
         return self.root / "store.json"
 
     def exists(self) -> bool:
+        """Whether a store has been created here (its ``store.json`` exists).
+
+        Example:
+            >>> import tempfile
+            >>> from infomarket.store import Store
+            >>> tmp = tempfile.TemporaryDirectory()
+            >>> store = Store(tmp.name + "/results")
+            >>> store.exists()
+            False
+            >>> store.create().exists(), store.committed()
+            (True, [])
+            >>> tmp.cleanup()
+        """
         return self.meta_path.exists()
 
     def meta(self) -> dict:
+        """The parsed ``store.json``.
+
+        Raises:
+            StoreError: it cannot be read or is not a JSON object.
+        """
         try:
             meta = json.loads(self.meta_path.read_text())
         except (OSError, ValueError) as exc:
@@ -172,6 +191,7 @@ class Store:
             self._write_meta(meta)
 
     def seeds(self) -> dict[str, int]:
+        """The base seed claimed for each experiment name (empty for a store not yet created)."""
         return {k: int(v) for k, v in self.meta().get("seeds", {}).items()} if self.exists() else {}
 
     def _part_ids(self, table: str) -> set[str]:
@@ -186,12 +206,15 @@ class Store:
         return {pid: self.part_path(table, pid) for pid in self._part_ids(table)}
 
     def part_path(self, table: str, part_id: str) -> Path:
+        """Where the part ``part_id`` of ``table`` lives (whether or not it exists yet)."""
         path = self._paths.get((table, part_id))
         if path is None:  # remembered: a store's checks name every part of every table each time
             path = self._paths[(table, part_id)] = self.root / table / f"part-{part_id}.parquet"
         return path
 
     def committed(self) -> list[str]:
+        """The ids of the committed parts: a part counts once its runs part is written, which is the last write of
+        a part."""
         return sorted(self._part_ids("runs"))
 
     def remove_orphans(self) -> int:
