@@ -37,6 +37,7 @@ def load(stores: list[str]) -> tuple[pd.DataFrame, pd.DataFrame | None, str]:
 
 
 def add_subcommand(subparsers) -> None:
+    """Add ``infomarket chain-study`` (answer the chain study's questions from its stores) to the command line."""
     p = subparsers.add_parser(
         "chain-study", help="answer the chain study's questions (does the paper's result survive the robots' "
                             "own chain?) from its stores, with a figure",
@@ -51,6 +52,14 @@ def add_subcommand(subparsers) -> None:
 
 
 def cmd_chain_study(args: argparse.Namespace) -> int:
+    """Run ``infomarket chain-study``: answer the declared questions and write the answers and the figure.
+
+    Returns:
+        The exit code (0).
+
+    Raises:
+        UsageError: the stores hold no completed run of the chain study.
+    """
     # the analysis and matplotlib load when the command runs, not when the CLI starts
     from . import study
     from .chain_figure import figure

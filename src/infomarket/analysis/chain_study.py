@@ -32,6 +32,7 @@ AXES = {"period": ("period_{}", 150), "loss": ("loss_{}", 0.0), "gas": ("gas_{}"
 
 
 def declaration() -> dict:
+    """The chain study's declared questions, rules and margins (``chain_questions.toml``) as parsed TOML."""
     return DECLARATION.data
 
 
@@ -153,6 +154,17 @@ def _d(runs: pd.DataFrame, decl: dict, angle: float) -> float:
 
 
 def wealth_question(runs: pd.DataFrame, decl: dict, setting: str) -> Verdict:
+    """Does the paper's wealth result hold on the chain ``setting`` as on the instant ledger?
+
+    Pairs each of Figs. 3 and 4's conditions (1, 3 and 5 Byzantines) on the chain with the same condition on
+    the instant ledger and judges them by the declared margin; the honest-minus-Byzantine gaps on the chain
+    are added as descriptive details.
+
+    Args:
+        runs: one row per run (``per_run``).
+        decl: the declaration (``declaration()``).
+        setting: the chain setting's name, as the runs' ``chain`` column writes it.
+    """
     pairs = []
     for payment in ("outlier", "staking"):
         for k in (1, 3, 5):
@@ -172,6 +184,11 @@ def wealth_question(runs: pd.DataFrame, decl: dict, setting: str) -> Verdict:
 
 
 def fig7_question(runs: pd.DataFrame, decl: dict, setting: str, angles=(45.0, 90.0)) -> Verdict:
+    """Does staking still raise the swarm's items on the chain ``setting`` (Fig. 7) at each of ``angles``?
+
+    Compares staking with no staking on the chain at each rotation angle; staking on the chain against
+    staking on the instant ledger is added as descriptive details.
+    """
     rows = [(f"{a:g} deg", _sel(runs, FIG7, "items", chain=setting, market="staking", rotation_angle=a),
              _sel(runs, FIG7, "items", chain=setting, market="no_staking", rotation_angle=a), _d(runs, decl, a))
             for a in angles]
@@ -299,6 +316,8 @@ def partition_questions(runs: pd.DataFrame, chain: pd.DataFrame | None, decl: di
 
 @dataclass
 class Answers:
+    """The chain study's answers: the summary table, each question's verdict, the per-run table they rest on, and
+    the declarations' status."""
     table: pd.DataFrame           # question, setting/axis, rule, n, effect, answer
     verdicts: dict[str, Verdict]
     runs: pd.DataFrame
@@ -343,6 +362,8 @@ def answer(runs: pd.DataFrame, chain: pd.DataFrame | None = None, decl: dict | N
 
 
 def markdown(a: Answers, wall: str = "") -> str:
+    """The answers as ``chain-study.md``: the table, each verdict's details, then the declaration's amendments and
+    deviations."""
     lines = ["# Chain study: answers", "",
              "Questions and rules: `src/infomarket/analysis/chain_questions.toml` (declared before the runs; "
              "its amendments and deviations are listed at the end).", ""]

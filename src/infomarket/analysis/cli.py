@@ -7,6 +7,8 @@ from ..cliargs import writable_dir
 
 
 def add_subcommand(subparsers) -> None:
+    """Add ``infomarket figures`` (the paper's figures and report from a store) and ``chain-study`` to the command
+    line."""
     p = subparsers.add_parser(
         "figures", help="draw the paper's Figs. 2-7 from a results store and write report.md/html",
         description="Draw every figure of the paper that the store has data for (PNG and SVG/PDF), compare "

@@ -29,6 +29,8 @@ class Gap:
     most: int                    # the most completed runs of one condition
 
     def describe(self) -> str:
+        """One line for the report: which conditions have no runs or too few, and the command that resumes the
+        sweep."""
         parts = []
         if self.missing:
             shown = "; ".join(self.missing[:3]) + (f"; and {len(self.missing) - 3} more" if len(self.missing) > 3 else "")

@@ -58,6 +58,8 @@ def check(recorded: dict | None, files: dict[str, Path] | None = None) -> list[L
 
 
 def status_of(locks: list[Lock], file: str, section: str) -> str:
+    """The status of one declaration (``file``'s ``section``) among ``locks``; ``NOT_RECORDED`` if the store holds
+    no record of it."""
     for lk in locks:
         if lk.file == file and lk.section == section:
             return lk.status

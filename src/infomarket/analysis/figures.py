@@ -326,6 +326,7 @@ def fig7(robots: pd.DataFrame) -> Figure:
 # ------------------------------------------------------------------------------------------ registry
 @dataclass(frozen=True)
 class FigureSpec:
+    """One of the paper's figures: its name, its caption and the function that draws it from the tables."""
     name: str
     caption: str
     draw: Callable[[Frames], Figure]

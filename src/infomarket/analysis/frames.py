@@ -31,6 +31,16 @@ class Frames:
 
     @classmethod
     def of(cls, source) -> "Frames":
+        """The tables from any source an analysis accepts.
+
+        Args:
+            source: a ``Frames`` (returned as is), a robots DataFrame, a dict of tables (robots, history, runs,
+                meta), a ``Store`` or the path of one.
+
+        Raises:
+            InputTypeError: ``source`` is none of these, or the dict names an unknown table.
+            StoreError: the path or store is not a readable results store.
+        """
         if isinstance(source, Frames):
             return source
         if isinstance(source, pd.DataFrame):
@@ -48,6 +58,11 @@ class Frames:
 
     @classmethod
     def from_store(cls, store: Store) -> "Frames":
+        """The robots, history and runs tables and the ``store.json`` of a results store.
+
+        Raises:
+            StoreError: the folder is missing, is not a store, or its ``store.json`` is unreadable.
+        """
         if not store.root.exists():
             raise StoreError(f"{store.root}: no such folder")
         if not store.exists():

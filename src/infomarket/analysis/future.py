@@ -86,6 +86,7 @@ def greater(a: np.ndarray, b: np.ndarray) -> float:
 # ----------------------------------------------------------------------------------------- questions
 @dataclass(frozen=True)
 class Question:
+    """One declared open question: its id, its text, the rule that answers it and the rule's parameters."""
     id: str
     question: str
     rule: str
@@ -120,6 +121,7 @@ ANSWERS: dict[str, Callable[[pd.DataFrame, dict], Verdict]] = {}
 
 
 def answers(qid: str):
+    """Decorator: register the function as the answer to the question ``qid`` (in ``ANSWERS``)."""
     def register(fn):
         ANSWERS[qid] = fn
         return fn
@@ -350,6 +352,8 @@ def figure_specs():
 
 
 def has_data(frames: Frames) -> bool:
+    """Whether the tables hold runs of the open-questions sweep (the attacks or the honest swarm), so the report
+    adds its section."""
     r = frames.robots
     return not r.empty and "experiment" in r.columns and r["experiment"].isin([*ATTACKS, HONEST]).any()
 
@@ -398,6 +402,7 @@ COLUMNS = ["question", "answer", "declared", "statistics", "rule"]
 
 
 def to_markdown(s: Section) -> list[str]:
+    """The open-questions section as Markdown lines: each figure (or why it was skipped), then the answers table."""
     md = ["## The paper's open questions: reputation-aware defences", "", INTRO, ""]
     for name, caption, files, note in s.figures:
         md += [f"### {name}", "", caption, ""]
@@ -409,6 +414,7 @@ def to_markdown(s: Section) -> list[str]:
 
 
 def to_html(s: Section) -> list[str]:
+    """The open-questions section as HTML fragments, the same content as ``to_markdown``."""
     e = html.escape
     parts = ["<h2>The paper's open questions: reputation-aware defences</h2>", f"<p>{e(INTRO)}</p>"]
     for name, caption, files, note in s.figures:

@@ -46,12 +46,14 @@ class Rule:
     params: dict = field(default_factory=dict, compare=False)  # other declared keys (e.g. alpha)
 
     def passes(self, value: float) -> bool:
+        """Whether ``value`` meets every declared bound (a missing or NaN value never passes)."""
         if value is None or math.isnan(value):
             return False
         return ((self.min is None or value >= self.min) and (self.max is None or value <= self.max)
                 and (self.above is None or value > self.above) and (self.below is None or value < self.below))
 
     def describe(self) -> str:
+        """The bounds as shown in a report: ``[min, max]``, or each bound as ``>= x``, ``< y`` joined by 'and'."""
         if self.min is not None and self.max is not None:
             return f"[{self.min:g}, {self.max:g}]"
         parts = [f"{op} {v:g}" for op, v in ((">=", self.min), ("<=", self.max), (">", self.above),
@@ -74,6 +76,7 @@ def load_rules(path: str | Path = TOLERANCES) -> dict[str, Rule]:
 
 @dataclass(frozen=True)
 class Measurement:
+    """A headline row's measured value, how the table shows it, and whether the store's runs can decide it."""
     value: float   # what the rule judges
     shown: str     # how the table shows it (with the numbers it was computed from)
     floor: float | None = None  # the smallest value the store's run counts allow (a p-value's minimum)
@@ -85,6 +88,7 @@ METRICS: dict[str, Callable[[Frames], Measurement]] = {}
 
 
 def metric(rid: str):
+    """Decorator: register the function as the measurement of the headline row ``rid`` (in ``METRICS``)."""
     def register(fn: Callable[[Frames], Measurement]):
         METRICS[rid] = fn
         return fn

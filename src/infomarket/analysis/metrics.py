@@ -21,6 +21,7 @@ def median(robots: pd.DataFrame, column: str, honest: bool) -> float:
 
 
 def iqr(values: pd.Series) -> float:
+    """Interquartile range (75th minus 25th percentile) of ``values``, the spread the paper's box plots show."""
     return float(values.quantile(0.75) - values.quantile(0.25))
 
 

@@ -181,9 +181,12 @@ class PairedComparison:
 
     @property
     def significant(self) -> bool:
+        """Whether the Holm-adjusted p-value is below alpha."""
         return self.p_adjusted < self.alpha
 
     def describe(self, unit: str = "") -> str:
+        """One line for a report: run count, medians, the Hodges-Lehmann shift with its interval, the p-value
+        (Holm-adjusted in a family) and the power; ``unit`` follows each effect."""
         adj = f", Holm over {self.family} {_fmt_p(self.p_adjusted)}" if self.family > 1 else ""
         pw = "" if math.isnan(self.power) else f", power {self.power:.2f} at {self.declared:+.3g}{unit}"
         return (f"{self.label}: {self.n} paired runs, medians {self.median_x:.4g} vs {self.median_y:.4g}, "

@@ -18,6 +18,7 @@ LISTED = 3  # list up to this many distinct values in a cell; beyond, give the c
 
 @dataclass(frozen=True)
 class Provenance:
+    """Where a report's numbers come from: report-wide facts (dates, versions, totals) and one row per experiment."""
     facts: dict[str, str]          # report-wide: dates, versions, totals
     experiments: pd.DataFrame      # one row per experiment
 

@@ -30,6 +30,8 @@ TABLE_COLUMNS = {"figure": "figure", "claim": "claim", "paper": "paper", "store"
 
 @dataclass
 class FigureResult:
+    """One figure of the report: the files drawn, or why it was skipped, and a warning if drawn from an incomplete
+    design."""
     name: str
     caption: str
     files: list[Path] = field(default_factory=list)  # empty when skipped
@@ -39,6 +41,8 @@ class FigureResult:
 
 @dataclass
 class Report:
+    """What ``build_report`` wrote and judged: the figures, the headline table with its verdicts, provenance and
+    extra sections."""
     source: str
     figures: list[FigureResult]
     table: pd.DataFrame
@@ -51,6 +55,7 @@ class Report:
     lengths: list[str] = field(default_factory=list)  # experiments run at another length than the paper's
 
     def counts(self) -> dict[str, int]:
+        """How many headline rows passed, failed, were inconclusive or had no data."""
         return {v: int((self.table["verdict"] == v).sum()) for v in (PASS, FAIL, INCONCLUSIVE, NO_DATA)}
 
 
@@ -150,6 +155,8 @@ def _summary(report: Report) -> str:
 
 
 def to_markdown(report: Report) -> str:
+    """The report as ``report.md``: run lengths and incomplete designs first, then figures, headline table and
+    provenance."""
     md = [f"# Paper figures from {report.source}", "",
           "Figures and headline numbers of *An Information Market for Social Navigation in Robots*, "
           "recomputed from this results store. Tolerances: `src/infomarket/analysis/tolerances.toml` "
@@ -199,6 +206,7 @@ td,th{border:1px solid #ccc;padding:4px 8px;text-align:left;vertical-align:top}t
 
 
 def to_html(report: Report) -> str:
+    """The report as a self-contained ``report.html`` page, the same content as ``to_markdown``."""
     e = html.escape
     parts = [f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>Paper figures from {e(report.source)}"
              f"</title><style>{CSS}</style></head><body>",

@@ -7,6 +7,7 @@ from ..cliargs import writable_dir
 
 
 def add_subcommand(subparsers) -> None:
+    """Add ``infomarket sensitivity`` (sensitivity indices of a store's sampled design) to the command line."""
     p = subparsers.add_parser(
         "sensitivity", help="Sobol'/Morris/PAWN indices of a store's sampled design: table, figures, report section",
         description="Compute the sensitivity indices (SALib) of every output of the sampled design kept in a "
@@ -26,6 +27,8 @@ def add_subcommand(subparsers) -> None:
 
 
 def cmd_sensitivity(args: argparse.Namespace) -> int:
+    """Run ``infomarket sensitivity``: compute the indices, answer the declared questions, write the tables,
+    figures and ``STEM.md``; returns the exit code."""
     # the analysis (SALib, matplotlib) loads when the command runs, not when the CLI starts
     from ..errors import report
     from ..store import Store

@@ -23,6 +23,7 @@ QUESTIONS = DECLARATION.path
 
 # ------------------------------------------------------------------------------------- questions
 def load_questions(path: Path = QUESTIONS) -> dict:
+    """The declared sensitivity questions (``sensitivity_questions.toml``, or the file ``path``) as parsed TOML."""
     return DECLARATION.data if Path(path) == QUESTIONS else Declaration.read(path).data
 
 
@@ -232,6 +233,8 @@ def _intro(s: Sensitivity) -> str:
 
 
 def markdown(s: Sensitivity, files: list[str], answers_table: pd.DataFrame | None = None) -> str:
+    """The global-sensitivity section as Markdown: the parameters and ranges, the seed-noise floor, the indices,
+    the answers and figures."""
     d = s.design
     lines = [f"## Global sensitivity: {d.experiment}", "", _intro(s), ""]
     lines += [md_table(pd.DataFrame({"parameter": d.names, "key": d.keys,
@@ -249,6 +252,7 @@ def markdown(s: Sensitivity, files: list[str], answers_table: pd.DataFrame | Non
 
 
 def html_section(s: Sensitivity, files: list[str], answers_table: pd.DataFrame | None = None) -> str:
+    """The global-sensitivity section as HTML, the same content as ``markdown``."""
     d = s.design
     parts = [f"<h2>Global sensitivity: {html.escape(d.experiment)}</h2>", f"<p>{html.escape(_intro(s))}</p>"]
     ft = floor_table(s)

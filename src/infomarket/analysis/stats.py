@@ -49,6 +49,7 @@ BATCH = 100  # resamples held in memory at once: 100 x 32 runs x 1001 steps x 8 
 
 @dataclass(frozen=True)
 class MannWhitney:
+    """A one-sided Mann-Whitney U test's statistic and p-value, with the two group sizes."""
     statistic: float
     pvalue: float
     n_honest: int
@@ -66,6 +67,7 @@ def mann_whitney(honest, byzantine) -> MannWhitney:
 
 @dataclass(frozen=True)
 class Correlation:
+    """A correlation coefficient ``r`` with its p-value, its confidence interval and the number of pairs."""
     r: float
     pvalue: float
     low: float   # confidence interval of r
@@ -227,9 +229,12 @@ class Comparison:
 
     @property
     def significant(self) -> bool:
+        """Whether the Holm-adjusted p-value is below alpha."""
         return self.p_adjusted < self.alpha
 
     def describe(self, unit: str = "") -> str:
+        """One line for a report: medians and sizes, Hodges-Lehmann shift and Cliff's delta with intervals, the
+        p-value (Holm-adjusted in a family) and the power; ``unit`` follows each effect."""
         e = self.effect
         adj = (f", Holm-adjusted over {self.family} {_fmt_p(self.p_adjusted)}"
                if self.family > 1 or self.p_adjusted != self.p else "")
@@ -344,9 +349,12 @@ class Paired:
 
     @property
     def significant(self) -> bool:
+        """Whether the run-level p-value is below alpha."""
         return self.p < self.alpha
 
     def describe(self, unit: str = "") -> str:
+        """One line for a report: the median difference, the Hodges-Lehmann pseudo-median with its interval, the
+        share of positive runs and the p-value."""
         return (f"{self.n} runs, median difference {self.median:+.3g}{unit}, HL pseudo-median {self.hl:+.3g}{unit} "
                 f"[{self.hl_low:.3g}, {self.hl_high:.3g}], positive in {100 * self.positive:.0f} % of runs; "
                 f"Wilcoxon signed-rank (run-level) p = {_fmt_p(self.p)} (smallest possible {_fmt_p(self.min_p)})")
@@ -386,6 +394,16 @@ class Ratio:
 
 
 def median_ratio(x, y, confidence: float = CONFIDENCE, resamples: int = RESAMPLES, seed: int = SEED) -> Ratio:
+    """The ratio of medians ``median(x) / median(y)`` with a seeded percentile bootstrap interval.
+
+    0 / 0 is NaN (no answer can rest on it) and x / 0 infinite; with fewer than two values in a group the
+    interval is NaN.
+
+    Example:
+        >>> from infomarket.analysis.stats import median_ratio
+        >>> median_ratio([2.0, 4.0, 6.0], [1.0, 2.0, 3.0]).value
+        2.0
+    """
     x, y = np.asarray(x, float), np.asarray(y, float)
 
     def ratio(a, b, axis=-1):  # 0 / 0 is undefined (NaN: no answer can rest on it), x / 0 infinite

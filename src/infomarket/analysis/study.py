@@ -55,6 +55,7 @@ class Record:
     questions: tuple[str, ...] = ()  # the questions it touches (none: the whole study)
 
     def markdown(self) -> str:
+        """The record as one Markdown list item: kind, date, scope, when it was made, what changed and why."""
         scope = f" ({', '.join(self.questions)})" if self.questions else ""
         return (f"- **{self.kind.capitalize()}, {self.date}**{scope}, {self.seen}: {self.what} "
                 f"*Why:* {self.why}")
@@ -70,6 +71,15 @@ class Declaration:
 
     @classmethod
     def read(cls, path: str | Path, name: str | None = None) -> "Declaration":
+        """Read a declaration file, checking its amendment and deviation records at once.
+
+        Args:
+            path: the TOML file.
+            name: the name a store records it under (default: the file's name).
+
+        Raises:
+            ConfigError: the file cannot be read or parsed, or a record is malformed.
+        """
         path = Path(path)
         try:
             data = tomllib.loads(path.read_text())
@@ -81,6 +91,7 @@ class Declaration:
 
     @property
     def questions(self) -> dict:
+        """The declared questions by id (empty if the file declares none)."""
         return self.data.get("questions", {})
 
     def records(self) -> list[Record]:
@@ -108,6 +119,7 @@ class Declaration:
         return lines + [r.markdown() for r in records] + [""]
 
     def record_html(self) -> str:
+        """The amendments and deviations as an HTML heading and list (``record_markdown`` rendered)."""
         md = self.record_markdown()
         items = "".join(f"<li>{html.escape(line[2:].replace('**', '').replace('*', ''))}</li>"
                         for line in md[2:] if line.startswith("- "))
@@ -120,9 +132,13 @@ class Declaration:
         return check(recorded, {self.name: declared.FILES.get(self.name, self.path)})
 
     def lock_summary(self, recorded: dict | None, prefix: str = "") -> str:
+        """One line: how many of the declarations (those starting with ``prefix``) were fixed before the store's
+        first run."""
         return summary(self.locks(recorded), self.name, prefix)
 
     def question_status(self, recorded: dict | None) -> set[str]:
+        """The set of statuses of the questions against the store's record (declared, edited, added or not
+        recorded)."""
         locks = self.locks(recorded)
         return {status_of(locks, self.name, f"questions.{q}") for q in self.questions}
 
@@ -164,10 +180,28 @@ def by_power(met: bool, power: float, target: float = st.POWER) -> str:
 
 # ------------------------------------------------------------------------------------------ tables
 def md_cell(text) -> str:
+    r"""A value as one Markdown table cell: pipes escaped, line breaks flattened.
+
+    Example:
+        >>> from infomarket.analysis.study import md_cell
+        >>> md_cell("a|b\nc")
+        'a\\|b c'
+    """
     return str(text).replace("|", "\\|").replace("\n", " ")
 
 
 def md_table(df: pd.DataFrame) -> str:
+    """A DataFrame as a Markdown table (header, rule, one line per row).
+
+    Example:
+        >>> import pandas as pd
+        >>> from infomarket.analysis.study import md_table
+        >>> print(md_table(pd.DataFrame({"n": [1, 2], "answer": ["yes", "no"]})))
+        | n | answer |
+        |---|---|
+        | 1 | yes |
+        | 2 | no |
+    """
     lines = ["| " + " | ".join(md_cell(c) for c in df.columns) + " |",
              "|" + "---|" * len(df.columns)]
     lines += ["| " + " | ".join(md_cell(v) for v in row) + " |" for row in df.itertuples(index=False)]

@@ -34,6 +34,7 @@ QUESTIONS = DECLARATION.path
 
 
 def questions() -> dict:
+    """The terrain study's declared questions by id."""
     return DECLARATION.questions
 
 
@@ -253,6 +254,7 @@ def terrain_figure(a: dict):
 
 
 def figure(a: dict, path: Path) -> Path:
+    """Draw the terrain study's figure from the answers ``a`` and save it (PNG, no timestamp) at ``path``."""
     terrain_figure(a).savefig(path, dpi=110, metadata={"Software": None})
     return path
 
@@ -267,6 +269,8 @@ def _declarations(root: Path, names) -> list[str]:
 
 
 def answer(root: Path) -> dict:
+    """Answer each terrain question from the stores under ``root`` (one folder per experiment); a question whose
+    store is absent is answered 'not run'."""
     q = questions()
     sites = _two_food_sites(root)
     return {"chain_blocked": chain_blocked(_robots(root, "corridor"), q["chain_blocked"]),
@@ -315,6 +319,7 @@ def _ci_txt(ci) -> str:
 
 
 def markdown(a: dict) -> str:
+    """The answers as ``terrain.md``: each question, its answer and the numbers it rests on."""
     q = questions()
     c, t, k = a["chain_blocked"], a["outlier_two_food"], a["crowd_collisions"]
     m = c["median_items"]

@@ -8,6 +8,7 @@ from pathlib import Path
 
 
 def add_subcommand(subparsers) -> None:
+    """Add ``infomarket terrain-report`` (answer the terrain questions from their stores) to the command line."""
     p = subparsers.add_parser("terrain-report", help="answer the terrain questions (corridor, two_food, crowd) "
                               "from their stores, with a figure")
     p.add_argument("results", help="folder holding the stores corridor/, two_food/, crowd/ (optionally corridor_waypoints/, crowd_sensing/)")
@@ -16,6 +17,8 @@ def add_subcommand(subparsers) -> None:
 
 
 def cmd_terrain_report(args: argparse.Namespace) -> int:
+    """Run ``infomarket terrain-report``: write ``terrain.md``, ``terrain.json`` and ``terrain.png``; returns the
+    exit code."""
     # the analysis (scipy.stats, pandas) loads when the command runs, not when the CLI starts
     from . import study
     from .terrain import answer, figure, jsonable, markdown
