@@ -37,6 +37,8 @@ AGENT_KEYS = {"radius": "radius", "speed": "speed", "communication_radius": "com
 
 
 def is_legacy(data: dict[str, Any]) -> bool:
+    """Whether parsed JSON is in the original simulator's format (it has ``behaviors`` or ``simulation_steps``), to
+    be translated."""
     return "behaviors" in data or "simulation_steps" in data
 
 

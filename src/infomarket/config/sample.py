@@ -46,6 +46,11 @@ class Output(_Strict):
 
 
 class Sample(_Strict):
+    """``[sweep.sample]``: a sampled design instead of a grid.
+
+    ``method`` (sobol, morris or lhs) draws ``samples`` base samples over ``bounds`` (a range per key, or a
+    ``Bound``); ``outputs`` are the per-run values whose indices are computed.
+    """
     method: Literal["sobol", "morris", "lhs"]
     samples: Annotated[int, Field(gt=0, strict=True)]
     second_order: bool = True          # Sobol': also the second-order indices (N (2D + 2) points, else N (D + 2))
@@ -56,6 +61,7 @@ class Sample(_Strict):
     bounds: dict[str, list[Annotated[float, Field(allow_inf_nan=False)]] | Bound] = Field(min_length=1)
 
     def bound(self, key: str) -> Bound:
+        """The bound of ``key`` as a ``Bound`` (a plain ``[low, high]`` range is wrapped into one)."""
         b = self.bounds[key]
         return b if isinstance(b, Bound) else Bound.model_construct(range=list(b), name=None, also=[])
 

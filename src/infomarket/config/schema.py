@@ -43,11 +43,13 @@ class _Strict(BaseModel):
 
 
 class Arena(_Strict):
+    """``[arena]``: the rectangle the robots live in, ``width`` by ``height`` (the paper's 1200 x 600)."""
     width: PosFloat = 1200.0
     height: PosFloat = 600.0
 
 
 class Site(_Strict):
+    """A food or nest site: a disc of centre (x, y) and ``radius``."""
     x: Finite
     y: Finite
     radius: PosFloat = 50.0
@@ -99,6 +101,7 @@ Obstacle = Annotated[Union[Rect, CircleObstacle, Segment], Field(discriminator="
 
 
 class Robot(_Strict):
+    """``[robot]``: every robot's body, motion, communication range and odometry error (docs/model.md lists each)."""
     radius: PosFloat = 8.0
     speed: PosFloat = 2.5
     communication_range: NonNegFloat = 50.0
@@ -117,17 +120,21 @@ class Robot(_Strict):
 
 
 class RandomWalk(_Strict):
+    """``[random_walk]``: the exploration walk, turning angles wrapped Cauchy (``rho``), run lengths Lévy
+    (``alpha``)."""
     rho: Annotated[float, Field(gt=0, lt=1)] = 0.9
     alpha: Annotated[float, Field(gt=0, le=2)] = 1.4
 
 
 class Group(_Strict):
+    """One group of the swarm: ``count`` robots of ``behaviour``, its parameters overridden by ``params``."""
     behaviour: str
     count: NonNegInt
     params: dict[str, Finite] = Field(default_factory=dict)
 
 
 class Swarm(_Strict):
+    """``[swarm]``: ``robots`` robots made of ``groups``, whose counts must add up to it."""
     robots: PosInt = 25
     groups: list[Group] = Field(min_length=1)
 
@@ -144,6 +151,8 @@ class Swarm(_Strict):
 
 
 class Payment(_Strict):
+    """``[payment]``: the payment ``scheme`` and its ``params``, the robots' initial wealth, the reward and the
+    stake."""
     scheme: str = "delayed"
     initial_wealth: NonNegFloat = 1.0
     reward: NonNegFloat = 1.0
@@ -193,6 +202,7 @@ class Chain(_Strict):
 
     @property
     def enabled(self) -> bool:
+        """Whether the robots run their own chain (any consensus but ``instant``, the paper's ideal ledger)."""
         return self.consensus != "instant"
 
 
@@ -372,10 +382,13 @@ class Experiment(_Strict):
                     or len(self.sites("food")) > 1 or len(self.sites("nest")) > 1)
 
     def behaviour_params(self, group: Group) -> dict[str, float]:
+        """The parameters of ``group``'s behaviour in call order: the group's values, else the behaviour's
+        defaults."""
         spec = behaviours()[group.behaviour]
         return {p: float(group.params.get(p, spec.defaults.get(p, 0.0))) for p in spec.params}
 
     def payment_params(self) -> dict[str, float]:
+        """The payment scheme's parameters in call order: the experiment's values, else the scheme's defaults."""
         spec = payments()[self.payment.scheme]
         return {p: float(self.payment.params.get(p, spec.defaults.get(p, 0.0))) for p in spec.params}
 

@@ -48,6 +48,16 @@ def human(n: float) -> str:
 
 
 def parse_bytes(text: str) -> int:
+    """A size as ``INFOMARKET_MEMORY_LIMIT`` writes it, in bytes (binary and decimal units, case-insensitive).
+
+    Raises:
+        ConfigError: ``text`` is not a number with an optional known unit.
+
+    Example:
+        >>> from infomarket.config.sizes import parse_bytes
+        >>> parse_bytes("64GiB") == 64 * 2**30, parse_bytes("500MB"), parse_bytes("1024")
+        (True, 500000000, 1024)
+    """
     m = re.fullmatch(r"\s*([0-9]+(?:\.[0-9]+)?)\s*([a-zA-Z]*)\s*", text)
     if not m or m.group(2).lower() not in _UNITS:
         raise ConfigError(f"{ENV}={text!r}: expected a size like 64GiB, 500MB or a number of bytes")
@@ -55,6 +65,7 @@ def parse_bytes(text: str) -> int:
 
 
 def physical_memory() -> int:
+    """This machine's physical memory in bytes (8 GiB assumed where the system does not tell)."""
     try:
         return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
     except (ValueError, OSError, AttributeError):  # pragma: no cover - not POSIX
