@@ -43,6 +43,12 @@ def _print_summary(robots, title: str) -> None:
 
 # ---------------------------------------------------------------------------------------------- run
 def cmd_run(args) -> int:
+    """Run ``infomarket run``: an experiment's runs into a results store, resumable, then a summary.
+
+    Returns:
+        0; 2 when a rule failed (the user's code: bad input) and 1 when a run failed otherwise; the
+        interrupt exit code when stopped, after keeping the runs that had finished.
+    """
     # with the command: `infomarket --help` does not import the runner
     from .runner.execute import default_workers
     from .runner.progress import progress
@@ -80,6 +86,7 @@ def cmd_run(args) -> int:
 
 # --------------------------------------------------------------------------------------------- demo
 def cmd_demo(args) -> int:
+    """Run ``infomarket demo``: a short Fig. 2 in a minute (``demo.run_demo``); returns the exit code."""
     from .demo import run_demo  # with the command: `infomarket --help` stays light
 
     return run_demo(runs=args.runs, workers=args.workers)
@@ -128,6 +135,8 @@ def cmd_list(args) -> int:
 
 
 def cmd_check(args) -> int:
+    """Run ``infomarket check``: validate an experiment file and print what it would run (swarm, scheme, chain,
+    sweep size) without running it; returns 0."""
     from .config import chain as chain_rules, load_experiment  # with the command: `--help` stays light
 
     cfg = load_experiment(args.experiment)
@@ -166,6 +175,8 @@ def cmd_check(args) -> int:
 
 # --------------------------------------------------------------------------------------------- main
 def build_parser() -> Parser:
+    """The ``infomarket`` argument parser with every command (each package adds its own through its
+    ``add_subcommand``)."""
     p = Parser(prog="infomarket", description="Information-market robot swarm simulator.")
     p.add_argument("--version", action="version", version=f"infomarket {__version__}")
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
@@ -209,6 +220,15 @@ def build_parser() -> Parser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """The ``infomarket`` command line: parse ``argv``, run the command, return its exit code.
+
+    Bad input (a configuration, an option, a store) is one ``infomarket: error:`` line and exit code 2,
+    never a traceback; Ctrl-C and SIGTERM stop any command, keeping what it finished.
+
+    Args:
+        argv: the arguments (default: ``sys.argv[1:]``); given, the caller is a test or a program, so a stop
+            signal returns its exit code instead of leaving the process.
+    """
     parser = build_parser()
     args = parser.parse_args(argv)
     quiet = bool(getattr(args, "quiet", False))

@@ -16,6 +16,8 @@ class Parser(argparse.ArgumentParser):
     """argparse, with its errors (unknown option, bad value) reported like every other CLI error."""
 
     def error(self, message: str):
+        """Print the usage and exit with code 2 through ``errors.report``, so a bad option reads like every other
+        error."""
         self.print_usage(sys.stderr)
         raise SystemExit(report(f"{self.prog}: {message}"))
 

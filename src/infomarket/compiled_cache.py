@@ -99,18 +99,25 @@ class PackageLocator(ni.CacheLocator):
 
     @classmethod
     def from_function(cls, py_func, py_file):
+        """A locator for a function defined in the package's own files; None for any other (numba then tries its
+        other locators)."""
         path = Path(py_file).resolve()
         if _PACKAGE not in path.parents or not path.is_file():
             return None
         return cls(path, py_func.__code__.co_firstlineno)
 
     def get_cache_path(self) -> str:
+        """The cache folder for the function's file, under the folder named by the package's digest."""
         return str(self._root / self._relative.parent)
 
     def get_source_stamp(self) -> str:
+        """The package digest, the same for every file: the folder is named by it already, so an index found there
+        is never stale."""
         return freeze_package_digest()  # the folder is named by it already: a fresh index is never stale
 
     def get_disambiguator(self) -> str:
+        """What tells apart functions of the same name in one file: their line (and the file's own hash outside the
+        compiled parts)."""
         return self._name  # its line, and its file's own hash (for files outside the digest's compiled parts)
 
 

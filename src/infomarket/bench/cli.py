@@ -21,6 +21,7 @@ def _sizes(text: str) -> list[int]:
 
 
 def add_subcommand(sub) -> None:
+    """Add ``infomarket bench`` (time the paper's setups against this machine's floor) to the command line."""
     b = sub.add_parser("bench", help="time the Fig. 2A, 2D and 4C setups (and 4C with the chain model) against "
                                      "this machine's floor",
                        description="Single-process runs after compilation (medians), each beside a floor kernel "
@@ -49,6 +50,8 @@ def add_subcommand(sub) -> None:
 
 
 def run(args) -> int:
+    """Run ``infomarket bench`` with the chosen mode (default, ``--robots``, ``--scaling`` or ``--env``) and print
+    or write its results; returns the exit code."""
     # with the command: `infomarket --help` does not import the benches
     from . import run_bench, run_scaling, run_swarm_sizes
 

@@ -67,6 +67,8 @@ def engine_rate(cfg, seconds: list[float]) -> dict:
 
 
 def sweep_rate(cfg, runs: int, folder: Path) -> dict:
+    """Sweep ``runs`` runs of ``cfg`` into a fresh store under ``folder`` and return runs, env-steps and CPU
+    seconds: the throughput of the whole path, store included."""
     cond = Condition(cfg.name, BASE, {}, cfg, runs, cfg.seed, 0)
     store = Store(folder / "sweep")
     t0 = time.process_time()

@@ -134,6 +134,7 @@ def settlement(w, buyer):
 
 @njit(forceinline=True, cache=True)
 def purchase_events(w, ok, buyer, seller, site, direction, x, y, age, sx, sy):
+    """Log a purchase (or, if refused, the refusal) in the event log; an accepted one records the stake it locked."""
     log_event(w, EV_PURCHASE if ok else EV_REFUSED, buyer, seller, site, direction, x, y, age,
               w.stake if ok else 0.0, sx, sy)
 

@@ -49,6 +49,7 @@ def knows(w, i, tx):
 
 @njit(forceinline=True, cache=True)
 def learn(w, i, tx):
+    """Mark transaction ``tx`` as known to node ``i`` (one bit in its mempool bitset)."""
     unlock(w.mp_known)[i, tx >> 6] |= np.uint64(1) << np.uint64(tx & 63)
 
 
