@@ -22,6 +22,7 @@ __all__ = ["BatchInterrupted", "BatchResult", "RunFailed", "RunOutput", "default
 
 @dataclass
 class BatchResult:
+    """The tables of a batch of runs stepped in one process, with the compile and run times and the steps per run."""
     robots: pd.DataFrame
     history: pd.DataFrame
     compile_seconds: float
@@ -32,6 +33,7 @@ class BatchResult:
 
     @property
     def env_steps_per_second(self) -> float:
+        """Environment steps (runs x steps) per second of running, compilation excluded."""
         runs = self.robots["run"].nunique() if len(self.robots) else 0
         return runs * self.steps / self.run_seconds if self.run_seconds > 0 else float("inf")
 

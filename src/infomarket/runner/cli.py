@@ -112,6 +112,8 @@ def _interrupted(store, conds, total: int, args) -> str:
 
 
 def cmd_sweep(args) -> int:
+    """Run ``infomarket sweep``: every condition of an experiment, or of a shipped set of them, into a results
+    store (resumable); returns the exit code."""
     # with the command: `infomarket --help` stays light
     from ..config import load_experiment
     from ..config.load import looks_like_path
@@ -143,6 +145,11 @@ def _with_samples(exp, samples: int):
 
 
 def cmd_reproduce(args) -> int:
+    """Run ``infomarket reproduce paper``: every experiment of the paper's figures into one store.
+
+    Raises:
+        UsageError: the target is not ``paper``.
+    """
     from ..config import load_experiment  # with the command: `infomarket --help` stays light
 
     if args.what != "paper":
@@ -164,6 +171,7 @@ def _executor_options(p) -> None:
 
 
 def add_subcommand(sub) -> None:
+    """Add ``sweep``, ``reproduce`` and the ``store`` commands (verify, repair, failed, sql) to the command line."""
     s = sub.add_parser("sweep", help="run every condition of an experiment into a results store (resumable)")
     s.add_argument("experiment", help="an experiment file, a shipped experiment, or a shipped set: "
                                       + ", ".join(f"{k} ({' + '.join(v)})" for k, v in SUITES.items()))
@@ -213,6 +221,7 @@ def _open(path: str):
 
 
 def cmd_store_verify(args) -> int:
+    """Run ``infomarket store verify``: list damaged parts and orphans; returns non-zero when a part is damaged."""
     store = _open(args.store)
     found = store.verify()
     for p in found.damaged:
@@ -228,6 +237,8 @@ def cmd_store_verify(args) -> int:
 
 
 def cmd_store_repair(args) -> int:
+    """Run ``infomarket store repair``: move damaged parts and orphans aside (into ``damaged/``) so the next sweep
+    reruns exactly their runs; returns 0."""
     store = _open(args.store)
     with store.lock():
         found, moved = store.repair()
@@ -243,6 +254,7 @@ def cmd_store_repair(args) -> int:
 
 
 def cmd_store_failed(args) -> int:
+    """Run ``infomarket store failed``: print each failed run with its seed and error; returns 0."""
     failed = _open(args.store).failed()
     for row in failed.itertuples():
         print(f"{row.experiment} [{row.condition}] run {row.run} (seed {row.seed}):")
@@ -252,6 +264,7 @@ def cmd_store_failed(args) -> int:
 
 
 def cmd_store_sql(args) -> int:
+    """Run ``infomarket store sql``: a DuckDB query over the store's tables, printed as a table or CSV; returns 0."""
     df = _open(args.store).sql(args.query)
     if args.csv:
         print(df.to_csv(index=False), end="")

@@ -68,9 +68,12 @@ class Design:
 
     @property
     def points(self) -> int:
+        """The number of points (rows of ``X``), each one condition of the sweep."""
         return len(self.X)
 
     def sampling_bounds(self) -> list[list[float]]:
+        """The bounds SALib samples in: an integer key's range widened by half a step at each end, so each integer
+        is drawn equally often once rounded."""
         return [[lo - 0.5, hi + 0.5] if integer else [lo, hi]
                 for lo, hi, integer in zip(self.low, self.high, self.integer)]
 
@@ -88,6 +91,7 @@ class Design:
         return out
 
     def point_keys(self, i: int, values: np.ndarray | None = None) -> dict[str, Any]:
+        """Point ``i``'s condition keys: its index and its value of each key (from ``values`` or the design's own)."""
         vals = self.values() if values is None else values
         return {"point": i, **{n: vals[i, j] for j, n in enumerate(self.names)}}
 
@@ -110,6 +114,7 @@ class Design:
 
     @classmethod
     def from_spec(cls, spec: dict, X: np.ndarray) -> "Design":
+        """The design back from its ``spec()`` (as the store's ``design.json`` holds it) and its matrix ``X``."""
         fields = {k: spec[k] for k in cls.__dataclass_fields__ if k != "X"}
         return cls(**fields, X=np.asarray(X, dtype=float))
 

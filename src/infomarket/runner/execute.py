@@ -176,6 +176,8 @@ def run_calls(calls: list[tuple]) -> list[RunOutput]:
 # ------------------------------------------------------------------------------------------ tasks
 @dataclass(frozen=True)
 class Task:
+    """One unit of work for a worker, written as one store part: runs of a condition, and more (condition, runs)
+    pairs grouped with it."""
     condition: Condition
     runs: tuple[int, ...]
     #: further (condition, runs) in the same task: conditions of a few runs each (the points of a sampled
@@ -185,14 +187,18 @@ class Task:
 
     @property
     def members(self) -> list[tuple[Condition, tuple[int, ...]]]:
+        """Every (condition, runs) pair of the task, the first one included."""
         return [(self.condition, self.runs), *self.more]
 
     @property
     def size(self) -> int:
+        """The number of runs in the task, over all its members."""
         return sum(len(r) for _, r in self.members)
 
     @property
     def part_id(self) -> str:
+        """The id of the store part this task writes: the experiment, condition and runs, or for a grouped task a
+        hash of its members, so a resumed sweep's parts never collide."""
         import hashlib
 
         c = self.condition
@@ -245,6 +251,7 @@ class InlineExecutor(Executor):
     """Runs each submitted call at once, in this process (``workers = 1``): no pickling, no warm-up."""
 
     def submit(self, fn, /, *args, **kwargs) -> Future:
+        """Run ``fn(*args, **kwargs)`` now and return a finished future holding its result or its exception."""
         future: Future = Future()
         future.set_running_or_notify_cancel()
         try:
@@ -255,6 +262,7 @@ class InlineExecutor(Executor):
 
 
 def default_workers() -> int:
+    """The worker processes to use by default: the CPUs this process may run on (its affinity), at least 1."""
     return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
 
 

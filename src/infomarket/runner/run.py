@@ -35,6 +35,8 @@ LEGACY_FILES = ("robots.parquet", "wealth_history.parquet", "sites.parquet")
 
 @dataclass
 class RunReport:
+    """What ``infomarket run`` did: the condition, the store, the sweep's report and the robots table of the
+    requested runs."""
     condition: Condition
     store: Store
     sweep: SweepReport
@@ -45,6 +47,7 @@ class RunReport:
 
     @property
     def runs_done(self) -> int:
+        """How many of the requested runs completed (distinct runs in the robots table)."""
         return int(self.robots["run"].nunique()) if len(self.robots) else 0
 
 

@@ -35,6 +35,8 @@ __all__ = ["SweepReport", "Task", "check_compatible", "make_tasks", "plan", "run
 
 @dataclass
 class SweepReport:
+    """What a sweep did: runs planned, skipped (already in the store), done and failed, the env-steps run and the
+    time taken."""
     planned: int
     skipped: int
     done: int
@@ -52,11 +54,14 @@ class SweepReport:
 
     @property
     def env_steps_per_second(self) -> float:
+        """Environment steps (runs x steps) per wall-clock second of the sweep (0 when nothing ran)."""
         return self.env_steps / self.wall_seconds if self.wall_seconds > 0 else 0.0
 
 
 def plan(experiments: Iterable[Experiment], *, runs: int | None = None, seed: int | None = None,
          scale: float = 1.0) -> list[Condition]:
+    """The conditions of every experiment, in order, with the runs, seed and scale overrides applied
+    (``runner.plan.conditions``)."""
     out: list[Condition] = []
     for exp in experiments:
         out += conditions(exp, runs=runs, seed=seed, scale=scale)
