@@ -28,6 +28,8 @@ CURVE_BYTES = 32
 
 
 def add_subcommand(sub) -> None:
+    """Add ``infomarket rl-train`` (learn an attack by evolution strategies through the RL environment) to the
+    command line."""
     t = sub.add_parser("rl-train", help="learn an attack with evolution strategies through the RL vector env",
                        description="Evolution strategies (numpy) over a linear policy shared by the `attacker` robots, "
                                    "played through the Gymnasium vector environment (docs/rl.md); then the learned "
@@ -55,6 +57,12 @@ def add_subcommand(sub) -> None:
 
 
 def cmd_rl_train(args) -> int:
+    """Run ``infomarket rl-train``: train the policy, then compare it with the experiment's own attack on held-out
+    seeds.
+
+    Raises:
+        UsageError: the optional ``rl`` extra (gymnasium) is not installed.
+    """
     try:
         from .envs import AttackVectorEnv  # gymnasium is an optional extra: refused with a message if missing
     except ModuleNotFoundError as exc:

@@ -77,6 +77,11 @@ def action_array(action, shape: tuple[int, ...], what: str) -> np.ndarray:
 
 
 def checked(interval, reward):
+    """``interval`` and ``reward`` checked: a positive integer number of steps per decision and a known reward.
+
+    Raises:
+        ConfigError: either is not.
+    """
     if isinstance(interval, bool) or not isinstance(interval, (int, np.integer)) or interval < 1:
         raise ConfigError(f"interval (K, engine steps per decision) must be a positive integer, got {interval!r}")
     if reward not in REWARDS:
@@ -148,6 +153,11 @@ class AttackEnv(Rebuilt, gym.Env):
         self._over = True
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
+        """Start a new episode (Gymnasium's API): a fresh run whose seed is drawn from the env's random stream.
+
+        Returns:
+            The first observation and ``{"seed": the run's seed}``.
+        """
         super().reset(seed=seed)
         s = episode_seed(self.np_random)
         self.runs.reset([0], [s])
@@ -156,6 +166,15 @@ class AttackEnv(Rebuilt, gym.Env):
         return self.runs.obs[0].copy(), {"seed": s}
 
     def step(self, action):
+        """Play ``action`` for ``interval`` engine steps (Gymnasium's API).
+
+        Returns:
+            ``(observation, reward, terminated, truncated, info)``: the team reward since the last step; an
+            episode is never terminated, only truncated at the run's last step.
+
+        Raises:
+            UsageError: the episode is over or was never started (call ``reset``).
+        """
         if self._over:
             raise UsageError("the episode is over (or was never started): call reset() first")
         self.runs.act(action_array(action, self.action_space.shape, "action")[None])
@@ -205,6 +224,14 @@ class AttackVectorEnv(Rebuilt, gym.vector.VectorEnv):
         self._started = False
 
     def reset(self, *, seed: int | list[int] | None = None, options: dict | None = None):
+        """Start every sub-environment afresh (Gymnasium's vector API).
+
+        Args:
+            seed: one int (sub-environment i gets ``seed + i``), one seed per sub-environment, or None.
+
+        Raises:
+            UsageError: a list of seeds of the wrong length.
+        """
         super().reset(seed=seed if isinstance(seed, (int, np.integer)) or seed is None else None)
         if seed is None:
             seeds = [None] * self.num_envs
@@ -222,6 +249,15 @@ class AttackVectorEnv(Rebuilt, gym.vector.VectorEnv):
         return self.runs.obs.copy(), self._info()
 
     def step(self, actions):
+        """Play one action per sub-environment for ``interval`` steps, all in one compiled call.
+
+        Returns:
+            ``(observations, rewards, terminated, truncated, info)``, one row per sub-environment; a run that
+            ended at the previous call starts its next episode instead (its action ignored, its reward 0).
+
+        Raises:
+            UsageError: the env was never reset.
+        """
         if not self._started:
             raise UsageError("the vector env was never reset: call reset() first")
         actions = action_array(actions, self.action_space.shape, "actions")

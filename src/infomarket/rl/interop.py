@@ -27,6 +27,11 @@ RENDER_MODES = ("rgb_array",)
 
 
 def checked_render_mode(render_mode) -> str | None:
+    """``render_mode`` if it is None or one the environments support.
+
+    Raises:
+        ConfigError: it is another.
+    """
     if render_mode is not None and render_mode not in RENDER_MODES:
         raise ConfigError(f"render_mode {render_mode!r}: unknown; allowed: None, {', '.join(map(repr, RENDER_MODES))}")
     return render_mode

@@ -42,21 +42,35 @@ class AttackParallelEnv(Rebuilt, ParallelEnv):
 
     @functools.lru_cache(maxsize=None)
     def observation_space(self, agent):
+        """Each agent's observation space: its observation row, every value in [0, 1]."""
         return spaces.Box(0.0, 1.0, (len(OBSERVATION),), np.float32)
 
     @functools.lru_cache(maxsize=None)
     def action_space(self, agent):
+        """Each agent's action space: the attack parameters within their bounds."""
         return spaces.Box(self._low, self._high, (len(self.runs.actions),), np.float32)
 
     def _split(self, rows) -> dict:
         return {a: rows[k] for k, a in enumerate(self.possible_agents)}
 
     def reset(self, seed: int | None = None, options: dict | None = None):
+        """Start a new episode (PettingZoo's parallel API): every agent acts again; returns per-agent observations
+        and infos."""
         obs, info = self._env.reset(seed=seed, options=options)
         self.agents = list(self.possible_agents)
         return self._split(obs), {a: dict(info) for a in self.agents}
 
     def step(self, actions: dict):
+        """Play every acting agent's action (PettingZoo's parallel API) for ``interval`` steps.
+
+        Returns:
+            Per-agent dicts of observations, rewards, terminations, truncations and infos; after the run's last
+            step every agent is done.
+
+        Raises:
+            UsageError: an agent has no action or is not acting, or no episode is running.
+            InputTypeError: ``actions`` is not a dict.
+        """
         if not self.agents:
             raise UsageError("every agent is done (or the env was never reset): call reset() first")
         if not isinstance(actions, Mapping):
@@ -96,4 +110,5 @@ class AttackParallelEnv(Rebuilt, ParallelEnv):
 
     @property
     def state_space(self):
+        """The global state's space: every agent's observation row stacked (see ``state``)."""
         return spaces.Box(0.0, 1.0, (len(self.possible_agents), len(OBSERVATION)), np.float32)

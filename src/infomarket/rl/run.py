@@ -13,6 +13,8 @@ HELD_OUT = 1
 
 
 def held_out_seeds(seed: int, n: int) -> np.ndarray:
+    """``n`` seeds for the final comparison: runs of a condition of their own (``HELD_OUT``) under ``seed``, apart
+    from the episodes' seeds."""
     return np.array([run_seed(seed, i, HELD_OUT) for i in range(n)], np.int64)
 
 
@@ -38,6 +40,7 @@ def compare(env, trained: Training, runs: int, seed: int) -> dict:
 
 
 def describe(r: dict) -> str:
+    """The training's result ``r`` in a few lines for the terminal: settings, held-out means and the verdict."""
     s = r["settings"]
     return "\n".join([
         f"{s['experiment']}: {s['iterations']} ES iterations x {2 * s['pairs']} runs of {s['steps']} steps "

@@ -111,6 +111,7 @@ class Runs:
 
     @property
     def clocks(self) -> np.ndarray:
+        """Each run's clock (steps simulated so far)."""
         return self.sims.clocks
 
     def reset(self, which, seeds, observe: bool = True) -> None:

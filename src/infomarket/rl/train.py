@@ -27,6 +27,7 @@ EDGE = 0.01
 
 
 def sigmoid(x):
+    """The logistic function, mapping the policy's outputs into (0, 1) before they are scaled to the action bounds."""
     return 1.0 / (1.0 + np.exp(-x))
 
 
@@ -65,6 +66,7 @@ class Adam:
     v: np.ndarray | None = None
 
     def step(self, grad: np.ndarray) -> np.ndarray:
+        """The Adam update for gradient ``grad`` (bias-corrected moments), to add to the parameters."""
         if self.m is None:
             self.m, self.v = np.zeros_like(grad), np.zeros_like(grad)
         self.t += 1
