@@ -91,10 +91,12 @@ class Policy:
 
     @property
     def low(self) -> np.ndarray:
+        """Each action's lower bound (the policy's outputs are scaled into [low, high])."""
         return np.array([_RANGES[a][0] for a in self.actions])
 
     @property
     def high(self) -> np.ndarray:
+        """Each action's upper bound."""
         return np.array([_RANGES[a][1] for a in self.actions])
 
     @classmethod
@@ -130,6 +132,11 @@ class Policy:
 
     @classmethod
     def load(cls, path) -> "Policy":
+        """A policy saved by ``save``.
+
+        Raises:
+            UsageError: the file is not a policy, or the policy reads another observation than this version's.
+        """
         try:
             with np.load(Path(path), allow_pickle=False) as z:
                 weights, meta = z["weights"], json.loads(str(z["meta"]))
@@ -221,9 +228,11 @@ class Training:
 
     @property
     def generations(self) -> int:
+        """The generations the budget allows (``budget // population``, at least 1)."""
         return max(1, self.budget // self.population)
 
     def as_dict(self) -> dict:
+        """The settings as JSON-able values (tuples as lists), as the checkpoint and the results record them."""
         return {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.__dict__.items()}
 
 

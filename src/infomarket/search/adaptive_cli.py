@@ -26,6 +26,7 @@ def _positive(text: str) -> float:
 
 
 def add_subcommand(sub) -> None:
+    """Add ``infomarket adaptive-attack`` (train an adaptive attacker against one study cell) to the command line."""
     p = sub.add_parser("adaptive-attack", help="train an adaptive attacker (a policy over the RL observation) "
                                                "against one cell of an attack-search study, by evolution strategies",
                        description="Evolution strategies (antithetic, rank-normalised, common random numbers per "
@@ -97,6 +98,8 @@ def _markdown(s: dict) -> str:
 
 
 def cmd_adaptive_attack(args) -> int:
+    """Run ``infomarket adaptive-attack``: train (resuming from the checkpoint in ``--out``), then compare with the
+    cell's attacks; returns the exit code."""
     # with the command: `infomarket --help` does not import the engine
     from .. import interrupts
     from ..cliargs import writable_dir

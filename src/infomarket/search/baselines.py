@@ -24,6 +24,13 @@ def angles(step: float) -> list[float]:
 
 
 def name(rotation: float, collude: bool, site: float) -> str:
+    """The label of one grid point: its rotation, whether it colludes, and the site it lies about.
+
+    Example:
+        >>> from infomarket.search.baselines import name
+        >>> name(30.0, True, 1.0), name(22.5, False, 2.0)
+        ('rot_030_collude_nest', 'rot_022p500_solo_both')
+    """
     whole = int(round(rotation))
     deg = f"{whole:03d}" if abs(rotation - whole) < 1e-9 else f"{rotation:07.3f}".replace(".", "p")
     return f"{PREFIX}{deg}_{'collude' if collude else 'solo'}_{SITES[float(site)]}"

@@ -77,6 +77,8 @@ def _list_baselines(st) -> int:
 
 
 def cmd_attack_search(args) -> int:
+    """Run ``infomarket attack-search``: search each cell's worst attack into the store (resumable), then write the
+    cells' frames and the summary; returns the exit code."""
     # with the command: `infomarket --help` does not import the search, runner and store
     from ..config import load_experiment
     from ..runner.execute import default_workers, local_executor, warm
@@ -189,6 +191,7 @@ def _adaptive(adaptive, st, cell, r, learner: dict, out: Path, args, workers: in
 
 
 def add_subcommand(sub) -> None:
+    """Add ``infomarket attack-search`` (the worst attack found against each defence) to the command line."""
     p = sub.add_parser("attack-search", help="the worst attack found against each defence: CMA-ES "
                                              "restarts and a random search, raced, confirmed on fresh seeds; resumable")
     p.add_argument("experiment", help="a study experiment (the shipped attack_search, or a file like it)")

@@ -67,6 +67,8 @@ class CRNCondition(Condition):
     crn: int = 0
 
     def seed(self, run: int) -> int:
+        """The seed of run ``run`` from the stream ``crn``, shared by the conditions compared together (common
+        random numbers: the same swarms for each)."""
         return run_seed(self.master_seed, run, self.crn)
 
 

@@ -26,6 +26,8 @@ class Race:
 
 
 def survivors(n: int, keep: float) -> int:
+    """How many of ``n`` candidates go on to the next stage: the ``keep`` share rounded up, at least 2 (all of them
+    when there are 2 or fewer)."""
     return n if n <= 2 else max(2, math.ceil(keep * n))
 
 

@@ -319,6 +319,8 @@ def _duel_cell(a: dict | None) -> str:
 
 def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, steps: int | None = None,
              transitory: int | None = None, provenance: dict | None = None) -> str:
+    """The attack search's answers ``a`` as Markdown: settings, the per-cell table and the paired comparisons,
+    marked if the run was reduced."""
     s = a["settings"]
     lines = ["# Attack search", ""]
     if reduced:

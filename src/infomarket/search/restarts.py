@@ -51,6 +51,7 @@ class Leg:
 
     @property
     def evaluations(self) -> int:
+        """The evaluations this restart spends (population x generations)."""
         return self.popsize * self.generations
 
 
@@ -102,6 +103,8 @@ class Restarts:
         self.es = cma.CMAEvolutionStrategy(x0, self.s.sigma0, opts)
 
     def ask(self) -> tuple[int, int, np.ndarray] | None:
+        """The next points to evaluate, as (restart, generation, points in [0, 1]^dim); None once the budget is
+        spent."""
         if self.r >= len(self.legs):
             return None
         if self.es is None:
@@ -111,6 +114,7 @@ class Restarts:
         return self.r, self.g, self.asked
 
     def tell(self, fitness) -> None:
+        """Hand back the fitness of the points last asked; moves to the next generation, or restart."""
         self.es.tell(list(self.asked), list(map(float, fitness)))
         self.g += 1
         if self.g >= self.legs[self.r].generations:

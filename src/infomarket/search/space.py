@@ -39,6 +39,7 @@ assert set(SHAPES) == set(NAMES)
 
 
 def dimension() -> int:
+    """The number of coordinates of the search space (one per attack parameter searched)."""
     return len(NAMES)
 
 

@@ -105,6 +105,7 @@ class Cell:
 
     @property
     def experiment(self) -> str:
+        """The cell's experiment name in the store: study, defence and Byzantine count (``NAME.DEFENCE.bK``)."""
         return f"{self.config.name}.{self.defence}.b{self.byzantines}"
 
     def with_attack(self, params: dict[str, float], *, steps: int | None = None,
@@ -135,6 +136,7 @@ class Study:
 
 
 def load_declarations(path: Path = QUESTIONS) -> dict:
+    """The attack-search study's declarations (its questions file, or ``path``) as parsed TOML."""
     return tomllib.loads(Path(path).read_text())
 
 

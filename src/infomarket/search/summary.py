@@ -54,6 +54,8 @@ def write(out: Path, study: Study, results: list[CellSearch], *, reduced: str = 
 
 
 def text(data: dict) -> str:
+    """The search's summary ``data`` as a short Markdown table: each cell's chosen attacks and confirmation
+    medians."""
     lines = ["# Attack search (summary)", ""]
     if data["reduced"]:
         lines += [f"**REDUCED RUN ({data['reduced']}): not the declared study.**", ""]
