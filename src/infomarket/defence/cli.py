@@ -56,6 +56,8 @@ def _list_families(st) -> int:
 
 
 def cmd_defence_search(args) -> int:
+    """Run ``infomarket defence-search``: the min-max search of defences per family (resumable), its frontier
+    confirmed and reported; returns the exit code."""
     # with the command: `infomarket --help` does not import the search, runner and store
     from ..config import load_experiment
     from ..runner.execute import default_workers, local_executor, warm
@@ -130,6 +132,7 @@ def cmd_defence_search(args) -> int:
 
 
 def add_subcommand(sub) -> None:
+    """Add ``infomarket defence-search`` (defences searched against the worst attack) to the command line."""
     p = sub.add_parser("defence-search", help="defences searched against the worst attack an inner attack search "
                                               "finds (min-max), the frontier confirmed on fresh seeds; resumable")
     p.add_argument("experiment", help="a study experiment (the shipped attack_search, or a file like it)")

@@ -79,6 +79,8 @@ def ratio_loss(x, reference) -> float:
 
 
 def cell(study: Study, c: Candidate, byzantines: int) -> Cell:
+    """The attack-search cell of a defence candidate with ``byzantines`` attackers, so the inner search runs
+    against it."""
     cfg = study.config(c, byzantines).model_copy(update={"name": NAME})
     return Cell(c.label, byzantines, cfg)
 

@@ -85,20 +85,29 @@ class Study:
 
     @property
     def robots(self) -> int:
+        """The swarm's size, kept whatever the defence or the Byzantine count."""
         return self.experiment.swarm.robots
 
     def base(self) -> dict:
+        """The experiment as a plain dict, the base each candidate's configuration is built from."""
         return self.experiment.model_dump()
 
     def config(self, candidate: Candidate, byzantines: int) -> Experiment:
+        """The experiment with ``candidate``'s defence settings and ``byzantines`` attackers.
+
+        Raises:
+            ConfigError: the combination is not a valid experiment (the message names the candidate).
+        """
         where = f"{self.experiment.name}: defence {candidate.label} with {byzantines} Byzantine(s)"
         return configure(self.base(), byzantines, self.robots, candidate.settings(self.families), where)
 
     def undefended_config(self) -> Experiment:
+        """The swarm without Byzantines and without defences: the reference a defence's cost is measured against."""
         where = f"{self.experiment.name}: the undefended swarm"
         return configure(self.base(), 0, self.robots, self.undefended, where)
 
     def existing_candidates(self) -> list[Candidate]:
+        """The experiment's own defences as candidates, searched beside the families' points."""
         return [Candidate(name, EXISTING, set=dict(s), origin="existing") for name, s in self.existing.items()]
 
 
