@@ -145,9 +145,12 @@ class RevmBackend:
 
     @property
     def block_number(self) -> int:
+        """The current block number (the in-process chain mines one block per transaction)."""
         return self._block
 
     def advance_to(self, block: int) -> None:
+        """Move the chain forward to block ``block`` (never back), so deadlines and delays measured in blocks
+        elapse."""
         if block > self._block:
             self._block = block
             self.evm.set_block_env(self._pyrevm.BlockEnv(number=block, timestamp=block,
@@ -175,6 +178,7 @@ class RevmBackend:
         return receipt
 
     def deploy(self, sender, code: bytes) -> tuple[str, Receipt]:
+        """Deploy ``code`` from ``sender``; returns the new contract's checksummed address and the receipt."""
         address = self._isolated(lambda: self.evm.deploy(sender.address, code, gas=self.gas_limit), keep=True)
         receipt = self._receipt()
         self._mined()
@@ -192,6 +196,7 @@ class RevmBackend:
         return [len(self._undo), self._block]
 
     def revert(self, snapshot: list) -> None:
+        """Go back to the state of ``snapshot``: undo every database write made since, and the block number."""
         mark, block = snapshot
         slots = []
         while len(self._undo) > mark:

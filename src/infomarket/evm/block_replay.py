@@ -74,9 +74,12 @@ class BlockReplayReport:
 
     @property
     def ok(self) -> bool:
+        """True when every block matched the model and tokens were conserved."""
         return self.first_mismatch is None and self.conserved
 
     def gas_summary(self) -> dict[str, float]:
+        """Mean gas per reveal and per deposit, measured on the EVM and as the model counts it, and how many calls
+        agree exactly."""
         def avg(xs):
             return mean(xs) if xs else float("nan")
 

@@ -34,14 +34,18 @@ class Codec:
         self.errors = _error_table(abi)
 
     def calldata(self, name: str, args: tuple) -> bytes:
+        """The calldata of a call to function ``name`` with ``args``: its selector and the ABI-encoded arguments."""
         selector, inputs, _ = self.functions[name]
         return selector + abi_encode(inputs, list(args))
 
     def result(self, name: str, data: bytes) -> Any:
+        """The decoded return value of function ``name`` (a tuple when it returns several values)."""
         values = abi_decode(self.functions[name][2], data)
         return values[0] if len(values) == 1 else values
 
     def decode_event(self, topics: list[bytes], data: bytes) -> Event | None:
+        """The contract's event in a log (``topics``, ``data``), with addresses checksummed; None for another
+        contract's event."""
         layout = self.events.get(topics[0]) if topics else None
         if layout is None:
             return None
@@ -51,6 +55,8 @@ class Codec:
         return Event(layout.name, {k: _checksum(args[k]) for k in layout.names})
 
     def refusal(self, data: bytes) -> ContractRevert | None:
+        """The contract's custom error in revert ``data``, with its arguments; None for a revert that is not one of
+        its errors."""
         if len(data) < 4 or data[:4] not in self.errors:
             return None
         name, names, types = self.errors[data[:4]]

@@ -43,10 +43,12 @@ class BalanceRow:
 
     @property
     def diff_units(self) -> float:
+        """Chain balance minus the model's expected wealth, in token units."""
         return self.chain_units - self.expected * TOKEN_UNIT
 
     @property
     def ok(self) -> bool:
+        """Whether the difference is within the rounding bound (plus the float slack of the model's own sums)."""
         return abs(self.diff_units) <= self.bound_units + FLOAT_SLACK_UNITS
 
 
@@ -77,10 +79,12 @@ class ReplayReport:
 
     @property
     def items(self) -> int:
+        """Items delivered on chain (one ``buyItem`` each)."""
         return len(self.buy_gas)
 
     @property
     def blocks_used(self) -> int:
+        """Blocks the replay spanned, from its first to its last."""
         return self.last_block - self.first_block
 
     @property
@@ -100,6 +104,8 @@ class ReplayReport:
                 for i in range(self.robots)]
 
     def summary(self) -> dict[str, float]:
+        """The replay's costs as a flat dict for tables: reveals, items, mean and worst gas per call and per item,
+        blocks used."""
         def avg(xs: list[int]) -> float:
             return mean(xs) if xs else float("nan")
 

@@ -98,6 +98,8 @@ class WorstCall:
 
     @property
     def largest(self) -> int:
+        """The most gas any single call of the deposit used (reveal, ``buyItem`` or ``settle``): what must fit a
+        block."""
         return max(self.reveal_max, self.buy_item, self.settle)
 
 
@@ -267,6 +269,8 @@ def constants(rows: list[GasRow]) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """``python -m infomarket.evm.gasreport``: measure the contract's gas on an in-process EVM (or a node) and
+    write the gas report; returns the exit code."""
     parser = argparse.ArgumentParser(prog="python -m infomarket.evm.gasreport", description=__doc__.splitlines()[0])
     parser.add_argument("--out", type=Path, default=Path("docs/gas.md"), help="Markdown file to write")
     parser.add_argument("--backend", choices=("revm", "py-evm"), default="revm",

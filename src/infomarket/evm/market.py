@@ -163,6 +163,8 @@ class MarketParams:
                    settle_batch, settlement_deadline, grant, **policy, cap=record_cap(scheme, cap))
 
     def constructor_args(self, market: str, registrars: list[str], nest: str) -> tuple:
+        """The contract's constructor arguments, in its order, for these parameters and the given market,
+        registrars and nest."""
         return (market, SCHEMES[self.scheme], self.reward, self.information_share, self.stake,
                 self.cos_theta, self.stake_expiry, self.max_records_per_seller, self.max_records_per_trip,
                 self.max_validity, self.settle_batch, self.settlement_deadline, self.max_grant, registrars,
@@ -262,6 +264,8 @@ class ChainMarket:
         return self.transact(robot, "exit")
 
     def withdraw_bond(self, robot: str, sender: LocalAccount | None = None) -> TxResult:
+        """Send ``withdrawBond`` for ``robot`` (from ``sender``, default the market), returning its registration
+        bond once its exit delay has passed."""
         return self.transact(sender or self.market, "withdrawBond", robot)
 
     def revoke(self, robot: str, registrars: list[LocalAccount] | None = None) -> TxResult:
@@ -407,18 +411,23 @@ class ChainMarket:
         return self._call(self.market.address, fn, *args)
 
     def has_role(self, role: str, account: str) -> bool:
+        """Whether ``account`` holds the contract role ``role`` (a name of ``ROLES``)."""
         return self.view("hasRole", ROLES[role], account)
 
     def balance_of(self, robot: str) -> int:
+        """``robot``'s token balance, in base units (``TOKEN_UNIT`` per token)."""
         return self.view("balanceOf", robot)
 
     def locked_stake(self, buyer: str) -> int:
+        """The stake ``buyer`` has locked: its open pot plus what waits in escrow for settlement."""
         return self.view("lockedStake", buyer)
 
     def total_supply(self) -> int:
+        """The token's total supply, in base units (conservation checks compare it with the balances)."""
         return self.view("totalSupply")
 
     def bond_of(self, robot: str) -> int:
+        """The registration bond ``robot`` has posted (0 when it is not registered nor exiting)."""
         return self.view("bondOf", robot)
 
     def round_trip(self, buyer: str) -> int:
@@ -426,6 +435,7 @@ class ChainMarket:
         return self.view("roundTrip", buyer)
 
     def pending_settlement(self, robot: str) -> tuple[bool, int, int]:
+        """Whether ``robot`` has a deposited round trip still to settle, its phase and the records remaining."""
         return tuple(self.view("pendingSettlement", robot))
 
     def contributors(self, buyer: str) -> list[tuple]:

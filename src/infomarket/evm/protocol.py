@@ -84,6 +84,7 @@ class Domain:
     version: str = "4"
 
     def as_dict(self) -> dict:
+        """The EIP-712 domain as signing libraries take it (``chainId``, ``verifyingContract`` checksummed)."""
         return {
             "name": self.name,
             "version": self.version,
@@ -110,6 +111,7 @@ class PathInfo:
         return keccak(abi_encode(["int64", "int64", "bytes32"], list(self.as_abi())))
 
     def as_abi(self) -> tuple:
+        """The path as the contract's ABI tuple (x, y, salt)."""
         return (self.x, self.y, self.salt)
 
 
@@ -124,9 +126,11 @@ class Offer:
     path_hash: bytes
 
     def as_abi(self) -> tuple:
+        """The offer as the contract's ABI tuple (seller, site, age, maxBlock, pathHash)."""
         return (checksum(self.seller), self.site, self.age, self.max_block, self.path_hash)
 
     def message(self) -> dict:
+        """The offer as the EIP-712 message the seller signs, keyed by the contract's field names."""
         return dict(zip(("seller", "site", "age", "maxBlock", "pathHash"), self.as_abi()))
 
 
@@ -145,6 +149,8 @@ class LightContract:
     s: bytes
 
     def as_abi(self) -> tuple:
+        """The agreement as the contract's ABI tuple: the offer, the buyer, the seller's position, the trip and the
+        signature."""
         return (self.offer.as_abi(), checksum(self.buyer), self.seller_x, self.seller_y,
                 self.trip, self.v, self.r, self.s)
 

@@ -115,6 +115,7 @@ class PyEvmBackend(_SignedChain):
         self.gas_limit = self.tester.get_block_by_number("latest")["gas_limit"]
 
     def balance(self, address: str) -> int:
+        """The ether balance of ``address`` in wei (what pays the gas)."""
         return self.tester.get_balance(address)
 
     def _latest(self) -> int:
