@@ -73,6 +73,7 @@ def _quiet(args) -> None:
 
 
 def cmd_view(args) -> int:
+    """Run ``infomarket view``: serve the live viewer in the browser until stopped; returns the exit code."""
     import asyncio
 
     _quiet(args)
@@ -120,6 +121,11 @@ def _refuse_too_big(cfg, every: int | None) -> None:
 
 
 def cmd_replay(args) -> int:
+    """Run ``infomarket replay``: record a run and write it as a self-contained HTML page, a movie, or both.
+
+    Raises:
+        UsageError: neither ``--out`` nor ``--movie`` is given, or a file has an unsupported suffix.
+    """
     from .recording import record, write_html  # with the command: `infomarket --help` stays light
 
     _quiet(args)

@@ -69,6 +69,7 @@ def layout(chain: bool = False) -> tuple[tuple[str, ...], tuple[tuple[str, str],
 
 
 def chain_on(sim) -> bool:
+    """Whether the simulation runs the chain model, so its frames carry the chain's fields."""
     return bool(sim.config.chain.enabled)
 
 
@@ -176,6 +177,7 @@ class Frame:
 
     @property
     def step(self) -> int:
+        """The step the frame shows."""
         return int(self.header["step"])
 
 

@@ -43,6 +43,7 @@ class Recording:
     every: int
 
     def frame(self, k: int) -> Frame:
+        """Frame ``k`` of the recording, decoded."""
         return decode(self.frames[k], self.scene["n"], self.scene.get("chain") is not None)
 
 

@@ -43,6 +43,7 @@ class CommandError(InfomarketError, ValueError):
 
 @dataclass(frozen=True)
 class Command:
+    """One command from the page (play, pause, speed, select, ...), with its number when it takes one."""
     name: str
     value: int | None = None
 
@@ -96,6 +97,7 @@ class Session:
 
     @property
     def robots(self) -> int:
+        """The swarm's size."""
         return len(self.sim.behaviour_names)
 
     def restart(self, seed: int | None = None) -> None:
@@ -111,16 +113,20 @@ class Session:
         self._branches = BranchNumbers()  # a branch keeps its number (its ring's colour) while it lasts
 
     def scene(self) -> dict:
+        """The ``scene`` message: what does not change while the run plays (arena, sites, robots' kinds)."""
         return {"type": "scene", **scene(self.sim)}
 
     def status(self) -> dict:
+        """The ``status`` message: playing or not, speed, step, seed and the selected robot."""
         return {"type": "status", "playing": self.playing, "speed": self.speed, "step": self.sim.clock,
                 "seed": self.seed, "selected": self.selected}
 
     def frame(self) -> bytes:
+        """The current frame, binary-encoded for the page (``viewer.frames``)."""
         return encode(self.sim, self._honest, self._branches)
 
     def detail(self) -> dict | None:
+        """The selected robot's details for the side panel; None when none is selected."""
         return None if self.selected is None else robot_detail(self.sim, self.selected, branches=self._branches)
 
     def advance(self, k: int) -> tuple[bytes, dict | None]:
