@@ -15,6 +15,8 @@ What counts as public, and why:
 * functions nested inside functions are implementation, not API.
 
 Each kind must be at least ``THRESHOLD`` documented; a failure lists what is missing, by file and line.
+And every docstring must read as Google style (``Args:``, ``Returns:``, ``Raises:``, ``Example:``), the one
+style the API reference renders, checked with griffe, the parser the documentation site uses.
 """
 from __future__ import annotations
 
@@ -138,6 +140,62 @@ def test_public_api_is_documented(kind):
     print(f"{kind}: {done}/{total} documented ({share:.1%})")
     assert share >= THRESHOLD, (f"{kind}: only {done}/{total} ({share:.1%}) have a docstring, need "
                                 f"{THRESHOLD:.0%}; undocumented:\n  " + "\n  ".join(missing))
+
+
+def google_style_warnings(package: str, search_path: Path) -> list[str]:
+    """What griffe (the reader of the documentation site's API pages) says while parsing every docstring of
+    ``package`` as Google style: a section it cannot read, an argument the signature does not have, an
+    argument with neither a type nor an annotation.  The site builds in strict mode, where each is an error."""
+    griffe = pytest.importorskip("griffe")
+    import logging
+
+    said: list[str] = []
+
+    class Collect(logging.Handler):
+        def emit(self, record):
+            said.append(record.getMessage())
+
+    handler, logger = Collect(level=logging.WARNING), logging.getLogger("griffe")
+    logger.addHandler(handler)
+    try:
+        root = griffe.load(package, search_paths=[str(search_path)], docstring_parser="google",
+                           allow_inspection=False)
+
+        def walk(obj):
+            for member in obj.members.values():
+                if member.is_alias:
+                    continue
+                if member.docstring:
+                    member.docstring.parsed  # parsing is what warns
+                if member.is_module or member.is_class:
+                    walk(member)
+
+        if root.docstring:
+            root.docstring.parsed
+        walk(root)
+    finally:
+        logger.removeHandler(handler)
+    return said
+
+
+def test_google_style_check_sees_a_bad_docstring(tmp_path):
+    (tmp_path / "pkg").mkdir()
+    (tmp_path / "pkg" / "__init__.py").write_text('''
+def f(a: int) -> int:
+    """Doc.
+
+    Args:
+        b: not an argument of f.
+    """
+    return a
+''')
+    assert any("'b' does not appear in the function signature" in w for w in google_style_warnings("pkg", tmp_path))
+
+
+def test_docstrings_read_as_google_style():
+    """One docstring style across the package, the one the API reference is rendered with."""
+    warnings = google_style_warnings("infomarket", PACKAGE.parent)
+    assert not warnings, "docstrings griffe cannot read as Google style:\n  " + "\n  ".join(warnings)
 
 
 if __name__ == "__main__":  # a report: python tests/test_docstrings.py

@@ -34,8 +34,9 @@ class Frames:
         """The tables from any source an analysis accepts.
 
         Args:
-            source: a ``Frames`` (returned as is), a robots DataFrame, a dict of tables (robots, history, runs,
-                meta), a ``Store`` or the path of one.
+            source (Frames | pandas.DataFrame | dict | Store | str | pathlib.Path): a ``Frames`` (returned
+                as is), a robots DataFrame, a dict of tables (robots, history, runs, meta), a ``Store`` or the
+                path of one.
 
         Raises:
             InputTypeError: ``source`` is none of these, or the dict names an unknown table.

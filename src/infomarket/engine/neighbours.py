@@ -35,11 +35,11 @@ def neighbours_by_all_pairs(pos, rc2, nbr, nbr_count, cap):
     """Fill the neighbour lists by testing every pair: O(n²), the fastest for small swarms.
 
     Args:
-        pos: robot positions, ``[n, 2] float64``.
-        rc2: the squared communication range; a pair strictly closer is linked.
-        nbr: ``[n, cap] int`` lists to append to; ids past ``cap`` are counted but not stored.
-        nbr_count: ``[n] int`` each robot's neighbour count so far (the caller zeroes it), updated in place.
-        cap: the lists' capacity.
+        pos (numpy.ndarray): robot positions, ``[n, 2] float64``.
+        rc2 (float): the squared communication range; a pair strictly closer is linked.
+        nbr (numpy.ndarray): ``[n, cap] int`` lists to append to; ids past ``cap`` are counted, not stored.
+        nbr_count (numpy.ndarray): ``[n] int`` neighbours so far (the caller zeroes it), updated in place.
+        cap (int): the lists' capacity.
     """
     n = pos.shape[0]
     for i in range(n):
@@ -66,11 +66,16 @@ def neighbours_by_grid(pos, rc2, nbr, nbr_count, cap, size, nx, ny, start, items
     depend on which of the two the engine picks.
 
     Args:
-        pos, rc2, nbr, nbr_count, cap: as ``neighbours_by_all_pairs``.
-        size: a cell's side.
-        nx, ny: the number of cells along x and y.
-        start: ``[nx * ny + 1] int`` scratch: where each cell's robots begin in ``items``.
-        items: ``[n] int`` scratch: robot ids sorted by cell.
+        pos (numpy.ndarray): as ``neighbours_by_all_pairs``.
+        rc2 (float): as ``neighbours_by_all_pairs``.
+        nbr (numpy.ndarray): as ``neighbours_by_all_pairs``.
+        nbr_count (numpy.ndarray): as ``neighbours_by_all_pairs``.
+        cap (int): as ``neighbours_by_all_pairs``.
+        size (float): a cell's side.
+        nx (int): the number of cells along x.
+        ny (int): the number of cells along y.
+        start (numpy.ndarray): ``[nx * ny + 1] int`` scratch: where each cell's robots begin in ``items``.
+        items (numpy.ndarray): ``[n] int`` scratch: robot ids sorted by cell.
     """
     n = pos.shape[0]
     ncell = nx * ny

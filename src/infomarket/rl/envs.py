@@ -155,8 +155,7 @@ class AttackEnv(Rebuilt, gym.Env):
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         """Start a new episode (Gymnasium's API): a fresh run whose seed is drawn from the env's random stream.
 
-        Returns:
-            The first observation and ``{"seed": the run's seed}``.
+        It returns the first observation and ``{"seed": the run's seed}``.
         """
         super().reset(seed=seed)
         s = episode_seed(self.np_random)
@@ -168,9 +167,8 @@ class AttackEnv(Rebuilt, gym.Env):
     def step(self, action):
         """Play ``action`` for ``interval`` engine steps (Gymnasium's API).
 
-        Returns:
-            ``(observation, reward, terminated, truncated, info)``: the team reward since the last step; an
-            episode is never terminated, only truncated at the run's last step.
+        It returns ``(observation, reward, terminated, truncated, info)``, with the team reward since the last
+        step; an episode is never terminated, only truncated at the run's last step.
 
         Raises:
             UsageError: the episode is over or was never started (call ``reset``).
@@ -251,9 +249,8 @@ class AttackVectorEnv(Rebuilt, gym.vector.VectorEnv):
     def step(self, actions):
         """Play one action per sub-environment for ``interval`` steps, all in one compiled call.
 
-        Returns:
-            ``(observations, rewards, terminated, truncated, info)``, one row per sub-environment; a run that
-            ended at the previous call starts its next episode instead (its action ignored, its reward 0).
+        It returns ``(observations, rewards, terminated, truncated, info)``, one row per sub-environment; a run
+        that ended at the previous call starts its next episode instead (its action ignored, its reward 0).
 
         Raises:
             UsageError: the env was never reset.

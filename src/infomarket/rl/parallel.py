@@ -63,9 +63,8 @@ class AttackParallelEnv(Rebuilt, ParallelEnv):
     def step(self, actions: dict):
         """Play every acting agent's action (PettingZoo's parallel API) for ``interval`` steps.
 
-        Returns:
-            Per-agent dicts of observations, rewards, terminations, truncations and infos; after the run's last
-            step every agent is done.
+        It returns per-agent dicts of observations, rewards, terminations, truncations and infos; after the
+        run's last step every agent is done.
 
         Raises:
             UsageError: an agent has no action or is not acting, or no episode is running.
