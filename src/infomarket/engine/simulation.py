@@ -91,7 +91,14 @@ class Simulation:
     The step it runs: ``engine/loop_template.py`` (the loop, in the order of docs/model.md §3), whose
     pieces are all in ``engine/step.py``; ``self.kernel_source`` is the generated module the loop was
     compiled from (the template specialised to this experiment's rules and step options).  The state
-    it steps is ``self.world`` (``engine.world``: parameters, swarm, ledger and log side by side)."""
+    it steps is ``self.world`` (``engine.world``: parameters, swarm, ledger and log side by side).
+
+    Example:
+        >>> sim = Simulation("fig2A", seed=1)
+        >>> sim.step(40)
+        >>> sim.clock, len(sim.result().robots)
+        (40, 25)
+    """
 
     def __init__(self, config: Experiment | str | Path, seed: int | None = None, *, record_events: bool = False,
                  history_every: int | None = None, kernel_kinds: tuple[str, ...] | None = None):
@@ -470,7 +477,13 @@ def simulate(config: Experiment | str | Path, seed: int | None = None, *, steps:
     """Run one experiment (an Experiment, a shipped name like ``"fig2D"`` or a file path) once.
     The same configuration and seed give identical results.  ``steps`` is the run's length, exactly as
     the experiment's ``steps`` (it shapes the Lévy step-length table), so ``simulate(cfg, seed, steps=N)``
-    reproduces a run stored with ``steps = N``."""
+    reproduces a run stored with ``steps = N``.
+
+    Example:
+        >>> res = simulate("fig2A", seed=1, steps=200)
+        >>> res.steps, sorted(res.robots.groupby("honest").size().items())
+        (200, [(True, 25)])
+    """
     config = as_experiment(config)
     if steps is not None:
         if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1:
