@@ -231,8 +231,8 @@ def _pct(v: dict) -> str:
 
 def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, provenance: dict | None = None,
              records: list[str] | None = None) -> str:
-    """The defence search's answers ``a`` as Markdown: the frontier, each family's best defence and its
-    confirmation, marked if the run was reduced."""
+    """The defence search's answers ``a`` as Markdown: each question answered from the confirmation seeds, then
+    the search phase that chose the confirmed defences; a reduced run says so first."""
     t = str(a["target"])
     lines = ["# Defence search", ""]
     if reduced:

@@ -145,7 +145,7 @@ class RevmBackend:
 
     @property
     def block_number(self) -> int:
-        """The current block number (the in-process chain mines one block per transaction)."""
+        """The current block number (with ``automine``, each transaction mines one block)."""
         return self._block
 
     def advance_to(self, block: int) -> None:

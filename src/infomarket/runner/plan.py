@@ -38,8 +38,8 @@ class Condition:
     design: Any = field(default=None, compare=False, repr=False)  # runner.design.Design of a sampled sweep
 
     def seed(self, run: int) -> int:
-        """The seed of run ``run`` of this condition, derived from the master seed, the run and the condition's
-        number (so runs never share a stream)."""
+        """The seed of run ``run`` of this condition: ``seeds.run_seed`` of the master seed, the run and the
+        condition's number (a ``SeedSequence`` keyed by both, so each run has a stream of its own)."""
         return run_seed(self.master_seed, run, self.number)
 
 

@@ -319,8 +319,8 @@ def _duel_cell(a: dict | None) -> str:
 
 def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, steps: int | None = None,
              transitory: int | None = None, provenance: dict | None = None) -> str:
-    """The attack search's answers ``a`` as Markdown: settings, the per-cell table and the paired comparisons,
-    marked if the run was reduced."""
+    """The attack search's answers ``a`` as Markdown: objective and settings, the answers from the confirmation
+    seeds (each search paired with the baselines), the chosen attacks and the cost; a reduced run says so first."""
     s = a["settings"]
     lines = ["# Attack search", ""]
     if reduced:
