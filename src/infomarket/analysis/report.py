@@ -155,8 +155,8 @@ def _summary(report: Report) -> str:
 
 
 def to_markdown(report: Report) -> str:
-    """The report as ``report.md``: run lengths and incomplete designs first, then figures, headline table and
-    provenance."""
+    """The report as ``report.md``: run lengths and incomplete designs first, then the figures, the paper
+    against this store (the headline table) and provenance."""
     md = [f"# Paper figures from {report.source}", "",
           "Figures and headline numbers of *An Information Market for Social Navigation in Robots*, "
           "recomputed from this results store. Tolerances: `src/infomarket/analysis/tolerances.toml` "

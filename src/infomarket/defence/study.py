@@ -102,7 +102,7 @@ class Study:
         return configure(self.base(), byzantines, self.robots, candidate.settings(self.families), where)
 
     def undefended_config(self) -> Experiment:
-        """The swarm without Byzantines and without defences: the reference a defence's cost is measured against."""
+        """The swarm without Byzantines nor defences: a defence's cost is its loss of items against this swarm."""
         where = f"{self.experiment.name}: the undefended swarm"
         return configure(self.base(), 0, self.robots, self.undefended, where)
 

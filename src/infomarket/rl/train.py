@@ -66,7 +66,7 @@ class Adam:
     v: np.ndarray | None = None
 
     def step(self, grad: np.ndarray) -> np.ndarray:
-        """The Adam update for gradient ``grad`` (bias-corrected moments), to add to the parameters."""
+        """The Adam step for gradient ``grad`` (bias-corrected moments); the caller applies it to the parameters."""
         if self.m is None:
             self.m, self.v = np.zeros_like(grad), np.zeros_like(grad)
         self.t += 1

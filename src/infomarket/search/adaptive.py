@@ -232,7 +232,7 @@ class Training:
         return max(1, self.budget // self.population)
 
     def as_dict(self) -> dict:
-        """The settings as JSON-able values (tuples as lists), as the checkpoint and the results record them."""
+        """The settings as JSON-able values (tuples as lists): what a checkpoint records and must match to resume."""
         return {k: (list(v) if isinstance(v, tuple) else v) for k, v in self.__dict__.items()}
 
 

@@ -98,8 +98,8 @@ def _markdown(s: dict) -> str:
 
 
 def cmd_adaptive_attack(args) -> int:
-    """Run ``infomarket adaptive-attack``: train (resuming from the checkpoint in ``--out``), then compare with the
-    cell's attacks; returns the exit code."""
+    """Run ``infomarket adaptive-attack``: train (resuming from the checkpoint in ``--out``), then play the learned
+    policy and the constant attack it started from on the same fresh seeds; returns the exit code."""
     # with the command: `infomarket --help` does not import the engine
     from .. import interrupts
     from ..cliargs import writable_dir
