@@ -10,8 +10,6 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from mkdocs.structure.files import File
-
 #: A Markdown link or image target that starts with docs/ (the README's links into the documentation).
 _DOCS_LINK = re.compile(r"(\]\()docs/")
 
@@ -23,6 +21,8 @@ def readme_as_home(readme: str) -> str:
 
 def on_files(files, config):
     """Add the README to the site as its home page (index.md)."""
+    from mkdocs.structure.files import File  # here, so the tests can import readme_as_home without mkdocs
+
     readme = Path(config["config_file_path"]).parent / "README.md"
     if files.get_file_from_path("index.md") is None:
         files.append(File.generated(config, "index.md", content=readme_as_home(readme.read_text(encoding="utf-8"))))
