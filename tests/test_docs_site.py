@@ -48,7 +48,7 @@ def test_the_build_is_strict_and_reads_google_style_docstrings():
 def test_api_reference_documents_the_public_modules():
     directives = set()
     for page in (DOCS / "api").glob("*.md"):
-        directives |= set(re.findall(r"^::: (\S+)$", page.read_text(encoding="utf-8"), re.M))
+        directives |= set(re.findall(r"^::: (\S+)$", page.read_text(encoding="utf-8"), re.MULTILINE))
     assert not set(DOCUMENTED) - directives
 
 

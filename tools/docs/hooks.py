@@ -21,7 +21,8 @@ def readme_as_home(readme: str) -> str:
 
 def on_files(files, config):
     """Add the README to the site as its home page (index.md)."""
-    from mkdocs.structure.files import File  # here, so the tests can import readme_as_home without mkdocs
+    # imported here, so the tests can import readme_as_home without mkdocs installed
+    from mkdocs.structure.files import File
 
     readme = Path(config["config_file_path"]).parent / "README.md"
     if files.get_file_from_path("index.md") is None:
