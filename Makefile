@@ -4,14 +4,14 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: venv demo test test-busy bench clean contracts gas node
+.PHONY: venv demo test test-busy bench clean contracts gas node docs
 
 venv: $(STAMP)
 
 $(STAMP): pyproject.toml Makefile
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
 	$(BIN)/python -m pip install -q --upgrade pip
-	$(BIN)/python -m pip install -q -e ".[dask,chain,dev,rl,sql]"
+	$(BIN)/python -m pip install -q -e ".[dask,chain,dev,docs,rl,sql]"
 	touch $(STAMP)
 
 demo: venv
@@ -34,7 +34,7 @@ bench: venv
 	$(BIN)/infomarket bench
 
 clean:
-	rm -rf $(VENV) .pytest_cache build dist
+	rm -rf $(VENV) .pytest_cache build dist site
 
 # The Solidity contract: solc-js pinned in tools/solc; the compiled artifact is committed in the package.
 contracts: tools/solc/node_modules
@@ -58,3 +58,8 @@ node: tools/node/node_modules
 tools/node/node_modules: tools/node/package.json tools/node/package-lock.json
 	cd tools/node && npm ci --no-audit --no-fund
 	touch $@
+
+# The documentation site (mkdocs.yml): docs/*.md, the README as its home page, and an API reference drawn
+# from the docstrings, built into site/.  --strict: a broken link, anchor or API reference fails the build.
+docs: venv
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict
