@@ -16,6 +16,7 @@ replayed (a message for a sale that is over) is refused, logged and reported on 
 from __future__ import annotations
 
 import json
+import os
 import random
 import sys
 import time
@@ -24,6 +25,7 @@ from pathlib import Path
 from eth_account import Account
 
 from ..evm.errors import ContractRevert
+from ..evm.market import ChainMarket, connect
 from ..evm.protocol import (LightContract, Offer, PathInfo, ProtocolError, accept_offer, acceptance_digest,
                             checksum, sign_deposit, sign_offer)
 from . import wire
@@ -47,8 +49,6 @@ class MarketAgent:
         from std_msgs.msg import Float64MultiArray, String, UInt8MultiArray
         from nav_msgs.msg import Odometry
         from rosgraph_msgs.msg import Clock
-
-        from ..evm.market import ChainMarket, connect
 
         self.robot, self.folder = robot, folder
         self.account = Account.from_key(load_or_create_key(folder))
@@ -106,8 +106,6 @@ class MarketAgent:
 
     def _say_hello(self) -> None:
         if not self.welcomed:
-            import os
-
             self._send(self.hello, self._String(data=json.dumps(
                 {"robot": self.robot, "address": self.account.address, "pid": os.getpid()})))
 

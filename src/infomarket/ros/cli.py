@@ -31,7 +31,7 @@ def _drop(text: str) -> float:
 
 
 def _fault(text: str):
-    from .swarm import parse_fault
+    from .faults import parse_fault  # at parse time: a light module (no engine, no ROS 2)
 
     try:
         return parse_fault(text)
@@ -71,7 +71,7 @@ def add_subcommand(subparsers) -> None:
 
 
 def _ready() -> str | None:
-    from . import env
+    from . import env  # with the command: `infomarket --help` does not look for ROS 2
 
     return env.ensure()
 
@@ -80,7 +80,7 @@ def run_agent(args) -> int:
     reason = _ready()
     if reason:
         return report_error(reason, 2)
-    from .agent import MarketAgent
+    from .agent import MarketAgent  # after ensure(): it loads ROS 2 and the chain client
 
     try:
         agent = MarketAgent(args.robot, args.state, args.rpc, args.market, drop=args.drop, seed=args.seed)
@@ -97,10 +97,12 @@ def run_swarm(args) -> int:
     reason = _ready()
     if reason:
         return report_error(reason, 2)
+    # after ensure(): the engine, the chain client and ROS 2 load with the command only
     from ..errors import ConfigError
     from ..evm.cli import DEMO_SCHEMES, FROM_EXPERIMENT
     from ..evm.errors import ChainError
-    from .swarm import Swarm, merge, prepare, write_report
+    from .faults import merge
+    from .swarm import Swarm, prepare, write_report
 
     if args.scheme not in (*DEMO_SCHEMES, FROM_EXPERIMENT):
         return report_error(f"--scheme {args.scheme!r}: choose {', '.join(sorted(DEMO_SCHEMES))} or {FROM_EXPERIMENT}", 2)

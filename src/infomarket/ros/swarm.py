@@ -9,53 +9,27 @@ every process of the swarm at once: each is SIGKILLed by process group, and dies
 from __future__ import annotations
 
 import json
-import re
 import time
-from dataclasses import dataclass, replace
+from dataclasses import replace
 from pathlib import Path
 from statistics import mean
 
+from .. import load_experiment
+from ..engine.simulation import Simulation
+from ..engine.world import EVENT_NAMES, headings
 from ..errors import ConfigError
+from ..evm.cli import demo_config
+from ..evm.evm_replay import REPLAY_NO_EXPIRY, BalanceRow, market_params
+from ..evm.market import ChainMarket, connect
+from ..evm.units import to_units
 from . import launch
-
-
-@dataclass(frozen=True)
-class Faults:
-    kill: tuple[int, int] | None = None  # (robot, step)
-    drop: float = 0.0
-    hostile: bool = False
-
-
-def parse_fault(text: str) -> Faults:
-    """One ``--fault`` value: ``kill:ROBOT@STEP``, ``drop:P`` (0 <= P < 1) or ``hostile``."""
-    if text == "hostile":
-        return Faults(hostile=True)
-    m = re.fullmatch(r"kill:(\d+)@(\d+)", text)
-    if m:
-        return Faults(kill=(int(m[1]), int(m[2])))
-    m = re.fullmatch(r"drop:([0-9.eE+-]+)", text)
-    if m:
-        try:
-            p = float(m[1])
-        except ValueError:
-            p = -1.0
-        if 0 <= p < 1:
-            return Faults(drop=p)
-        raise ValueError(f"--fault drop:P needs 0 <= P < 1, not {m[1]}")
-    raise ValueError(f"--fault {text!r}: expected kill:ROBOT@STEP, drop:P or hostile")
-
-
-def merge(faults: list[Faults]) -> Faults:
-    kill = next((f.kill for f in faults if f.kill), None)
-    return Faults(kill, max((f.drop for f in faults), default=0.0), any(f.hostile for f in faults))
+from .faults import Faults
+from .hostile import Hostile
+from .world import Trader, World
 
 
 def prepare(experiment: str, robots: int, steps: int, scheme: str, faults: Faults):
     """The scaled experiment and the contract's parameters, refused with a ConfigError when not runnable."""
-    from .. import load_experiment
-    from ..evm.cli import demo_config
-    from ..evm.evm_replay import REPLAY_NO_EXPIRY, market_params
-
     config = demo_config(load_experiment(experiment), robots, steps, scheme)
     if config.chain.enabled:
         raise ConfigError("the ROS swarm runs the market on a real chain node: use an experiment without the chain model")
@@ -101,18 +75,11 @@ class Swarm:
                                    f"{self.out / 'agents' / f'robot_{robot}.log'}")
 
     def run(self, say=print) -> dict:
-        from ..engine.simulation import Simulation
-        from ..engine.world import EVENT_NAMES, headings
-        from ..evm.market import ChainMarket, connect
-        from ..evm.units import to_units
-        from .hostile import Hostile
-        from .world import Trader, World
-
         t0 = time.perf_counter()
         self.out.mkdir(parents=True, exist_ok=True)
         if self.rpc is None:
             self.node, self.rpc = launch.start_node(self.out / "chain-node.log")
-            say(f"chain node: Hardhat at {self.rpc}")
+            say(f"chain node: Hardhat at {self.rpc} (up after {time.perf_counter() - t0:.1f} s)")
         chain = connect(self.rpc)
         self.market = market = ChainMarket.deploy(self.params, backend=chain, seed=self.seed)
         say(f"market contract at {market.address}; starting {self.n} agent processes")
@@ -129,9 +96,11 @@ class Swarm:
             world.hostile = Hostile(world, market.domain, addresses)
         trader = Trader(world, market, addresses, self.params, on_wait=self._check)
         sim = Simulation(self.config, self.seed, record_events=True)
-        say(f"agents registered ({', '.join(str(p.pid) for p in self.agents)}); running {self.config.steps} steps")
+        say(f"agents registered ({', '.join(str(p.pid) for p in self.agents)}) after {time.perf_counter() - t0:.1f} s; "
+            f"running {self.config.steps} steps")
         comm = float(self.config.robot.communication_range)
         seen = 0
+        self.seconds = {"setup": time.perf_counter() - t0, "world": 0.0, "trading": 0.0}
         for step in range(1, self.config.steps + 1):
             if self.faults.kill and step == self.faults.kill[1]:
                 robot = self.faults.kill[0]
@@ -139,10 +108,13 @@ class Swarm:
                 self.agents[robot] = self._agent(robot)
                 self.restarted += 1
                 say(f"step {step}: robot {robot}'s agent killed (SIGKILL) and started again")
+            t1 = time.perf_counter()
             sim.step(1)
             w = sim.world
             world.publish_step(step, w.pos, headings(w), comm)
             world.spin(0)
+            t2 = time.perf_counter()
+            self.seconds["world"] += t2 - t1
             for k in range(seen, int(w.ev_count[0])):
                 ev = {"kind": EVENT_NAMES[int(w.ev_kind[k])], "step": int(w.ev_step[k]), "buyer": int(w.ev_buyer[k]),
                       "seller": int(w.ev_seller[k]), "site": int(w.ev_site[k]), "x": float(w.ev_x[k]),
@@ -151,11 +123,10 @@ class Swarm:
                 if ev["kind"] in ("purchase", "refused", "deposit"):
                     trader.event(k, ev)
             seen = int(w.ev_count[0])
+            self.seconds["trading"] += time.perf_counter() - t2
         return self._report(sim.result(), trader, addresses, time.perf_counter() - t0)
 
     def _report(self, result, trader, addresses, wall: float) -> dict:
-        from ..evm.evm_replay import BalanceRow
-
         market, tally = self.market, self.world.tally
         wealth = result.robots.sort_values("robot")["wealth"].to_numpy()
         rows = [BalanceRow(i, market.balance_of(a), float(wealth[i]), trader.bound[i]) for i, a in enumerate(addresses)]
@@ -179,7 +150,7 @@ class Swarm:
             "on_chain_matches_engine": all(r.ok for r in rows) and not tally.disagreements,
             "faults": {"kill": list(self.faults.kill) if self.faults.kill else None, "drop": self.faults.drop,
                        "hostile": self.faults.hostile},
-            "wall_seconds": round(wall, 2),
+            "wall_seconds": round(wall, 2), "seconds": {k: round(v, 2) for k, v in self.seconds.items()},
             "balances": [{"robot": r.robot, "address": addresses[r.robot], "on_chain": r.chain_units / 1e9,
                           "engine": r.expected, "diff_units": round(r.diff_units, 3), "bound_units": r.bound_units,
                           "ok": r.ok} for r in rows],
