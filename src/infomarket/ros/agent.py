@@ -26,8 +26,17 @@ from eth_account import Account
 
 from ..evm.errors import ContractRevert
 from ..evm.market import ChainMarket, connect
-from ..evm.protocol import (LightContract, Offer, PathInfo, ProtocolError, accept_offer, acceptance_digest,
-                            checksum, sign_deposit, sign_offer)
+from ..evm.protocol import (
+    LightContract,
+    Offer,
+    PathInfo,
+    ProtocolError,
+    accept_offer,
+    acceptance_digest,
+    checksum,
+    sign_deposit,
+    sign_offer,
+)
 from . import wire
 from .state import AgentState, load_or_create_key
 
@@ -45,10 +54,10 @@ class MarketAgent:
     def __init__(self, robot: int, folder: Path, rpc: str, market_address: str, *, drop: float = 0.0,
                  seed: int = 0):
         import rclpy
-        from rclpy.signals import SignalHandlerOptions
-        from std_msgs.msg import Float64MultiArray, String, UInt8MultiArray
         from nav_msgs.msg import Odometry
+        from rclpy.signals import SignalHandlerOptions
         from rosgraph_msgs.msg import Clock
+        from std_msgs.msg import Float64MultiArray, String, UInt8MultiArray
 
         self.robot, self.folder = robot, folder
         self.account = Account.from_key(load_or_create_key(folder))
@@ -211,7 +220,7 @@ class MarketAgent:
         try:
             digest = acceptance_digest(self.domain, offer, lc.buyer, lc.seller_x, lc.seller_y, lc.trip)
             signer = Account._recover_hash(digest, vrs=(lc.v, int.from_bytes(lc.r, "big"), int.from_bytes(lc.s, "big")))
-        except Exception as exc:  # a signature that recovers to nothing
+        except Exception as exc:  # noqa: BLE001 - a signature that recovers to nothing
             return self.refuse("acceptance", f"task {task_id}: bad signature ({type(exc).__name__})")
         if lc.buyer != buyer or signer != buyer:
             return self.refuse("acceptance", f"task {task_id}: signed by {signer} for {lc.buyer}, not the buyer {buyer}")
@@ -236,7 +245,6 @@ class MarketAgent:
                 result = {"refused": True, "gas": 0, "error": err.name}
         self.state.put(task_id, {**rec, "result": result})
         self._report(kind="done", id=task_id, **result)
-        return None
 
     def _recover(self) -> None:
         """After a restart: reveal every light contract held but not revealed (the world asks again too)."""

@@ -31,7 +31,8 @@ def _drop(text: str) -> float:
 
 
 def _fault(text: str):
-    from .faults import parse_fault  # at parse time: a light module (no engine, no ROS 2)
+    # at parse time: a light module (no engine, no ROS 2)
+    from .faults import parse_fault
 
     try:
         return parse_fault(text)
@@ -80,7 +81,8 @@ def run_agent(args) -> int:
     reason = _ready()
     if reason:
         return report_error(reason, 2)
-    from .agent import MarketAgent  # after ensure(): it loads ROS 2 and the chain client
+    # after ensure(): it loads ROS 2 and the chain client
+    from .agent import MarketAgent
 
     try:
         agent = MarketAgent(args.robot, args.state, args.rpc, args.market, drop=args.drop, seed=args.seed)

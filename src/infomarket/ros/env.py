@@ -50,7 +50,7 @@ def missing() -> str | None:
         from nav_msgs.msg import Odometry  # noqa: F401
         from rosgraph_msgs.msg import Clock  # noqa: F401
         from std_msgs.msg import String  # noqa: F401
-    except Exception as exc:  # an ImportError, or a missing shared library (OSError)
+    except Exception as exc:  # noqa: BLE001 - an ImportError, a missing shared library (OSError), ...
         return f"{type(exc).__name__}: {exc}"
     return None
 

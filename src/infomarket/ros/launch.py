@@ -32,7 +32,8 @@ def start(argv: list[str], log: Path, cwd: Path | None = None) -> subprocess.Pop
     log.parent.mkdir(parents=True, exist_ok=True)
     with open(log, "ab") as out:
         return subprocess.Popen(argv, stdout=out, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
-                                cwd=cwd, env=env.child_env(), preexec_fn=_detached)
+                                cwd=cwd, env=env.child_env(),
+                                preexec_fn=_detached)  # noqa: PLW1509 - the command's own fork, as interrupts does
 
 
 def stop(proc: subprocess.Popen | None) -> None:

@@ -133,7 +133,7 @@ class Swarm:
         sales = trader.sales
         gas_total = sum(tally.reveal_gas) + sum(tally.deposit_gas)
         protocol = sum(tally.messages[k] for k in ("offer", "acceptance", "deposit", "task", "done"))
-        avg = lambda xs: mean(xs) if xs else None  # noqa: E731
+        avg = lambda xs: mean(xs) if xs else None
         return {
             "robots": self.n, "steps": self.config.steps, "seed": self.seed, "rpc": self.rpc,
             "market": market.address, "processes": len({p.pid for p in self.agents}), "restarted_agents": self.restarted,

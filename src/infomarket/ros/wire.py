@@ -66,7 +66,7 @@ _DEPOSIT = ["uint64", "address", "uint64", "uint8", "bytes32", "bytes32"]
 def _decode(types: list[str], data: bytes) -> tuple:
     try:
         return abi_decode(types, bytes(data))
-    except Exception as exc:  # eth_abi raises several kinds on short or bad input
+    except Exception as exc:  # noqa: BLE001 - eth_abi raises several kinds on short or bad input
         raise WireError(f"malformed message ({len(data)} bytes): {type(exc).__name__}") from None
 
 

@@ -53,10 +53,10 @@ class World:
 
     def __init__(self, robots: int, hostile=None):
         import rclpy
-        from rclpy.signals import SignalHandlerOptions
-        from std_msgs.msg import Float64MultiArray, String, UInt8MultiArray
         from nav_msgs.msg import Odometry
+        from rclpy.signals import SignalHandlerOptions
         from rosgraph_msgs.msg import Clock
+        from std_msgs.msg import Float64MultiArray, String, UInt8MultiArray
 
         rclpy.init(args=None, signal_handler_options=SignalHandlerOptions.NO)
         self.rclpy = rclpy
@@ -120,9 +120,9 @@ class World:
 
     def publish_step(self, step: int, pos: np.ndarray, heading_deg: np.ndarray, comm_range: float) -> None:
         """``/clock`` and, per robot, its odometry and the robots within communication range (own frame)."""
-        String, Odometry, Float64MultiArray, Clock = self._types
+        _, Odometry, Float64MultiArray, Clock = self._types
         self.step = step
-        ns = int(round(step * STEP_SECONDS * 1e9))
+        ns = round(step * STEP_SECONDS * 1e9)
         clock = Clock()
         clock.clock.sec, clock.clock.nanosec = ns // 10**9, ns % 10**9
         self.clock.publish(clock)
@@ -232,7 +232,7 @@ class Trader:
         try:
             signer = Account._recover_hash(deposit_digest(self.market.domain, robot, trip),
                                            vrs=(v, int.from_bytes(r, "big"), int.from_bytes(s, "big")))
-        except Exception:
+        except Exception:  # noqa: BLE001 - any bad signature is one the robot did not make
             signer = None
         if robot != checksum(address) or signer != robot or trip != self.market.round_trip(address):
             del self.world.signed[task_id]
