@@ -69,7 +69,7 @@ class MarketAgent:
         self.welcomed = False
         self.step = -1
         self.latest_buy = -1
-        self.early: dict[int, bytes] = {}
+        self.early: dict[int, list[bytes]] = {}
         self.pose = None
         self.sensed: list[float] = []
         self._String, self._Bytes = String, UInt8MultiArray
@@ -142,8 +142,9 @@ class MarketAgent:
             self.latest_buy = max(self.latest_buy, int(t["id"]))
             if self.state.get(t["id"]) is None:
                 self.state.put(t["id"], {"kind": "buy", "task": t})
-            early = self.early.pop(int(t["id"]), None)
-            return self._accept(early) if early is not None else None
+            for data in self.early.pop(int(t["id"]), []):
+                self._accept(data)
+            return None
         if kind == "deposit":
             return self._deposit(t)
         return self.refuse("task", f"unknown kind {kind!r}")
@@ -175,8 +176,8 @@ class MarketAgent:
             return self.refuse("offer", str(exc))
         rec = self.state.get(task_id)
         if rec is None:
-            if task_id > self.latest_buy and len(self.early) < EARLY_OFFERS:
-                self.early[task_id] = data  # its task may still be on its way
+            if task_id > self.latest_buy and sum(map(len, self.early.values())) < EARLY_OFFERS:
+                self.early.setdefault(task_id, []).append(data)  # its task may still be on its way
                 return None
             return self.refuse("offer", f"task {task_id}: no purchase of this robot (unsolicited or replayed)")
         t = rec["task"]

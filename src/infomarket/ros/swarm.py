@@ -1,8 +1,8 @@
 """``infomarket ros swarm``: the chain node, one agent process per robot, the engine as the world, and
 ``report.json`` saying whether every robot's balance on chain equals its wealth in the engine.
 
-Faults: ``kill:R@S`` SIGKILLs robot R's agent at the start of step S and starts it again (same key, same
-state folder); ``drop:P`` makes every agent lose that share of the messages it sends; ``hostile`` sends
+Faults: ``kill:R@S`` SIGKILLs robot R's agent at step S (in the middle of its sale when it sells then)
+and starts it again (same key, same state folder); ``drop:P`` makes every agent lose that share of the messages it sends; ``hostile`` sends
 malformed, forged and replayed messages before every sale (``hostile.py``). Ctrl-C (or SIGTERM) ends
 every process of the swarm at once: each is SIGKILLed by process group, and dies with the swarm anyway.
 """
@@ -102,12 +102,6 @@ class Swarm:
         seen = 0
         self.seconds = {"setup": time.perf_counter() - t0, "world": 0.0, "trading": 0.0}
         for step in range(1, self.config.steps + 1):
-            if self.faults.kill and step == self.faults.kill[1]:
-                robot = self.faults.kill[0]
-                launch.kill(self.agents[robot])
-                self.agents[robot] = self._agent(robot)
-                self.restarted += 1
-                say(f"step {step}: robot {robot}'s agent killed (SIGKILL) and started again")
             t1 = time.perf_counter()
             sim.step(1)
             w = sim.world
@@ -115,6 +109,9 @@ class Swarm:
             world.spin(0)
             t2 = time.perf_counter()
             self.seconds["world"] += t2 - t1
+            if self.faults.kill and step == self.faults.kill[1]:
+                self._arm_kill(step, [int(w.ev_seller[k]) for k in range(seen, int(w.ev_count[0]))
+                                      if EVENT_NAMES[int(w.ev_kind[k])] == "purchase"], say)
             for k in range(seen, int(w.ev_count[0])):
                 ev = {"kind": EVENT_NAMES[int(w.ev_kind[k])], "step": int(w.ev_step[k]), "buyer": int(w.ev_buyer[k]),
                       "seller": int(w.ev_seller[k]), "site": int(w.ev_site[k]), "x": float(w.ev_x[k]),
@@ -125,6 +122,28 @@ class Swarm:
             seen = int(w.ev_count[0])
             self.seconds["trading"] += time.perf_counter() - t2
         return self._report(sim.result(), trader, addresses, time.perf_counter() - t0)
+
+    def _arm_kill(self, step: int, sellers: list[int], say) -> None:
+        """The ``kill`` fault at ``step``: if the robot sells in this step, in the middle of its first sale
+        (as its acceptance goes out, whether or not it has revealed yet); else at once."""
+        robot = self.faults.kill[0]
+
+        def kill(where: str) -> None:
+            launch.kill(self.agents[robot])
+            self.agents[robot] = self._agent(robot)
+            self.restarted += 1
+            say(f"step {step}: robot {robot}'s agent killed (SIGKILL) {where} and started again")
+
+        if robot not in sellers:
+            kill("between sales")
+            return
+
+        def on_acceptance(seller: int) -> None:
+            if seller == robot:
+                self.world.acceptance_seen = None
+                kill("in the middle of a sale")
+
+        self.world.acceptance_seen = on_acceptance
 
     def _report(self, result, trader, addresses, wall: float) -> dict:
         market, tally = self.market, self.world.tally

@@ -74,12 +74,19 @@ class World:
         self.hellos: dict[int, dict] = {}
         self.outcomes: dict[int, dict] = {}
         self.signed: dict[int, tuple] = {}
+        #: called with the seller's number when an acceptance goes to it (the mid-sale ``kill`` fault)
+        self.acceptance_seen = None
         node.create_subscription(String, wire.HELLO, self._on_hello, q)
         node.create_subscription(String, wire.DONE, self._on_done, q)
         node.create_subscription(UInt8MultiArray, wire.DEPOSIT, self._on_deposit, q)
         for i in range(robots):
             node.create_subscription(UInt8MultiArray, wire.offers(i), lambda m: self._count("offer"), q)
-            node.create_subscription(UInt8MultiArray, wire.acceptances(i), lambda m: self._count("acceptance"), q)
+            node.create_subscription(UInt8MultiArray, wire.acceptances(i), lambda m, i=i: self._on_acceptance(i), q)
+
+    def _on_acceptance(self, seller: int) -> None:
+        self._count("acceptance")
+        if self.acceptance_seen is not None:
+            self.acceptance_seen(seller)
 
     def _count(self, kind: str) -> None:
         self.tally.messages[kind] += 1
