@@ -9,6 +9,7 @@ every process of the swarm at once: each is SIGKILLed by process group, and dies
 from __future__ import annotations
 
 import json
+import os
 import time
 from dataclasses import replace
 from pathlib import Path
@@ -83,6 +84,10 @@ class Swarm:
         chain = connect(self.rpc)
         self.market = market = ChainMarket.deploy(self.params, backend=chain, seed=self.seed)
         say(f"market contract at {market.address}; starting {self.n} agent processes")
+        # A swarm of its own: another swarm on this machine (a parallel test, another user) must not
+        # hear these topics. The agents inherit both variables.
+        os.environ.setdefault("ROS_DOMAIN_ID", str(1 + os.getpid() % 100))
+        os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
         self.world = world = World(self.n)
         self.agents = [self._agent(i) for i in range(self.n)]
         while len(self.welcomed) < self.n:
@@ -155,6 +160,7 @@ class Swarm:
         avg = lambda xs: mean(xs) if xs else None
         return {
             "robots": self.n, "steps": self.config.steps, "seed": self.seed, "rpc": self.rpc,
+            "ros_domain_id": os.environ["ROS_DOMAIN_ID"],
             "market": market.address, "processes": len({p.pid for p in self.agents}), "restarted_agents": self.restarted,
             "light_contracts": sales, "refusals_confirmed": tally.refusals_confirmed,
             "deposits": len(tally.deposit_gas),
