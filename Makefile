@@ -11,7 +11,7 @@ venv: $(STAMP)
 $(STAMP): pyproject.toml Makefile
 	test -x $(BIN)/python || $(PY) -m venv $(VENV)
 	$(BIN)/python -m pip install -q --upgrade pip
-	$(BIN)/python -m pip install -q -e ".[dask,chain,dev,docs,rl,sql]"
+	$(BIN)/python -m pip install -q -e ".[dask,chain,dev,docs,rl,sql,ros]"
 	touch $(STAMP)
 
 demo: venv

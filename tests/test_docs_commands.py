@@ -50,6 +50,12 @@ NOT_RUN = {
         "2026-11-24); tests/evm/test_cli.py runs short ones",
     "infomarket chain demo --chain-period 5":
         "a 3 000-step chain run replayed block by block (~15 s); tests/evm/test_block_replay.py runs this very command",
+    "infomarket ros swarm fig4C --robots 6 --steps 2000 --seed 3 --out runs/ros6":
+        "six agent processes and a chain node for minutes; tests/ros/test_swarm.py runs three agents",
+    "infomarket ros swarm fig4C --robots 6 --steps 2000 --seed 3 --out runs/kill --fault kill:2@800":
+        "as above; tests/ros/test_swarm.py kills an agent in the middle of a sale",
+    "infomarket ros swarm fig4C --robots 6 --steps 2000 --seed 3 --out runs/drop --fault drop:0.05":
+        "as above; tests/ros/test_swarm.py drops a fifth of the agents' messages",
     "infomarket store verify STORE": "a placeholder store; verify is tested in tests/store/test_integrity.py",
     "infomarket store repair STORE": "a placeholder store; repair is tested in tests/store/test_integrity.py",
     "infomarket sweep EXP --out STORE": "a placeholder experiment; sweeps are tested in tests/runner",

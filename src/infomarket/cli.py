@@ -24,6 +24,7 @@ SUBCOMMAND_MODULES += ("infomarket.search.cli",)  # attack-search (docs/attack-s
 SUBCOMMAND_MODULES += ("infomarket.rl.cli",)  # rl-train (docs/rl.md)
 SUBCOMMAND_MODULES += ("infomarket.search.adaptive_cli",)  # adaptive-attack (docs/rl.md)
 SUBCOMMAND_MODULES += ("infomarket.defence.cli",)  # defence-search (docs/defences.md)
+SUBCOMMAND_MODULES += ("infomarket.ros.cli",)  # ros agent, ros swarm (docs/ros.md)
 
 
 def _print_summary(robots, title: str) -> None:
