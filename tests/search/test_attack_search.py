@@ -249,3 +249,18 @@ def test_a_reduced_search_with_the_declared_seed_is_refused_and_some_cells_are_n
     from infomarket.search.cli import refuse_declared_seed
 
     refuse_declared_seed(st.settings.seed, st.settings.seed, [])  # some cells, declared settings: allowed
+
+
+def test_a_rerun_over_a_finished_store_makes_no_run_and_compiles_nothing(inline, tmp_path, monkeypatch):
+    """The same command over its finished store (copied) builds no world on any kernel, starts no compile
+    child and no worker pool, and gives the same frames and choices."""
+    import shutil
+
+    from ..runner.loads import counting
+
+    out = tmp_path / "again"
+    shutil.copytree(inline, out)
+    with counting(monkeypatch) as counts:
+        assert main(TINY + ["--workers", "2", "--quiet", "--out", str(out)]) == 0
+    assert counts == {"worlds": 0, "compile_children": 0, "submitted": 0}
+    _same_frames(inline, out)

@@ -58,7 +58,7 @@ def _list_families(st) -> int:
 def cmd_defence_search(args) -> int:
     # with the command: `infomarket --help` does not import the search, runner and store
     from ..config import load_experiment
-    from ..runner.execute import default_workers, local_executor, warm
+    from ..runner.execute import default_workers, local_executor
     from ..runner.progress import progress
     from ..search.cli import refuse_declared_seed
     from ..search.driver import store_runner
@@ -104,8 +104,6 @@ def cmd_defence_search(args) -> int:
     total = driver.planned_runs(st)
     t0 = time.perf_counter()
     try:
-        if client is None and workers > 1:
-            warm(st.config(every[0] if every else st.existing_candidates()[0], st.settings.target))
         with progress(f"defence-search {exp.name}", total, enabled=not args.quiet) as bar, \
                 local_executor(1 if client is not None else workers) as pool:
             executor = client.get_executor(pure=False) if client is not None else pool

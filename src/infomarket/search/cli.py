@@ -79,7 +79,7 @@ def _list_baselines(st) -> int:
 def cmd_attack_search(args) -> int:
     # with the command: `infomarket --help` does not import the search, runner and store
     from ..config import load_experiment
-    from ..runner.execute import default_workers, local_executor, warm
+    from ..runner.execute import default_workers, local_executor
     from ..runner.progress import progress
     from ..store import Store
     from . import study as study_mod
@@ -126,8 +126,6 @@ def cmd_attack_search(args) -> int:
     t0 = time.perf_counter()
     results = []
     try:
-        if client is None and workers > 1:
-            warm(chosen[0].with_attack({}, steps=args.steps, transitory=args.transitory))  # forked workers inherit it
         with progress(f"attack-search {exp.name} ({len(chosen)} cell(s))", total, enabled=not args.quiet) as bar, \
                 local_executor(1 if client is not None else workers) as pool:
             executor = client.get_executor(pure=False) if client is not None else pool
