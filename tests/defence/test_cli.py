@@ -25,7 +25,7 @@ TINY = ["defence-search", "attack_search", "--questions", str(TINY_FILE), "--fam
 def _answers(out: Path) -> dict:
     """Everything the report decides (not how long it took, nor what this call made or found)."""
     a = json.loads((out / "defence.json").read_text())
-    for k in ("wall_seconds", "made", "found", "provenance"):
+    for k in ("wall_seconds", "made", "found", "provenance", "busy"):
         a.pop(k)
     return a
 
