@@ -71,6 +71,12 @@ class Busy:
     workers: int = 1
     runs: int = 0
     env_steps: int = 0
+    #: the main thread's own work: checking the store and making a sweep's tasks (``plan``), writing the
+    #: finished tasks' parts and handing their rows to the searches (``write``); and the searches' own work
+    #: between their sweeps (``searches``: the optimisers, reading their runs' values), each in seconds
+    plan_seconds: float = 0.0
+    write_seconds: float = 0.0
+    search_seconds: float = 0.0
 
     @property
     def share(self) -> float:
@@ -80,7 +86,8 @@ class Busy:
     def as_dict(self) -> dict:
         return {"wall_seconds": self.wall_seconds, "run_seconds": self.run_seconds,
                 "compile_seconds": self.compile_seconds, "workers": self.workers, "runs": self.runs,
-                "env_steps": self.env_steps, "share_in_runs": self.share}
+                "env_steps": self.env_steps, "share_in_runs": self.share, "plan_seconds": self.plan_seconds,
+                "write_seconds": self.write_seconds, "search_seconds": self.search_seconds}
 
 
 class Feed:
@@ -101,6 +108,7 @@ class Feed:
         self._inflight: set = set()
         self._wake = threading.Event()
         self._main: threading.Thread | None = None
+        self._since = 0.0
 
     # ------------------------------------------------------------------------------- a job's side
     def sweep(self, conds: list, store: Store | None = None, *, on_plan=None, on_part=None, **_) -> SweepReport:
@@ -118,11 +126,11 @@ class Feed:
         s = _Sweep(list(conds), on_plan, on_part)
         self._asked.append(s)
         self._wake.set()
-        self._baton.release()
+        self._turn(False)
         try:
             s.done.wait()
         finally:
-            self._baton.acquire()
+            self._turn(True)
         if s.error is not None:
             raise s.error
         return s.report
@@ -138,13 +146,14 @@ class Feed:
         errors: list[tuple[float, BaseException]] = []
 
         def body(k: int) -> None:
-            with self._baton:
-                try:
-                    results[k] = jobs[k]()
-                except BaseException as exc:  # noqa: BLE001 - raised in the main thread
-                    errors.append((time.perf_counter(), exc))
-                finally:
-                    self._wake.set()
+            self._turn(True)
+            try:
+                results[k] = jobs[k]()
+            except BaseException as exc:  # noqa: BLE001 - raised in the main thread
+                errors.append((time.perf_counter(), exc))
+            finally:
+                self._wake.set()
+                self._turn(False)
 
         self._main = threading.current_thread()
         t0 = time.perf_counter()
@@ -180,6 +189,15 @@ class Feed:
             raise min(errors, key=lambda e: e[0])[1]
         return results
 
+    def _turn(self, take: bool) -> None:
+        """A search takes its turn (the baton) or gives it up; the seconds it held it are its own work."""
+        if take:
+            self._baton.acquire()
+            self._since = time.perf_counter()
+        else:
+            self.busy.search_seconds += time.perf_counter() - self._since
+            self._baton.release()
+
     def _wait(self) -> None:
         if self._wake.is_set():
             return
@@ -192,6 +210,7 @@ class Feed:
         """Plan every sweep asked since the last look: check the store as ``run_sweep`` does, make its tasks,
         compile ahead what they need, queue them."""
         asked, self._asked = self._asked, []
+        t0 = time.perf_counter()
         for s in asked:
             try:
                 self._plan_one(s)
@@ -200,6 +219,7 @@ class Feed:
                     raise
                 s.error = exc
                 s.done.set()
+        self.busy.plan_seconds += time.perf_counter() - t0 - sum(s.compile_seconds for s in asked)
 
     def _plan_one(self, s: _Sweep) -> None:
         s.t0 = time.perf_counter()
@@ -251,6 +271,7 @@ class Feed:
         self._settle()
 
     def _finished(self, task: Task, s: _Sweep, outputs: list[RunOutput]) -> None:
+        t0 = time.perf_counter()
         tables = _frames(task, outputs)
         keys = dict.fromkeys(k for c, _ in task.members for k in c.keys)
         with self.store.writing():
@@ -269,6 +290,7 @@ class Feed:
             other.waiting -= committed
         if self.on_done:
             self.on_done(task.size)
+        self.busy.write_seconds += time.perf_counter() - t0
 
     def _count(self, runs: int, steps: int, seconds: float, compile_seconds: float) -> None:
         self.busy.runs += runs
