@@ -25,7 +25,7 @@ TINY = ["defence-search", "attack_search", "--questions", str(TINY_FILE), "--fam
 def _answers(out: Path) -> dict:
     """Everything the report decides (not how long it took, nor what this call made or found)."""
     a = json.loads((out / "defence.json").read_text())
-    for k in ("wall_seconds", "made", "found", "provenance"):
+    for k in ("wall_seconds", "made", "found", "provenance", "busy"):
         a.pop(k)
     return a
 
@@ -204,3 +204,18 @@ def test_a_reduced_study_with_the_declared_seed_is_refused_and_a_part_of_the_stu
     part = ["defence-search", "attack_search", "--questions", str(TINY_FILE), "--family", "theta",
             "--byzantines", "3", "--list-families"]
     assert main(part) == 0
+
+
+def test_a_rerun_over_a_finished_store_makes_no_run_and_compiles_nothing(inline, tmp_path, monkeypatch):
+    """The same command over its finished store (copied) builds no world on any kernel (no run, no warm-up,
+    no kernel's preflight), starts no compile child and hands no task to a worker pool, and writes the same answers."""
+    import shutil
+
+    from ..runner.loads import counting
+
+    out = tmp_path / "again"
+    shutil.copytree(inline, out)
+    with counting(monkeypatch) as counts:
+        assert main(TINY + ["--workers", "2", "--quiet", "--out", str(out)]) == 0
+    assert counts == {"worlds": 0, "compile_children": 0, "submitted": 0}
+    _same(inline, out)

@@ -249,3 +249,41 @@ def test_a_reduced_search_with_the_declared_seed_is_refused_and_some_cells_are_n
     from infomarket.search.cli import refuse_declared_seed
 
     refuse_declared_seed(st.settings.seed, st.settings.seed, [])  # some cells, declared settings: allowed
+
+
+def test_a_rerun_over_a_finished_store_makes_no_run_and_compiles_nothing(inline, tmp_path, monkeypatch):
+    """The same command over its finished store (copied) builds no world on any kernel, starts no compile
+    child and no worker pool, and gives the same frames and choices."""
+    import shutil
+
+    from ..runner.loads import counting
+
+    out = tmp_path / "again"
+    shutil.copytree(inline, out)
+    with counting(monkeypatch) as counts:
+        assert main(TINY + ["--workers", "2", "--quiet", "--out", str(out)]) == 0
+    assert counts == {"worlds": 0, "compile_children": 0, "submitted": 0}
+    _same_frames(inline, out)
+
+
+#: tools/study_stores.py's digest of the store of TWO_CELLS on 2 workers, made by the code before the study's
+#: searches shared the workers (each cell's sweeps one after another): every row of runs, robots, history
+#: and configs, sorted, without timings and part checksums; and the digest of the sorted part file names.
+BEFORE = "4b50d397201b93833e695349610ea91fd38ce8f1982010a7dd5e41082e7e4574"
+BEFORE_PARTS = "d23853f7fa41abffc03657c5ea8f8a1c9e0d46a79c6073cde6e4ee1a17f722b9"
+TWO_CELLS = [a if a != "staking" else "outlier,staking" for a in TINY]
+
+
+def test_two_cells_sharing_the_workers_make_the_store_the_cells_made_one_after_another(tmp_path):
+    """The cells' searches run side by side on 2 workers (runner.feed); the store holds the same runs, rows
+    and parts as the code that ran them one after another made (digests recorded from that code)."""
+    import importlib.util
+
+    path = Path(__file__).resolve().parents[2] / "tools" / "study_stores.py"
+    spec = importlib.util.spec_from_file_location("study_stores", path)
+    tool = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(tool)
+    out = tmp_path / "two"
+    assert main(TWO_CELLS + ["--workers", "2", "--quiet", "--out", str(out)]) == 0
+    assert tool.digest(out / "store") == BEFORE
+    assert hashlib.sha256(tool.part_names(out / "store").encode()).hexdigest() == BEFORE_PARTS

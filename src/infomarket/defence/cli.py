@@ -60,7 +60,8 @@ def cmd_defence_search(args) -> int:
     confirmed and reported; returns the exit code."""
     # with the command: `infomarket --help` does not import the search, runner and store
     from ..config import load_experiment
-    from ..runner.execute import default_workers, local_executor, warm
+    from ..runner.execute import default_workers, local_executor
+    from ..runner.feed import Feed, dask_threads
     from ..runner.progress import progress
     from ..search.cli import refuse_declared_seed
     from ..search.driver import store_runner
@@ -106,25 +107,27 @@ def cmd_defence_search(args) -> int:
     total = driver.planned_runs(st)
     t0 = time.perf_counter()
     try:
-        if client is None and workers > 1:
-            warm(st.config(every[0] if every else st.existing_candidates()[0], st.settings.target))
         with progress(f"defence-search {exp.name}", total, enabled=not args.quiet) as bar, \
                 local_executor(1 if client is not None else workers) as pool:
             executor = client.get_executor(pure=False) if client is not None else pool
-            run = store_runner(store, executor=executor, on_done=bar.advance, on_skip=lambda k: k and bar.skip(k))
+            feed = Feed(store, workers=dask_threads(client) if client is not None else workers, executor=executor,
+                        on_done=bar.advance)
+            run = store_runner(store, on_skip=lambda k: k and bar.skip(k), feed=feed)
             judged = driver.search(st, store, run)
             result = driver.confirm(st, judged, store, run)
     finally:
         if client is not None:
             client.close()
     wall = time.perf_counter() - t0
+    feed.busy.wall_seconds = wall
+    busy = feed.busy.as_dict()
     analysis = report.analyse(st, result)
     prov = store.meta().get(driver.NAME)
     written = report.write_frames(out, result)
     written += report.write(out, analysis, reduced=reduced, wall_seconds=wall, provenance=prov,
-                            records=declaration.record_markdown())
+                            records=declaration.record_markdown(), busy=busy)
     if not args.quiet:
-        print(report.markdown(analysis, reduced=reduced, wall_seconds=wall, provenance=prov))
+        print(report.markdown(analysis, reduced=reduced, wall_seconds=wall, provenance=prov, busy=busy))
         print(f"defence-search: {sum(j.runs for j in judged)} search-phase runs, "
               f"{result.made + result.found} confirmation runs; {wall:.1f} s wall; "
               f"wrote {', '.join(str(p) for p in written)}")

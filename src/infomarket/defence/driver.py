@@ -21,6 +21,7 @@ same choices and runs only what is missing, inline, on the process pool or on Da
 """
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
@@ -193,32 +194,35 @@ def search(study: Study, store: Store, run: Callable, *, on_judged: Callable[[Ju
     """The outer search over every family of the study, then the existing defences (module docstring, 1)."""
     s = study.settings
     attack.record_provenance(store, study.declaration.path, key=NAME)
-    runner = _Runner(run, store)
-    judged: list[Judged] = []
 
-    def add(c: Candidate) -> Judged:
-        j = judge(study, c, store, run, runner=runner)
-        judged.append(j)
-        if on_judged:
-            on_judged(j)
-        return j
-
-    for fam in study.families.values():
-        first = [add(c) for c in first_candidates(fam, s.candidates, s.seed)]
+    def family(fam) -> list[Judged]:
+        runner = _Runner(run, store)
+        first = [judge(study, c, store, run, runner=runner) for c in first_candidates(fam, s.candidates, s.seed)]
         best = min(first, key=lambda j: (j.trade(s.target, s.max_cost), j.candidate.label))
-        for c in refine(fam, best.candidate, s.refine, len(first), s.seed, s.refine_sigma):
-            add(c)
-    for c in study.existing_candidates():
-        add(c)
+        return first + [judge(study, c, store, run, runner=runner)
+                        for c in refine(fam, best.candidate, s.refine, len(first), s.seed, s.refine_sigma)]
+
+    # each family, and each existing defence, is a job of its own: ``run.map`` may run them side by side
+    # (runner.feed), and every choice in one depends on its own runs alone
+    jobs = [functools.partial(family, fam) for fam in study.families.values()]
+    jobs += [functools.partial(lambda c: [judge(study, c, store, run)], c) for c in study.existing_candidates()]
+    judged = [j for part in _map(run, jobs) for j in part]
+    for j in judged if on_judged else ():
+        on_judged(j)
     return judged
+
+
+def _map(run: Callable, jobs: list) -> list:
+    """``run.map(jobs)`` where the runner has one (``search.driver.store_runner``), else the jobs in turn."""
+    return run.map(jobs) if hasattr(run, "map") else [job() for job in jobs]
 
 
 def confirm(study: Study, judged: list[Judged], store: Store, run: Callable) -> Result:
     """The existing defences and the frontier on the confirmation seeds (module docstring, 2)."""
     s = study.settings
     chosen = [j for j in judged if j.candidate.origin == "existing"] + frontier(study, judged)
-    for j in chosen:  # the counts the outer search left out (Settings.every_count)
-        complete(study, j, store, run)
+    # the counts the outer search left out (Settings.every_count), each candidate a job of its own
+    _map(run, [functools.partial(complete, study, j, store, run) for j in chosen])
     runner = _Runner(run, store)
     crn = stream(s.seed, "confirmation")
     n = s.confirmation_runs

@@ -16,6 +16,7 @@ import numpy as np
 
 from ..analysis import paired_runs as pr
 from ..analysis import stats
+from ..runner.progress import busy_markdown
 from ..search.report import interval_text, json_ready
 from ..store.files import write_atomic, write_parquet_atomic, write_text_atomic
 from .driver import Judged, Result, pareto
@@ -230,7 +231,7 @@ def _pct(v: dict) -> str:
 
 
 def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, provenance: dict | None = None,
-             records: list[str] | None = None) -> str:
+             records: list[str] | None = None, busy: dict | None = None) -> str:
     """The defence search's answers ``a`` as Markdown: each question answered from the confirmation seeds, then
     the search phase that chose the confirmed defences; a reduced run says so first."""
     t = str(a["target"])
@@ -286,6 +287,8 @@ def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, p
                   "the confirmed ones at every count, on the same search seeds)."]
     lines += ["", f"Runs: {a['made']} made in the confirmation now, {a['found']} found in the store"
               + (f"; {wall_seconds:.0f} s wall." if wall_seconds is not None else ".")]
+    if busy:
+        lines += ["", "## Cost", "", busy_markdown(busy).rstrip()]
     if records:
         lines += ["", *records]
     return "\n".join(lines) + "\n"
@@ -308,13 +311,14 @@ def write_frames(out: Path, result: Result) -> list[Path]:
 
 
 def write(out: Path, a: dict, *, reduced: str = "", wall_seconds: float | None = None,
-          provenance: dict | None = None, records: list[str] | None = None) -> list[Path]:
-    """``defence.json``, ``defence.md`` and ``frontier.png`` into ``out``, each written whole or not at all."""
+          provenance: dict | None = None, records: list[str] | None = None, busy: dict | None = None) -> list[Path]:
+    """``defence.json``, ``defence.md`` and ``frontier.png`` into ``out``, each written whole or not at all;
+    ``busy``: how busy the study kept its workers (``runner.feed.Busy.as_dict``)."""
     out = Path(out)
-    meta = {"reduced": reduced, "wall_seconds": wall_seconds, "provenance": provenance or {}}
+    meta = {"reduced": reduced, "wall_seconds": wall_seconds, "provenance": provenance or {}, "busy": busy or {}}
     text = json.dumps(json_ready({**meta, **a}), indent=2) + "\n"
     paths = [write_text_atomic(text, out / "defence.json")]
-    md = markdown(a, reduced=reduced, wall_seconds=wall_seconds, provenance=provenance, records=records)
+    md = markdown(a, reduced=reduced, wall_seconds=wall_seconds, provenance=provenance, records=records, busy=busy)
     paths.append(write_text_atomic(md, out / "defence.md"))
     if a["confirmed"]:
         import matplotlib.pyplot as plt  # only when a figure is drawn

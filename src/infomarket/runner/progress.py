@@ -78,3 +78,16 @@ def progress(label: str, total: int, *, enabled: bool = True, stream=None):
             yield _Bar(bar, bar.add_task(label, total=total, rate=""))
     else:
         yield _Lines(label, total, stream)
+
+
+def busy_markdown(busy: dict | None) -> str:
+    """The Cost section's lines on how busy the study kept the machine (empty without a record)."""
+    if not busy:
+        return ""
+    return (f"Machine: {busy['wall_seconds']:.0f} s of wall time on {busy['workers']} worker(s); "
+            f"{busy['runs']} runs made now, {busy['run_seconds']:.0f} s in runs (summed over workers), "
+            f"{busy['compile_seconds']:.1f} s compiling or loading kernels; "
+            f"**{100 * busy['share_in_runs']:.0f} % of the workers' wall time in runs**"
+            + (f"; the main process {busy['plan_seconds']:.0f} s checking the store and planning sweeps, "
+               f"{busy['write_seconds']:.0f} s writing parts, {busy['search_seconds']:.0f} s in the searches' own "
+               f"work (optimisers, reading values)" if busy.get("search_seconds") else "") + ".\n")

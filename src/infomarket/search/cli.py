@@ -1,6 +1,7 @@
 """``infomarket attack-search``: the worst attack found against each defence (docs/attack-search.md)."""
 from __future__ import annotations
 
+import functools
 import time
 from pathlib import Path
 
@@ -81,7 +82,8 @@ def cmd_attack_search(args) -> int:
     cells' frames and the summary; returns the exit code."""
     # with the command: `infomarket --help` does not import the search, runner and store
     from ..config import load_experiment
-    from ..runner.execute import default_workers, local_executor, warm
+    from ..runner.execute import default_workers, local_executor
+    from ..runner.feed import Feed, dask_threads
     from ..runner.progress import progress
     from ..store import Store
     from . import study as study_mod
@@ -128,29 +130,30 @@ def cmd_attack_search(args) -> int:
     t0 = time.perf_counter()
     results = []
     try:
-        if client is None and workers > 1:
-            warm(chosen[0].with_attack({}, steps=args.steps, transitory=args.transitory))  # forked workers inherit it
         with progress(f"attack-search {exp.name} ({len(chosen)} cell(s))", total, enabled=not args.quiet) as bar, \
                 local_executor(1 if client is not None else workers) as pool:
             executor = client.get_executor(pure=False) if client is not None else pool
-            run = store_runner(store, executor=executor, on_done=bar.advance, on_skip=lambda k: k and bar.skip(k))
-            for c in chosen:
-                r = search_cell(st, c, store, run=run, steps=args.steps, transitory=args.transitory)
-                if learner["budget"]:
-                    r.extra["adaptive"] = _adaptive(adaptive, st, c, r, learner, out, args,
-                                                    1 if client is not None else workers)
-                results.append(r)
+            feed = Feed(store, workers=dask_threads(client) if client is not None else workers, executor=executor,
+                        on_done=bar.advance)
+            run = store_runner(store, on_skip=lambda k: k and bar.skip(k), feed=feed)
+            results = run.map([functools.partial(search_cell, st, c, store, run=run, steps=args.steps,
+                                                 transitory=args.transitory) for c in chosen])
+            for c, r in zip(chosen, results) if learner["budget"] else ():  # after every cell: its own pool
+                r.extra["adaptive"] = _adaptive(adaptive, st, c, r, learner, out, args,
+                                                1 if client is not None else workers)
     finally:
         if client is not None:
             client.close()
     wall = time.perf_counter() - t0
+    feed.busy.wall_seconds = wall  # the whole command's, the adaptive attacker's training included
+    busy = feed.busy.as_dict()
     written, text = write(out, st, results, reduced=reduced, wall_seconds=wall, steps=first.steps,
                           transitory=first.transitory)
     analysis = report.analyse(st, results)
     length = {"steps": first.steps, "transitory": first.transitory}
     written += report.write(out, analysis, reduced=reduced, wall_seconds=wall,
-                            provenance=store.meta().get("attack_search"), **length)
-    text = report.markdown(analysis, reduced=reduced, wall_seconds=wall, **length)
+                            provenance=store.meta().get("attack_search"), busy=busy, **length)
+    text = report.markdown(analysis, reduced=reduced, wall_seconds=wall, busy=busy, **length)
     if not args.quiet:
         print(text)
         made = sum(r.done for r in results)

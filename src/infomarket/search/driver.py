@@ -157,12 +157,15 @@ class _Evaluator:
         t0 = time.perf_counter()
         made, found = self.run(conds)
         self.done, self.skipped = self.done + made, self.skipped + found
+        # the runs' own seconds (summed over workers) where the runner says them: the call's wall time also
+        # holds other searches' runs when several share the workers (runner.feed)
+        ran = getattr(self.run, "seconds", None)
         if any(k not in self.values.get(c.id, {}) for c in conds for k in range(c.runs)):
             per = per_run(self.robots(conds))
             per = per[per.condition.isin({c.id for c in conds})]
             for cid, r, items, lw in zip(per.condition, per.run, per["items"], per.liar_wealth):
                 self.values.setdefault(cid, {})[int(r)] = (float(items), float(lw))
-        seconds = time.perf_counter() - t0
+        seconds = time.perf_counter() - t0 if ran is None else ran
         new = {c.id: c.runs - self.counted.get(c.id, 0) for c in conds}
         total = max(1, sum(new.values()))
         out = []
@@ -335,13 +338,14 @@ def _robots(store: Store, cell: Cell) -> pd.DataFrame:
 
 def store_runner(store: Store, *, workers: int = 1, executor=None,
                  on_done: Callable[[int], None] | None = None,
-                 on_skip: Callable[[int], None] | None = None) -> Callable[[list[Condition]], tuple[int, int]]:
+                 on_skip: Callable[[int], None] | None = None, feed=None) -> Callable[[list[Condition]], tuple[int, int]]:
     """``run(conds)`` for ``search_cell``: their missing runs into ``store`` on the sweep machinery.
     A condition run again with more runs (a race's next stage) counts only its new runs as made or found.
     ``run.robots(conds)``: the robots rows of ``conds``, kept from the parts just written when every run of
     theirs was made by this runner (the store is read back only for a search that resumes): reading the
     whole store after every generation cost the parent more the larger the store grew, while the
-    workers waited."""
+    workers waited.  ``feed`` (a ``runner.feed.Feed``): sweep there instead, so that several searches run
+    by ``run.map(jobs)`` keep the workers fed together; without one ``run.map`` runs the jobs in turn."""
     kept: dict[tuple[str, str], list[pd.DataFrame]] = {}
     made: dict[tuple[str, str], set[int]] = {}
 
@@ -366,8 +370,9 @@ def store_runner(store: Store, *, workers: int = 1, executor=None,
     def run(conds: list[Condition]) -> tuple[int, int]:
         before = sum(seen.get((c.experiment, c.id), 0) for c in conds)
         planned = sum(c.runs for c in conds) - before
-        rep = run_sweep(conds, store, workers=workers, executor=executor, on_done=on_done,
-                        on_plan=(lambda todo: on_skip(planned - todo)) if on_skip else None, on_part=keep)
+        rep = (feed.sweep if feed is not None else run_sweep)(
+            conds, store, workers=workers, executor=executor, on_done=on_done,
+            on_plan=(lambda todo: on_skip(planned - todo)) if on_skip else None, on_part=keep)
         if rep.failed:
             from ..errors import SimulationError  # only when a run failed
 
@@ -375,7 +380,9 @@ def store_runner(store: Store, *, workers: int = 1, executor=None,
                                   f"`infomarket store failed {store.root}` lists them")
         for c in conds:
             seen[(c.experiment, c.id)] = max(c.runs, seen.get((c.experiment, c.id), 0))
+        run.seconds = rep.run_seconds  # read by the caller at once, before another search's turn
         return rep.done, rep.skipped - before
 
     run.robots = robots
+    run.map = feed.map if feed is not None else (lambda jobs: [job() for job in jobs])
     return run

@@ -26,6 +26,7 @@ from ..analysis import paired_runs as pr
 from ..analysis import stats
 from ..analysis.declared import size_note
 from ..errors import ArgumentError
+from ..runner.progress import busy_markdown
 from .objective import loss
 from .study import DECLARATION, Study
 
@@ -259,17 +260,18 @@ def figure(analysis: dict):
 
 
 def write(out: Path, analysis: dict, *, reduced: str = "", wall_seconds: float | None = None,
-          steps: int | None = None, transitory: int | None = None, provenance: dict | None = None) -> list[Path]:
+          steps: int | None = None, transitory: int | None = None, provenance: dict | None = None,
+          busy: dict | None = None) -> list[Path]:
     """``report.json``, ``report.md`` and ``loss.png`` into ``out``; ``steps`` and ``transitory``: the runs'
     length, recorded so a shortened search reads as one; ``provenance``: e.g. the questions file's commit
     and the first run's time, printed as they are."""
     out = Path(out)
     paths = [out / "report.json", out / "report.md"]
     meta = {"reduced": reduced, "wall_seconds": wall_seconds, "steps": steps, "transitory": transitory,
-            "provenance": provenance or {}}
+            "provenance": provenance or {}, "busy": busy or {}}
     paths[0].write_text(json.dumps(json_ready({**meta, **analysis}), indent=2) + "\n")
     paths[1].write_text(markdown(analysis, reduced=reduced, wall_seconds=wall_seconds, steps=steps,
-                                 transitory=transitory, provenance=provenance))
+                                 transitory=transitory, provenance=provenance, busy=busy))
     if analysis["cells"]:
         import matplotlib.pyplot as plt  # only when a figure is drawn: matplotlib is slow to import
 
@@ -318,7 +320,7 @@ def _duel_cell(a: dict | None) -> str:
 
 
 def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, steps: int | None = None,
-             transitory: int | None = None, provenance: dict | None = None) -> str:
+             transitory: int | None = None, provenance: dict | None = None, busy: dict | None = None) -> str:
     """The attack search's answers ``a`` as Markdown: objective and settings, the answers from the confirmation
     seeds (each search paired with the baselines), the chosen attacks and the cost; a reduced run says so first."""
     s = a["settings"]
@@ -389,5 +391,6 @@ def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, s
                          f"{v.get('env_steps', 0):.3g} | {v.get('seconds', 0):.0f} |")
     total = {k: sum(c["cost_total"][k] for c in a["cells"]) for k in ("runs", "env_steps", "seconds")}
     lines += ["", f"All cells: {total['runs']:.0f} runs, {total['env_steps']:.3g} env-steps, "
-                  f"{total['seconds']:.0f} s of run time.", "", *DECLARATION.record_markdown()]
+                  f"{total['seconds']:.0f} s of run time.", *(["", busy_markdown(busy).rstrip()] if busy else []),
+              "", *DECLARATION.record_markdown()]
     return "\n".join(lines) + "\n"
