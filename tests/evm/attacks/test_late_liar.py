@@ -23,7 +23,7 @@ from .helpers import sell, settle_all
 
 TOKEN = 1_000_000_000
 WEALTH = TOKEN
-DEADLINE = 5
+DEADLINE = 100  # blocks: the prompt settlement (25 calls of one unit, a block each on py-evm) ends within it
 
 #: scheme -> (the liar's net, each honest seller's net), by hand (above)
 PROMPT = {"outlier_distinct": (-298_000_000, 266_000_000), "capped_outlier": (26_000_000, 158_000_000)}
