@@ -20,8 +20,9 @@ pragma solidity 0.8.28;
 /// `stakeExpiry` blocks (never 0) give their stake back to their seller (anyone may trigger it) and are
 /// paid, at the buyer's next deposit, an equal part of the share (share / records of the round trip),
 /// so a buyer gains nothing by waiting for its records to expire; a deposit not weighed within
-/// `settlementDeadline` blocks is paid by the delayed rule instead (stake plus an equal part of the
-/// share per live record), so a buyer gains nothing by leaving its settlement unfinished either. Every call does a bounded amount of work: a round trip holds at most
+/// `settlementDeadline` blocks is still weighed, never paid by a cruder rule (so nobody gains by
+/// leaving it unfinished), and from then on any caller earns the bounty for finishing it. Every call
+/// does a bounded amount of work: a round trip holds at most
 /// `maxRecordsPerTrip` (<= 512) live records, one seller at most `maxRecordsPerSeller` of them, and
 /// `buyItem`, `settle` and `refundExpired` each do at most `settleBatch` (<= 48) units of work, so no
 /// call exceeds the gas bound docs/gas.md declares, measured with cold storage, whatever the number of
@@ -30,8 +31,10 @@ pragma solidity 0.8.28;
 ///
 /// Trust (docs/chain.md, "Trust model"): roles, as in OpenZeppelin's AccessControl. The admin grants
 /// and revokes roles (key rotation; several accounts may hold a role). A robot is registered when
-/// `registrarThreshold` distinct registrars approved the same (robot, grant), and a registrar approves
-/// at most `registrarQuota` robots per `registrarPeriod` blocks. Registering locks `registrationBond` of
+/// `registrarThreshold` distinct registrars approved the same (robot, grant), each approval standing
+/// only while its key holds the registrar role and for `registrarPeriod` blocks (its registrar may
+/// cancel it), and a registrar approves (registrations and revocations together) at most
+/// `registrarQuota` times in any `registrarPeriod` consecutive blocks. Registering locks `registrationBond` of
 /// the robot's grant as its bond: it comes back to the robot `bondDelay` blocks after the robot leaves
 /// the market (`exit`, then `withdrawBond`), and is forfeited (burned) when `registrarThreshold`
 /// registrars revoke the robot (`revokeRegistration`), before or during that delay. A depositor
@@ -279,6 +282,12 @@ contract InformationMarket {
     /// @param approvals Distinct registrars that approved revoking it so far.
     event RevocationApproved(address indexed registrar, address indexed robot, uint256 approvals);
 
+    /// @notice `registrar` withdrew its approval of `request` (a registration or a revocation of `robot`).
+    /// @param registrar The registrar.
+    /// @param robot The robot.
+    /// @param request keccak256(abi.encode(robot, amount)) or keccak256(abi.encode("revoke", robot)).
+    event ApprovalCancelled(address indexed registrar, address indexed robot, bytes32 request);
+
     /// @notice `robot` was revoked and its bond burned.
     /// @param robot The robot.
     /// @param amount The bond, 1e-9 units.
@@ -330,6 +339,11 @@ contract InformationMarket {
     /// @param registrar The registrar.
     /// @param limit `registrarQuota`.
     error InfoMarketRegistrarQuotaExceeded(address registrar, uint256 limit);
+
+    /// @notice `registrar` has no standing approval of that request about `robot` to cancel.
+    /// @param registrar The caller.
+    /// @param robot The robot.
+    error InfoMarketNotApproved(address registrar, address robot);
 
     /// @notice The deposit's robot signature does not recover to the robot (for its open round trip).
     /// @param robot The depositing robot.
@@ -404,6 +418,14 @@ contract InformationMarket {
     /// @param buyer The buyer.
     /// @param limit `maxRecordsPerTrip`.
     error InfoMarketTripFull(address buyer, uint256 limit);
+
+    /// @notice `seller` already sold in `buyer`'s open round trip, and its further record would take room
+    /// kept for sellers not yet heard: further records take at most half of the room first records leave,
+    /// 2 * `repeats` + first records <= `maxRecordsPerTrip`.
+    /// @param buyer The buyer.
+    /// @param seller The seller refused.
+    /// @param repeats Further records (a seller's second and later) the round trip already holds.
+    error InfoMarketTripReserved(address buyer, address seller, uint256 repeats);
 
     /// @notice The light contract was signed for another of the buyer's round trips (a reveal must land
     /// before the buyer's next deposit).
@@ -482,14 +504,17 @@ contract InformationMarket {
     /// @dev Under OutlierCapped the reward and the stake stay below this, so that no product of the
     /// payment (amount * (share + 512 stakes) * 512) can overflow.
     uint256 private constant _MAX_CAPPED_AMOUNT = 2 ** 96;
+    /// @dev Longest bond delay, blocks: block numbers plus it never overflow 64 bits.
+    uint64 private constant _MAX_DELAY = 2 ** 40;
     uint8 private constant _EXPIRE = 0;
     uint8 private constant _WEIGH = 1;
     uint8 private constant _PAY = 2;
-    uint8 private constant _EQUAL = 3;
     /// @dev An identity's life after registration: active (`_registered`), exiting (bond locked until
     /// `_exits[robot].at`), closed (bond returned or forfeited; the robot may not register again).
     uint8 private constant _EXITING = 1;
     uint8 private constant _CLOSED = 2;
+    /// @dev An approval withdrawn by its registrar.
+    uint256 private constant _CANCELLED = type(uint256).max;
 
     /// @notice Role that grants and revokes every role (as AccessControl's DEFAULT_ADMIN_ROLE).
     bytes32 public constant ADMIN_ROLE = 0x00;
@@ -552,14 +577,27 @@ contract InformationMarket {
     /// @dev ((round trip + 1) << 128) | (index of the seller's last record << 64) | records sold in
     /// the round trip, per buyer and seller (0: none yet).
     mapping(address buyer => mapping(address seller => uint256)) private _sold;
+    /// @dev ((round trip + 1) << 64) | records of the round trip that were not their seller's first in it,
+    /// per buyer (0: none yet).
+    mapping(address buyer => uint256) private _repeats;
     mapping(bytes32 key => bool) private _revealed;
     mapping(address robot => bool) private _registered;
     mapping(bytes32 role => mapping(address account => bool)) private _roles;
-    /// @dev Approvals per keccak256(robot, amount), and by whom.
-    mapping(bytes32 request => uint256) private _approvals;
-    mapping(bytes32 request => mapping(address registrar => bool)) private _approvedBy;
-    /// @dev (period << 128) | approvals the registrar made in that period.
+    /// @dev Per request (keccak256(robot, amount), or keccak256("revoke", robot)): every registrar key that
+    /// ever approved it, and the block of each one's approval (`_CANCELLED` once withdrawn). An approval
+    /// stands while its key holds the registrar role, held it when approving, and for `registrarPeriod`
+    /// blocks.
+    mapping(bytes32 request => address[]) private _approvers;
+    /// (The approval is packed: (the key's registrar grants when it approved << 64) | block.)
+    mapping(bytes32 request => mapping(address registrar => uint256)) private _approvedAt;
+    /// @dev How many times an account was granted a role: an approval given under an earlier grant does
+    /// not stand.
+    mapping(bytes32 role => mapping(address account => uint256)) private _roleGrants;
+    /// @dev Approvals (and revocation approvals) each registrar made, and the blocks of its last
+    /// `registrarQuota` ones, a ring: a new one is allowed when the one `registrarQuota` back is
+    /// `registrarPeriod` blocks old, so no window of that many blocks holds more than the quota.
     mapping(address registrar => uint256) private _quotaUsed;
+    mapping(address registrar => mapping(uint256 slot => uint64)) private _quotaBlocks;
     bool private _paused;
     /// @dev Exits: the block from which the bond may be withdrawn, and the identity's state.
     struct Exit {
@@ -580,9 +618,9 @@ contract InformationMarket {
     /// @param maxRecordsPerSeller_ Most records one seller may sell one buyer in one round trip (>= 1).
     /// @param maxRecordsPerTrip_ Most live records a buyer's open round trip may hold (1 to 512).
     /// @param maxValidity_ Furthest a light contract's last block may lie ahead of its reveal (>= 1).
-    /// @param settleBatch_ Work units of one `buyItem`, `settle` or `refundExpired` call (1 to 64).
-    /// @param settlementDeadline_ Blocks after `buyItem` from which an unfinished settlement returns its
-    /// stakes to their sellers and the share to the robot instead of weighing (>= 1).
+    /// @param settleBatch_ Work units of one `buyItem`, `settle` or `refundExpired` call (1 to 48).
+    /// @param settlementDeadline_ Blocks after `buyItem` from which any caller, registered or not, earns
+    /// the bounty for continuing an unfinished settlement (>= 1); the rule it pays by never changes.
     /// @param maxGrant_ Most initial wealth the market may grant one robot, 1e-9 units.
     /// @param registrars_ Accounts that receive the registrar role (at least `registrarThreshold_`).
     /// @param registrarThreshold_ Distinct registrar approvals that register a robot (>= 1).
@@ -593,7 +631,7 @@ contract InformationMarket {
     /// the bounty of the largest settlement must fit in the reward's share.
     /// @param registrationBond_ Bond every registration locks out of the grant, 1e-9 units (at most
     /// `maxGrant_`).
-    /// @param bondDelay_ Blocks between a robot's `exit` and the return of its bond (>= 1): the time the
+    /// @param bondDelay_ Blocks between a robot's `exit` and the return of its bond (1 to 2^40): the time the
     /// registrars have to revoke it.
     /// @param cap_ Under OutlierCapped, most records per seller that count in a round trip (>= 1; the
     /// reward and the stake below 2^96 units); 0 under every other scheme.
@@ -649,7 +687,10 @@ contract InformationMarket {
         if (registrationBond_ > maxGrant_) {
             revert InfoMarketInvalidParameter("registrationBond", int256(registrationBond_));
         }
-        if (bondDelay_ == 0) revert InfoMarketInvalidParameter("bondDelay", 0);
+        // Beyond 2^40 blocks (about 400 000 years) `exit` would overflow the block it computes.
+        if (bondDelay_ == 0 || bondDelay_ > _MAX_DELAY) {
+            revert InfoMarketInvalidParameter("bondDelay", int256(uint256(bondDelay_)));
+        }
         if (scheme_ == Scheme.OutlierCapped ? cap_ == 0 : cap_ != 0) revert InfoMarketInvalidParameter("cap", int256(cap_));
         if (scheme_ == Scheme.OutlierCapped) {
             if (reward_ >= _MAX_CAPPED_AMOUNT) revert InfoMarketInvalidParameter("reward", int256(reward_));
@@ -694,9 +735,10 @@ contract InformationMarket {
     /// `registrarThreshold`-th distinct registrar to approve the same (robot, amount) registers it and
     /// mints the grant. Only registered robots may buy, sell or deposit.
     /// The registration locks `registrationBond` of the grant as the robot's bond.
-    /// @dev Requirements: the caller is a registrar within its quota for the period; not paused;
-    /// `robot` is not registered and never was; `amount` covers the bond and is at most `maxGrant`; the
-    /// caller has not approved this (robot, amount) yet. Emits {RegistrationApproved}, and
+    /// @dev Requirements: the caller is a registrar within its quota (at most `registrarQuota` approvals
+    /// in any `registrarPeriod` consecutive blocks); not paused; `robot` is not registered and never was;
+    /// `amount` covers the bond and is at most `maxGrant`; the caller's approval of this (robot, amount)
+    /// does not stand already. Only standing approvals count (`_stands`). Emits {RegistrationApproved}, and
     /// {WealthGranted} and {BondLocked} when it registers.
     /// @param robot Receiving account.
     /// @param amount Tokens, 1e-9 units.
@@ -707,16 +749,7 @@ contract InformationMarket {
         if (_registered[robot] || _exits[robot].state != 0) revert InfoMarketAlreadyRegistered(robot);
         if (amount > _maxGrant) revert InfoMarketGrantTooLarge(amount, _maxGrant);
         if (amount < _registrationBond) revert InfoMarketGrantBelowBond(amount, _registrationBond);
-        uint256 period = block.number / _registrarPeriod;
-        uint256 used = _quotaUsed[msg.sender];
-        used = used >> 128 == period ? used & type(uint128).max : 0;
-        if (used >= _registrarQuota) revert InfoMarketRegistrarQuotaExceeded(msg.sender, _registrarQuota);
-        _quotaUsed[msg.sender] = (period << 128) | (used + 1);
-        bytes32 request = keccak256(abi.encode(robot, amount));
-        if (_approvedBy[request][msg.sender]) revert InfoMarketAlreadyApproved(msg.sender, robot);
-        _approvedBy[request][msg.sender] = true;
-        uint256 count = _approvals[request] + 1;
-        _approvals[request] = count;
+        uint256 count = _approve(keccak256(abi.encode(robot, amount)), robot);
         emit RegistrationApproved(msg.sender, robot, amount, count);
         if (count < _registrarThreshold) return false;
         registered = true;
@@ -756,7 +789,8 @@ contract InformationMarket {
     /// @notice Approves revoking `robot` (registered, or exited within its bond delay); the
     /// `registrarThreshold`-th distinct registrar to approve revokes it: it may no longer buy, sell or
     /// deposit, nor register again, and its bond is burned. Works while paused.
-    /// @dev Requirements: the caller is a registrar that has not approved revoking `robot` yet; `robot`
+    /// @dev Requirements: the caller is a registrar within its quota (as for `grantWealth`) whose approval of
+    /// revoking `robot` does not stand already (only standing approvals count); `robot`
     /// holds a bond. Emits {RevocationApproved}, and {BondForfeited} when it revokes.
     /// @param robot The robot.
     /// @return revoked Whether this approval revoked it.
@@ -764,11 +798,7 @@ contract InformationMarket {
         _requireRole(REGISTRAR_ROLE);
         Exit storage e = _exits[robot];
         if (!_registered[robot] && e.state != _EXITING) revert InfoMarketUnregistered(robot);
-        bytes32 revocation = keccak256(abi.encode("revoke", robot));
-        if (_approvedBy[revocation][msg.sender]) revert InfoMarketAlreadyApproved(msg.sender, robot);
-        _approvedBy[revocation][msg.sender] = true;
-        uint256 count = _approvals[revocation] + 1;
-        _approvals[revocation] = count;
+        uint256 count = _approve(keccak256(abi.encode("revoke", robot)), robot);
         emit RevocationApproved(msg.sender, robot, count);
         revoked = count >= _registrarThreshold;
         if (!revoked) return false;
@@ -776,6 +806,29 @@ contract InformationMarket {
         e.state = _CLOSED;
         _totalSupply -= _registrationBond;
         emit BondForfeited(robot, _registrationBond);
+    }
+
+    /// @notice Withdraws the caller's standing approval of registering `robot` with `amount`.
+    /// @dev Requirements: the approval stands. Emits {ApprovalCancelled}.
+    /// @param robot The robot.
+    /// @param amount The grant approved.
+    function cancelApproval(address robot, uint256 amount) external {
+        _cancel(keccak256(abi.encode(robot, amount)), robot);
+    }
+
+    /// @notice Withdraws the caller's standing approval of revoking `robot`.
+    /// @dev Requirements: the approval stands. Emits {ApprovalCancelled}.
+    /// @param robot The robot.
+    function cancelRevocation(address robot) external {
+        _cancel(keccak256(abi.encode("revoke", robot)), robot);
+    }
+
+    function _cancel(bytes32 request, address robot) private {
+        if (!_stands(msg.sender, _approvedAt[request][msg.sender])) {
+            revert InfoMarketNotApproved(msg.sender, robot);
+        }
+        _approvedAt[request][msg.sender] = _CANCELLED;
+        emit ApprovalCancelled(msg.sender, robot, request);
     }
 
     /// @notice Buys the item `robot` deposited: pays it the reward, closes its round trip and settles
@@ -827,7 +880,8 @@ contract InformationMarket {
 
     /// @notice Continues the settlement of `robot`'s deposited round trip for at most `maxRecords`
     /// records of work; anyone may call it (it moves money only by the market's rules), and a
-    /// registered caller earns `settleBounty` per unit of work, from the share.
+    /// registered caller (any caller from `settlementDeadline` blocks after the deposit) earns `settleBounty`
+    /// per unit of work, from the share.
     /// @dev Requirements: a settlement is pending. Emits {RecordExpired}, {RewardShared},
     /// {SettlementBountyPaid} and, at the end, {SettlementCompleted}.
     /// @param robot The depositing robot.
@@ -841,7 +895,8 @@ contract InformationMarket {
     }
 
     /// @notice Returns to their sellers the stakes of `buyer`'s open records that expired (opened
-    /// `stakeExpiry` blocks ago or more), oldest first, at most `maxRecords`; anyone may call it.
+    /// `stakeExpiry` blocks ago or more, or any record once the buyer is no longer registered: revoked or
+    /// exited, it can never deposit), oldest first, at most `maxRecords`; anyone may call it.
     /// @dev Records are appended in block order, so the expired ones are a prefix of the open round
     /// trip. Emits {RecordExpired} per record.
     /// @param buyer The buyer whose pot holds the stakes.
@@ -852,7 +907,8 @@ contract InformationMarket {
         Round storage round = _rounds[buyer];
         uint64 i = round.start;
         uint64 end = round.count;
-        while (i < end && refunded < maxRecords && _expired(_records[buyer][i].openedAt, block.number)) {
+        bool gone = !_registered[buyer]; // revoked or exited: it can never deposit, its records expire now
+        while (i < end && refunded < maxRecords && (gone || _expired(_records[buyer][i].openedAt, block.number))) {
             _pots[buyer] -= _refund(buyer, i);
             ++i;
             ++refunded;
@@ -890,10 +946,11 @@ contract InformationMarket {
 
     /// @notice Stops (`paused_` true) or resumes registrations, reveals and deposits. Settlements and
     /// stake refunds never stop.
-    /// @dev Requirements: the caller is a pauser. Emits {PauseSet}.
+    /// @dev Requirements: the caller is a pauser. Emits {PauseSet} when the state changes.
     /// @param paused_ The new state.
     function setPaused(bool paused_) external {
         _requireRole(PAUSER_ROLE);
+        if (_paused == paused_) return; // nothing changes: no event
         _paused = paused_;
         emit PauseSet(msg.sender, paused_);
     }
@@ -983,8 +1040,7 @@ contract InformationMarket {
     /// @notice Whether `robot` has a deposited round trip still to settle, and where it stands.
     /// @param robot The account.
     /// @return pending True until the settlement completes.
-    /// @return phase 0 refunding expired records, 1 weighing, 2 paying by weight, 3 paying equal parts
-    /// (weighing missed the settlement deadline).
+    /// @return phase 0 refunding expired records, 1 weighing, 2 paying.
     /// @return remaining Records left in the current phase.
     function pendingSettlement(address robot) external view returns (bool pending, uint8 phase, uint256 remaining) {
         Settlement storage s = _settlements[robot];
@@ -1041,7 +1097,7 @@ contract InformationMarket {
     /// @param amount The grant.
     /// @return The number of distinct registrars that approved it.
     function approvals(address robot, uint256 amount) external view returns (uint256) {
-        return _approvals[keccak256(abi.encode(robot, amount))];
+        return _standing(keccak256(abi.encode(robot, amount)));
     }
 
     /// @notice The EIP-712 digest a robot and a nest sign for the deposit that ends round trip `trip`.
@@ -1154,7 +1210,7 @@ contract InformationMarket {
     /// @return maxRecordsPerTrip_ Most live records per round trip.
     /// @return maxValidity_ Furthest a light contract's last block may lie ahead.
     /// @return settleBatch_ Work units per call.
-    /// @return settlementDeadline_ Blocks after a deposit from which its settlement refunds instead.
+    /// @return settlementDeadline_ Blocks after a deposit from which any caller earns the settle bounty.
     /// @return maxGrant_ Most initial wealth per robot.
     /// @return settleBounty_ Bounty per unit of settlement work.
     /// @return cap_ Most records per seller that count in a round trip under OutlierCapped (0 otherwise).
@@ -1232,6 +1288,7 @@ contract InformationMarket {
     function _grantRole(bytes32 role, address account) private {
         if (!_roles[role][account]) {
             _roles[role][account] = true;
+            ++_roleGrants[role][account];
             emit RoleGranted(role, account, msg.sender);
         }
     }
@@ -1241,6 +1298,40 @@ contract InformationMarket {
             _roles[role][account] = false;
             emit RoleRevoked(role, account, msg.sender);
         }
+    }
+
+    /// @dev Records the caller's approval of `request` about `robot`, within its quota; returns how many
+    /// approvals of it stand. A registrar whose approval stands may not approve again; one whose approval
+    /// lapsed, was cancelled or predates its role may.
+    function _approve(bytes32 request, address robot) private returns (uint256) {
+        uint256 at = _approvedAt[request][msg.sender];
+        if (at == 0) _approvers[request].push(msg.sender);
+        else if (_stands(msg.sender, at)) revert InfoMarketAlreadyApproved(msg.sender, robot);
+        uint256 used = _quotaUsed[msg.sender];
+        uint256 slot = used % _registrarQuota;
+        if (used >= _registrarQuota && uint256(_quotaBlocks[msg.sender][slot]) + _registrarPeriod > block.number) {
+            revert InfoMarketRegistrarQuotaExceeded(msg.sender, _registrarQuota);
+        }
+        _quotaBlocks[msg.sender][slot] = uint64(block.number);
+        _quotaUsed[msg.sender] = used + 1;
+        _approvedAt[request][msg.sender] = (_roleGrants[REGISTRAR_ROLE][msg.sender] << 64) | block.number;
+        return _standing(request);
+    }
+
+    /// @dev How many approvals of `request` stand (one per registrar key that approved it).
+    function _standing(bytes32 request) private view returns (uint256 count) {
+        address[] storage list = _approvers[request];
+        for (uint256 i; i < list.length; ++i) {
+            if (_stands(list[i], _approvedAt[request][list[i]])) ++count;
+        }
+    }
+
+    /// @dev Whether `registrar`'s approval `at` ((grants << 64) | block) stands: given and not withdrawn,
+    /// while the key holds the registrar role under the grant it approved under, less than
+    /// `registrarPeriod` blocks ago.
+    function _stands(address registrar, uint256 at) private view returns (bool) {
+        return at != 0 && at != _CANCELLED && _roles[REGISTRAR_ROLE][registrar]
+            && at >> 64 == _roleGrants[REGISTRAR_ROLE][registrar] && (at & type(uint64).max) + _registrarPeriod > block.number;
     }
 
     /// @dev The signer of `digest`, refusing the malleated (high-s) twin of a signature; zero when none.
@@ -1273,8 +1364,13 @@ contract InformationMarket {
     /// @dev Counts a sale of `seller` to `buyer` in the buyer's open round trip, within the bound, as
     /// record `index`; returns how far back the seller's previous record of the round trip lies (0 when
     /// none, or when it is too far back to be live: a live window is at most 512 records).
+    /// A seller's further record (not its first in the round trip) is refused when it would take more
+    /// than half of the room the first records leave, so that colluders cannot fill a round trip with
+    /// repeated sales: a seller not yet heard is refused only when at least half of `maxRecordsPerTrip`
+    /// distinct sellers sold in it.
     function _countSale(address buyer, address seller, uint64 index) private returns (uint16 prevGap) {
-        uint256 trip = _rounds[buyer].trip;
+        Round storage round = _rounds[buyer];
+        uint256 trip = round.trip;
         uint256 packed = _sold[buyer][seller];
         bool same = packed >> 128 == trip + 1;
         uint256 n = same ? packed & type(uint64).max : 0;
@@ -1282,6 +1378,11 @@ contract InformationMarket {
         if (same) {
             uint256 gap = index - ((packed >> 64) & type(uint64).max);
             if (gap <= _MAX_TRIP_RECORDS) prevGap = uint16(gap);
+            uint256 rp = _repeats[buyer];
+            uint256 repeats = rp >> 64 == trip + 1 ? rp & type(uint64).max : 0;
+            uint256 firsts = index - round.first - repeats;
+            if (2 * (repeats + 1) + firsts > _maxRecordsPerTrip) revert InfoMarketTripReserved(buyer, seller, repeats);
+            _repeats[buyer] = ((trip + 1) << 64) | (repeats + 1);
         }
         _sold[buyer][seller] = ((trip + 1) << 128) | (uint256(index) << 64) | (n + 1);
     }
@@ -1301,14 +1402,17 @@ contract InformationMarket {
     /// @dev Runs the pending settlement of `robot` for at most `budget` units of work, phase by phase:
     /// refund the expired prefix, weigh the live records, pay every record of the round trip (an
     /// expired one the share over the number of records, the live ones the rest by weight); then return
-    /// the rest. Weighing not finished `settlementDeadline` blocks after the deposit stops there, and
-    /// the live records are paid equal parts instead (the delayed rule), so the robot gains nothing by
-    /// a settlement left pending.
-    /// A registered caller earns `settleBounty` per unit: for refunding and weighing from the escrow
-    /// before the paid amount is fixed, for paying from each record's share.
+    /// the rest. However late it is finished, the live records are weighed as a prompt settlement
+    /// weighs them: a seller gains nothing by a settlement left pending.
+    /// A registered caller, and from `settlementDeadline` blocks after the deposit any caller, earns
+    /// `settleBounty` per unit: for refunding and weighing from the escrow before the paid amount is
+    /// fixed, for paying from each record's share.
     function _settle(address robot, uint256 budget) private returns (bool) {
         Settlement storage s = _settlements[robot];
-        uint256 rate = _settleBounty != 0 && _registered[msg.sender] ? _settleBounty : 0;
+        // Past the settlement deadline the bounty is paid to any caller, registered or not, so that an
+        // outside keeper is paid to finish what the robots left.
+        bool late = block.number >= uint256(s.closedAt) + _settlementDeadline;
+        uint256 rate = _settleBounty != 0 && (_registered[msg.sender] || late) ? _settleBounty : 0;
         uint256 units = budget;
         uint64 next = s.next;
         uint64 end = s.end;
@@ -1324,9 +1428,6 @@ contract InformationMarket {
             if (next < end && budget == 0) return _pause(robot, next, escrow, rate * units);
             s.live = next;
             phase = _scheme == Scheme.Delayed ? _PAY : _WEIGH;
-        }
-        if (phase == _WEIGH && block.number >= uint256(s.closedAt) + _settlementDeadline) {
-            phase = _EQUAL;
         }
         if (phase == _WEIGH) {
             // Weighing one record compares it with every live record: it costs ceil(m / pairs per unit)
@@ -1362,7 +1463,7 @@ contract InformationMarket {
             bounty = rate * (units - budget);
             escrow -= bounty;
             s.amount = escrow;
-            if (phase == _EQUAL || _scheme == Scheme.Delayed) s.totalWeight = end - live;
+            if (_scheme == Scheme.Delayed) s.totalWeight = end - live;
             if (live > first) s.perExpired = (escrow - (end - live) * _stake) / (end - first);
             s.phase = phase;
             next = first;
@@ -1371,7 +1472,7 @@ contract InformationMarket {
         uint256 total = s.totalWeight;
         uint256 perExpired = live > first ? s.perExpired : 0;
         uint256 liveAmount = amount - (live - first) * perExpired;
-        bool equal = phase == _EQUAL || _scheme == Scheme.Delayed;
+        bool equal = _scheme == Scheme.Delayed;
         bool capped = !equal && _scheme == Scheme.OutlierCapped;
         while (next < end && budget > 0) {
             Information storage record = _records[robot][next];

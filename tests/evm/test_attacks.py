@@ -283,7 +283,9 @@ def test_the_trip_bound_and_the_batch_bound_cannot_be_configured_away(make_marke
                                 # 500_000_000 units of the share; 65_104 fit
                                 ("settle_bounty", 65_105, "settleBounty"),
                                 # a bond above the largest grant would let no one register
-                                ("registration_bond", 10**12 + 1, "registrationBond"), ("bond_delay", 0, "bondDelay")):
+                                ("registration_bond", 10**12 + 1, "registrationBond"), ("bond_delay", 0, "bondDelay"),
+                                # beyond 2^40 blocks, exit() would overflow (a delay of 2^64 - 1 did)
+                                ("bond_delay", 2**40 + 1, "bondDelay")):
         with pytest.raises(ContractRevert) as info:
             make_market("outlier", **{option: value})
         assert info.value.name == "InfoMarketInvalidParameter"
@@ -309,12 +311,13 @@ def test_no_call_does_more_than_one_batch_of_work_whatever_it_asks(make_market, 
     assert len(market.refund_expired(buyer.address, 2**200).of("RecordExpired")) == 2
 
 
-def test_a_deposit_not_weighed_by_its_deadline_pays_every_live_record_equally(make_market, robots):
-    """Stakes of a round trip that no one settles are never locked for ever, and the buyer gains nothing
-    by leaving it: from settlementDeadline blocks after the deposit, weighing stops and every live
-    record is paid an equal part of the share plus the stakes (the delayed rule), in bounded calls. By
-    hand: 3 sellers at 10, 15 and 20 degrees and one outlier at 100; (0.5 + 4 * 0.04) / 4 = 0.165 token
-    each, where the weighted rule would pay the outlier 1/10 of 0.66."""
+def test_a_deposit_not_weighed_by_its_deadline_is_still_weighed_and_anyone_finishing_it_is_paid(make_market, robots):
+    """Stakes of a round trip that no one settles are never locked for ever, and nobody gains by leaving
+    it: from settlementDeadline blocks after the deposit any caller earns the bounty for finishing it, and
+    the records are weighed as a prompt settlement weighs them (paying them equal parts instead paid an
+    outlier as much as the honest: test_late_liar.py). By hand: 3 sellers at 10, 15 and 20 degrees and
+    one outlier at 100, weights 3, 3, 3 and 1; 3 records left to weigh cost 30 000 units of bounty from
+    the escrow of 0.5 + 4 * 0.04 = 0.66 token, and each payment 10 000 of the record's share."""
     market = make_market("outlier", stake=0.04, settle_batch=1, settlement_deadline=3)
     buyer = robots[0]
     for age, (seller, direction) in enumerate(zip(robots[1:5], (10.0, 15.0, 20.0, 100.0))):
@@ -324,13 +327,13 @@ def test_a_deposit_not_weighed_by_its_deadline_pays_every_live_record_equally(ma
     results = []
     while market.pending_settlement(buyer.address)[0]:
         results.append(market.settle(buyer.address, 1))
+    amount = 660_000_000 - 30_000
     shares = [e for r in results for e in r.of("RewardShared")]
-    assert [(e["seller"], e["weight"], e["amount"]) for e in shares] == [(s.address, 1, 165_000_000)
-                                                                         for s in robots[1:5]]
+    expected = [(s.address, 3, amount * 3 // 10 - 10_000) for s in robots[1:4]]
+    assert [(e["seller"], e["weight"], e["amount"]) for e in shares] == expected + [
+        (robots[4].address, 1, amount // 10 - 10_000)]
     (done,) = results[-1].of("SettlementCompleted")
-    assert done == {"robot": buyer.address, "shared": 660_000_000, "kept": 0, "totalWeight": 4}
-    for seller in robots[1:5]:
-        assert market.balance_of(seller.address) == 1_000_000_000 - 40_000_000 + 165_000_000
+    assert done == {"robot": buyer.address, "shared": amount, "kept": 0, "totalWeight": 10}
     assert market.balance_of(buyer.address) == 1_500_000_000
     assert market.locked_stake(buyer.address) == 0
 

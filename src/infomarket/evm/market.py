@@ -278,6 +278,13 @@ class ChainMarket:
         """One registrar's approval of registering ``robot`` with ``amount``."""
         return self.transact(registrar, "grantWealth", robot, amount)
 
+    def cancel_approval(self, registrar: LocalAccount, robot: str, amount: int | None = None) -> TxResult:
+        """``registrar`` withdraws its standing approval of registering ``robot`` with ``amount``, or, with
+        no amount, of revoking ``robot``."""
+        if amount is None:
+            return self.transact(registrar, "cancelRevocation", robot)
+        return self.transact(registrar, "cancelApproval", robot, amount)
+
     def buy_item(self, robot: Robot, sender: LocalAccount | None = None, evidence: tuple | None = None) -> TxResult:
         """The depositor buys ``robot``'s deposited item, with the robot's signed round trip and the
         nest's acknowledgement, and settles what fits in one batch (``sender`` and ``evidence`` only to

@@ -4,14 +4,14 @@ The exploit: the bound (6 M gas a call) was measured with 16 sellers; under `out
 distinct, similar sellers skip no comparison, and `buyItem` took 6.5 M gas at the default batch of 48
 (7.7 M at the batch of 64 the contract allowed). Now a distinct-seller weighing costs more units of the
 batch (ceil(m / 40) a record instead of ceil(m / 64)), the batch is at most 48, and docs/gas.md
-measures every scheme at 512 distinct sellers.
+measures every scheme at 512 distinct sellers (and `outlier_distinct` at 480, its worst size).
 """
 from __future__ import annotations
 
 import re
 from pathlib import Path
 
-from infomarket.evm.gasreport import SCHEMES, gas_backend, worst_call
+from infomarket.evm.gasreport import MORE_SCHEMES, SCHEMES, gas_backend, worst_call
 from infomarket.evm.market import DECLARED_MAX_TX_GAS
 
 from .helpers import sell
@@ -40,7 +40,7 @@ def test_the_report_measures_every_scheme_at_its_worst_and_under_the_bound():
         if found := BOUND_ROW.match(line):
             scheme, n, sellers, *gas = found.groups()
             rows[scheme] = (int(n), int(sellers), [int(g.replace(",", "")) for g in gas])
-    assert set(rows) == set(SCHEMES)
+    assert set(SCHEMES) <= set(rows) <= set(SCHEMES) | set(MORE_SCHEMES)  # the report's, and the other schemes'
     for scheme, (n, sellers, (reveal, buy, settle, calls, total)) in rows.items():
         assert (n, sellers) == (512, 512), scheme
         assert max(reveal, buy, settle) < DECLARED_MAX_TX_GAS, scheme

@@ -6,8 +6,7 @@ had expired and then deposited kept the whole reward, share included (+1 token i
 paper's terms), and its sellers got only their stakes back. Now every record of the round trip is
 paid at the deposit: an expired one an equal part of the share, share / n for the round trip's n
 records (its stake already went back), the live ones the rest (share * live / n, plus their stakes) by
-the scheme's weights; past the settlement deadline the live ones by equal parts too, so every record
-gets share / n. By hand (outlier_distinct, stake 0.04, share 0.5 of a reward of 1, wealth 1 each).
+the scheme's weights, however late the settlement is finished. By hand (outlier_distinct, stake 0.04, share 0.5 of a reward of 1, wealth 1 each).
 """
 from __future__ import annotations
 
@@ -61,7 +60,7 @@ def test_expired_records_are_paid_equal_parts_and_the_live_ones_the_rest_by_weig
     assert supply == market.total_supply()
 
 
-def test_past_the_deadline_with_expired_records_every_record_gets_an_equal_part(make_market, robots):
+def test_past_the_deadline_expired_records_get_equal_parts_and_the_live_ones_their_weight(make_market, robots):
     market = make_market("outlier_distinct", stake=0.04, stake_expiry=EXPIRY, settlement_deadline=5, settle_batch=1)
     buyer = robots[0]
     sell(market, robots[1], buyer, 10.0, age=0)
@@ -71,7 +70,13 @@ def test_past_the_deadline_with_expired_records_every_record_gets_an_equal_part(
         sell(market, seller, buyer, direction, age=2 + age)
     market.buy_item(buyer.address)  # one unit of work (one refund): the settlement stays pending
     market.backend.advance_to(market.backend.block_number + 5)  # nobody settled in time
-    settle_all(market, buyer.address, 1)
+    settle_all(market, buyer.address, 1)  # the market's node: past the deadline it earns the bounty
     assert market.balance_of(buyer.address) == TOKEN + TOKEN // 2
-    # 0.1 token per record, the live ones their stake back besides: 0.42 / 3 = 0.04 + 0.1
-    assert [market.balance_of(r.address) for r in robots[1:6]] == [TOKEN + TOKEN // 10] * 5
+    # one refund and 3 weighings paid from the escrow (0.5 + 3 * 0.04 - 40 000 units), an expired record
+    # a fifth of what is left past the 3 live stakes, the live ones the rest by voices 2, 2 and 1 of 5,
+    # each payment less its 10 000 units of bounty
+    amount = 620_000_000 - 40_000
+    expired = (amount - 120_000_000) // 5
+    live = amount - 2 * expired
+    expected = [TOKEN + expired - 10_000] * 2 + [TOKEN - 40_000_000 + live * w // 5 - 10_000 for w in (2, 2, 1)]
+    assert [market.balance_of(r.address) for r in robots[1:6]] == expected

@@ -239,8 +239,8 @@ def test_a_pause_stops_registrations_reveals_and_deposits_but_never_refunds_or_s
     sell(market, seller, buyer, 14.0, age=3)  # the next round trip
     refused(lambda: market.set_paused(True, sender=seller), "InfoMarketUnauthorized", caller=seller.address,
             role=ROLES["pauser"])
-    market.set_paused(True)
-    assert market.view("paused")
+    assert market.set_paused(True).of("PauseSet") and market.view("paused")
+    assert market.set_paused(True).of("PauseSet") == []  # nothing changed: no event
     refused(lambda: sell(market, seller, buyer, 10.0, age=4), "InfoMarketPaused")
     refused(lambda: market.grant_wealth(late, 0), "InfoMarketPaused")
     settle_all(market, buyer.address, 1)  # settling goes on
