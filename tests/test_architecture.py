@@ -318,7 +318,9 @@ def private_names_taken(text: str, module: str, is_package: bool = False) -> lis
     def unit(name: str) -> str:
         return name.split(".")[1] if name.count(".") else ""
 
-    private = (lambda n: n.startswith("_") and not n.startswith("__"))
+    def private(n: str) -> bool:
+        return n.startswith("_") and not n.startswith("__")
+
     tree, found, modules = ast.parse(text), [], {}  # modules: local name -> the project module it is bound to
     for node, _ in _imports(tree):
         if isinstance(node, ast.Import):

@@ -312,7 +312,7 @@ def test_the_python_examples_of_the_small_run_pages_run_at_a_small_size(tmp_path
         for big, small in PY_SMALL.items():
             code = code.replace(big, small)
         names: dict = {}
-        exec(compile(code, "<docs example>", "exec"), names)  # noqa: S102 - the docs' own example
+        exec(compile(code, "<docs example>", "exec"), names)  # the docs' own example, run as a reader would
         for name in ("env", "venv"):  # whatever vector env an example built runs at the small size
             if hasattr(names.get(name), "num_envs") and hasattr(names[name], "runs"):
                 assert names[name].num_envs == 2 and names[name].runs.steps == 60

@@ -2,7 +2,6 @@
 exit code 2 (no traceback, nothing written outside the output folder), or the documented result."""
 import json
 import os
-from pathlib import Path
 
 import pytest
 

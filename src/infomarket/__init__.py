@@ -15,7 +15,7 @@ __version__ = "0.1.0"
 
 # First: numba caches the package's own compiled functions by its source (compiled_cache), so each must be
 # decorated after this.
-from .compiled_cache import install as _install_compiled_cache  # noqa: E402
+from .compiled_cache import install as _install_compiled_cache
 
 _install_compiled_cache()
 

@@ -86,7 +86,7 @@ def _behaviour_bounds_checked(name: str, cfg, seed: int, steps: int, kinds) -> N
                 except (IndexError, ZeroDivisionError) as exc:
                     # plain Python on the world's arrays names the line
                     raise CheckFailed(f"behaviour {name!r}: its {role} rule "
-                                      + _located(exc, py, lambda: py(w, *args, *extra))) from None
+                                      + _located(exc, py, lambda: py(w, *args, *extra))) from None  # noqa: B023 - called at once
 
 
 def _kernel_kinds(name: str, alongside) -> tuple[str, ...]:
@@ -176,7 +176,7 @@ def _bounds_checked(name: str, events: list, robots: int, stake: float) -> None:
     py = rule.py_func
     try:
         checked = njit(boundscheck=True)(py)
-    except Exception:  # not a compilable function: the ordinary replay reports it
+    except Exception:  # noqa: BLE001 - not a compilable function: the ordinary replay reports it
         return
 
     def ledger_with(func) -> Ledger:
@@ -299,7 +299,7 @@ def explain_run_failure(cfg, seed: int, exc: BaseException, step: int, *, record
                 rule.func(*args)
             except type(exc) as again:
                 py = rule.py_func
-                at = _where_line(py, lambda: py(*plain))
+                at = _where_line(py, lambda: py(*plain))  # noqa: B023 - called at once
                 what = "sell" if role == "sell" else "buy" if role == "buy" else "weight"
                 return (f"{owner}: its {what} rule {py.__name__} raised {type(exc).__name__} "
                         f"({_short(again)}) at step {step} ({label}), at {at}")

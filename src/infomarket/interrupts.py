@@ -455,7 +455,7 @@ def wait_for(call: Callable[[], T], cancel: Callable[[], object]) -> T:
         thread = threading.Thread(target=work, daemon=True, name="infomarket-wait")
         thread.start()
         thread.join()  # a plain lock wait, which a signal interrupts cleanly
-    except BaseException as exc:
+    except BaseException as exc:  # noqa: BLE001 - the wait is cancelled, then raised again as a stop
         with contextlib.suppress(Exception):
             cancel()
         raise_stopped(exc)

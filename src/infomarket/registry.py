@@ -14,7 +14,7 @@ import inspect
 import math
 import re
 from dataclasses import dataclass, field
-from typing import Callable
+from collections.abc import Callable
 
 from ._numba_internals import CPUDispatcher
 from .compiled_cache import in_package

@@ -103,7 +103,7 @@ def test_the_selective_liar_lies_only_with_no_other_seller_in_range():
 
 def test_the_newcomer_withdraws_once_its_record_is_spent():
     spent = fresh = 0
-    for w, me, site, offer, own in _offers("newcomer", {"rotation_angle": 30.0, "fresh_record": 3.0}, steps=4000):
+    for w, me, _site, offer, own in _offers("newcomer", {"rotation_angle": 30.0, "fresh_record": 3.0}, steps=4000):
         if w.rep_settled[me] >= 3:
             assert not offer[0]
             spent += 1

@@ -156,7 +156,7 @@ def test_a_weight_rule_raising_at_a_deposit_is_named_with_the_step(tmp_path, sha
     seed = int(Store(out).runs().seed.iloc[0])
     step = _first_paid_deposit(cfg, seed)
     at = f"{shared / 'divided.py'}:{line_of(shared / 'divided.py', 'weights[x] = 1.0 / k')}"
-    assert f"payment scheme 'divided': its weight rule divided raised ZeroDivisionError" in err
+    assert "payment scheme 'divided': its weight rule divided raised ZeroDivisionError" in err
     assert f"at step {step} (buyer " in err and at in err
 
 

@@ -80,7 +80,7 @@ return [grey, food(200, 300), food(700, 100), k];
 
 @pytest.mark.skipif(not (CHROMIUM and CHROMEDRIVER), reason="headless Chromium not installed "
                     "(tools/ci/install-browser.sh)")
-def test_browser_shows_obstacles_every_site_and_contacts(driver, recording, tmp_path):
+def test_browser_shows_obstacles_every_site_and_contacts(driver, recording, tmp_path):  # noqa: F811 - pytest's fixture
     path = write_html(recording, tmp_path / "terrain.html")
     open_page(driver, path.as_uri())
     subtitle = driver.execute_script("return document.getElementById('subtitle').textContent")

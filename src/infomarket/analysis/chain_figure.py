@@ -10,7 +10,7 @@ import numpy as np
 from .chain_study import FIG7, FIG7_SWEEP, PAPER, SWEEP, Answers, _sel, axis_values, declaration
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
+import matplotlib.pyplot as plt  # after the backend is chosen
 
 
 def figure(a: Answers, path: Path, decl: dict | None = None) -> None:

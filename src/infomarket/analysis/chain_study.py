@@ -128,7 +128,7 @@ def fig7_verdict(angles: list[tuple[str, np.ndarray, np.ndarray, float]], alpha:
     no = any(c.significant for c in not_d)
     ans = st.answer(yes, no)
     details, weak = [], False
-    for (lab, x, y, d), h, nd in zip(angles, helps, not_d):
+    for (lab, _x, _y, d), h, nd in zip(angles, helps, not_d):
         state = "helps" if h.significant else "does NOT help" if nd.significant else "undecided"
         if not h.significant and not nd.significant and h.power < target:
             weak = True

@@ -30,7 +30,7 @@ class Frames:
     meta: dict = field(default_factory=dict)  # store.json: format, package version, creation time
 
     @classmethod
-    def of(cls, source) -> "Frames":
+    def of(cls, source) -> Frames:
         if isinstance(source, Frames):
             return source
         if isinstance(source, pd.DataFrame):
@@ -47,7 +47,7 @@ class Frames:
         raise InputTypeError(f"cannot read tables from a {type(source).__name__}")
 
     @classmethod
-    def from_store(cls, store: Store) -> "Frames":
+    def from_store(cls, store: Store) -> Frames:
         if not store.root.exists():
             raise StoreError(f"{store.root}: no such folder")
         if not store.exists():

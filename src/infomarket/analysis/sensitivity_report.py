@@ -14,7 +14,7 @@ from .declared import status_of
 from .figures import save
 from .frames import MissingDataError
 from . import sensitivity as sens  # module-level knobs (PAWN_PERMUTATIONS) read when drawing
-from .sensitivity import TITLES, Sensitivity, drivers, floor_of, from_store, morris_noise, noise_floor
+from .sensitivity import TITLES, Sensitivity, floor_of, from_store, morris_noise
 from .study import INCONCLUSIVE, NO, YES, Declaration, html_table, md_table, packaged
 
 DECLARATION = packaged("sensitivity_questions.toml")
@@ -68,7 +68,7 @@ def answers(s: Sensitivity, questions: dict | None = None, local: tuple[pd.DataF
                 text = (f"floor {f:.2f} [{flo:.2f}, {fhi:.2f}]; S_T - floor: "
                         + ", ".join(f"{n} {excess[n]:+.2f}" for n in excess.sort_values(ascending=False).index)
                         + f"; largest S_1: {top} {s1.value[top]:.2f} [{s1.low[top]:.2f}, {s1.high[top]:.2f}]"
-                        + (f" (dominant)" if dominant else " (none dominant)") + pawn_text)
+                        + (" (dominant)" if dominant else " (none dominant)") + pawn_text)
                 rows.append(["drivers", output, ", ".join(drive) or "none", size + text, lock("drivers")])
                 inter = [n for n in d.names if st.value[n] - s1.value[n] - f >= q["interactions"]["min_excess"]]
                 rows.append(["interactions", output, ", ".join(inter) or "none", size + "S_T - S_1 - floor: "

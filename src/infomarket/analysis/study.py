@@ -69,7 +69,7 @@ class Declaration:
     data: dict
 
     @classmethod
-    def read(cls, path: str | Path, name: str | None = None) -> "Declaration":
+    def read(cls, path: str | Path, name: str | None = None) -> Declaration:
         path = Path(path)
         try:
             data = tomllib.loads(path.read_text())

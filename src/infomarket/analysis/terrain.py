@@ -14,7 +14,6 @@ p-value reported beside it; the crowd's ratio is read from its bootstrap interva
 """
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np

@@ -12,7 +12,7 @@ import hashlib
 import json
 import re
 from pathlib import Path
-from typing import Annotated, Any, Literal, Union
+from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, StrictBool, ConfigDict, Field, ValidationError, ValidationInfo, field_validator, model_validator
 
@@ -23,7 +23,7 @@ from . import chain as chain_rules, messages, sizes, terrain
 from .sample import Sample
 
 #: Seeds are 63-bit everywhere (files, the command line, the Python API, the store's int64 columns).
-from ..seeds import MAX_SEED  # noqa: E402  (one definition, infomarket.seeds)
+from ..seeds import MAX_SEED  # one definition, infomarket.seeds
 
 #: An experiment's name is also a folder name (``results/NAME``) and a label in tables: ASCII letters, digits
 #: and ``_ - . + = ,``, starting with a letter, digit or ``_``, at most NAME_MAX characters (no path separators,
@@ -63,7 +63,7 @@ class Rect(_Strict):
     y1: Finite
 
     @model_validator(mode="after")
-    def _ordered(self) -> "Rect":
+    def _ordered(self) -> Rect:
         if not (self.x0 < self.x1 and self.y0 < self.y1):
             raise ConfigError(f"a rect needs x0 < x1 and y0 < y1, got ({self.x0}, {self.y0}) - ({self.x1}, {self.y1})")
         return self
@@ -88,14 +88,14 @@ class Segment(_Strict):
     y1: Finite
 
     @model_validator(mode="after")
-    def _long(self) -> "Segment":
+    def _long(self) -> Segment:
         if self.x0 == self.x1 and self.y0 == self.y1:
             raise ConfigError(f"a segment needs two different end points, got ({self.x0}, {self.y0}) twice")
         return self
 
 
 #: ``[[obstacles]]`` entries, told apart by ``shape`` (space.obstacles has the geometry).
-Obstacle = Annotated[Union[Rect, CircleObstacle, Segment], Field(discriminator="shape")]
+Obstacle = Annotated[Rect | CircleObstacle | Segment, Field(discriminator="shape")]
 
 
 class Robot(_Strict):
@@ -132,7 +132,7 @@ class Swarm(_Strict):
     groups: list[Group] = Field(min_length=1)
 
     @model_validator(mode="after")
-    def _counts(self) -> "Swarm":
+    def _counts(self) -> Swarm:
         for k, g in enumerate(self.groups):
             if g.count > self.robots:
                 raise ConfigError(f"groups[{k}].count = {g.count} is more robots of {g.behaviour!r} than "
@@ -185,7 +185,7 @@ class Chain(_Strict):
     partition: tuple[NonNegInt, NonNegInt] | None = None
 
     @model_validator(mode="after")
-    def _partition_window(self) -> "Chain":
+    def _partition_window(self) -> Chain:
         if self.partition is not None and self.partition[1] <= self.partition[0]:
             raise ConfigError(f"chain.partition = [{self.partition[0]}, {self.partition[1]}]: the end step must "
                               f"come after the start step")
@@ -214,7 +214,7 @@ class Sweep(_Strict):
     sample: Sample | None = None
 
     @model_validator(mode="after")
-    def _not_empty(self) -> "Sweep":
+    def _not_empty(self) -> Sweep:
         if self.sample is not None and (self.grid or self.axes):
             raise ConfigError("a sweep has either a grid and axes or a sample design, not both")
         if not self.grid and not self.axes and self.sample is None:
@@ -281,12 +281,12 @@ class Experiment(_Strict):
         for e in resolved:
             try:
                 plugins.load(e)
-            except Exception as exc:  # a plugin's own error is the user's to see, in one line
+            except Exception as exc:  # noqa: BLE001 - a plugin's own error is the user's to see, in one line
                 raise ConfigError(f"cannot load plugin {e!r}: {type(exc).__name__}: {exc}") from None
         return resolved
 
     @model_validator(mode="after")
-    def _coherent(self) -> "Experiment":
+    def _coherent(self) -> Experiment:
         if self.transitory >= self.steps:
             raise ConfigError(f"transitory = {self.transitory} must be smaller than steps = {self.steps}")
         w, h, r = self.arena.width, self.arena.height, self.robot.radius
@@ -379,7 +379,7 @@ class Experiment(_Strict):
         spec = payments()[self.payment.scheme]
         return {p: float(self.payment.params.get(p, spec.defaults.get(p, 0.0))) for p in spec.params}
 
-    def with_overrides(self, **changes) -> "Experiment":
+    def with_overrides(self, **changes) -> Experiment:
         """A re-validated copy with top-level fields replaced (e.g. steps, runs, seed)."""
         data = self.model_dump()
         data.update(changes)

@@ -137,7 +137,7 @@ class Simulation:
         self._view = kernel_view(world) if self._kernel is not None else None
         self.run_seconds = 0.0
 
-    def another(self, seed: int) -> "Simulation":
+    def another(self, seed: int) -> Simulation:
         """A new run of the same configuration with ``seed``, sharing this one's loaded kernel."""
         sim = copy.copy(self)
         sim.compile_seconds = 0.0

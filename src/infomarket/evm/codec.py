@@ -70,7 +70,7 @@ class _EventLayout(NamedTuple):
     names: list[str]
 
     @classmethod
-    def of(cls, abi: dict) -> "_EventLayout":
+    def of(cls, abi: dict) -> _EventLayout:
         plain = [i for i in abi["inputs"] if not i["indexed"]]
         indexed = [i for i in abi["inputs"] if i["indexed"]]
         return cls(abi["name"], [i["name"] for i in indexed], [i["type"] for i in indexed],

@@ -210,7 +210,7 @@ class Web3Backend(_SignedChain):
     def _execute(self, message: dict) -> bytes:
         try:
             return bytes(self.w3.eth.call(message, "pending"))
-        except Exception as exc:  # noqa: BLE001 - anything that is not a revert is re-raised as it came
+        except Exception as exc:  # anything that is not a revert is re-raised as it came
             raw = revert_data(exc)
             if raw is None:
                 raise

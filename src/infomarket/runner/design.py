@@ -109,7 +109,7 @@ class Design:
         return df
 
     @classmethod
-    def from_spec(cls, spec: dict, X: np.ndarray) -> "Design":
+    def from_spec(cls, spec: dict, X: np.ndarray) -> Design:
         fields = {k: spec[k] for k in cls.__dataclass_fields__ if k != "X"}
         return cls(**fields, X=np.asarray(X, dtype=float))
 
@@ -120,7 +120,7 @@ class Design:
             s.pop(k)
         return s
 
-    def extends(self, old: "Design") -> bool:
+    def extends(self, old: Design) -> bool:
         """Whether this design is ``old`` grown: the same settings but more base samples, and ``old``'s
         points first.  Saltelli's scheme on a Sobol' sequence has that property, so a study whose
         intervals came out too wide grows in place and reruns none of its points (their seeds follow

@@ -98,7 +98,7 @@ class Policy:
         return np.array([_RANGES[a][1] for a in self.actions])
 
     @classmethod
-    def constant(cls, values: dict, actions=ACTIONS, interval: int = 10, base: dict | None = None) -> "Policy":
+    def constant(cls, values: dict, actions=ACTIONS, interval: int = 10, base: dict | None = None) -> Policy:
         """The policy that plays ``values`` (action -> parameter value, defaults where absent) whatever it
         observes."""
         actions = _checked_actions(actions)
@@ -129,7 +129,7 @@ class Policy:
         return path
 
     @classmethod
-    def load(cls, path) -> "Policy":
+    def load(cls, path) -> Policy:
         try:
             with np.load(Path(path), allow_pickle=False) as z:
                 weights, meta = z["weights"], json.loads(str(z["meta"]))

@@ -55,7 +55,7 @@ class BorrowedArray(types.Array):
                          name=f"{kind}({dtype}, {ndim}d, {layout})")
 
     @classmethod
-    def of(cls, t: types.Array, readonly: bool) -> "BorrowedArray":
+    def of(cls, t: types.Array, readonly: bool) -> BorrowedArray:
         return cls(t.dtype, t.ndim, t.layout, readonly=readonly or not t.mutable, aligned=t.aligned)
 
 
@@ -80,7 +80,7 @@ class GuardedArray(BorrowedArray):
                              name=f"guarded array({dtype}, {ndim}d, {layout})")
 
     @classmethod
-    def of(cls, t: types.Array, readonly: bool = True) -> "GuardedArray":
+    def of(cls, t: types.Array, readonly: bool = True) -> GuardedArray:
         return cls(t.dtype, t.ndim, t.layout, aligned=t.aligned)
 
 

@@ -94,7 +94,7 @@ class Store:
                              f"{type(meta).__name__})")
         return meta
 
-    def create(self) -> "Store":
+    def create(self) -> Store:
         """Create the folder layout (idempotent); refuse a folder that holds something else."""
         if self.exists():
             meta = self.meta()

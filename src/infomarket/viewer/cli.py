@@ -59,7 +59,7 @@ def _warm_up(cfg, seed: int | None) -> None:
         Simulation(cfg, seed)
     except InfomarketError:
         raise
-    except Exception as exc:  # a rule that keeps the kernel from compiling: named (checks.explain)
+    except Exception as exc:  # noqa: BLE001 - a rule that keeps the kernel from compiling: named (checks.explain)
         from ..checks import explain
 
         raise explain(cfg, seed, exc) from None
