@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import traceback
+from typing import Any
 
 import numba
 import numpy as np
@@ -229,10 +230,10 @@ def check_payment(name: str, *, robots: int = 6, sequences: int = 30, seed: int 
 _RETURNS = {"sell": (4, "(valid, x, y, age)"), "buy": (None, "nothing"), "weights": (None, "nothing (it fills weights)")}
 
 
-def _config_rules(cfg, kinds) -> list[tuple[str, str, object, object]]:
+def _config_rules(cfg, kinds) -> list[tuple[str, str, Any, Any]]:
     """(owner, role, Rule, spec) of every rule a run of ``cfg`` calls: each behaviour's sell and buy
     rules (in kind order), then the scheme's weight rule."""
-    out = []
+    out: list[tuple[str, str, Any, Any]] = []
     for role in ("sell", "buy"):  # the step's order: every offer, then every purchase
         for name in kinds:
             spec = get_behaviour(name)
@@ -324,7 +325,10 @@ def explain_compile_failure(cfg, exc: BaseException) -> str | None:
     from .engine.world import kernel_view
 
     class _Probe:  # the few attributes _calls reads
-        pass
+        rng: np.random.Generator
+        kinds: tuple[str, ...]
+        world: Any
+        _view: Any
 
     try:
         probe = _Probe()

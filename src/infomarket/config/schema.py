@@ -269,6 +269,7 @@ class Experiment(_Strict):
     def _site_defaults(cls, value: Any, info: ValidationInfo) -> Any:
         """One site given in part (``[food]`` with only ``radius``) takes the default site's other keys."""
         if isinstance(value, dict):
+            assert info.field_name is not None  # a field validator's
             default = cls.model_fields[info.field_name].default
             return {"x": default.x, "y": default.y, **value}
         return value
@@ -339,9 +340,9 @@ class Experiment(_Strict):
             raise ConfigError(f"payment.params: scheme {spec.name!r} needs {', '.join(missing)}")
         chain_rules.check(self.chain, self.steps)  # contradictions refused; what cannot act, warned about
         if self.chain.enabled:
-            for s in self.chain.signers:
-                if s >= self.swarm.robots:
-                    raise ConfigError(f"chain.signers: robot {s} does not exist (robots = {self.swarm.robots})")
+            for signer in self.chain.signers:
+                if signer >= self.swarm.robots:
+                    raise ConfigError(f"chain.signers: robot {signer} does not exist (robots = {self.swarm.robots})")
             if len(set(self.chain.signers)) != len(self.chain.signers):
                 raise ConfigError("chain.signers: a robot is listed twice")
             if self.robot.fuel_cost > 0 or self.payment.stake_expiry > 0 or self.payment.reputation_decay < 1:

@@ -17,6 +17,7 @@ import warnings
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -105,7 +106,7 @@ class Simulation:
                                                                                               config.steps)
         self._room_key = (self.kinds, config.payment.scheme, config.terrain, config.chain.enabled, record_events,
                           tuple((g.behaviour, g.count) for g in config.swarm.groups))
-        self._kernel = None
+        self._kernel: Any = None  # the generated module of the compiled loop, loaded by reset
         self._params = build_params(config, behaviour_table(config, self.kinds)[1])  # the same for every run
         self.reset(config.seed if seed is None else seed)
         t0 = time.perf_counter()
@@ -262,7 +263,7 @@ class Simulation:
         k, j = int(w.ev_count[0]), int(w.pay_count[0])
         events = events_of(k) if k else _empty(("events", type(w)), lambda: events_of(0))
         payments = payments_of(j) if j else _empty(("payments", type(w)), lambda: payments_of(0))
-        totals = {"wealth": total, "pots": float(w.pot.sum()), "burned": float(w.burned[0]),
+        totals: dict[str, Any] = {"wealth": total, "pots": float(w.pot.sum()), "burned": float(w.burned[0]),
                   "items": int(w.items.sum())}
         if self.config.terrain:
             totals["sites"] = self.site_counts()

@@ -329,8 +329,11 @@ def _compile_together(configs: list[Experiment]) -> None:
     """In a command, the kernels of ``configs`` not yet in the cache and their batch drivers compiled in
     one child (``interrupts.compiled_together``), which types the step's helpers once for all of them;
     the calls here then load them."""
-    interrupts.compiled_together(lambda: [_try_warm(cfg) for cfg in configs],
-                                 [kernel_marker(cfg) for cfg in configs])
+    def warm_all() -> None:
+        for cfg in configs:
+            _try_warm(cfg)
+
+    interrupts.compiled_together(warm_all, [kernel_marker(cfg) for cfg in configs])
 
 
 def preflight(configs: Iterable[Experiment]) -> None:

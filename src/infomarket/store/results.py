@@ -3,6 +3,7 @@ columns and integrity checks: the package docstring, ``infomarket.store``)."""
 from __future__ import annotations
 
 from collections.abc import Iterable
+import functools
 import json
 import os
 import time
@@ -229,7 +230,7 @@ class Store:
             if df is not None and len(df):
                 path = self.part_path(t, part_id)
                 path.parent.mkdir(exist_ok=True)
-                write_atomic(path, lambda tmp, df=df, t=t: write_table(t, df, tmp, keys))
+                write_atomic(path, functools.partial(write_table, t, df, keys=keys))
                 sha, rows = sha256_file(path), len(df)
                 if self._cache is not None:  # the bytes it hashed are the file's: no need to read them again
                     self._cache.put("sha256", path, sha)
