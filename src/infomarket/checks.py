@@ -55,7 +55,7 @@ def _with_bounds_check(py):
     if py not in _BOUNDS_CHECKED:
         try:
             _BOUNDS_CHECKED[py] = njit(boundscheck=True)(py)
-        except Exception:  # noqa: BLE001
+        except Exception:  # noqa: BLE001 - where it does not compile here, the runs report it
             _BOUNDS_CHECKED[py] = None
     return _BOUNDS_CHECKED[py]
 
@@ -227,7 +227,8 @@ def check_payment(name: str, *, robots: int = 6, sequences: int = 30, seed: int 
 
 # ------------------------------------------------------------------ explaining a run that failed
 #: What each kind of rule returns, for messages, and how many values (None: nothing).
-_RETURNS = {"sell": (4, "(valid, x, y, age)"), "buy": (None, "nothing"), "weights": (None, "nothing (it fills weights)")}
+_RETURNS = {"sell": (4, "(valid, x, y, age)"), "buy": (None, "nothing"),
+            "weights": (None, "nothing (it fills weights)")}
 
 
 def _config_rules(cfg, kinds) -> list[tuple[str, str, Any, Any]]:
@@ -336,7 +337,7 @@ def explain_compile_failure(cfg, exc: BaseException) -> str | None:
         probe.kinds = behaviour_kinds(cfg)
         probe.world, _ = build_world(cfg, probe.rng, record_events=False, history_every=0)
         probe._view = kernel_view(probe.world)
-    except Exception:  # noqa: BLE001
+    except Exception:  # noqa: BLE001 - a repeat that cannot start: the run's last step is the best known
         return None
     w = probe.world
     for owner, role, rule, spec in _config_rules(cfg, probe.kinds):
@@ -358,7 +359,7 @@ def explain_compile_failure(cfg, exc: BaseException) -> str | None:
             sig = tuple(numba.typeof(a) for a in args)
             rule.func.compile(sig)
             ret = rule.func.overloads[sig].signature.return_type
-        except Exception as failed:  # noqa: BLE001
+        except Exception as failed:  # noqa: BLE001 - any error compiling the rule alone is the rule's, reported by name
             lines = [ln for ln in str(failed).splitlines() if ln.strip() and "During:" not in ln]
             return f"{owner}: its {what} {py.__name__} ({where}) does not compile: " + " | ".join(lines[:6])
         count, shape = _RETURNS[role]
@@ -431,7 +432,7 @@ def _first_flagged_step(cfg, sim) -> int:
     its call before the host reads the bits, so the run is repeated one step at a time up to there."""
     try:
         again = Simulation(cfg, sim.seed, record_events=bool(sim.world.record))
-    except Exception:  # noqa: BLE001
+    except Exception:  # noqa: BLE001 - a repeat that cannot start: the run's last step is the best known
         return sim.clock
     try:
         while again.clock < sim.clock:

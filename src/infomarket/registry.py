@@ -187,7 +187,8 @@ def register_behaviour(name: str, *, buy: Callable | str, sell: Callable | str, 
     ``buy(w, me, nbrs, *params)`` buys from the neighbours ``nbrs`` (ids, increasing) and installs what it
     buys; ``sell(w, me, site, *params) -> (valid, x, y, age)`` is the offer for ``site`` (0 food, 1 nest)
     in the seller's own frame.  A rule whose first argument after the fixed ones is named ``rng`` gets
-    the run's numpy Generator there (so a random rule stays reproducible from the run's seed).  ``honest`` says whether robots of this behaviour count as honest in the
+    the run's numpy Generator there (so a random rule stays reproducible from the run's seed).  ``honest`` says
+    whether robots of this behaviour count as honest in the
     metrics (Byzantine otherwise).  ``limits`` maps a parameter to ``(text, predicate)``, e.g.
     ``{"threshold": ("> 0", lambda v: v > 0)}``: configurations breaking it are rejected with the text.
     ``paths=True`` says the rules buy or install waypoint paths (``behaviours.paths``); runs with such a

@@ -22,7 +22,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))  # a script: the checkout's tests package, for its one way to start a process
-from tests.procs import Procs  # noqa: E402
+from tests.procs import Procs  # noqa: E402 - after the checkout is on the path
 
 SOURCE = ROOT / "contracts" / "InformationMarket.sol"
 COMPILER = ROOT / "tools" / "solc" / "compile.js"

@@ -59,7 +59,7 @@ def test_movie_draws_the_obstacles(recording, tmp_path):
 
 
 # ------------------------------------------------------------------------------------------ browser
-from .test_browser import CHROMEDRIVER, CHROMIUM, driver, js_errors, open_page, wait_for  # noqa: E402,F401
+from .test_browser import CHROMEDRIVER, CHROMIUM, driver, js_errors, open_page, wait_for  # noqa: E402,F401 - pytest's fixture and helpers, after this file's own tests
 
 GREY_AND_FOOD = """
 const c = document.getElementById('arena'), d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;

@@ -63,7 +63,8 @@ def figure(a: Answers, path: Path, decl: dict | None = None) -> None:
                         label=f"{market.replace('_', ' ')}: chain")
             ref = _sel(runs, FIG7, "items", chain="instant", market=market, rotation_angle=90.0)
             if len(ref):
-                ax.axhline(np.median(ref), color=colour, ls="--", lw=1, label=f"{market.replace('_', ' ')}: instant (n={len(ref)})")
+                ax.axhline(np.median(ref), color=colour, ls="--", lw=1,
+                           label=f"{market.replace('_', ' ')}: instant (n={len(ref)})")
         ax.set_xticks(xs, [f"{v:g}" for v, _ in pts])
         ax.set_xlabel(xlabels[axis])
         ax.set_ylabel("swarm items, last 10 000 steps (median, IQR)")

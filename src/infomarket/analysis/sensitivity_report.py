@@ -151,7 +151,8 @@ def _bars(s: Sensitivity):
             null = t[(t.output == output) & (t["index"] == "PAWN_null")].set_index("parameter").reindex(d.names)
             ax.bar(x, rows["value"], 0.6, color="#9467bd", edgecolor="black", linewidth=0.5, label=TITLES["PAWN"])
             ax.plot(x, null["value"], linestyle="none", marker="_", markersize=14, markeredgewidth=2,
-                    color="black", label=f"no effect: 95th percentile,\n{sens.PAWN_PERMUTATIONS} shuffles of the output")
+                    color="black",
+                    label=f"no effect: 95th percentile,\n{sens.PAWN_PERMUTATIONS} shuffles of the output")
             ax.set_xticks(x, d.names, rotation=40, ha="right", rotation_mode="anchor", fontsize=8)
             ax.set_ylim(0, max(0.1, float(np.nanmax(rows["value"].to_numpy())) * 1.15,
                                float(np.nanmax(null["value"].to_numpy())) * 1.15))
@@ -214,7 +215,8 @@ def floor_table(s: Sensitivity) -> pd.DataFrame:
     return pd.DataFrame({"output": s.floor.output,
                          "runs per point": s.floor.runs_per_point,
                          "seed noise, share of single-run variance": [
-                             f"{r.run_share:.3f} [{r.run_share_low:.3f}, {r.run_share_high:.3f}]" for r in s.floor.itertuples()],
+                             f"{r.run_share:.3f} [{r.run_share_low:.3f}, {r.run_share_high:.3f}]"
+                             for r in s.floor.itertuples()],
                          "floor of S_T (share of the point means' variance)": [
                              f"{r.floor:.3f} [{r.floor_low:.3f}, {r.floor_high:.3f}]" for r in s.floor.itertuples()]})
 

@@ -10,7 +10,8 @@ from pathlib import Path
 def add_subcommand(subparsers) -> None:
     p = subparsers.add_parser("terrain-report", help="answer the terrain questions (corridor, two_food, crowd) "
                               "from their stores, with a figure")
-    p.add_argument("results", help="folder holding the stores corridor/, two_food/, crowd/ (optionally corridor_waypoints/, crowd_sensing/)")
+    p.add_argument("results", help="folder holding the stores corridor/, two_food/, crowd/ "
+                                   "(optionally corridor_waypoints/, crowd_sensing/)")
     p.add_argument("--out", required=True, help="folder for terrain.md, terrain.json, terrain.png")
     p.set_defaults(func=cmd_terrain_report)
 

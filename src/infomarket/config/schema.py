@@ -14,7 +14,8 @@ import re
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, StrictBool, ConfigDict, Field, ValidationError, ValidationInfo, field_validator, model_validator
+from pydantic import (BaseModel, StrictBool, ConfigDict, Field, ValidationError, ValidationInfo, field_validator,
+                      model_validator)
 
 from .. import plugins
 from ..errors import ConfigError
@@ -261,7 +262,8 @@ class Experiment(_Strict):
             raise ConfigError(f"a name of {len(name)} characters; at most {NAME_MAX} (it is used as a folder)")
         if not re.fullmatch(NAME_PATTERN, name):
             raise ConfigError("a name may hold only ASCII letters, digits and _ - . + = , and must start with a "
-                              "letter, digit or _ (it is used as a folder: no / or \\, no spaces or control characters)")
+                              "letter, digit or _ (it is used as a folder: no / or \\, no spaces or control "
+                              "characters)")
         return name
 
     @field_validator("food", "nest", mode="before")
@@ -368,7 +370,8 @@ class Experiment(_Strict):
     @property
     def terrain(self) -> bool:
         """Does this setup leave the paper's plane (obstacles, several sites of a kind, line of sight,
-        collisions)?  Only then does the engine compile the terrain variant of the step (engine.step, engine.terrain)."""
+        collisions)?  Only then does the engine compile the terrain variant of the step (engine.step,
+        engine.terrain)."""
         return bool(self.obstacles or self.robot.line_of_sight or self.robot.collisions or self.robot.sense_robots
                     or len(self.sites("food")) > 1 or len(self.sites("nest")) > 1)
 

@@ -29,9 +29,9 @@ from ..state import log as log_state
 from ..state.view import make_view, register_layout
 from . import params, swarm
 from .params import FOOD, NEST, SITE_NAMES  # noqa: F401  (re-exported: one place to import the codes from)
-from .swarm import EXPLORING, PATH_POINTS, SEEKING_FOOD, SEEKING_NEST, STATE_NAMES  # noqa: F401
-from ..ledger.state import REPUTATION, TX_POOL  # noqa: F401
-from ..state.log import EV_DEPOSIT, EV_PURCHASE, EV_REFUSED, EVENT_NAMES  # noqa: F401
+from .swarm import EXPLORING, PATH_POINTS, SEEKING_FOOD, SEEKING_NEST, STATE_NAMES  # noqa: F401 - re-exported with the site codes
+from ..ledger.state import REPUTATION, TX_POOL  # noqa: F401 - re-exported with the site codes
+from ..state.log import EV_DEPOSIT, EV_PURCHASE, EV_REFUSED, EVENT_NAMES  # noqa: F401 - re-exported with the site codes
 
 #: The domains of the flat world, in order.
 DOMAINS = (params.SPEC, swarm.SPEC, ledger_state.SPEC, log_state.SPEC)

@@ -199,7 +199,8 @@ class Web3Backend(_SignedChain):
         return self.w3.eth.get_balance(address)
 
     def _send_value(self, payer: str, to: str, value: int) -> None:
-        self.w3.eth.wait_for_transaction_receipt(self.w3.eth.send_transaction({"from": payer, "to": to, "value": value}))
+        sent = self.w3.eth.send_transaction({"from": payer, "to": to, "value": value})
+        self.w3.eth.wait_for_transaction_receipt(sent)
 
     def _nonce(self, address: str) -> int:
         return self.w3.eth.get_transaction_count(address, "pending")

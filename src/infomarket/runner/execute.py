@@ -348,7 +348,7 @@ def preflight(configs: Iterable[Experiment]) -> None:
             Simulation(cfg, 0)  # compiles or loads the kernel (what a warm-up then finds done)
         except InfomarketError:
             raise
-        except Exception as exc:  # noqa: BLE001
+        except Exception as exc:  # noqa: BLE001 - a compile error: the rule is named where it can be, else the runs report it
             why = explain_compile_failure(cfg, exc)
             if why:
                 raise RuleRunError(f"{cfg.name}: {why}; the step kernel cannot be compiled, nothing was run") from None

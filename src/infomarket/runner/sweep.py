@@ -110,7 +110,8 @@ def _frames(task: Task, outputs: list[RunOutput]) -> dict[str, pd.DataFrame | No
             parts.append(_frames(Task(c, runs), outputs[k:k + len(runs)]))
             k += len(runs)
         return {t: _concat([p[t] for p in parts if p[t] is not None]) for t in parts[0]}
-    frames: dict[str, tuple[list, list]] = {t: ([], []) for t in _PER_RUN}  # table -> (the runs' frames, the condition of each)
+    # table -> (the runs' frames, the condition of each)
+    frames: dict[str, tuple[list, list]] = {t: ([], []) for t in _PER_RUN}
     rows, configs, k = [], [], 0
     for c, runs in members:
         for o, run in zip(outputs[k:k + len(runs)], runs):

@@ -59,7 +59,8 @@ def _checked_actions(actions) -> tuple[str, ...]:
     actions = tuple(actions)
     bad = [a for a in actions if a not in NAMES]
     if not actions or bad or len(set(actions)) != len(actions):
-        raise ArgumentError(f"actions {actions}: each must be one of the attacker's parameters, once: {', '.join(NAMES)}")
+        raise ArgumentError(f"actions {actions}: each must be one of the attacker's parameters, once: "
+                            f"{', '.join(NAMES)}")
     return actions
 
 

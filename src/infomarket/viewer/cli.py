@@ -1,6 +1,7 @@
 """The ``view`` and ``replay`` commands (added to ``infomarket`` by the main CLI).
 
-Bad input raises ``UsageError`` or ``ConfigError`` before anything runs or is written; the main CLI prints it in one line
+Bad input raises ``UsageError`` or ``ConfigError`` before anything runs or is written; the main CLI prints it in
+one line
 and exits 2.  Heavy imports (aiohttp, matplotlib) wait until a command actually needs them.
 """
 from __future__ import annotations
