@@ -270,7 +270,8 @@ def _njit_inlined_by_numba(source: str) -> list[str]:
         if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
             for d in node.decorator_list:
                 if (isinstance(d, ast.Call) and ast.unparse(d.func).split(".")[-1] == "njit"
-                        and any(k.arg == "inline" and ast.unparse(k.value).strip("'\"") == "always" for k in d.keywords)):
+                        and any(k.arg == "inline" and ast.unparse(k.value).strip("'\"") == "always"
+                                for k in d.keywords)):
                     found.append(node.name)
     return found
 

@@ -71,7 +71,8 @@ def run():
             tmp = STORES / "terrain-toml"
             tmp.mkdir(parents=True, exist_ok=True)
             for name in ("corridor", "two_food", "crowd"):
-                assert main(["sweep", str(_small(name, tmp)), "--runs", "2", "--out", str(root / name), "--workers", "1", "--quiet"]) == 0
+                assert main(["sweep", str(_small(name, tmp)), "--runs", "2", "--out", str(root / name),
+                             "--workers", "1", "--quiet"]) == 0
         assert main(["terrain-report", str(root), "--out", str(fresh(OUT / "terrain"))]) == 0
     if "sens" in what:
         from tests.analysis import test_sensitivity as ts

@@ -39,7 +39,8 @@ PLANNED = (N + 2) * 2 + (2 + 4) * 2 + (2 * 3 + 2 * 3 + N * 2 + (N + 1) // 2 + 3)
 
 
 def _frames(out: Path) -> dict:
-    return {n: pd.read_parquet(out / "cells" / CELL / f"{n}.parquet") for n in ("candidates", "selection", "confirmation")}
+    return {n: pd.read_parquet(out / "cells" / CELL / f"{n}.parquet")
+            for n in ("candidates", "selection", "confirmation")}
 
 
 def _same_frames(a: Path, b: Path) -> None:

@@ -64,7 +64,8 @@ from .test_browser import CHROMEDRIVER, CHROMIUM, driver, js_errors, open_page, 
 GREY_AND_FOOD = """
 const c = document.getElementById('arena'), d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
 const k = c.width / 1200;
-const near = (i, r, g, b, tol) => Math.abs(d[i] - r) < tol && Math.abs(d[i + 1] - g) < tol && Math.abs(d[i + 2] - b) < tol;
+const near = (i, r, g, b, tol) =>
+  Math.abs(d[i] - r) < tol && Math.abs(d[i + 1] - g) < tol && Math.abs(d[i + 2] - b) < tol;
 let grey = 0;
 for (let i = 0; i < d.length; i += 4) if (near(i, 0x5a, 0x5a, 0x5a, 12)) grey++;
 const food = (cx, cy) => {  // pixels of the food fill (green at alpha 0.35 on the arena's #f4f4f1)
