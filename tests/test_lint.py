@@ -72,6 +72,8 @@ def test_every_noqa_says_why():
     """A kept ``# noqa`` comment names its codes and, after them, why it is kept."""
     bare = []
     for path in [*(ROOT / "src").rglob("*.py"), *(ROOT / "tests").rglob("*.py")]:
+        if "noqa" not in path.read_text():
+            continue
         with tokenize.open(path) as f:
             comments = [t for t in tokenize.generate_tokens(f.readline) if t.type == tokenize.COMMENT]
         for t in comments:
