@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
-.PHONY: venv demo test test-busy bench clean contracts gas node docs
+.PHONY: venv demo lint test test-busy bench clean contracts gas node docs
 
 venv: $(STAMP)
 
@@ -16,6 +16,12 @@ $(STAMP): pyproject.toml Makefile
 
 demo: venv
 	$(BIN)/infomarket demo
+
+# The linters, configured in pyproject.toml: ruff on src and tests, then mypy on the public API (the files its
+# section names; its cache in .mypy_cache).  CI runs this before the suite; either one's finding fails it.
+lint: venv
+	$(BIN)/ruff check src tests
+	$(BIN)/mypy
 
 # Two processes (CI has 2 cores), tests handed out one by one as a process frees up (worksteal): on a
 # fresh clone most of the time is compiling step kernels, and a module that compiles many must not keep one
@@ -34,7 +40,7 @@ bench: venv
 	$(BIN)/infomarket bench
 
 clean:
-	rm -rf $(VENV) .pytest_cache build dist site
+	rm -rf $(VENV) .pytest_cache .mypy_cache .ruff_cache build dist site
 
 # The Solidity contract: solc-js pinned in tools/solc; the compiled artifact is committed in the package.
 contracts: tools/solc/node_modules

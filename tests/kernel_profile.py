@@ -120,7 +120,8 @@ def summary(path: str, top: int = 40) -> str:
         lines.append(f"{sum(c['cpu'] for c in cs):7.1f} {used}  {module}  {cs[0]['test']}")
     lines += ["", f"the {top} costliest files (CPU s, their processes included):"]
     lines += [f"{cpu:7.1f}  {name}" for name, cpu in files.most_common(top)]
-    lines += ["", f"the {top // 2} costliest tests (CPU s, their processes included; the longest bounds a parallel run):"]
+    lines += ["", f"the {top // 2} costliest tests (CPU s, their processes included; the longest bounds a parallel "
+                  "run):"]
     costly = sorted(tests.items(), key=lambda kv: -(kv[1]["cpu"] + kv[1]["children_cpu"]))[:top // 2]
     lines += [f"{t['cpu'] + t['children_cpu']:7.1f}  {name}" for name, t in costly]
     return "\n".join(lines)

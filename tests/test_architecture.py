@@ -270,7 +270,8 @@ def _njit_inlined_by_numba(source: str) -> list[str]:
         if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
             for d in node.decorator_list:
                 if (isinstance(d, ast.Call) and ast.unparse(d.func).split(".")[-1] == "njit"
-                        and any(k.arg == "inline" and ast.unparse(k.value).strip("'\"") == "always" for k in d.keywords)):
+                        and any(k.arg == "inline" and ast.unparse(k.value).strip("'\"") == "always"
+                                for k in d.keywords)):
                     found.append(node.name)
     return found
 
@@ -318,7 +319,9 @@ def private_names_taken(text: str, module: str, is_package: bool = False) -> lis
     def unit(name: str) -> str:
         return name.split(".")[1] if name.count(".") else ""
 
-    private = (lambda n: n.startswith("_") and not n.startswith("__"))
+    def private(n: str) -> bool:
+        return n.startswith("_") and not n.startswith("__")
+
     tree, found, modules = ast.parse(text), [], {}  # modules: local name -> the project module it is bound to
     for node, _ in _imports(tree):
         if isinstance(node, ast.Import):

@@ -51,7 +51,9 @@ def test_run_and_sweep_refuse_too_many_runs_at_once_and_write_nothing(tmp_path, 
     import infomarket.runner.run
     import infomarket.runner.sweep
 
-    never = lambda *a, **k: pytest.fail("started running instead of refusing")  # noqa: E731
+    def never(*a, **k):
+        pytest.fail("started running instead of refusing")
+
     monkeypatch.setattr(infomarket.runner.run, "run_experiment", never)
     monkeypatch.setattr(infomarket.runner.sweep, "run_sweep", never)
     exp = write(tmp_path)

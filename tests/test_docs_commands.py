@@ -29,6 +29,7 @@ RUN = {
 NOT_RUN = {
     "make demo": "the same as `infomarket demo`, run with --runs 1 in tests/test_commands.py",
     "make test": "the test suite itself",
+    "make lint": "ruff and mypy, which CI runs before the suite; tests/test_lint.py checks how",
     "infomarket run fig2B --runs 16 --out results/2b": "16 full runs; `run` is tested in tests/test_cli.py",
     "infomarket run my.toml --history 100": "16 full runs; --history is tested in tests/test_cli.py",
     "infomarket run path/to/original/fig4C.json": "a placeholder path; the format is tested in tests/config",
@@ -69,7 +70,8 @@ NOT_RUN = {
     "infomarket figures results/future --out results/future-report":
         "needs the future sweep's store; tests/analysis/test_future.py draws it from a synthetic one",
     # docs/terrain.md
-    "infomarket run two_food --runs 4 --out results/two_food": "4 full runs; the store's sites table: tests/terrain/test_cli.py",
+    "infomarket run two_food --runs 4 --out results/two_food":
+        "4 full runs; the store's sites table: tests/terrain/test_cli.py",
     "infomarket sweep corridor --out results/corridor": "128 full runs; sweeps are tested in tests/runner",
     "infomarket sweep crowd --out results/crowd": "128 full runs (100 robots); sweeps are tested in tests/runner",
     "infomarket terrain-report results --out results/terrain":
@@ -78,7 +80,8 @@ NOT_RUN = {
         "128 full runs; sweeps are tested in tests/runner, the waypoint rules in tests/terrain/test_waypoints.py",
     "infomarket view corridor": "a web server that runs until stopped; tests/viewer",
     "infomarket replay crowd --movie crowd.gif": "a full-length recording; movies: tests/viewer/test_terrain_view.py",
-    "infomarket sweep sensitivity --out results/sensitivity --workers 2": "the full study, 5 120 runs (~18 min on 2 cores)",
+    "infomarket sweep sensitivity --out results/sensitivity --workers 2":
+        "the full study, 5 120 runs (~18 min on 2 cores)",
     "infomarket sweep sensitivity_local --out results/sensitivity_local":
         "576 runs of 15 000 steps; tests/analysis/test_sensitivity.py judges a local design",
     "infomarket sensitivity results/sensitivity --out report --local results/sensitivity_local":
@@ -106,13 +109,15 @@ NOT_RUN = {
     "infomarket attack-search attack_search --defence staking,theta20 --byzantines 3 --dask tcp://head:8786 "
     "--out results/as-dask": "needs a Dask scheduler at that address; tests/search runs one on a LocalCluster",
     # docs/defences.md
-    "infomarket defence-search attack_search --out results/defence --workers 2": "the declared study, about 176 000 runs",
+    "infomarket defence-search attack_search --out results/defence --workers 2":
+        "the declared study, about 176 000 runs",
     "infomarket defence-search attack_search --family robust_median --byzantines 3 --candidates 2 --refine 0 "
     "--steps 3000 --transitory 1000 --inner-budget 4 --inner-runs 2 --inner-grid-step 90 --inner-race 2,4 "
     "--cost-runs 4 --frontier 2 --confirmation-runs 8 --seed 7 --out /tmp/defence":
         "minutes of runs; tests/defence/test_cli.py runs a tiny declared study",
     # docs/rl.md
-    "infomarket bench --env --json": "5 timed episodes of 64 runs; tests/bench/test_bench_env.py runs it with --steps 60",
+    "infomarket bench --env --json":
+        "5 timed episodes of 64 runs; tests/bench/test_bench_env.py runs it with --steps 60",
     "infomarket rl-train --steps 4000 --transitory 1000 --iterations 60 --pairs 32 --eval-runs 32 --seed 0 "
     "--out rl-train.json": "minutes of training; tests/rl/test_cli.py runs a tiny one",
     "infomarket adaptive-attack attack_search --defence staking --byzantines 3 --budget 170 --seed 0 "
@@ -189,14 +194,16 @@ SIZE_OPTIONS = frozenset({"steps", "transitory", "budget", "popsize", "runs", "r
                           # (search/questions.toml [seed_sets]; the CLI refuses it otherwise)
                           "seed"})
 TINY_SEARCH = ("--defence staking --byzantines 3 --budget 2 --popsize 2 --restarts 1 --runs 1 --finalists 1 "
-               "--race 2 --confirmation-runs 2 --grid-step 90 --adaptive-budget 0 --steps 60 --transitory 20 --workers 1")
+               "--race 2 --confirmation-runs 2 --grid-step 90 --adaptive-budget 0 --steps 60 --transitory 20 "
+               "--workers 1")
 SMALL = {
     "infomarket check attack_search": "infomarket check attack_search",
     "infomarket check chain_partition": "infomarket check chain_partition",
     "infomarket attack-search attack_search --out results/attack_search":
         f"infomarket attack-search attack_search {TINY_SEARCH} --seed 7 --out as",
-    "infomarket attack-search attack_search --defence staking --byzantines 3 --budget 48 --runs 4 --confirmation-runs 16 "
-    "--seed 7 --out /tmp/attack-reduced": f"infomarket attack-search attack_search {TINY_SEARCH} --seed 7 --out as",
+    "infomarket attack-search attack_search --defence staking --byzantines 3 --budget 48 --runs 4 "
+    "--confirmation-runs 16 --seed 7 --out /tmp/attack-reduced":
+        f"infomarket attack-search attack_search {TINY_SEARCH} --seed 7 --out as",
     "infomarket bench --env --json": "infomarket bench --env --json --steps 60 --repeats 1 --batch 2",
     "infomarket rl-train --steps 4000 --transitory 1000 --iterations 60 --pairs 32 --eval-runs 32 --seed 0 "
     "--out rl-train.json": "infomarket rl-train --steps 60 --transitory 20 --iterations 1 --pairs 1 --eval-runs 2 "
@@ -229,7 +236,8 @@ SMALL_NOT_RUN = {
     "infomarket attack-search attack_search --defence staking,theta20 --byzantines 3 --dask tcp://head:8786 "
     "--out results/as-dask": "needs a Dask scheduler at that address; tests/search runs one on a LocalCluster",
     "infomarket view": "a web server that runs until stopped; tests/viewer",
-    "infomarket replay --movie": "the command's name in the text (rl.md's rendering); tests/viewer/test_movie.py runs it",
+    "infomarket replay --movie":
+        "the command's name in the text (rl.md's rendering); tests/viewer/test_movie.py runs it",
     "infomarket attack-search": "the command's name in the text; its commands are the ones above",
     "infomarket adaptive-attack": "the command's name in the text (rl.md); its command is the one above",
     "infomarket sweep attack_search": "sweep has no --steps: 24 runs of 30 000 steps at the least; `check "
@@ -318,7 +326,7 @@ def test_the_python_examples_of_the_small_run_pages_run_at_a_small_size(tmp_path
         for big, small in PY_SMALL.items():
             code = code.replace(big, small)
         names: dict = {}
-        exec(compile(code, "<docs example>", "exec"), names)  # noqa: S102 - the docs' own example
+        exec(compile(code, "<docs example>", "exec"), names)  # the docs' own example, run as a reader would
         for name in ("env", "venv"):  # whatever vector env an example built runs at the small size
             if hasattr(names.get(name), "num_envs") and hasattr(names[name], "runs"):
                 assert names[name].num_envs == 2 and names[name].runs.steps == 60

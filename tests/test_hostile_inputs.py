@@ -196,7 +196,8 @@ def test_the_search_says_what_is_reduced(tmp_path):
     got = _reductions(small, declared, exp, every[:1], every, Namespace(steps=60, transitory=20))
     assert got == [f"1 of {len(every)} cells", f"--steps 60 (declared {exp.steps})",
                    f"--transitory 20 (declared {exp.transitory})", f"--budget 4 (declared {declared.settings.budget})",
-                   f"--popsize 4 (declared {declared.settings.popsize})", f"--runs 1 (declared {declared.settings.runs})"]
+                   f"--popsize 4 (declared {declared.settings.popsize})",
+                   f"--runs 1 (declared {declared.settings.runs})"]
 
 
 def test_check_attack_search_shows_the_cells_the_search_runs_as_the_doc_says(capsys):
@@ -273,8 +274,8 @@ def test_a_chain_that_acts_gives_no_warning_and_check_describes_it(tmp_path, cap
     assert main(["check", path]) == 0
     captured = capsys.readouterr()
     assert "warning" not in captured.err
-    assert ("chain: poa, a block every 5 step(s) (out-of-turn delay 1), every robot signs; a backbone 3 step(s) "
-            "late, message loss 0; gas price 0; finality 32 blocks, partitioned during steps [100, 200)") in captured.out
+    assert ("chain: poa, a block every 5 step(s) (out-of-turn delay 1), every robot signs; a backbone 3 step(s) late, "
+            "message loss 0; gas price 0; finality 32 blocks, partitioned during steps [100, 200)") in captured.out
 
 
 @pytest.mark.parametrize("lines, words", [

@@ -261,7 +261,7 @@ def test_a_stop_held_across_a_fork_is_raised_after_the_fork_not_dropped_in_its_h
 
 # The console script's own two lines (pyproject's [project.scripts]), after a finder that stops the start-up
 # in the middle of the imports, just before the module named on its command line is imported, and says so.
-_START_SCRIPT = """
+_START_SCRIPT = f"""
 import os, sys, time
 
 MODULE = sys.argv[1]
@@ -271,14 +271,14 @@ class Pause:
         if name == MODULE:
             sys.meta_path.remove(self)
             os.write(1, b"importing " + name.encode() + b"\\n")
-            time.sleep(%r)  # the signal comes meanwhile
+            time.sleep({HANG!r})  # the signal comes meanwhile
         return None
 
 sys.meta_path.insert(0, Pause())
 sys.argv[1:] = ["list"]
 from infomarket_entry import main
 sys.exit(main())
-""" % HANG
+"""
 
 
 def test_the_console_script_is_the_light_entry():
@@ -304,23 +304,23 @@ def test_a_stop_during_the_start_up_imports_ends_the_command_with_one_line(procs
     assert (proc.returncode, err, out) == (128 + sig, "infomarket: error: interrupted\n", "")
 
 
-_STRAY_SCRIPT = """
+_STRAY_SCRIPT = f"""
 import os, subprocess, sys, time
 from infomarket import interrupts
 
 with interrupts.handling():
-    started = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(%r)"], stdout=subprocess.DEVNULL,
+    started = subprocess.Popen([sys.executable, "-c", "import time; time.sleep({HANG!r})"], stdout=subprocess.DEVNULL,
                                stderr=subprocess.DEVNULL)  # a program the command started: not its to end
     pid = os.fork()
     if pid == 0:  # a fork that nothing registered (a pool worker whose start a stop cut short)
         null = os.open(os.devnull, os.O_WRONLY)
         os.dup2(null, 1)
         os.dup2(null, 2)
-        time.sleep(%r)
+        time.sleep({HANG!r})
         os._exit(0)
     print(pid, started.pid, flush=True)
     interrupts.exit_now(130)
-""" % (HANG, HANG)
+"""
 
 
 def test_a_stopped_command_leaves_no_fork_of_itself_behind(procs):

@@ -6,6 +6,8 @@ import re
 import shutil
 from pathlib import Path
 
+from .procs import Procs
+
 ROOT = Path(__file__).resolve().parents[1]
 MODEL = ROOT / "docs" / "model.md"
 #: Spelled in pieces so that this file does not match itself.
@@ -16,7 +18,6 @@ OUTSIDE = ("MODEL" + ".md", ".." + "/shared", "/work" + "/shared")
 #: ``.ci/run`` is the CI harness's entry point (a comment on how CI lays out its checkout), not the
 #: project's; the project must not depend on what it mentions.
 STILL_ALLOWED: frozenset = frozenset()
-from .procs import Procs
 
 CITATION = re.compile(r"docs/model\.md §(\d+)(?:\s*[-–]\s*§?(\d+))?")
 SECTION = re.compile(r"^## (\d+)\. \S", re.MULTILINE)

@@ -2,7 +2,6 @@
 exit code 2 (no traceback, nothing written outside the output folder), or the documented result."""
 import json
 import os
-from pathlib import Path
 
 import pytest
 
@@ -113,7 +112,8 @@ SWARM = {"steps": 40, "swarm": {"robots": 2, "groups": [{"behaviour": "naive", "
                                          ({"steps": 1.5}, "steps must be a positive integer"),
                                          ({"history_every": -3}, "history_every must be an integer in [0, steps = 40]"),
                                          ({"history_every": 2.5}, "history_every must be an integer"),
-                                         ({"history_every": 41}, "history_every must be an integer in [0, steps = 40]")])
+                                         ({"history_every": 41},
+                                          "history_every must be an integer in [0, steps = 40]")])
 def test_simulate_refuses_impossible_lengths(kw, fragment):
     import infomarket as im
 
@@ -211,7 +211,8 @@ def test_a_folder_named_like_a_shipped_suite_does_not_hide_it(tmp_path, monkeypa
     monkeypatch.chdir(tmp_path)
     (tmp_path / "future").mkdir()  # what `infomarket sweep future --out future` wrote before
     got = {}
-    monkeypatch.setattr(runner_cli, "_execute", lambda exps, args, label: got.setdefault("names", [e.name for e in exps]) and 0)
+    monkeypatch.setattr(runner_cli, "_execute",
+                        lambda exps, args, label: got.setdefault("names", [e.name for e in exps]) and 0)
     assert main(["sweep", "future", "--out", "future", "--quiet"]) == 0
     assert got["names"] == ["future_honest", "future_liar", "future_farmer", "future_surfer"]
 

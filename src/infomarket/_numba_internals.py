@@ -37,7 +37,8 @@ def check_version(version: str) -> None:
     try:
         major_minor = tuple(int(p) for p in version.split(".")[:2])
     except ValueError:
-        raise UnsupportedNumba(f"numba {version}: cannot read the version; infomarket supports {_range_text()}") from None
+        raise UnsupportedNumba(f"numba {version}: cannot read the version; "
+                               f"infomarket supports {_range_text()}") from None
     low, high = SUPPORTED
     if not low <= major_minor < high:
         raise UnsupportedNumba(f"numba {version} is not supported: infomarket supports {_range_text()} "

@@ -37,9 +37,9 @@ register_payment("outlier", schemes.outlier_weights,
                  limits={"theta": _ANGLE})
 
 # The paper's open questions (docs/research.md): rules that read the ledger's reputation record.
-from .behaviours import reputation  # noqa: E402
-from .payments import adaptive  # noqa: E402
-from .payments import distinct  # noqa: E402
+from .behaviours import reputation  # noqa: E402 - here: rules register in this order
+from .payments import adaptive  # noqa: E402 - here: rules register in this order
+from .payments import distinct  # noqa: E402 - here: rules register in this order
 
 register_behaviour("reputation_sceptic", buy=reputation.reputation_sceptic_buy, sell="naive", honest=True,
                    needs_neighbours=True,
@@ -74,7 +74,7 @@ register_payment("adaptive_outlier", adaptive.adaptive_outlier_weights,
                          "theta_min": _ANGLE})
 
 # The parameterised attack family, the threats the hand-written set lacked, and continuous trust.
-from .behaviours import attacks, weighted  # noqa: E402
+from .behaviours import attacks, weighted  # noqa: E402 - here: rules register in this order
 
 _UNIT = ("in [0, 1]", lambda v: 0 <= v <= 1)
 _ANGLE = ("in [0, 180]", lambda v: 0 <= v <= 180)
@@ -114,7 +114,7 @@ register_behaviour("reputation_weighted", buy=weighted.reputation_weighted_buy, 
                    limits={"power": (">= 0", lambda v: v >= 0)})
 
 # Robust buyers: a robust combination of the last purchases from distinct sellers (docs/defences.md).
-from .behaviours import robust  # noqa: E402
+from .behaviours import robust  # noqa: E402 - here: rules register in this order
 
 _ROBUST = {"vectors": (">= 1", lambda v: v >= 1), "power": (">= 0", lambda v: v >= 0),
            "horizon": (">= 0", lambda v: v >= 0)}
@@ -129,7 +129,7 @@ register_behaviour("robust_geometric", buy=robust.robust_geometric_buy, sell="na
                    limits={**_ROBUST, "iterations": (">= 0", lambda v: v >= 0)})
 
 # Market-side rules that give back or keep each seller's stake at settlement (docs/defences.md).
-from .payments import consensus  # noqa: E402
+from .payments import consensus  # noqa: E402 - here: rules register in this order
 
 register_payment("consensus_slash", consensus.consensus_slash_weights,
                  description="a record d degrees from its site's settled consensus (medoid) loses min(1, d / "

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import dataclasses
 import traceback
+from typing import Any
 
 import numba
 import numpy as np
@@ -54,7 +55,7 @@ def _with_bounds_check(py):
     if py not in _BOUNDS_CHECKED:
         try:
             _BOUNDS_CHECKED[py] = njit(boundscheck=True)(py)
-        except Exception:  # noqa: BLE001
+        except Exception:  # noqa: BLE001 - where it does not compile here, the runs report it
             _BOUNDS_CHECKED[py] = None
     return _BOUNDS_CHECKED[py]
 
@@ -86,7 +87,7 @@ def _behaviour_bounds_checked(name: str, cfg, seed: int, steps: int, kinds) -> N
                 except (IndexError, ZeroDivisionError) as exc:
                     # plain Python on the world's arrays names the line
                     raise CheckFailed(f"behaviour {name!r}: its {role} rule "
-                                      + _located(exc, py, lambda: py(w, *args, *extra))) from None
+                                      + _located(exc, py, lambda: py(w, *args, *extra))) from None  # noqa: B023 - called at once
 
 
 def _kernel_kinds(name: str, alongside) -> tuple[str, ...]:
@@ -176,7 +177,7 @@ def _bounds_checked(name: str, events: list, robots: int, stake: float) -> None:
     py = rule.py_func
     try:
         checked = njit(boundscheck=True)(py)
-    except Exception:  # not a compilable function: the ordinary replay reports it
+    except Exception:  # noqa: BLE001 - not a compilable function: the ordinary replay reports it
         return
 
     def ledger_with(func) -> Ledger:
@@ -226,13 +227,14 @@ def check_payment(name: str, *, robots: int = 6, sequences: int = 30, seed: int 
 
 # ------------------------------------------------------------------ explaining a run that failed
 #: What each kind of rule returns, for messages, and how many values (None: nothing).
-_RETURNS = {"sell": (4, "(valid, x, y, age)"), "buy": (None, "nothing"), "weights": (None, "nothing (it fills weights)")}
+_RETURNS = {"sell": (4, "(valid, x, y, age)"), "buy": (None, "nothing"),
+            "weights": (None, "nothing (it fills weights)")}
 
 
-def _config_rules(cfg, kinds) -> list[tuple[str, str, object, object]]:
+def _config_rules(cfg, kinds) -> list[tuple[str, str, Any, Any]]:
     """(owner, role, Rule, spec) of every rule a run of ``cfg`` calls: each behaviour's sell and buy
     rules (in kind order), then the scheme's weight rule."""
-    out = []
+    out: list[tuple[str, str, Any, Any]] = []
     for role in ("sell", "buy"):  # the step's order: every offer, then every purchase
         for name in kinds:
             spec = get_behaviour(name)
@@ -299,7 +301,7 @@ def explain_run_failure(cfg, seed: int, exc: BaseException, step: int, *, record
                 rule.func(*args)
             except type(exc) as again:
                 py = rule.py_func
-                at = _where_line(py, lambda: py(*plain))
+                at = _where_line(py, lambda: py(*plain))  # noqa: B023 - called at once
                 what = "sell" if role == "sell" else "buy" if role == "buy" else "weight"
                 return (f"{owner}: its {what} rule {py.__name__} raised {type(exc).__name__} "
                         f"({_short(again)}) at step {step} ({label}), at {at}")
@@ -324,7 +326,10 @@ def explain_compile_failure(cfg, exc: BaseException) -> str | None:
     from .engine.world import kernel_view
 
     class _Probe:  # the few attributes _calls reads
-        pass
+        rng: np.random.Generator
+        kinds: tuple[str, ...]
+        world: Any
+        _view: Any
 
     try:
         probe = _Probe()
@@ -332,7 +337,7 @@ def explain_compile_failure(cfg, exc: BaseException) -> str | None:
         probe.kinds = behaviour_kinds(cfg)
         probe.world, _ = build_world(cfg, probe.rng, record_events=False, history_every=0)
         probe._view = kernel_view(probe.world)
-    except Exception:  # noqa: BLE001
+    except Exception:  # noqa: BLE001 - a repeat that cannot start: the run's last step is the best known
         return None
     w = probe.world
     for owner, role, rule, spec in _config_rules(cfg, probe.kinds):
@@ -354,7 +359,7 @@ def explain_compile_failure(cfg, exc: BaseException) -> str | None:
             sig = tuple(numba.typeof(a) for a in args)
             rule.func.compile(sig)
             ret = rule.func.overloads[sig].signature.return_type
-        except Exception as failed:  # noqa: BLE001
+        except Exception as failed:  # noqa: BLE001 - any error compiling the rule alone is the rule's, reported by name
             lines = [ln for ln in str(failed).splitlines() if ln.strip() and "During:" not in ln]
             return f"{owner}: its {what} {py.__name__} ({where}) does not compile: " + " | ".join(lines[:6])
         count, shape = _RETURNS[role]
@@ -427,7 +432,7 @@ def _first_flagged_step(cfg, sim) -> int:
     its call before the host reads the bits, so the run is repeated one step at a time up to there."""
     try:
         again = Simulation(cfg, sim.seed, record_events=bool(sim.world.record))
-    except Exception:  # noqa: BLE001
+    except Exception:  # noqa: BLE001 - a repeat that cannot start: the run's last step is the best known
         return sim.clock
     try:
         while again.clock < sim.clock:

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import sys
 import warnings
+from typing import TextIO
 
 EXIT_USAGE = 2
 EXIT_FAILED = 1
@@ -82,7 +83,8 @@ def report(error: str | BaseException, code: int | None = None) -> int:
     return code
 
 
-def show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+def show_warning(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+                 file: TextIO | None = None, line: str | None = None) -> None:
     """``warnings.showwarning`` for the command line: a ``ConfigWarning`` as ``infomarket: warning: ...``
     (one line, no source location); any other warning as Python prints it."""
     out = sys.stderr if file is None else file

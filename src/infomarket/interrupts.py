@@ -20,7 +20,8 @@ fails, and each has its own remedy here, none of which waits for or guesses at a
   and let through again only once the fork has returned to its caller: at-fork hooks drop exceptions.
 
 A stretch that an exception must not land in (DuckDB's import aborts when one does) runs in ``held()``,
-whose end raises a stop that came meanwhile.  The request to stop is sticky: ``check`` raises again at the safe points (after each kernel call, after
+whose end raises a stop that came meanwhile.  The request to stop is sticky: ``check`` raises again at the safe
+points (after each kernel call, after
 each finished task), so a ``KeyboardInterrupt`` lost anyway (raised inside a finalizer, say) cannot let a
 command run on.  SIGTERM takes the same path as Ctrl-C (finished work kept, the resume command printed)
 and exits with 143 instead of 130.
@@ -455,7 +456,7 @@ def wait_for(call: Callable[[], T], cancel: Callable[[], object]) -> T:
         thread = threading.Thread(target=work, daemon=True, name="infomarket-wait")
         thread.start()
         thread.join()  # a plain lock wait, which a signal interrupts cleanly
-    except BaseException as exc:
+    except BaseException as exc:  # noqa: BLE001 - the wait is cancelled, then raised again as a stop
         with contextlib.suppress(Exception):
             cancel()
         raise_stopped(exc)

@@ -51,6 +51,8 @@ def _load(entry: str) -> None:
         if name in sys.modules:
             return
         spec = importlib.util.spec_from_file_location(name, path)
+        if spec is None or spec.loader is None:
+            raise PluginError(f"{entry} cannot be loaded as a Python module")
         module = importlib.util.module_from_spec(spec)
         sys.modules[name] = module
         try:

@@ -14,7 +14,7 @@ import inspect
 import math
 import re
 from dataclasses import dataclass, field
-from typing import Callable
+from collections.abc import Callable
 
 from ._numba_internals import CPUDispatcher
 from .compiled_cache import in_package
@@ -45,8 +45,22 @@ class Rule:
         return getattr(self.func, "py_func", self.func)
 
 
+class _Limited:
+    """A rule's spec whose parameters have limits: ``check`` says why a value is not allowed."""
+
+    limits: dict[str, tuple[str, Callable[[float], bool]]]
+
+    def check(self, name: str, value: float) -> str | None:
+        """Why ``value`` is not allowed for parameter ``name``, or None."""
+        if name in self.limits:
+            text, ok = self.limits[name]
+            if not ok(value):
+                return f"must be {text}"
+        return None
+
+
 @dataclass(frozen=True)
-class BehaviourSpec:
+class BehaviourSpec(_Limited):
     """A robot behaviour: what it buys (and how it uses it) and what it sells."""
 
     name: str
@@ -64,25 +78,15 @@ class BehaviourSpec:
     #: the step does not call it for one.  Off, it is called for every robot out of cooldown every step.
     needs_neighbours: bool = False
 
-    def check(self, name: str, value: float) -> str | None:
-        """Why ``value`` is not allowed for parameter ``name``, or None."""
-        if name in self.limits:
-            text, ok = self.limits[name]
-            if not ok(value):
-                return f"must be {text}"
-        return None
-
 
 @dataclass(frozen=True)
-class PaymentSpec:
+class PaymentSpec(_Limited):
     """A payment scheme: how the shared reward (plus stakes) is split among a round trip's sellers."""
 
     name: str
     weights: Rule
     description: str = ""
     limits: dict[str, tuple[str, Callable[[float], bool]]] = field(default_factory=dict)
-
-    check = BehaviourSpec.check
 
     @property
     def params(self) -> tuple[str, ...]:
@@ -187,7 +191,8 @@ def register_behaviour(name: str, *, buy: Callable | str, sell: Callable | str, 
     ``buy(w, me, nbrs, *params)`` buys from the neighbours ``nbrs`` (ids, increasing) and installs what it
     buys; ``sell(w, me, site, *params) -> (valid, x, y, age)`` is the offer for ``site`` (0 food, 1 nest)
     in the seller's own frame.  A rule whose first argument after the fixed ones is named ``rng`` gets
-    the run's numpy Generator there (so a random rule stays reproducible from the run's seed).  ``honest`` says whether robots of this behaviour count as honest in the
+    the run's numpy Generator there (so a random rule stays reproducible from the run's seed).  ``honest`` says
+    whether robots of this behaviour count as honest in the
     metrics (Byzantine otherwise).  ``limits`` maps a parameter to ``(text, predicate)``, e.g.
     ``{"threshold": ("> 0", lambda v: v > 0)}``: configurations breaking it are rejected with the text.
     ``paths=True`` says the rules buy or install waypoint paths (``behaviours.paths``); runs with such a
@@ -209,11 +214,11 @@ def register_behaviour(name: str, *, buy: Callable | str, sell: Callable | str, 
     sell_rule = _BEHAVIOURS[sell].sell if isinstance(sell, str) else _rule(sell, SELL_ARGS, "sell rule")
     params: list[str] = []
     defaults: dict[str, float] = {}
-    for r in (buy_rule, sell_rule):
-        for p in r.params:
+    for rule in (buy_rule, sell_rule):
+        for p in rule.params:
             if p not in params:
                 params.append(p)
-        for k, v in r.defaults.items():
+        for k, v in rule.defaults.items():
             if k in defaults and defaults[k] != v:
                 raise RegistrationError(f"behaviour {name!r}: rules disagree on the default of {k!r}")
             defaults[k] = v

@@ -14,8 +14,8 @@ import numpy as np
 import pandas as pd
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
-from infomarket.cli import main  # noqa: E402  (after the repository is on the path)
-from tests.analysis.synthetic import _runs, paper_like, write_store  # noqa: E402
+from infomarket.cli import main  # after the repository is on the path
+from tests.analysis.synthetic import _runs, paper_like, write_store
 
 OUT = Path(sys.argv[1]) if __name__ == "__main__" else None
 STORES = Path(sys.argv[2]) if len(sys.argv) > 2 and "/" in sys.argv[2] else Path("/tmp/infomarket-report-stores")
@@ -30,7 +30,8 @@ def run():
     if "headline" in what:
         for name, kw in (("paper", {}), ("equal", {"honest_richer": False})):
             st = STORES / name
-            if not st.exists(): write_store(st, paper_like(**kw))
+            if not st.exists():
+                write_store(st, paper_like(**kw))
             assert main(["figures", str(st), "--out", str(fresh(OUT / f"figures-{name}")), "--quiet"]) == 0
     if "future" in what:
         from tests.analysis import test_future as tf
@@ -45,7 +46,9 @@ def run():
         from infomarket.analysis import chain_study as cs
         for shift in (0.0, 15.0):
             d = STORES / f"chain-{shift:g}"
-            if not d.exists(): d.mkdir(parents=True); tc._write(d, shift)
+            if not d.exists():
+                d.mkdir(parents=True)
+                tc._write(d, shift)
             assert main(["chain-study", str(d / "store"), "--out", str(fresh(OUT / f"chain-cli-{shift:g}"))]) == 0
         # in-memory: every question with data
         rng = np.random.default_rng(8)
@@ -65,9 +68,11 @@ def run():
         from tests.terrain.test_report import _small
         root = STORES / "terrain"
         if not root.exists():
-            tmp = STORES / "terrain-toml"; tmp.mkdir(parents=True, exist_ok=True)
+            tmp = STORES / "terrain-toml"
+            tmp.mkdir(parents=True, exist_ok=True)
             for name in ("corridor", "two_food", "crowd"):
-                assert main(["sweep", str(_small(name, tmp)), "--runs", "2", "--out", str(root / name), "--workers", "1", "--quiet"]) == 0
+                assert main(["sweep", str(_small(name, tmp)), "--runs", "2", "--out", str(root / name),
+                             "--workers", "1", "--quiet"]) == 0
         assert main(["terrain-report", str(root), "--out", str(fresh(OUT / "terrain"))]) == 0
     if "sens" in what:
         from tests.analysis import test_sensitivity as ts
@@ -75,7 +80,8 @@ def run():
         sm.PAWN_PERMUTATIONS = 20
         st = STORES / "sens"
         if not st.exists():
-            st.mkdir(parents=True); ts.sweep(st, "sobol", 128)
+            st.mkdir(parents=True)
+            ts.sweep(st, "sobol", 128)
         assert main(["sensitivity", str(st / "store-sobol"), "--out", str(fresh(OUT / "sens"))]) == 0
         assert main(["figures", str(st / "store-sobol"), "--out", str(fresh(OUT / "sens-figures")), "--quiet"]) == 0
         st2 = STORES / "shipped-sens"

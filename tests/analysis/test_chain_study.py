@@ -30,7 +30,8 @@ def paper_runs(rng, n=24, shift=0.0, settings=("toychain",)) -> pd.DataFrame:
     frames = []
     for payment in ("outlier", "staking"):
         for k in (1, 3, 5):
-            frames.append(_rows(cs.PAPER, n, rng, centre=2.0 * k, sd=0.5, chain="instant", payment=payment, byzantines=k))
+            frames.append(_rows(cs.PAPER, n, rng, centre=2.0 * k, sd=0.5, chain="instant", payment=payment,
+                                byzantines=k))
             for s in settings:
                 frames.append(_rows(cs.PAPER, n, rng, centre=2.0 * k + shift, sd=0.5, chain=s, payment=payment,
                                     byzantines=k))
@@ -52,7 +53,8 @@ def fig7_runs(rng, n=24, gain=60.0, experiment=cs.FIG7, settings=("instant", "to
 # ------------------------------------------------------------------------------------------ per run
 def test_per_run_by_hand():
     # one run, 4 robots: shares 0.4, 0.3 honest, 0.2, 0.1 Byzantine; items 3, 2, 1, 0
-    robots = pd.DataFrame({"experiment": "chain_paper", "condition": "c", "run": 0, "honest": [True, True, False, False],
+    robots = pd.DataFrame({"experiment": "chain_paper", "condition": "c", "run": 0,
+                           "honest": [True, True, False, False],
                            "wealth_share": [0.4, 0.3, 0.2, 0.1], "items_collected": [3, 2, 1, 0],
                            "chain": "toychain", "payment": "staking", "byzantines": 2})
     r = cs.per_run(robots).iloc[0]
@@ -107,7 +109,8 @@ def test_fig7_yes_no_inconclusive():
 def test_fig7_gain_margin_comes_from_the_instant_ledger():
     # instant no-staking median 250 -> d = 25: a true gain of 40 on the chain helps, is not "below d"
     rng = np.random.default_rng(7)
-    runs = pd.concat([fig7_runs(rng, gain=0.0, settings=("instant",)), fig7_runs(rng, gain=40.0, settings=("toychain",))])
+    runs = pd.concat([fig7_runs(rng, gain=0.0, settings=("instant",)),
+                      fig7_runs(rng, gain=40.0, settings=("toychain",))])
     assert cs._d(runs, DECL, 90.0) == pytest.approx(0.1 * np.median(
         runs[(runs.chain == "instant") & (runs.market == "no_staking") & (runs.rotation_angle == 90.0)]["items"]))
     assert cs.fig7_question(runs, DECL, "toychain").answer == st.YES
@@ -132,7 +135,8 @@ def test_breaks_at_the_smallest_breaking_period():
     v = cs.breaks_question(runs, DECL, "period")
     assert v.answer == st.YES and v.value == 50
     # the Fig. 7 half was not run below 50, so 50 is an upper bound of the smallest breaking period
-    assert v.note == "Fig. 7 not run at period 1, 5, 20, 50, 500; breaks at or below 50: a value below it is not fully run"
+    assert v.note == ("Fig. 7 not run at period 1, 5, 20, 50, 500; breaks at or below 50: a value below it is not "
+                      "fully run")
     # period 150 (toychain, from chain_paper) holds between the two broken values
     assert any(d.startswith("period 150 (toychain): holds") for d in v.details)
 
@@ -172,7 +176,8 @@ def _store_robots(rng, shift: float) -> pd.DataFrame:
             share[:20] = (1 - 5 * byz) / 20
             frames.append(pd.DataFrame({
                 "experiment": cs.PAPER, "condition": f"byzantines=5,chain={chain},payment=staking", "run": run,
-                "seed": np.uint64(100 + run), "robot": np.arange(25), "behaviour": ["sceptical"] * 20 + ["scaboteur"] * 5,
+                "seed": np.uint64(100 + run), "robot": np.arange(25),
+                "behaviour": ["sceptical"] * 20 + ["scaboteur"] * 5,
                 "honest": [True] * 20 + [False] * 5, "drift": 0.0, "items_collected": np.full(25, 3),
                 "wealth": share * 25, "wealth_share": share,
                 "byzantines": 5, "chain": chain, "payment": "staking"}))
@@ -184,14 +189,16 @@ def _write(tmp_path, shift):
     robots = _store_robots(np.random.default_rng(12), shift)
     parts = {}
     for cond, rows in robots.groupby("condition"):
-        runs = rows.groupby(["experiment", "condition", "run", "byzantines", "chain", "payment"], as_index=False)["seed"].first()
+        runs = rows.groupby(["experiment", "condition", "run", "byzantines", "chain", "payment"],
+                            as_index=False)["seed"].first()
         runs = runs.assign(config_hash="cafe", package_version="0.1.0", duration_s=0.1, steps=15000, transitory=0,
                            status="ok")
         parts[cond.replace(",", "_").replace("=", "-")] = (rows.reset_index(drop=True), runs, None)
     return write_store(tmp_path / "store", parts)
 
 
-@pytest.mark.parametrize("shift, expected", [(0.0, "yes (1 of 6 conditions run)"), (15.0, "no (1 of 6 conditions run)")])
+@pytest.mark.parametrize("shift, expected", [(0.0, "yes (1 of 6 conditions run)"),
+                                             (15.0, "no (1 of 6 conditions run)")])
 def test_cli_writes_answers_and_figure(tmp_path, capsys, shift, expected):
     # only Fig. 4C's condition is in the store (12 runs a ledger): +15 pp on the chain breaks it against
     # its 5 pp margin; without a shift it holds; either answer says it rests on 1 of the 6 conditions
@@ -235,7 +242,8 @@ def test_fig7_no_when_staking_helps_at_one_angle_only():
     runs = pd.concat([fig7_runs(rng, gain=60.0, angles=(45.0,)), fig7_runs(rng, gain=0.0, angles=(90.0,))])
     v = cs.fig7_question(runs, DECL, "toychain")
     assert v.answer == st.NO
-    assert any(d.startswith("45 deg: helps") for d in v.details) and any(d.startswith("90 deg: does NOT") for d in v.details)
+    assert any(d.startswith("45 deg: helps") for d in v.details)
+    assert any(d.startswith("90 deg: does NOT") for d in v.details)
 
 
 def partition_runs(rng, shift: float, col="byz_share", centre=4.0, sd=0.5, n=24) -> pd.DataFrame:
@@ -251,7 +259,8 @@ def test_partition_rules_once_its_runs_exist():
     # the Byzantines' share 10 pp higher with the partition (margin 5): who gets rich changes -> yes;
     # reorganised transactions 50 with it, 0 without -> forks that undo payments -> yes
     chain = partition_runs(rng, 50.0, col="reorganised_tx", centre=0.0, sd=0.0)
-    chain["reorganised_tx"] = chain["reorganised_tx"] + np.where(chain["partition"] == "on", rng.integers(0, 5, len(chain)), 0)
+    chain["reorganised_tx"] = chain["reorganised_tx"] + np.where(chain["partition"] == "on",
+                                                                 rng.integers(0, 5, len(chain)), 0)
     forks, rich = cs.partition_questions(partition_runs(rng, 10.0), chain, DECL)
     assert (forks.answer, rich.answer) == (st.YES, st.YES)
     # the same share with and without (equivalent within 5 pp) and no chain measures stored

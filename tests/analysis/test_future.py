@@ -184,7 +184,8 @@ def test_no_cost_needs_a_shown_margin_not_a_missing_difference():
     honest = robots["experiment"] == future.HONEST
     noise = {key: rng.integers(-80, 80) for key in robots.loc[honest, ["defence", "run"]].itertuples(index=False)}
     robots.loc[honest & (robots["robot"] == 0), "items_collected"] += [
-        noise[(d, r)] for d, r in robots.loc[honest & (robots["robot"] == 0), ["defence", "run"]].itertuples(index=False)]
+        noise[(d, r)]
+        for d, r in robots.loc[honest & (robots["robot"] == 0), ["defence", "run"]].itertuples(index=False)]
     a = dict(zip(*future.question_table(Frames(robots=robots))[["id", "answer"]].T.values))
     assert a["honest_cost_reputation_sceptic"] == future.INCONCLUSIVE
 

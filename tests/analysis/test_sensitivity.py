@@ -135,8 +135,9 @@ def test_the_command_writes_table_figures_and_report(sobol_store, tmp_path, caps
     assert {"sensitivity-known.csv", "sensitivity-known.parquet", "sensitivity-known-indices.png",
             "sensitivity-known-indices.svg", "sensitivity-known.md"} <= names
     table = pd.read_parquet(out / "sensitivity-known.parquet")
-    pd.testing.assert_frame_equal(table, pd.read_csv(out / "sensitivity-known.csv", keep_default_na=False, na_values={"conf": [""], "low": [""], "high": [""]}),
-                                  check_dtype=False)
+    csv = pd.read_csv(out / "sensitivity-known.csv", keep_default_na=False,
+                      na_values={"conf": [""], "low": [""], "high": [""]})
+    pd.testing.assert_frame_equal(table, csv, check_dtype=False)
     assert set(table["index"]) == {"S1", "ST", "PAWN", "PAWN_null"} and set(table.output) == {"honest_robots", "items"}
     assert "honest_robots" in capsys.readouterr().out
     rep = tmp_path / "rep"

@@ -49,7 +49,8 @@ def test_the_record_is_printed_whole_and_in_order(tmp_path):
 
 def test_a_file_without_a_record_says_so(tmp_path):
     (tmp_path / "q.toml").write_text(FILE.split("[[amendments]]")[0])
-    assert study.Declaration.read(tmp_path / "q.toml").record_markdown()[2] == "q.toml records none: the study ran as declared."
+    record = study.Declaration.read(tmp_path / "q.toml").record_markdown()
+    assert record[2] == "q.toml records none: the study ran as declared."
 
 
 @pytest.mark.parametrize("old, new, words", [
@@ -79,8 +80,8 @@ def test_the_record_is_no_declaration_for_the_lock_check(tmp_path):
     assert {lk.status for lk in d.locks({"q.toml": before})} == {ADDED}
 
 
-SHIPPED = {"chain": chain_study.DECLARATION, "terrain": terrain.DECLARATION, "sensitivity": sensitivity_report.DECLARATION,
-           "tolerances": TOLERANCES, "search": SEARCH}
+SHIPPED = {"chain": chain_study.DECLARATION, "terrain": terrain.DECLARATION,
+           "sensitivity": sensitivity_report.DECLARATION, "tolerances": TOLERANCES, "search": SEARCH}
 
 
 @pytest.mark.parametrize("name", SHIPPED)

@@ -49,7 +49,8 @@ def test_an_attacker_whose_reputation_gate_never_opens_is_an_honest_sceptic():
     ("colluder", {"rotation_angle": 30.0}, {"rot_base": 30.0, "collude": 1.0}),
     ("newcomer", {"rotation_angle": 30.0, "fresh_record": 4.0}, {"rot_base": 30.0, "fresh_record": 4.0}),
     ("selective_liar", {"rotation_angle": 30.0, "max_confirmers": 0.0}, {"rot_base": 30.0, "max_confirmers": 0.0}),
-    ("sceptic_surfer", {"rotation_angle": 90.0, "margin": 0.9}, {"rot_base": 90.0, "cap_theta": 0.9, "cap_sceptic": 0.9}),
+    ("sceptic_surfer", {"rotation_angle": 90.0, "margin": 0.9},
+     {"rot_base": 90.0, "cap_theta": 0.9, "cap_sceptic": 0.9}),
     ("tuned_farmer", {"rotation_angle": 90.0, "farm_reputation": 0.6, "farm_record": 3.0},
      {"rot_base": 90.0, "lie_from_rep": 0.6, "lie_min_record": 3.0}),
 ])
@@ -103,7 +104,7 @@ def test_the_selective_liar_lies_only_with_no_other_seller_in_range():
 
 def test_the_newcomer_withdraws_once_its_record_is_spent():
     spent = fresh = 0
-    for w, me, site, offer, own in _offers("newcomer", {"rotation_angle": 30.0, "fresh_record": 3.0}, steps=4000):
+    for w, me, _site, offer, own in _offers("newcomer", {"rotation_angle": 30.0, "fresh_record": 3.0}, steps=4000):
         if w.rep_settled[me] >= 3:
             assert not offer[0]
             spent += 1

@@ -26,7 +26,10 @@ def test_each_setup_is_reported_beside_the_floor_measured_in_the_same_run():
 
 def test_swarm_sizes_keep_the_papers_density_and_site_geometry():
     paper, big = scaled_config(25, 100), scaled_config(10000, 100)
-    area = lambda c: c.arena.width * c.arena.height  # noqa: E731
+
+    def area(c):
+        return c.arena.width * c.arena.height
+
     assert area(big) / 10000 == pytest.approx(area(paper) / 25)  # 28 800 square units per robot
     k = math.sqrt(10000 / 25)  # 20
     assert (big.food.x, big.food.y, big.food.radius) == pytest.approx((200 * k, 300 * k, 50 * k))

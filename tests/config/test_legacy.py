@@ -55,7 +55,8 @@ def test_explicit_zero_stake_and_delayed(tmp_path):
     assert cfg.payment.scheme == "delayed" and cfg.payment.stake == 0.0 and cfg.payment.initial_wealth == 3
 
 
-@pytest.mark.skipif(not REFERENCE, reason="INFOMARKET_REFERENCE_CONFIGS names no folder of original configuration files")
+@pytest.mark.skipif(not REFERENCE,
+                    reason="INFOMARKET_REFERENCE_CONFIGS names no folder of original configuration files")
 def test_every_reference_config_is_accepted():
     folder = Path(REFERENCE)
     assert folder.is_dir(), f"INFOMARKET_REFERENCE_CONFIGS={REFERENCE}: not a folder"

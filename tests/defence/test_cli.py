@@ -118,7 +118,8 @@ def test_the_same_study_on_dask_gives_the_same_frontier(inline, tmp_path):
 def _with_counts(tmp_path: Path, every_count: bool) -> list[str]:
     """TINY at 1 and 3 Byzantines, from a copy of tiny.toml with ``every_count`` set."""
     q = tmp_path / f"tiny-every-{every_count}.toml"
-    q.write_text(TINY_FILE.read_text().replace("seed = 5\n", f"seed = 5\nevery_count = {str(every_count).lower()}\n", 1))
+    q.write_text(TINY_FILE.read_text().replace("seed = 5\n", f"seed = 5\nevery_count = {str(every_count).lower()}\n",
+                                               1))
     args = list(TINY)
     args[args.index("--questions") + 1] = str(q)
     args[args.index("--byzantines") + 1] = "1,3"

@@ -51,7 +51,8 @@ def test_the_existing_defences_name_is_reserved():
 
 def _theta_family():
     return parse_family("theta", {"set": {"swarm.groups[0].behaviour": "sceptical", "payment.scheme": "outlier"},
-                                  "params": {"theta": {"paths": ["payment.params.theta", "swarm.groups[1].params.theta"],
+                                  "params": {"theta": {"paths": ["payment.params.theta",
+                                                                 "swarm.groups[1].params.theta"],
                                                        "low": 10, "high": 40, "default": 30}}}, "q.toml")
 
 

@@ -25,7 +25,6 @@ from pathlib import Path
 import numpy as np
 
 import infomarket as im
-from infomarket.seeds import run_seed
 from infomarket.runner.plan import conditions
 
 FILE = Path(__file__).with_name("golden_digests.json")

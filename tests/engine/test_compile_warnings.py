@@ -12,9 +12,9 @@ def test_pedantic_warnings_are_silenced_while_compiling_and_others_are_not(monke
     with warnings.catch_warnings(record=True) as seen:
         warnings.simplefilter("always")
         with compile_notice(["naive"], "delayed", after=60.0):
-            warnings.warn("variable 'x.1' is not in scope", NumbaIRAssumptionWarning)
-            warnings.warn("a loop was not vectorised", NumbaPerformanceWarning)
-        warnings.warn("after the compile", NumbaIRAssumptionWarning)
+            warnings.warn("variable 'x.1' is not in scope", NumbaIRAssumptionWarning, stacklevel=1)
+            warnings.warn("a loop was not vectorised", NumbaPerformanceWarning, stacklevel=1)
+        warnings.warn("after the compile", NumbaIRAssumptionWarning, stacklevel=1)
     assert [str(w.message).split("\n")[0] for w in seen] == ["a loop was not vectorised", "after the compile"]
 
 
@@ -23,6 +23,6 @@ def test_quiet_compiles_are_silenced_too(monkeypatch):
     with warnings.catch_warnings(record=True) as seen:
         warnings.simplefilter("always")
         with compile_notice(["naive"], "delayed"):
-            warnings.warn("variable 'x.1' is not in scope", NumbaIRAssumptionWarning)
+            warnings.warn("variable 'x.1' is not in scope", NumbaIRAssumptionWarning, stacklevel=1)
     assert seen == []
 

@@ -7,14 +7,14 @@ from scipy import stats
 
 from infomarket.engine import step
 from infomarket.engine.step import variant
-
-K = step
-P = variant(terrain=False, paths=False)  # the paper's plane
 from infomarket.engine.params import cauchy_cdf, guide_table, levy_cdf
 from infomarket.engine.neighbours import find_all_neighbours as find_neighbours
 from infomarket.engine.world import EXPLORING, FOOD, NEST, SEEKING_FOOD, headings
 
 from ..conftest import Handle, make_config
+
+K = step
+P = variant(terrain=False, paths=False)  # the paper's plane
 
 
 def test_neighbours_strict_range_and_id_order():

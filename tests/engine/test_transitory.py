@@ -1,6 +1,5 @@
 """Which deposits count: the transitory boundary, pinned to the original simulator's rule."""
 import numpy as np
-import pytest
 
 import infomarket as im
 

@@ -22,7 +22,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))  # a script: the checkout's tests package, for its one way to start a process
-from tests.procs import Procs  # noqa: E402
+from tests.procs import Procs  # noqa: E402 - after the checkout is on the path
 
 SOURCE = ROOT / "contracts" / "InformationMarket.sol"
 COMPILER = ROOT / "tools" / "solc" / "compile.js"
@@ -46,7 +46,8 @@ MUTANTS = [
      ["test_only_a_depositor", "test_only_registrars_approve", "test_the_admin_rotates"]),
     ("signature s is low", "uint256(s) > _HALF_ORDER",
      ["test_a_malleated_high_s_signature", "test_a_deposit_needs_the_robots"]),
-    ("seller vector in range", "dx >= _MAX_COMPONENT || dx <= -_MAX_COMPONENT || dy >= _MAX_COMPONENT || dy <= -_MAX_COMPONENT",
+    ("seller vector in range",
+     "dx >= _MAX_COMPONENT || dx <= -_MAX_COMPONENT || dy >= _MAX_COMPONENT || dy <= -_MAX_COMPONENT",
      ["test_malformed_site_and_vector_out_of_range"]),
     ("records per seller bounded", "n >= _maxRecordsPerSeller",
      ["test_one_seller_cannot_fill"]),
@@ -80,7 +81,8 @@ MUTANTS = [
      ["test_the_trip_bound_and_the_batch_bound"]),
     ("stake expiry never off", "stakeExpiry_ == 0", ["test_the_trip_bound_and_the_batch_bound"]),
     ("settlement deadline never off", "settlementDeadline_ == 0", ["test_the_trip_bound_and_the_batch_bound"]),
-    ("registrar threshold within the registrars", "registrarThreshold_ == 0 || registrarThreshold_ > registrars_.length",
+    ("registrar threshold within the registrars",
+     "registrarThreshold_ == 0 || registrarThreshold_ > registrars_.length",
      ["test_the_trip_bound_and_the_batch_bound"]),
     ("registrar quota never 0", "registrarQuota_ == 0", ["test_the_trip_bound_and_the_batch_bound"]),
     ("registrar period never 0", "registrarPeriod_ == 0", ["test_the_trip_bound_and_the_batch_bound"]),
@@ -106,7 +108,8 @@ MUTANTS = [
 
 #: (the rule broken, text replaced, its wrong replacement, tests that must then fail)
 REWRITES = [
-    ("weights from the committed vector", "(int64 dx, int64 dy) = _sellerVector(info.x, info.y, lc.sellerX, lc.sellerY);",
+    ("weights from the committed vector",
+     "(int64 dx, int64 dy) = _sellerVector(info.x, info.y, lc.sellerX, lc.sellerY);",
      "(int64 dx, int64 dy) = _sellerVector(info.x, info.y, 0, 0);",
      ["test_a_saboteurs_rotated_vector", "test_a_settlement_can_be_recomputed"]),
     ("similarity strictly within theta", "if (c >= 0) return d > 0 && lhs > rhs;",

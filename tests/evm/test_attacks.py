@@ -429,7 +429,8 @@ def test_the_client_needs_the_seller_position_and_caps_its_acceptances(make_mark
     from infomarket.evm.market import ChainMarket
     from infomarket.evm.protocol import ProtocolError
 
-    assert inspect.signature(ChainMarket.light_contract).parameters["seller_position"].default is inspect.Parameter.empty
+    signature = inspect.signature(ChainMarket.light_contract)
+    assert signature.parameters["seller_position"].default is inspect.Parameter.empty
     market = make_market("outlier", stake=0.04)
     market.max_acceptances_per_trip = 2
     seller, buyer = robots[1], robots[0]
@@ -447,7 +448,8 @@ def test_withholding_an_outlier_reveal_gains_at_most_the_stake(make_market, robo
     (outlier weighting, staking 0.04, share 0.5, 1 token = 10**9 units): against 6 honest sellers the
     outlier's reveal weighs 1 of 6 * 6 + 1 = 37 in a pot of 0.5 + 7 * 0.04 = 0.78, so revealing nets
     780_000_000 // 37 - 40_000_000 = -18_918_919 and withholding (net 0) gains 18_918_919 units, less
-    than the stake (against 10 honest sellers, as docs/chain.md computes, 0.031 token); against 3 honest sellers the reveal nets 660_000_000 // 10 - 40_000_000 = +26 000 000,
+    than the stake (against 10 honest sellers, as docs/chain.md computes, 0.031 token); against 3 honest sellers
+    the reveal nets 660_000_000 // 10 - 40_000_000 = +26 000 000,
     so withholding loses that."""
     outcome = {}
     for withhold in (False, True):

@@ -61,7 +61,7 @@ def test_a_dropped_reveal_is_caught_at_its_block(modelled):
     blocks = log.canonical()
     # a block with a reveal whose buyer does not deposit in the same block, its seller the only one
     # selling in that block, and no deposit paying the seller in it
-    for k, blk in enumerate(blocks):
+    for k, blk in enumerate(blocks):  # noqa: B007 - the block's index, read after the loop
         if len(blk.txs) == 1 and blk.txs[0].kind == "reveal":
             break
     else:

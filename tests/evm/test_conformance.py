@@ -61,8 +61,12 @@ def deposit(step, robot):
             "x": 0.0, "y": 0.0, "seller_x": 0.0, "seller_y": 0.0, "age": 0}
 
 
+#: The schemes the scenarios draw from: those without a cap.
+UNCAPPED = tuple(sorted(set(SCHEMES) - set(CAPS)))
+
+
 @st.composite
-def scenarios(draw, expiries=(0, 0, 3, 10), longest=1000, schemes=tuple(sorted(set(SCHEMES) - set(CAPS)))):
+def scenarios(draw, expiries=(0, 0, 3, 10), longest=1000, schemes=UNCAPPED):
     """(robots, scheme, wealth, expiry, events): hypothesis draws the sizes and a seed, the events
     come from the seed (1 000 operations drawn one by one would exceed hypothesis' data budget);
     most sequences are short, one in eight is long (up to ``longest`` operations)."""

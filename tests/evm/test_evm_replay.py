@@ -41,7 +41,8 @@ def test_replay_of_a_two_trip_log_matches_the_exact_ledger_within_the_rounding_b
     report = replay_on_chain(events, robots=4, params=MarketParams.from_floats("outlier", stake=0.04),
                              initial_wealth=1.0)
     assert report.conserved() and not report.disagreements
-    assert report.items == 4 and len(report.reveal_gas) == 6 and report.blocks_used == 3  # one block per step, steps 0 to 3
+    # one block per step, steps 0 to 3
+    assert report.items == 4 and len(report.reveal_gas) == 6 and report.blocks_used == 3
     assert report.rounding_bound == exact.bound
     rows = report.compare([float(b) for b in exact.balance])
     assert all(r.ok for r in rows), rows

@@ -90,7 +90,8 @@ def test_shares_follow_the_outlier_weights_and_the_stakes_are_shared(make_market
     assert [e["weight"] for e in shares] == [2, 2, 1, 1]
     amount = 500_000_000 + 4 * 40_000_000
     assert [e["amount"] for e in shares] == [amount * w // 6 for w in (2, 2, 1, 1)]
-    assert market.balance_of(buyer.address) == TOKEN_UNIT + TOKEN_UNIT + 160_000_000 - sum(amount * w // 6 for w in (2, 2, 1, 1))
+    assert market.balance_of(buyer.address) == (TOKEN_UNIT + TOKEN_UNIT + 160_000_000
+                                                - sum(amount * w // 6 for w in (2, 2, 1, 1)))
 
 
 @pytest.mark.parametrize(("theta", "a", "b", "expected"), [
@@ -225,7 +226,8 @@ def test_a_settlement_can_be_recomputed_from_the_logs_alone(make_market, robots)
 
     assert len({e["pathHash"] for e in revealed}) == len(revealed)  # each commitment is in its event
     weights = [sum(1 for o in revealed if o["site"] == e["site"]
-                   and min(abs(direction_of(o) - direction_of(e)) % 360, 360 - abs(direction_of(o) - direction_of(e)) % 360) < 30)
+                   and min(abs(direction_of(o) - direction_of(e)) % 360,
+                           360 - abs(direction_of(o) - direction_of(e)) % 360) < 30)
                for e in revealed]
     amount = 500_000_000 + bought["pot"]
     assert [e["weight"] for e in logged] == weights
@@ -293,7 +295,8 @@ def test_contract_reproduces_the_original_simulators_payments(case, vector_marke
         assert abs(chain[i] - expected * TOKEN_UNIT) <= exact.bound[i] + FLOAT_SLACK_UNITS
     pots = sum(market.locked_stake(robots[i].address) for i in range(n))
     bonds = sum(market.bond_of(a.address) for a in robots)  # every robot registered, each locked its bond
-    assert sum(chain) + pots + bonds == market.total_supply() == to_units(case["initial_wealth"]) * n + TOKEN_UNIT + bonds
+    assert sum(chain) + pots + bonds == market.total_supply() == (to_units(case["initial_wealth"]) * n + TOKEN_UNIT
+                                                                  + bonds)
 
 
 def test_the_cap_is_a_constructor_parameter_validated_like_the_others(chain, artifact, make_market):

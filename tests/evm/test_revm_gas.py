@@ -122,7 +122,7 @@ def test_every_kind_of_transaction_costs_the_same_gas_on_revm_as_on_py_evm(schem
     twin = Twin(f"{scheme}-{stake}", scheme, stake, [1.0] * (SELLERS - 1) + [0.0, 1.0, 0.0], settle_batch=8)
     poor, (buyer, other) = twin.sellers[-1], twin.buyers
     age = 0
-    for trip in range(2):
+    for _trip in range(2):
         for m, who in ((1, buyer), (3, other), (12, buyer)):
             for k in range(m):
                 direction = 100.0 if k == 2 else 10.0 + k  # one outlier in the larger trips

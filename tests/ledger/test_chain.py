@@ -339,7 +339,8 @@ def _run_conserving_money(sim, steps, robots=25):
         w = sim.world
         known: dict = {}
         for b in np.flatnonzero(w.blk_live):
-            assert arena.balances_after(w, b).sum() == pytest.approx(robots * W0 + R * _branch_deposits(w, int(b), known), abs=1e-9)
+            assert arena.balances_after(w, b).sum() == pytest.approx(
+                robots * W0 + R * _branch_deposits(w, int(b), known), abs=1e-9)
         assert w.balance.sum() + w.pot.sum() == pytest.approx(robots * W0 + R * int(w.rep_deposits.sum()), abs=1e-9)
         canon, cur = int(w.chn_canon[0]), int(w.state_block[0])
         assert w.blk_live[cur] and w.blk_state[cur] == w.blk_state[canon]

@@ -2,7 +2,8 @@
 
 The chain's own numbers are guarded like the paper's (``tests/engine/golden.py``): each case hashes the
 robots table, the event and payment logs, the wealth history and the chain's measures of one run bit for
-bit.  Work that only restructures the code or makes it faster must leave them alone.  A change that is meant to move the chain's numbers regenerates them (say why in the
+bit.  Work that only restructures the code or makes it faster must leave them alone.  A change that is meant to
+move the chain's numbers regenerates them (say why in the
 commit and in docs/chain-model.md)::
 
     python -m tests.ledger.test_chain_digest

@@ -71,7 +71,8 @@ def test_readers_compute_from_the_record():
 def test_money_is_the_sum_of_balances_through_a_run_with_fuel_and_staking():
     cfg = im.Experiment.model_validate({
         "steps": 3000, "robot": {"fuel_cost": 0.0001},
-        "swarm": {"robots": 25, "groups": [{"behaviour": "naive", "count": 20}, {"behaviour": "scaboteur", "count": 5}]},
+        "swarm": {"robots": 25, "groups": [{"behaviour": "naive", "count": 20},
+                                           {"behaviour": "scaboteur", "count": 5}]},
         "payment": {"scheme": "outlier", "stake": 0.04, "initial_wealth": 2.0}})
     sim = simulation(cfg, 4, record_events=True)  # on the rule checks' kernel: nothing new to compile
     res = sim.run()

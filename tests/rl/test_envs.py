@@ -8,13 +8,13 @@ import pytest
 pytest.importorskip("gymnasium")
 pytest.importorskip("pettingzoo")
 
-from gymnasium.utils.env_checker import check_env  # noqa: E402
-from pettingzoo.test import parallel_api_test, parallel_seed_test  # noqa: E402
+from gymnasium.utils.env_checker import check_env
+from pettingzoo.test import parallel_api_test, parallel_seed_test
 
-from infomarket.config import load_experiment  # noqa: E402
-from infomarket.engine.simulation import simulate  # noqa: E402
-from infomarket.errors import UsageError  # noqa: E402
-from infomarket.rl import AttackEnv, AttackParallelEnv, AttackVectorEnv  # noqa: E402
+from infomarket.config import load_experiment
+from infomarket.engine.simulation import simulate
+from infomarket.errors import UsageError
+from infomarket.rl import AttackEnv, AttackParallelEnv, AttackVectorEnv
 
 SMALL = dict(steps=300, transitory=100, interval=10)
 

@@ -8,10 +8,10 @@ import pytest
 pytest.importorskip("gymnasium")
 pytest.importorskip("pettingzoo")
 
-from infomarket.config import sizes  # noqa: E402
-from infomarket.errors import ArgumentError, InfomarketError, InputTypeError, UsageError  # noqa: E402
-from infomarket.rl import AttackEnv, AttackParallelEnv, AttackVectorEnv  # noqa: E402
-from infomarket.rl.envs import configured  # noqa: E402
+from infomarket.config import sizes
+from infomarket.errors import ArgumentError, InfomarketError, InputTypeError, UsageError
+from infomarket.rl import AttackEnv, AttackParallelEnv, AttackVectorEnv
+from infomarket.rl.envs import configured
 
 SMALL = dict(steps=60, transitory=20, interval=10)
 

@@ -11,12 +11,12 @@ import pytest
 gym = pytest.importorskip("gymnasium")
 pytest.importorskip("pettingzoo")
 
-from gymnasium.utils.env_checker import check_env  # noqa: E402
-from pettingzoo.test import parallel_api_test  # noqa: E402
+from gymnasium.utils.env_checker import check_env  # noqa: E402 - after the skip without the rl extra
+from pettingzoo.test import parallel_api_test  # noqa: E402 - after the skip without the rl extra
 
-from infomarket.errors import ConfigError, UsageError  # noqa: E402
-from infomarket.rl import ENV_ID, AttackEnv, AttackParallelEnv, AttackVectorEnv  # noqa: E402
-from infomarket.viewer import movie  # noqa: E402
+from infomarket.errors import ConfigError, UsageError  # noqa: E402 - after the skip without the rl extra
+from infomarket.rl import ENV_ID, AttackEnv, AttackParallelEnv, AttackVectorEnv  # noqa: E402 - after the skip without the rl extra
+from infomarket.viewer import movie  # noqa: E402 - after the skip without the rl extra
 
 SMALL = dict(steps=300, transitory=100, interval=10)
 

@@ -7,8 +7,8 @@ import pytest
 
 pytest.importorskip("stable_baselines3")
 
-from infomarket.config import load_experiment  # noqa: E402
-from infomarket.engine.simulation import simulate  # noqa: E402
+from infomarket.config import load_experiment
+from infomarket.engine.simulation import simulate
 
 EXAMPLE = Path(__file__).parents[2] / "examples" / "sb3_attack.py"
 ARGS = ["--timesteps", "128", "--steps", "1500", "--transitory", "300", "--interval", "30", "--eval-runs", "2"]

@@ -8,7 +8,6 @@ import pytest
 
 import infomarket as im
 from infomarket.cli import main
-from infomarket.errors import ConfigError
 from infomarket.runner.design import load, make_design
 from infomarket.runner.plan import conditions
 from infomarket.runner.sweep import run_sweep

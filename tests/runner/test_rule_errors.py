@@ -156,7 +156,7 @@ def test_a_weight_rule_raising_at_a_deposit_is_named_with_the_step(tmp_path, sha
     seed = int(Store(out).runs().seed.iloc[0])
     step = _first_paid_deposit(cfg, seed)
     at = f"{shared / 'divided.py'}:{line_of(shared / 'divided.py', 'weights[x] = 1.0 / k')}"
-    assert f"payment scheme 'divided': its weight rule divided raised ZeroDivisionError" in err
+    assert "payment scheme 'divided': its weight rule divided raised ZeroDivisionError" in err
     assert f"at step {step} (buyer " in err and at in err
 
 
@@ -165,7 +165,8 @@ def test_a_rule_returning_three_values_is_refused_before_anything_is_written(tmp
     out = tmp_path / "store"
     assert main(["sweep", exp, "--out", str(out), "--quiet"]) == 2
     err = one_message(capsys)
-    assert (f"behaviour 'three_values': its sell rule three_values_sell ({shared / 'three.py'}:{line_of(shared / 'three.py', '@im.behaviour')}) returns "
+    line = line_of(shared / "three.py", "@im.behaviour")
+    assert (f"behaviour 'three_values': its sell rule three_values_sell ({shared / 'three.py'}:{line}) returns "
             f"3 values") in err
     assert "a sell rule returns 4: (valid, x, y, age)" in err and "Cannot unify" not in err
     assert not out.exists()

@@ -39,7 +39,8 @@ PLANNED = (N + 2) * 2 + (2 + 4) * 2 + (2 * 3 + 2 * 3 + N * 2 + (N + 1) // 2 + 3)
 
 
 def _frames(out: Path) -> dict:
-    return {n: pd.read_parquet(out / "cells" / CELL / f"{n}.parquet") for n in ("candidates", "selection", "confirmation")}
+    return {n: pd.read_parquet(out / "cells" / CELL / f"{n}.parquet")
+            for n in ("candidates", "selection", "confirmation")}
 
 
 def _same_frames(a: Path, b: Path) -> None:
@@ -104,8 +105,8 @@ def test_the_store_records_the_questions_file_and_the_first_run_time(inline):
     assert meta["questions_sha256"] == hashlib.sha256(study.QUESTIONS.read_bytes()).hexdigest()
     assert meta["questions_commit"] is None or len(meta["questions_commit"]) == 40
     first = datetime.datetime.strptime(meta["first_run_utc"], "%Y-%m-%dT%H:%M:%SZ")
-    assert first <= datetime.datetime.now(datetime.timezone.utc).replace(tzinfo=None)
-    assert first >= datetime.datetime.now(datetime.timezone.utc).replace(tzinfo=None) - datetime.timedelta(hours=2)
+    assert first <= datetime.datetime.now(datetime.UTC).replace(tzinfo=None)
+    assert first >= datetime.datetime.now(datetime.UTC).replace(tzinfo=None) - datetime.timedelta(hours=2)
 
 
 def test_a_second_search_into_another_store_is_the_same_bit_for_bit(inline, tmp_path):

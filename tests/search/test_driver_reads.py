@@ -33,7 +33,10 @@ def test_a_race_stage_counts_only_its_new_runs(tmp_path):
     store = Store(tmp_path / "s")
     run = driver.store_runner(store)
     ev = driver._Evaluator(st, cell, store, run, 60, 20)
-    cond = lambda runs: ev.condition({}, "selection", "baseline", -1, -1, -1, "x", runs, 11)  # noqa: E731
+
+    def cond(runs):
+        return ev.condition({}, "selection", "baseline", -1, -1, -1, "x", runs, 11)
+
     first = ev.evaluate([cond(2)])[0]
     assert run([cond(2)]) == (0, 0)  # asked again: nothing new
     grown = ev.evaluate([cond(5)])[0]

@@ -20,7 +20,7 @@ from infomarket.search.study import load_declarations
 matplotlib.use("Agg")
 QUESTIONS = load_declarations()["questions"]
 N = 8
-I = np.arange(1, N + 1)
+IDX = np.arange(1, N + 1)
 
 
 @dataclass(frozen=True)
@@ -82,13 +82,13 @@ def search(defence, byz, *, worst, base, rand, extra=None, wealth=None):
 # cell A: per-seed loss 0.01 i (within 10 %); the search beats the best baseline by 1.0 + 0.1 i items on
 # seed i; against the random search it differs by +-0.2 (nothing shown, with power); the adaptive searcher
 # beats it by 0.5 + 0.05 i
-W_A = 10.0 - 0.1 * I
-A = search("staking", 1, worst=W_A, base=W_A + 1.0 + 0.1 * I, rand=W_A - 0.2 * (-1.0) ** I,
-           extra=W_A - 0.5 - 0.05 * I)
+W_A = 10.0 - 0.1 * IDX
+A = search("staking", 1, worst=W_A, base=W_A + 1.0 + 0.1 * IDX, rand=W_A - 0.2 * (-1.0) ** IDX,
+           extra=W_A - 0.5 - 0.05 * IDX)
 # cell B: per-seed loss 0.25 + 0.01 i (beyond 10 %); the search differs from the baseline by +-3 (too noisy
 # to decide) and from the random search by -(1.0 + 0.1 i)
-W_B = 7.5 - 0.1 * I
-B = search("staking", 3, worst=W_B, base=W_B - 3.0 * (-1.0) ** I, rand=W_B + 1.0 + 0.1 * I)
+W_B = 7.5 - 0.1 * IDX
+B = search("staking", 3, worst=W_B, base=W_B - 3.0 * (-1.0) ** IDX, rand=W_B + 1.0 + 0.1 * IDX)
 
 
 @pytest.fixture(scope="module")
@@ -124,7 +124,7 @@ def test_search_vs_best_baseline_and_random_search(analysis):
     rnd = a["search_beats_random"]
     assert rnd["hl"] == pytest.approx(0.0) and not rnd["significant"]
     assert rnd["power"] == 1.0 and rnd["answer"] == "no"
-    assert rnd["declared"] == pytest.approx(-0.1 * np.median(W_A + 0.2 * (-1.0) ** I))
+    assert rnd["declared"] == pytest.approx(-0.1 * np.median(W_A + 0.2 * (-1.0) ** IDX))
     # cell B: +-3 noise, the same declared effect cannot be seen often: inconclusive, not "no"
     nb = b["search_beats_baseline"]
     assert nb["power"] < 0.8 and nb["answer"] == "inconclusive"
@@ -182,7 +182,7 @@ def test_the_objective_liar_wealth_compares_the_liars_wealth():
     # items equal everywhere; the search's liars gain 0.01 i more wealth share than the baseline's
     flat = np.full(N, 9.0)
     cell = search("outlier", 3, worst=flat, base=flat, rand=flat,
-                  wealth={"cma_best": 0.3 + 0.01 * I, "base_best": np.full(N, 0.3), "rnd_best": np.full(N, 0.3)})
+                  wealth={"cma_best": 0.3 + 0.01 * IDX, "base_best": np.full(N, 0.3), "rnd_best": np.full(N, 0.3)})
     c = report.analyse(study(objective="liar_wealth"), [cell])["cells"][0]
     assert c["search_beats_baseline"]["hl"] == pytest.approx(-0.045) and c["search_beats_baseline"]["answer"] == "yes"
     assert c["worst_case_bounded"]["loss"] == pytest.approx(0.1)   # the loss is always in items: 1 - 9 / 10

@@ -36,7 +36,8 @@ def test_start_points_spread_over_the_cube():
     # a Sobol sequence of 8 points puts exactly one in each eighth of every coordinate's range
     for k in range(space.dimension()):
         assert sorted(np.floor(pts[:, k] * 8).astype(int)) == list(range(8))
-    assert np.array_equal(pts, design(8, space.dimension(), 11)) and not np.array_equal(pts, design(8, space.dimension(), 12))
+    assert np.array_equal(pts, design(8, space.dimension(), 11))
+    assert not np.array_equal(pts, design(8, space.dimension(), 12))
 
 
 def test_each_restart_starts_where_it_is_told_and_replays_exactly():

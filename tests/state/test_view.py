@@ -11,14 +11,14 @@ from numba import njit
 
 from infomarket.engine.lists import typed_list
 from infomarket.engine.step import variant
-
-STEP = variant(terrain=False, paths=False)
-find_neighbours, begin_communication, install_table, forage, behaviour_step, move = (
-    STEP.find_neighbours, STEP.begin_communication, STEP.install_table, STEP.forage, STEP.behaviour_step, STEP.move)
 from infomarket.errors import InternalError
 from infomarket.state.view import BorrowedArray, GuardedArray, WorldType, layout_type, make_view
 
 from ..conftest import Handle, make_config
+
+STEP = variant(terrain=False, paths=False)
+find_neighbours, begin_communication, install_table, forage, behaviour_step, move = (
+    STEP.find_neighbours, STEP.begin_communication, STEP.install_table, STEP.forage, STEP.behaviour_step, STEP.move)
 
 
 @njit

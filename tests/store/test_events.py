@@ -62,7 +62,8 @@ def test_sweep_payments_say_which_seller_was_paid_what(tmp_path):
     assert main(["sweep", str(exp), "--out", str(out), "--workers", "1", "--quiet", "--events"]) == 0
     store = Store(out)
     pays, events = store.payments(), store.events()
-    assert {"experiment", "condition", "run", "seed", "step", "buyer", "seller", "site", "weight", "amount"} <= set(pays)
+    assert {"experiment", "condition", "run", "seed", "step", "buyer", "seller", "site", "weight",
+            "amount"} <= set(pays)
     c = conditions(im.load_experiment(exp))[1]
     alone = im.simulate(c.config, seed=c.seed(1), record_events=True)
     assert len(alone.payments) > 0

@@ -1,6 +1,5 @@
 """Failure isolation: a run that raises (here a user's plugin with a bug, in one condition of a grid) is
 committed as failed with its error text; every other run completes; --retry-failed reruns only those."""
-import textwrap
 
 import pytest
 

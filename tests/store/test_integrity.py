@@ -118,7 +118,8 @@ def test_one_value_edited_in_a_commit_record_fails_verify(store, tmp_path, capsy
     table = pq.read_table(part)
     seeds = table.column("seed").to_pylist()
     seeds[0] += 1
-    edited = table.set_column(table.column_names.index("seed"), "seed", pa.array(seeds, table.schema.field("seed").type))
+    edited = table.set_column(table.column_names.index("seed"), "seed",
+                              pa.array(seeds, table.schema.field("seed").type))
     if keep_metadata:
         pq.write_table(edited, part)
     else:

@@ -59,12 +59,13 @@ def test_movie_draws_the_obstacles(recording, tmp_path):
 
 
 # ------------------------------------------------------------------------------------------ browser
-from .test_browser import CHROMEDRIVER, CHROMIUM, driver, js_errors, open_page, wait_for  # noqa: E402,F401
+from .test_browser import CHROMEDRIVER, CHROMIUM, driver, js_errors, open_page, wait_for  # noqa: E402,F401 - pytest's fixture and helpers, after this file's own tests
 
 GREY_AND_FOOD = """
 const c = document.getElementById('arena'), d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
 const k = c.width / 1200;
-const near = (i, r, g, b, tol) => Math.abs(d[i] - r) < tol && Math.abs(d[i + 1] - g) < tol && Math.abs(d[i + 2] - b) < tol;
+const near = (i, r, g, b, tol) =>
+  Math.abs(d[i] - r) < tol && Math.abs(d[i + 1] - g) < tol && Math.abs(d[i + 2] - b) < tol;
 let grey = 0;
 for (let i = 0; i < d.length; i += 4) if (near(i, 0x5a, 0x5a, 0x5a, 12)) grey++;
 const food = (cx, cy) => {  // pixels of the food fill (green at alpha 0.35 on the arena's #f4f4f1)
@@ -80,7 +81,7 @@ return [grey, food(200, 300), food(700, 100), k];
 
 @pytest.mark.skipif(not (CHROMIUM and CHROMEDRIVER), reason="headless Chromium not installed "
                     "(tools/ci/install-browser.sh)")
-def test_browser_shows_obstacles_every_site_and_contacts(driver, recording, tmp_path):
+def test_browser_shows_obstacles_every_site_and_contacts(driver, recording, tmp_path):  # noqa: F811 - pytest's fixture
     path = write_html(recording, tmp_path / "terrain.html")
     open_page(driver, path.as_uri())
     subtitle = driver.execute_script("return document.getElementById('subtitle').textContent")

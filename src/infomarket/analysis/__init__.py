@@ -23,7 +23,7 @@ _LAZY = {
     "swarm_throughput": "metrics", "wealth_curves": "metrics",
 }
 
-__all__ = ["summarise", *_LAZY]
+__all__ = ["summarise", *_LAZY]  # noqa: PLE0604 - the keys of _LAZY, all strings
 
 
 def __getattr__(name: str):

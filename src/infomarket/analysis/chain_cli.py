@@ -3,8 +3,12 @@
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
 from ..cliargs import UsageError
+
+if TYPE_CHECKING:  # pandas is imported where the stores are read
+    import pandas as pd
 
 
 def load(stores: list[str]) -> tuple[pd.DataFrame, pd.DataFrame | None, str]:

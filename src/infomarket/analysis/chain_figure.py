@@ -10,7 +10,7 @@ import numpy as np
 from .chain_study import FIG7, FIG7_SWEEP, PAPER, SWEEP, Answers, _sel, axis_values, declaration
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
+import matplotlib.pyplot as plt  # after the backend is chosen
 
 
 def figure(a: Answers, path: Path, decl: dict | None = None) -> None:
@@ -63,7 +63,8 @@ def figure(a: Answers, path: Path, decl: dict | None = None) -> None:
                         label=f"{market.replace('_', ' ')}: chain")
             ref = _sel(runs, FIG7, "items", chain="instant", market=market, rotation_angle=90.0)
             if len(ref):
-                ax.axhline(np.median(ref), color=colour, ls="--", lw=1, label=f"{market.replace('_', ' ')}: instant (n={len(ref)})")
+                ax.axhline(np.median(ref), color=colour, ls="--", lw=1,
+                           label=f"{market.replace('_', ' ')}: instant (n={len(ref)})")
         ax.set_xticks(xs, [f"{v:g}" for v, _ in pts])
         ax.set_xlabel(xlabels[axis])
         ax.set_ylabel("swarm items, last 10 000 steps (median, IQR)")

@@ -3,7 +3,8 @@ paper's result (Figs. 3-4: the Byzantines' wealth share stays low; Fig. 7: staki
 against 3 Byzantines above Theta) hold when the robots run the ledger themselves (docs/chain-model.md),
 at toychain's and geth-argos's settings, and at what block period, loss rate or gas price does it break?
 
-``infomarket chain-study STORE [STORE ...] --out DIR`` (``analysis.chain_cli``; figure: ``analysis.chain_figure``) reads the stores of the shipped experiments
+``infomarket chain-study STORE [STORE ...] --out DIR`` (``analysis.chain_cli``; figure: ``analysis.chain_figure``)
+reads the stores of the shipped experiments
 ``chain_paper``, ``chain_fig7``, ``chain_sweep``, ``chain_fig7_sweep`` (and ``chain_partition`` once
 ``chain.partition`` exists), made with ``infomarket sweep NAME --out STORE``, and writes DIR/chain-study.md,
 DIR/chain-study.csv (question, rule, n, effect with its 95 % interval, answer) and DIR/chain-study.png.
@@ -68,7 +69,8 @@ def _sel(runs: pd.DataFrame, experiment: str, col: str = "byz_share", **keys) ->
 # ------------------------------------------------------------------------------------------ verdicts
 def _ci(c: st.Comparison, unit: str) -> str:
     e = c.effect
-    return f"HL {e.hl:+.3g}{unit} [{e.hl_low:.3g}, {e.hl_high:.3g}], Cliff's delta {e.delta:+.2f} [{e.delta_low:.2f}, {e.delta_high:.2f}]"
+    return (f"HL {e.hl:+.3g}{unit} [{e.hl_low:.3g}, {e.hl_high:.3g}], "
+            f"Cliff's delta {e.delta:+.2f} [{e.delta_low:.2f}, {e.delta_high:.2f}]")
 
 
 def wealth_verdict(pairs: list[tuple[str, np.ndarray, np.ndarray, float]], alpha: float = st.ALPHA,
@@ -96,7 +98,8 @@ def wealth_verdict(pairs: list[tuple[str, np.ndarray, np.ndarray, float]], alpha
             weak = True
         details.append(f"{lab}: {state}; byz share medians {a.median_x:.3g} % vs {a.median_y:.3g} % (n = {a.n_x}, "
                        f"{a.n_y}), {_ci(a, ' pp')}; non-inferiority within {m:g} pp p_Holm = {st._fmt_p(a.p_adjusted)} "
-                       f"(power {a.power:.2f}), beyond-margin p_Holm = {st._fmt_p(b.p_adjusted)}, TOST p = {st._fmt_p(tost_p)}")
+                       f"(power {a.power:.2f}), beyond-margin p_Holm = {st._fmt_p(b.p_adjusted)}, "
+                       f"TOST p = {st._fmt_p(tost_p)}")
     if all(holds):
         ans = YES
     elif any(breaks):
@@ -129,13 +132,14 @@ def fig7_verdict(angles: list[tuple[str, np.ndarray, np.ndarray, float]], alpha:
     no = any(c.significant for c in not_d)
     ans = st.answer(yes, no)
     details, weak = [], False
-    for (lab, x, y, d), h, nd in zip(angles, helps, not_d):
+    for (lab, _x, _y, d), h, nd in zip(angles, helps, not_d):
         state = "helps" if h.significant else "does NOT help" if nd.significant else "undecided"
         if not h.significant and not nd.significant and h.power < target:
             weak = True
         details.append(f"{lab}: {state}; items medians staking {h.median_x:.4g} vs no staking {h.median_y:.4g} "
                        f"(n = {h.n_x}, {h.n_y}), gain {_ci(h, '')}; p_Holm(gain > 0) = {st._fmt_p(h.p_adjusted)} "
-                       f"(power {h.power:.2f} for a gain of {d:.3g}), p_Holm(gain < {d:.3g}) = {st._fmt_p(nd.p_adjusted)}")
+                       f"(power {h.power:.2f} for a gain of {d:.3g}), "
+                       f"p_Holm(gain < {d:.3g}) = {st._fmt_p(nd.p_adjusted)}")
     least = min(range(k), key=lambda i: helps[i].effect.hl)
     n = ", ".join(sorted({f"{c.n_x} vs {c.n_y}" for c in helps}))
     note = st.N_TOO_SMALL if ans == INCONCLUSIVE and weak else ""
@@ -175,7 +179,8 @@ def wealth_question(runs: pd.DataFrame, decl: dict, setting: str) -> Verdict:
     v = wealth_verdict(pairs, decl["study"]["alpha"], decl["study"]["power_target"])
     for payment in ("outlier", "staking"):  # the paper's own claim on the chain (descriptive, declared)
         for k in (1, 3, 5):
-            gap = _sel(runs, PAPER, "gap", chain=setting, payment=payment, byzantines=k) if "gap" in runs.columns else []
+            gap = (_sel(runs, PAPER, "gap", chain=setting, payment=payment, byzantines=k)
+                   if "gap" in runs.columns else [])
             if len(gap) and not np.isnan(gap).all():
                 fig = "3" if payment == "outlier" else "4"
                 v.details.append(f"(descriptive) Fig. {fig}{'ABC'[(k - 1) // 2]} on {setting}, honest minus Byzantine "
@@ -199,7 +204,8 @@ def fig7_question(runs: pd.DataFrame, decl: dict, setting: str, angles=(45.0, 90
         if len(x) and len(y):
             e = st.effect(x, y)
             v.details.append(f"(descriptive) {a:g} deg, staking on {setting} vs on the instant ledger: medians "
-                             f"{np.median(x):.4g} vs {np.median(y):.4g}, HL {e.hl:+.3g} items [{e.hl_low:.3g}, {e.hl_high:.3g}]")
+                             f"{np.median(x):.4g} vs {np.median(y):.4g}, "
+                             f"HL {e.hl:+.3g} items [{e.hl_low:.3g}, {e.hl_high:.3g}]")
     return v
 
 
@@ -271,7 +277,8 @@ def breaks_question(runs: pd.DataFrame, decl: dict, axis: str) -> Verdict:
         below = [s for s in states if s[0] < v and NOT_RUN in (s[2].answer, s[3].answer)]
         if below:  # the smallest breaking value may lie below, where a half of the rule was not run
             note = "; ".join(x for x in (note, f"breaks at or below {v:g}: a value below it is not fully run") if x)
-        return Verdict(YES, n=why.n, effect=f"breaks at {axis} {v:g}: {why.effect}", details=details, note=note, value=v)
+        return Verdict(YES, n=why.n, effect=f"breaks at {axis} {v:g}: {why.effect}", details=details, note=note,
+                       value=v)
     if all(s[1].startswith("holds") for s in ran):
         if any(s[2].answer == NOT_RUN for s in states):  # "no" needs the wealth rule at every value
             return Verdict(INCONCLUSIVE, effect=f"holds at every {axis} value run", details=details, note=note)
@@ -287,7 +294,10 @@ def partition_questions(runs: pd.DataFrame, chain: pd.DataFrame | None, decl: di
         why = "the store holds no runs of chain_partition (infomarket sweep chain_partition)"
         return Verdict(PENDING, note=why), Verdict(PENDING, note=why)
     bases = sorted(part["base"].unique()) if "base" in part.columns else ["all"]
-    sel = lambda df, b, p: df[((df["base"] == b) if "base" in df.columns else True) & (df["partition"] == p)]  # noqa: E731
+
+    def sel(df, b, p):
+        return df[((df["base"] == b) if "base" in df.columns else True) & (df["partition"] == p)]
+
     m = _margin(decl, 5)
     rich_up, rich_down, tost_ok, det = [], [], [], []
     for b in bases:

@@ -1,5 +1,6 @@
 """Is a store's design complete?  Conditions missing from a shipped experiment, and conditions with fewer
-runs than the others, so that no figure or answer is drawn silently from part of its design (after ``store repair`` a damaged part is set aside, and a figure would otherwise lose a condition).
+runs than the others, so that no figure or answer is drawn silently from part of its design (after ``store repair``
+a damaged part is set aside, and a figure would otherwise lose a condition).
 
 A store does not record the grid it was swept from, but a shipped experiment's grid is known: the
 conditions of an experiment in the store are compared with those the shipped file plans (by their keys,
@@ -33,7 +34,8 @@ class Gap:
         sweep."""
         parts = []
         if self.missing:
-            shown = "; ".join(self.missing[:3]) + (f"; and {len(self.missing) - 3} more" if len(self.missing) > 3 else "")
+            more = f"; and {len(self.missing) - 3} more" if len(self.missing) > 3 else ""
+            shown = "; ".join(self.missing[:3]) + more
             parts.append(f"{len(self.missing)} of its {self.planned} conditions have no runs in the store ({shown})")
         if self.short:
             parts.append(f"{len(self.short)} condition(s) have fewer runs than the {self.most} of the others "

@@ -30,7 +30,7 @@ class Frames:
     meta: dict = field(default_factory=dict)  # store.json: format, package version, creation time
 
     @classmethod
-    def of(cls, source) -> "Frames":
+    def of(cls, source) -> Frames:
         """The tables from any source an analysis accepts.
 
         Args:
@@ -58,7 +58,7 @@ class Frames:
         raise InputTypeError(f"cannot read tables from a {type(source).__name__}")
 
     @classmethod
-    def from_store(cls, store: Store) -> "Frames":
+    def from_store(cls, store: Store) -> Frames:
         """The robots, history and runs tables and the ``store.json`` of a results store.
 
         Raises:

@@ -169,10 +169,11 @@ def _liar_recovered(runs: pd.DataFrame, p: dict) -> Verdict:
                        for k in keys])
     yes = [d for d in NEW if all(c.significant for c, k in zip(ni, keys) if k[0] == d)]
     no = all(any(c.significant for c, k in zip(below, keys) if k[0] == d) for d in NEW)
+    shown_below = [d for d in NEW if any(c.significant for c, k in zip(below, keys) if k[0] == d)]
     return Verdict(st.answer(bool(yes), no),
                   f"{_size(p, ni)}reference (paper, 0 Byzantines) median {_med(ref):g} items, n = {len(ref)}; "
                   f"margin {m:.3g} items; shown within the margin at every angle: {', '.join(yes) or 'no defence'}; "
-                  f"shown below at some angle: {', '.join(d for d in NEW if any(c.significant for c, k in zip(below, keys) if k[0] == d)) or 'no defence'}; "
+                  f"shown below at some angle: {', '.join(shown_below) or 'no defence'}; "
                   f"{_power_line(ni, p)}. Non-inferiority (Holm over {len(keys)}): {_lines(ni)}", tuple(ni + below))
 
 
@@ -346,8 +347,8 @@ def attack_figure(robots: pd.DataFrame, experiment: str) -> Figure:
 def figure_specs():
     """(name, caption, draw) of each attack's figure, for the report."""
     return [(f"{name}", f"Swarm items after the transitory period vs rotation angle, attack: {label}; "
-             "boxes per defence; lines (one style per defence): each defence's median without Byzantines; 32 runs per box "
-             "at full scale.", (lambda f, n=name: attack_figure(f.robots, n)))
+             "boxes per defence; lines (one style per defence): each defence's median without Byzantines; "
+             "32 runs per box at full scale.", (lambda f, n=name: attack_figure(f.robots, n)))
             for name, label in ATTACKS.items()]
 
 
@@ -386,14 +387,16 @@ def section(frames: Frames, out: Path, vector: str, echo: Callable[[str], None])
     counts = table["answer"].value_counts()
     small = int((table["note"] == st.N_TOO_SMALL).sum())
     echo(f"open questions: {counts.get(YES, 0)} yes, {counts.get(NO, 0)} no, {counts.get(INCONCLUSIVE, 0)} "
-         f"inconclusive{f' ({small} with n too small to reach alpha)' if small else ''}, {counts.get(NO_DATA, 0)} no data")
+         f"inconclusive{f' ({small} with n too small to reach alpha)' if small else ''}, "
+         f"{counts.get(NO_DATA, 0)} no data")
     lock = DECLARATION.lock_summary(frames.meta.get("declarations") if frames.meta else None, "questions.")
     return Section(figs, table, lock)
 
 
 INTRO = ("The paper's future work, run: reputation-aware scepticism and adaptive Theta against attacks aimed at "
          "them (docs/research.md). Questions and decision rules: `src/infomarket/analysis/tolerances.toml` "
-         "([statistics], [questions]); the rules were revised after the first full sweep (the amendments are listed at the end of this report). "
+         "([statistics], [questions]); the rules were revised after the first full sweep (the amendments are "
+         "listed at the end of this report). "
          "The sample is the run (swarm items in the last 10 000 steps). Each comparison gives the Hodges-Lehmann "
          "shift and Cliff's delta with 95 % bootstrap intervals, a one-sided Mann-Whitney U test (Holm-adjusted "
          "over the angles or defences the question spans), and its simulated power for the declared margin; "

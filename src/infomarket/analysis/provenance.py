@@ -44,7 +44,7 @@ def collect_provenance(source, store_path: str | None = None) -> Provenance:
     f = Frames.of(source)
     runs = f.runs
     facts = {
-        "report date": dt.datetime.now(dt.timezone.utc).strftime("%Y-%m-%d %H:%M UTC"),
+        "report date": dt.datetime.now(dt.UTC).strftime("%Y-%m-%d %H:%M UTC"),
         "report made by": f"infomarket {__version__}",
     }
     if store_path:

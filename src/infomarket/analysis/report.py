@@ -109,7 +109,8 @@ def length_notes(runs: pd.DataFrame) -> list[str]:
     (the paper's length): its rows compare numbers of runs of two lengths, which the page must say."""
     if runs.empty or "steps" not in runs.columns or "experiment" not in runs.columns:
         return []
-    from ..config.load import load_experiment, shipped_experiments  # with the report: the loader is not needed otherwise
+    # with the report: the loader is not needed otherwise
+    from ..config.load import load_experiment, shipped_experiments
 
     shipped, out = shipped_experiments(), []
     for name, group in runs.groupby("experiment", sort=True):
@@ -119,7 +120,8 @@ def length_notes(runs: pd.DataFrame) -> list[str]:
         have = sorted({int(s) for s in group["steps"].dropna()})
         if have and have != [declared]:
             out.append(f"{name}: runs of {' and '.join(f'{s:,}' for s in have)} steps, judged against numbers for runs "
-                       f"of {declared:,} steps (the paper's, the experiment's declared length); counts that grow with the run's length (items, "
+                       f"of {declared:,} steps (the paper's, the experiment's declared length); counts that grow "
+                       f"with the run's length (items, "
                        f"wealth) are not comparable, so read its rows and figures as a look, not a check")
     return out
 
@@ -160,7 +162,8 @@ def to_markdown(report: Report) -> str:
     md = [f"# Paper figures from {report.source}", "",
           "Figures and headline numbers of *An Information Market for Social Navigation in Robots*, "
           "recomputed from this results store. Tolerances: `src/infomarket/analysis/tolerances.toml` "
-          "(declared before any result was seen; rows marked REVISED there were changed after the full paper sweep: see the amendments at the end).", ""]
+          "(declared before any result was seen; rows marked REVISED there were changed after the full paper "
+          "sweep: see the amendments at the end).", ""]
     if report.lengths:
         md += ["## Run lengths", "", "These experiments were run at another length than the paper's:", ""] + \
             [f"- **{n}**" for n in report.lengths] + [""]
@@ -213,7 +216,8 @@ def to_html(report: Report) -> str:
              f"<h1>Paper figures from {e(report.source)}</h1>",
              "<p>Figures and headline numbers of <i>An Information Market for Social Navigation in Robots</i>, "
              "recomputed from this results store. Tolerances: <code>src/infomarket/analysis/tolerances.toml"
-             "</code> (declared before any result was seen; rows marked REVISED there were changed after the full paper sweep: see the amendments at the end).</p>", "<h2>Figures</h2>"]
+             "</code> (declared before any result was seen; rows marked REVISED there were changed after the full "
+             "paper sweep: see the amendments at the end).</p>", "<h2>Figures</h2>"]
     if report.lengths:
         parts += ["<h2>Run lengths</h2><p>These experiments were run at another length than the paper's:</p><ul>"] \
             + [f"<li><b>{e(n)}</b></li>" for n in report.lengths] + ["</ul>"]

@@ -231,7 +231,7 @@ def noise_floor(runs: pd.DataFrame, design: Design, *, seed: int | None = None) 
         for k in (0, 1):
             def stat(i, axis=-1, k=k):
                 i = np.asarray(i, dtype=np.int64)
-                return _floor_stats(m[i], v[i], n[i])[k]
+                return _floor_stats(m[i], v[i], n[i])[k]  # noqa: B023 - called within this iteration
             res = sps.bootstrap((np.arange(m.shape[0]),), stat, vectorized=True, n_resamples=RESAMPLES,
                                 batch=100, confidence_level=CONF_LEVEL, method="percentile",
                                 rng=np.random.default_rng(seed))
@@ -401,7 +401,7 @@ def local_robustness(local: Sensitivity, reference: pd.DataFrame | None = None, 
 
         def stat(i, axis=-1):
             i = np.asarray(i, dtype=np.int64)
-            return _spread(m[i], v[i], n[i])
+            return _spread(m[i], v[i], n[i])  # noqa: B023 - called within this iteration
 
         res = sps.bootstrap((np.arange(m.shape[0]),), stat, vectorized=True, n_resamples=RESAMPLES, batch=100,
                             confidence_level=CONF_LEVEL, method="percentile", rng=np.random.default_rng(seed))
@@ -423,5 +423,5 @@ def local_robustness(local: Sensitivity, reference: pd.DataFrame | None = None, 
     return pd.DataFrame(verdicts), pd.DataFrame(params)
 
 
-__all__ = ["BUILTIN_OUTPUTS", "Sensitivity", "analyse", "answers", "from_store", "local_robustness", "noise_floor",
+__all__ = ["BUILTIN_OUTPUTS", "Sensitivity", "analyse", "from_store", "local_robustness", "noise_floor",
            "pawn", "point_outputs", "run_outputs", "sensitivity"]

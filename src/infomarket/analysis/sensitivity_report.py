@@ -14,7 +14,7 @@ from .declared import status_of
 from .figures import save
 from .frames import MissingDataError
 from . import sensitivity as sens  # module-level knobs (PAWN_PERMUTATIONS) read when drawing
-from .sensitivity import TITLES, Sensitivity, drivers, floor_of, from_store, morris_noise, noise_floor
+from .sensitivity import TITLES, Sensitivity, floor_of, from_store, morris_noise
 from .study import INCONCLUSIVE, NO, YES, Declaration, html_table, md_table, packaged
 
 DECLARATION = packaged("sensitivity_questions.toml")
@@ -69,7 +69,7 @@ def answers(s: Sensitivity, questions: dict | None = None, local: tuple[pd.DataF
                 text = (f"floor {f:.2f} [{flo:.2f}, {fhi:.2f}]; S_T - floor: "
                         + ", ".join(f"{n} {excess[n]:+.2f}" for n in excess.sort_values(ascending=False).index)
                         + f"; largest S_1: {top} {s1.value[top]:.2f} [{s1.low[top]:.2f}, {s1.high[top]:.2f}]"
-                        + (f" (dominant)" if dominant else " (none dominant)") + pawn_text)
+                        + (" (dominant)" if dominant else " (none dominant)") + pawn_text)
                 rows.append(["drivers", output, ", ".join(drive) or "none", size + text, lock("drivers")])
                 inter = [n for n in d.names if st.value[n] - s1.value[n] - f >= q["interactions"]["min_excess"]]
                 rows.append(["interactions", output, ", ".join(inter) or "none", size + "S_T - S_1 - floor: "
@@ -152,7 +152,8 @@ def _bars(s: Sensitivity):
             null = t[(t.output == output) & (t["index"] == "PAWN_null")].set_index("parameter").reindex(d.names)
             ax.bar(x, rows["value"], 0.6, color="#9467bd", edgecolor="black", linewidth=0.5, label=TITLES["PAWN"])
             ax.plot(x, null["value"], linestyle="none", marker="_", markersize=14, markeredgewidth=2,
-                    color="black", label=f"no effect: 95th percentile,\n{sens.PAWN_PERMUTATIONS} shuffles of the output")
+                    color="black",
+                    label=f"no effect: 95th percentile,\n{sens.PAWN_PERMUTATIONS} shuffles of the output")
             ax.set_xticks(x, d.names, rotation=40, ha="right", rotation_mode="anchor", fontsize=8)
             ax.set_ylim(0, max(0.1, float(np.nanmax(rows["value"].to_numpy())) * 1.15,
                                float(np.nanmax(null["value"].to_numpy())) * 1.15))
@@ -215,7 +216,8 @@ def floor_table(s: Sensitivity) -> pd.DataFrame:
     return pd.DataFrame({"output": s.floor.output,
                          "runs per point": s.floor.runs_per_point,
                          "seed noise, share of single-run variance": [
-                             f"{r.run_share:.3f} [{r.run_share_low:.3f}, {r.run_share_high:.3f}]" for r in s.floor.itertuples()],
+                             f"{r.run_share:.3f} [{r.run_share_low:.3f}, {r.run_share_high:.3f}]"
+                             for r in s.floor.itertuples()],
                          "floor of S_T (share of the point means' variance)": [
                              f"{r.floor:.3f} [{r.floor_low:.3f}, {r.floor_high:.3f}]" for r in s.floor.itertuples()]})
 

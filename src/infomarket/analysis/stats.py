@@ -238,7 +238,8 @@ class Comparison:
         e = self.effect
         adj = (f", Holm-adjusted over {self.family} {_fmt_p(self.p_adjusted)}"
                if self.family > 1 or self.p_adjusted != self.p else "")
-        pw = "" if math.isnan(self.power) else f", power {self.power:.2f} if the true shift is {self.declared:+.3g}{unit}"
+        pw = ("" if math.isnan(self.power)
+              else f", power {self.power:.2f} if the true shift is {self.declared:+.3g}{unit}")
         return (f"{self.label}: medians {self.median_x:.4g} vs {self.median_y:.4g} (n = {self.n_x}, {self.n_y}), "
                 f"HL shift {e.hl:+.3g}{unit} [{e.hl_low:.3g}, {e.hl_high:.3g}], Cliff's delta {e.delta:+.2f} "
                 f"[{e.delta_low:.2f}, {e.delta_high:.2f}]; Mann-Whitney {self.test}: p = {_fmt_p(self.p)}{adj}{pw}")

@@ -6,7 +6,8 @@ question from a store's runs, and write the verdicts as markdown (and CSV/JSON) 
 common lives here: reading the file, how its declarations relate to a store's record (``declared``), the
 study's record of amendments and deviations (printed in every report it writes), tables in markdown and
 HTML, the ``Verdict`` every question is answered with (its answer, the numbers and comparisons it rests
-on, what qualifies it), and the command-line plumbing (``--out`` checked before anything runs; files written at the end).
+on, what qualifies it), and the command-line plumbing (``--out`` checked before anything runs; files written at the
+end).
 The studies keep only what is theirs: the per-run values, the rule of each question, the figure.
 
 A declaration file records its history in two arrays of tables, beside its questions:
@@ -70,7 +71,7 @@ class Declaration:
     data: dict
 
     @classmethod
-    def read(cls, path: str | Path, name: str | None = None) -> "Declaration":
+    def read(cls, path: str | Path, name: str | None = None) -> Declaration:
         """Read a declaration file, checking its amendment and deviation records at once.
 
         Args:

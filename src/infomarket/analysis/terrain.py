@@ -14,7 +14,6 @@ p-value reported beside it; the crowd's ratio is read from its bootstrap interva
 """
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
@@ -118,7 +117,10 @@ def waypoints_restore(naive: pd.DataFrame, waypoint: pd.DataFrame, rule: dict) -
     share = st.median_ratio(way, plane)
     a = test.p < rule["p_below"] and ratio >= rule["min_ratio"]
     b = share.value >= rule["min_share_of_plane"]
-    two = lambda x, y: float(sps.mannwhitneyu(x, y, alternative="two-sided").pvalue)  # noqa: E731
+
+    def two(x, y):
+        return float(sps.mannwhitneyu(x, y, alternative="two-sided").pvalue)
+
     answer = (YES if b else "partly") if a else by_power(False, test.power)
     return {"answer": answer, "beats_vector_market": bool(a),
             "keeps_half_of_plane": bool(b), "runs": len(way),
@@ -364,8 +366,12 @@ def markdown(a: dict) -> str:
     for qid, key in (("chain_blocked", "runs"), ("waypoints_restore", "runs"), ("outlier_two_food", None),
                      ("crowd_collisions", None)):
         ans = a[qid]
-        runs = (ans.get(key) if key else (ans["two_sites"]["runs"] if qid == "outlier_two_food" else ans[100]["runs"])) \
-            if ans.get("answer") != NOT_RUN else None
+        if ans.get("answer") == NOT_RUN:
+            runs = None
+        elif key:
+            runs = ans.get(key)
+        else:
+            runs = ans["two_sites"]["runs"] if qid == "outlier_two_food" else ans[100]["runs"]
         note = size_note(q[qid].get("runs"), [runs] if runs else [])
         if note:
             notes.append(f"{qid}: {note}")

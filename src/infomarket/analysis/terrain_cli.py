@@ -11,7 +11,8 @@ def add_subcommand(subparsers) -> None:
     """Add ``infomarket terrain-report`` (answer the terrain questions from their stores) to the command line."""
     p = subparsers.add_parser("terrain-report", help="answer the terrain questions (corridor, two_food, crowd) "
                               "from their stores, with a figure")
-    p.add_argument("results", help="folder holding the stores corridor/, two_food/, crowd/ (optionally corridor_waypoints/, crowd_sensing/)")
+    p.add_argument("results", help="folder holding the stores corridor/, two_food/, crowd/ "
+                                   "(optionally corridor_waypoints/, crowd_sensing/)")
     p.add_argument("--out", required=True, help="folder for terrain.md, terrain.json, terrain.png")
     p.set_defaults(func=cmd_terrain_report)
 

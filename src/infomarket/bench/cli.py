@@ -29,7 +29,8 @@ def add_subcommand(sub) -> None:
                                    "by swarm size at the paper's density; or, with --scaling, sweep throughput.")
     b.add_argument("--json", action="store_true", help="print one JSON object")
     b.add_argument("--steps", type=at_least(1), help="steps per run (default 15000; 3000 with --env)")
-    b.add_argument("--repeats", type=at_least(1), help="timed runs per setup (median reported; default 7, 5 with --env)")
+    b.add_argument("--repeats", type=at_least(1),
+                   help="timed runs per setup (median reported; default 7, 5 with --env)")
     mode = b.add_mutually_exclusive_group()
     mode.add_argument("--robots", type=_sizes, metavar="N,N,...",
                       help="instead: robot-steps/s and peak memory for these swarm sizes (one process each)")
@@ -138,7 +139,7 @@ def _check_sizes(args) -> None:
 def _env(args) -> int:
     try:  # the vector env needs the optional rl extra: refused with a message if missing
         from .env import run_env_bench
-        import gymnasium  # noqa: F401
+        import gymnasium  # noqa: F401 - only to find out whether the rl extra is installed
     except ModuleNotFoundError as exc:
         raise UsageError(f"bench --env needs {exc.name}: pip install 'infomarket[rl]'") from exc
     # with the command, once the rl extra is known to be there
@@ -172,7 +173,7 @@ def _many(repeats: int) -> dict:
 
     many = run_many_bench(repeats=min(repeats, 5))
     try:
-        import gymnasium  # noqa: F401
+        import gymnasium  # noqa: F401 - only to find out whether the rl extra is installed
     except ModuleNotFoundError:
         many["vector_env"] = None
         return many
@@ -197,6 +198,7 @@ def _print_many(m: dict) -> None:
               f"{p['wall_ratio_to_engine_per_worker']:.2f} of the engine's on every worker (a quiet machine only)")
     v = m.get("vector_env")
     if v:
-        print(f"  vector env  {v['vector_env_steps_per_second']:>12,.0f} env-steps/s  {v['ratio_to_engine']:.2f} of the "
+        print(f"  vector env  {v['vector_env_steps_per_second']:>12,.0f} env-steps/s  "
+              f"{v['ratio_to_engine']:.2f} of the "
               f"engine's {v['engine_env_steps_per_second']:,.0f} on {v['steps']}-step episodes (goal >= {v['goal']}; "
               f"B = {v['batch']})")

@@ -104,7 +104,8 @@ def search_rate(steps: int, transitory: int, folder: Path, *, budget: int, popsi
            "runs_per_second": result.done / cpu, "budget": budget, "popsize": popsize, "runs_per_candidate": runs,
            "workers": workers, "phases": {k: v["runs"] for k, v in result.cost.items()}}
     if workers > 1:
-        out.update(wall_seconds=wall, wall_env_steps_per_second=env_steps / wall, wall_runs_per_second=result.done / wall)
+        out.update(wall_seconds=wall, wall_env_steps_per_second=env_steps / wall,
+                   wall_runs_per_second=result.done / wall)
     return out
 
 

@@ -22,8 +22,8 @@ def shipped_experiments() -> dict[str, Path]:
     """Experiment files that ship with the package, by name (e.g. ``fig2A``)."""
     found: dict[str, Path] = {}
     root = resources.files(SHIPPED)
-    for sub in sorted(p for p in root.iterdir() if p.is_dir() and not p.name.startswith("_")):
-        for f in sorted(sub.iterdir()):
+    for sub in sorted((p for p in root.iterdir() if p.is_dir() and not p.name.startswith("_")), key=lambda p: p.name):
+        for f in sorted(sub.iterdir(), key=lambda f: f.name):
             if f.name.endswith(".toml"):
                 found[f.name[:-5]] = Path(str(f))
     return found

@@ -6,12 +6,13 @@ Kept apart from the schema's models so that both ``config.schema`` (re-validatin
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
 from pydantic import ValidationError
 
 
-def key_path(loc: tuple) -> str:
+def key_path(loc: tuple[Any, ...]) -> str:
     """A validation location as users write keys: ``swarm.groups[0].count`` (as in sweep grids)."""
     out = ""
     for part in loc:
@@ -39,7 +40,7 @@ def _describe(err: dict[str, Any]) -> str:
     return f"{loc + ': ' if loc else ''}{msg}{shown}"
 
 
-def _allowed_keys(model: type, loc: tuple) -> list[str]:
+def _allowed_keys(model: Any, loc: tuple[Any, ...]) -> list[str]:
     """Field names allowed where an unknown key was found."""
     for part in loc[:-1]:
         if isinstance(part, int):
@@ -57,7 +58,7 @@ def _allowed_keys(model: type, loc: tuple) -> list[str]:
     return sorted(model.model_fields)
 
 
-def _union_errors(errors: list[dict[str, Any]], branches: dict[str, type | None]) -> list[dict[str, Any]]:
+def _union_errors(errors: list[Any], branches: Mapping[str, Any]) -> list[dict[str, Any]]:
     """One error per problem for union-typed keys: drop a branch's "not a dict" / "not a list" error
     when the other branch says what is really wrong, and take branch names out of locations."""
     out = []
@@ -87,7 +88,7 @@ def _union_errors(errors: list[dict[str, Any]], branches: dict[str, type | None]
     return kept
 
 
-def invalid(source: str, exc: ValidationError, model: type, branches: dict[str, type | None]) -> str:
+def invalid(source: str, exc: ValidationError, model: Any, branches: Mapping[str, Any]) -> str:
     """The ConfigError message for ``exc`` raised validating ``model``; ``branches`` are the union
     branches pydantic names inside locations (left out of the key paths, their model's keys listed)."""
     lines = []

@@ -66,7 +66,7 @@ class Sample(_Strict):
         return b if isinstance(b, Bound) else Bound.model_construct(range=list(b), name=None, also=[])
 
     @model_validator(mode="after")
-    def _usable(self) -> "Sample":
+    def _usable(self) -> Sample:
         for key in self.bounds:
             r = self.bound(key).range
             if len(r) != 2:

@@ -12,9 +12,10 @@ import hashlib
 import json
 import re
 from pathlib import Path
-from typing import Annotated, Any, Literal, Union
+from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, StrictBool, ConfigDict, Field, ValidationError, ValidationInfo, field_validator, model_validator
+from pydantic import (BaseModel, StrictBool, ConfigDict, Field, ValidationError, ValidationInfo, field_validator,
+                      model_validator)
 
 from .. import plugins
 from ..errors import ConfigError
@@ -23,7 +24,7 @@ from . import chain as chain_rules, messages, sizes, terrain
 from .sample import Sample
 
 #: Seeds are 63-bit everywhere (files, the command line, the Python API, the store's int64 columns).
-from ..seeds import MAX_SEED  # noqa: E402  (one definition, infomarket.seeds)
+from ..seeds import MAX_SEED  # one definition, infomarket.seeds
 
 #: An experiment's name is also a folder name (``results/NAME``) and a label in tables: ASCII letters, digits
 #: and ``_ - . + = ,``, starting with a letter, digit or ``_``, at most NAME_MAX characters (no path separators,
@@ -65,7 +66,7 @@ class Rect(_Strict):
     y1: Finite
 
     @model_validator(mode="after")
-    def _ordered(self) -> "Rect":
+    def _ordered(self) -> Rect:
         if not (self.x0 < self.x1 and self.y0 < self.y1):
             raise ConfigError(f"a rect needs x0 < x1 and y0 < y1, got ({self.x0}, {self.y0}) - ({self.x1}, {self.y1})")
         return self
@@ -90,14 +91,14 @@ class Segment(_Strict):
     y1: Finite
 
     @model_validator(mode="after")
-    def _long(self) -> "Segment":
+    def _long(self) -> Segment:
         if self.x0 == self.x1 and self.y0 == self.y1:
             raise ConfigError(f"a segment needs two different end points, got ({self.x0}, {self.y0}) twice")
         return self
 
 
 #: ``[[obstacles]]`` entries, told apart by ``shape`` (space.obstacles has the geometry).
-Obstacle = Annotated[Union[Rect, CircleObstacle, Segment], Field(discriminator="shape")]
+Obstacle = Annotated[Rect | CircleObstacle | Segment, Field(discriminator="shape")]
 
 
 class Robot(_Strict):
@@ -139,7 +140,7 @@ class Swarm(_Strict):
     groups: list[Group] = Field(min_length=1)
 
     @model_validator(mode="after")
-    def _counts(self) -> "Swarm":
+    def _counts(self) -> Swarm:
         for k, g in enumerate(self.groups):
             if g.count > self.robots:
                 raise ConfigError(f"groups[{k}].count = {g.count} is more robots of {g.behaviour!r} than "
@@ -194,7 +195,7 @@ class Chain(_Strict):
     partition: tuple[NonNegInt, NonNegInt] | None = None
 
     @model_validator(mode="after")
-    def _partition_window(self) -> "Chain":
+    def _partition_window(self) -> Chain:
         if self.partition is not None and self.partition[1] <= self.partition[0]:
             raise ConfigError(f"chain.partition = [{self.partition[0]}, {self.partition[1]}]: the end step must "
                               f"come after the start step")
@@ -224,7 +225,7 @@ class Sweep(_Strict):
     sample: Sample | None = None
 
     @model_validator(mode="after")
-    def _not_empty(self) -> "Sweep":
+    def _not_empty(self) -> Sweep:
         if self.sample is not None and (self.grid or self.axes):
             raise ConfigError("a sweep has either a grid and axes or a sample design, not both")
         if not self.grid and not self.axes and self.sample is None:
@@ -271,7 +272,8 @@ class Experiment(_Strict):
             raise ConfigError(f"a name of {len(name)} characters; at most {NAME_MAX} (it is used as a folder)")
         if not re.fullmatch(NAME_PATTERN, name):
             raise ConfigError("a name may hold only ASCII letters, digits and _ - . + = , and must start with a "
-                              "letter, digit or _ (it is used as a folder: no / or \\, no spaces or control characters)")
+                              "letter, digit or _ (it is used as a folder: no / or \\, no spaces or control "
+                              "characters)")
         return name
 
     @field_validator("food", "nest", mode="before")
@@ -279,6 +281,7 @@ class Experiment(_Strict):
     def _site_defaults(cls, value: Any, info: ValidationInfo) -> Any:
         """One site given in part (``[food]`` with only ``radius``) takes the default site's other keys."""
         if isinstance(value, dict):
+            assert info.field_name is not None  # a field validator's
             default = cls.model_fields[info.field_name].default
             return {"x": default.x, "y": default.y, **value}
         return value
@@ -291,12 +294,12 @@ class Experiment(_Strict):
         for e in resolved:
             try:
                 plugins.load(e)
-            except Exception as exc:  # a plugin's own error is the user's to see, in one line
+            except Exception as exc:  # noqa: BLE001 - a plugin's own error is the user's to see, in one line
                 raise ConfigError(f"cannot load plugin {e!r}: {type(exc).__name__}: {exc}") from None
         return resolved
 
     @model_validator(mode="after")
-    def _coherent(self) -> "Experiment":
+    def _coherent(self) -> Experiment:
         if self.transitory >= self.steps:
             raise ConfigError(f"transitory = {self.transitory} must be smaller than steps = {self.steps}")
         w, h, r = self.arena.width, self.arena.height, self.robot.radius
@@ -349,9 +352,9 @@ class Experiment(_Strict):
             raise ConfigError(f"payment.params: scheme {spec.name!r} needs {', '.join(missing)}")
         chain_rules.check(self.chain, self.steps)  # contradictions refused; what cannot act, warned about
         if self.chain.enabled:
-            for s in self.chain.signers:
-                if s >= self.swarm.robots:
-                    raise ConfigError(f"chain.signers: robot {s} does not exist (robots = {self.swarm.robots})")
+            for signer in self.chain.signers:
+                if signer >= self.swarm.robots:
+                    raise ConfigError(f"chain.signers: robot {signer} does not exist (robots = {self.swarm.robots})")
             if len(set(self.chain.signers)) != len(self.chain.signers):
                 raise ConfigError("chain.signers: a robot is listed twice")
             if self.robot.fuel_cost > 0 or self.payment.stake_expiry > 0 or self.payment.reputation_decay < 1:
@@ -377,7 +380,8 @@ class Experiment(_Strict):
     @property
     def terrain(self) -> bool:
         """Does this setup leave the paper's plane (obstacles, several sites of a kind, line of sight,
-        collisions)?  Only then does the engine compile the terrain variant of the step (engine.step, engine.terrain)."""
+        collisions)?  Only then does the engine compile the terrain variant of the step (engine.step,
+        engine.terrain)."""
         return bool(self.obstacles or self.robot.line_of_sight or self.robot.collisions or self.robot.sense_robots
                     or len(self.sites("food")) > 1 or len(self.sites("nest")) > 1)
 
@@ -392,7 +396,7 @@ class Experiment(_Strict):
         spec = payments()[self.payment.scheme]
         return {p: float(self.payment.params.get(p, spec.defaults.get(p, 0.0))) for p in spec.params}
 
-    def with_overrides(self, **changes) -> "Experiment":
+    def with_overrides(self, **changes) -> Experiment:
         """A re-validated copy with top-level fields replaced (e.g. steps, runs, seed)."""
         data = self.model_dump()
         data.update(changes)

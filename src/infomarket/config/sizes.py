@@ -21,8 +21,10 @@ import re
 from ..errors import ConfigError
 
 ENV = "INFOMARKET_MEMORY_LIMIT"
-ROBOT_BYTES = 1200           # O(1) per-robot state (~480 B: engine.world) + its first 16-entry transaction block (40 B each)
-SLOT_BYTES = 160             # per neighbour slot per robot: index (8), a pending entry per site (2 x 32), 2 transactions (2 x 40)
+# O(1) per-robot state (~480 B: engine.world) + its first 16-entry transaction block (40 B each)
+ROBOT_BYTES = 1200
+# per neighbour slot per robot: index (8), a pending entry per site (2 x 32), 2 transactions (2 x 40)
+SLOT_BYTES = 160
 LEVY_BYTES = 16              # per entry of the step-length table (CDF + guide), steps + 1 entries
 HISTORY_BYTES = 8 + 24       # per robot per sample: the float64 array, then its long table (step, robot, wealth)
 EVENTS_PER_ROBOT_STEP = 0.5  # the paper's runs log 0.21-0.29 events per robot per step

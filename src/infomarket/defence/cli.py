@@ -41,7 +41,8 @@ def _reductions(st, declared, args) -> list[str]:
     if st.inner.settings.race != declared.inner.settings.race:
         out.append(f"--inner-race {','.join(map(str, st.inner.settings.race))}")
     if st.inner.settings.grid_step > declared.inner.settings.grid_step:
-        out.append(f"--inner-grid-step {st.inner.settings.grid_step:g} (declared {declared.inner.settings.grid_step:g})")
+        out.append(f"--inner-grid-step {st.inner.settings.grid_step:g} "
+                   f"(declared {declared.inner.settings.grid_step:g})")
     return out
 
 

@@ -36,7 +36,8 @@ def _ratio_loss(x: np.ndarray, ref: np.ndarray) -> np.ndarray | None:
 
 def _interval(v: np.ndarray | None, confidence: float) -> dict:
     if v is None:
-        return {"hl": math.nan, "low": math.nan, "high": math.nan, "note": "undefined: a reference run collected nothing"}
+        return {"hl": math.nan, "low": math.nan, "high": math.nan,
+                "note": "undefined: a reference run collected nothing"}
     low, high, cover = pr.hl_interval(v, confidence)
     return {"hl": pr.hodges_lehmann(v), "low": low, "high": high, "coverage": cover}
 
@@ -134,8 +135,8 @@ def _search_rows(study: Study, judged: list[Judged], confirmed: set[str]) -> lis
     front = {id(j) for j in pareto([j for j in judged if j.candidate.origin != "existing"], s.target)}
     return [{"label": j.candidate.label, "family": j.candidate.family, "origin": j.candidate.origin,
              "values": dict(j.candidate.values), "cost": j.cost, "losses": {str(b): v for b, v in j.losses.items()},
-             "trade": j.trade(s.target, s.max_cost), "pareto": id(j) in front, "confirmed": j.candidate.label in confirmed,
-             "runs": j.runs} for j in judged]
+             "trade": j.trade(s.target, s.max_cost), "pareto": id(j) in front,
+             "confirmed": j.candidate.label in confirmed, "runs": j.runs} for j in judged]
 
 
 # ------------------------------------------------------------------------------------------ output

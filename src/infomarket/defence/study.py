@@ -155,7 +155,8 @@ def load(experiment: Experiment, declaration: Declaration | None = None, *, fami
     use = tuple(b for b in counts if not byzantines or b in byzantines or b == s.target)
     undefended = dict((d.get("undefended") or {}).get("set") or {})
     if not undefended:
-        raise ConfigError(f"{declaration.path.name}: [undefended] set: the swarm the cost is measured against is missing")
+        raise ConfigError(f"{declaration.path.name}: [undefended] set: the swarm the cost is measured against is "
+                          f"missing")
     return Study(experiment, s, inner_study, chosen, exist, undefended, use, d.get("questions", {}), declaration)
 
 

@@ -17,6 +17,7 @@ import warnings
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -113,7 +114,7 @@ class Simulation:
                                                                                               config.steps)
         self._room_key = (self.kinds, config.payment.scheme, config.terrain, config.chain.enabled, record_events,
                           tuple((g.behaviour, g.count) for g in config.swarm.groups))
-        self._kernel = None
+        self._kernel: Any = None  # the generated module of the compiled loop, loaded by reset
         self._params = build_params(config, behaviour_table(config, self.kinds)[1])  # the same for every run
         self.reset(config.seed if seed is None else seed)
         t0 = time.perf_counter()
@@ -145,7 +146,7 @@ class Simulation:
         self._view = kernel_view(world) if self._kernel is not None else None
         self.run_seconds = 0.0
 
-    def another(self, seed: int) -> "Simulation":
+    def another(self, seed: int) -> Simulation:
         """A new run of the same configuration with ``seed``, sharing this one's loaded kernel."""
         sim = copy.copy(self)
         sim.compile_seconds = 0.0
@@ -287,7 +288,7 @@ class Simulation:
         k, j = int(w.ev_count[0]), int(w.pay_count[0])
         events = events_of(k) if k else _empty(("events", type(w)), lambda: events_of(0))
         payments = payments_of(j) if j else _empty(("payments", type(w)), lambda: payments_of(0))
-        totals = {"wealth": total, "pots": float(w.pot.sum()), "burned": float(w.burned[0]),
+        totals: dict[str, Any] = {"wealth": total, "pots": float(w.pot.sum()), "burned": float(w.burned[0]),
                   "items": int(w.items.sum())}
         if self.config.terrain:
             totals["sites"] = self.site_counts()

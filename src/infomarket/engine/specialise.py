@@ -14,7 +14,7 @@ from pathlib import Path
 from types import ModuleType
 
 from ..errors import InternalError
-from ..generated import COMPILED_PARTS, cache_dir, generated_digest, load_generated  # noqa: F401
+from ..generated import COMPILED_PARTS, cache_dir, generated_digest, load_generated  # noqa: F401 - cache_dir re-exported with the kernels' loader
 from ..ledger.backends import LEDGERS
 from ..registry import BehaviourSpec, PaymentSpec, Rule, get_behaviour, get_payment
 from .params import behaviour_kinds
@@ -117,7 +117,8 @@ def generate_source(behaviours: list[BehaviourSpec], payment: PaymentSpec, terra
         lines += [f"    {'if' if k == 0 else 'elif'} kind == {k}:",
                   f"        _b{k}_buy(w, i, nbrs{_args(b.buy, b.params, 'w.bparams[i]')})"]
     lines += ["", "", "@njit(cache=True)", "def pay_dispatch(w, buyer, sellers, sites, directions, weights, rng):",
-              f"    _pay(buyer, sellers, sites, directions, weights{_args(payment.weights, payment.params, 'w.pparams')})",
+              f"    _pay(buyer, sellers, sites, directions, "
+              f"weights{_args(payment.weights, payment.params, 'w.pparams')})",
               ""]
     return "\n".join(lines)
 

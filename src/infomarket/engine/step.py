@@ -18,7 +18,8 @@ Nothing here depends on the configured rules; the loop's generated dispatch call
 """
 import functools
 import math
-from typing import Callable, NamedTuple
+from typing import NamedTuple
+from collections.abc import Callable
 
 from ..jit import njit
 

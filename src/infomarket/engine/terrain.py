@@ -64,7 +64,8 @@ def place_clear(world, rng) -> None:
             pos[i, 0] = rng.integers(lo, hi_x, endpoint=True)
             pos[i, 1] = rng.integers(lo, hi_y, endpoint=True)
         else:
-            raise ConfigError(f"cannot place robot {i} clear of obstacles{' and other robots' if world.collisions else ''}"
+            others = " and other robots" if world.collisions else ""
+            raise ConfigError(f"cannot place robot {i} clear of obstacles{others}"
                               f" after {PLACEMENT_TRIES} tries: the arena has too little free space")
 
 

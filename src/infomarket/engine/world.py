@@ -19,6 +19,7 @@ prints every field.
 from __future__ import annotations
 
 from collections import namedtuple
+from typing import TYPE_CHECKING, Any, TypeAlias
 
 import numpy as np
 
@@ -28,19 +29,23 @@ from ..state import log as log_state
 from ..state.view import make_view, register_layout
 from . import params, swarm
 from .params import FOOD, NEST, SITE_NAMES  # noqa: F401  (re-exported: one place to import the codes from)
-from .swarm import EXPLORING, PATH_POINTS, SEEKING_FOOD, SEEKING_NEST, STATE_NAMES  # noqa: F401
-from ..ledger.state import REPUTATION, TX_POOL  # noqa: F401
-from ..state.log import EV_DEPOSIT, EV_PURCHASE, EV_REFUSED, EVENT_NAMES  # noqa: F401
+from .swarm import EXPLORING, PATH_POINTS, SEEKING_FOOD, SEEKING_NEST, STATE_NAMES  # noqa: F401 - re-exported with the site codes
+from ..ledger.state import REPUTATION, TX_POOL  # noqa: F401 - re-exported with the site codes
+from ..state.log import EV_DEPOSIT, EV_PURCHASE, EV_REFUSED, EVENT_NAMES  # noqa: F401 - re-exported with the site codes
 
 #: The domains of the flat world, in order.
 DOMAINS = (params.SPEC, swarm.SPEC, ledger_state.SPEC, log_state.SPEC)
-World = namedtuple("World", tuple(name for spec in DOMAINS for name in spec.names))
 register_layout("world", DOMAINS)
 #: A chain model's world (docs/chain-model.md): the same domains and the chain's (``ledger.poa``).
 #: A separate layout, so the paper's world type (and every kernel compiled for it) has none of its fields.
 CHAIN_DOMAINS = DOMAINS + (chain_state.SPEC,)
-ChainWorld = namedtuple("ChainWorld", tuple(name for spec in CHAIN_DOMAINS for name in spec.names))
 register_layout("chainworld", CHAIN_DOMAINS)
+if TYPE_CHECKING:  # their fields are made from the domains' specs at import, which a type checker cannot read
+    World: TypeAlias = Any
+    ChainWorld: TypeAlias = Any
+else:
+    World = namedtuple("World", tuple(name for spec in DOMAINS for name in spec.names))
+    ChainWorld = namedtuple("ChainWorld", tuple(name for spec in CHAIN_DOMAINS for name in spec.names))
 
 #: Field names by writer (``state.spec``).
 PARAMS = tuple(f.name for spec in CHAIN_DOMAINS for f in spec if f.writer == "host")

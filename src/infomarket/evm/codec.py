@@ -10,7 +10,8 @@ from typing import Any, NamedTuple
 from eth_abi import decode as abi_decode
 from eth_abi import encode as abi_encode
 from eth_utils import keccak
-from eth_utils.abi import event_abi_to_log_topic, function_abi_to_4byte_selector, get_abi_input_types, get_abi_output_types
+from eth_utils.abi import (event_abi_to_log_topic, function_abi_to_4byte_selector, get_abi_input_types,
+                           get_abi_output_types)
 
 from .errors import ContractRevert
 from .protocol import checksum
@@ -76,7 +77,7 @@ class _EventLayout(NamedTuple):
     names: list[str]
 
     @classmethod
-    def of(cls, abi: dict) -> "_EventLayout":
+    def of(cls, abi: dict) -> _EventLayout:
         plain = [i for i in abi["inputs"] if not i["indexed"]]
         indexed = [i for i in abi["inputs"] if i["indexed"]]
         return cls(abi["name"], [i["name"] for i in indexed], [i["type"] for i in indexed],

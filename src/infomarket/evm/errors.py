@@ -38,7 +38,8 @@ def revert_data(exc: BaseException) -> bytes | None:
     """The raw revert bytes, wherever the backend put them.
 
     A JSON-RPC node's answer reaches us as web3's ``ContractCustomError``/``ContractLogicError`` with a
-    hex ``data`` (Hardhat Network nests it: ``{"message": ..., "data": "0x..."}``). eth-tester raises ``TransactionFailed`` whose message is the bytes' repr, and web3
+    hex ``data`` (Hardhat Network nests it: ``{"message": ..., "data": "0x..."}``). eth-tester raises
+    ``TransactionFailed`` whose message is the bytes' repr, and web3
     re-raises it with a message of its own (sometimes a string it guessed out of the bytes), so the
     repr is looked for along the exception's cause/context chain.
     """

@@ -204,7 +204,8 @@ def render(rows: list[GasRow], worst: list[WorstCall], backend: str = "revm", ch
         "",
     ]
     lines += ["The chain model (docs/chain-model.md, `ledger.gas`) charges every reveal the *reveal, mean* at",
-              f"n = {MODEL_REVEAL_N} and a deposit the *deposit, later trips* figure at the number of reveals it settles,",
+              f"n = {MODEL_REVEAL_N} and a deposit the *deposit, later trips* figure at the number of reveals it "
+              "settles,",
               "linear between the sizes measured; a deposit of more than "
               f"{SIZES[-1]} reveals (the contract refuses reveals beyond",
               f"{DEFAULT_MAX_RECORDS_PER_TRIP} live records per round trip; the model does not) costs the "
@@ -218,7 +219,8 @@ def render(rows: list[GasRow], worst: list[WorstCall], backend: str = "revm", ch
                         ""]
     for scheme in dict.fromkeys(r.scheme for r in rows):
         lines += [f"## {scheme}", "",
-                  "| n | reveal, mean | reveal, max | deposit, first trip | deposit, later trips | transactions | largest tx |",
+                  "| n | reveal, mean | reveal, max | deposit, first trip | deposit, later trips | transactions "
+                  "| largest tx |",
                   "|---:|---:|---:|---:|---:|---:|---:|"]
         lines += [f"| {r.n} | {r.reveal_mean:,.0f} | {r.reveal_max:,} | {r.deposit_first:,} | {r.deposit_later:,} "
                   f"| {r.transactions} | {r.largest_tx:,} |" for r in rows if r.scheme == scheme]

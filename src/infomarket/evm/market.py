@@ -239,7 +239,8 @@ class ChainMarket:
         codec = Codec(artifact["abi"])
         ctor = next(e for e in artifact["abi"] if e["type"] == "constructor")
         args = params.constructor_args(market.address, [r.address for r in registrars], nest.address)
-        code = bytes.fromhex(artifact["bytecode"].removeprefix("0x")) + abi_encode(get_abi_input_types(ctor), list(args))
+        code = (bytes.fromhex(artifact["bytecode"].removeprefix("0x"))
+                + abi_encode(get_abi_input_types(ctor), list(args)))
         try:
             address, _ = backend.deploy(market, code)
         except RevertedCall as exc:

@@ -200,7 +200,8 @@ class Web3Backend(_SignedChain):
         return self.w3.eth.get_balance(address)
 
     def _send_value(self, payer: str, to: str, value: int) -> None:
-        self.w3.eth.wait_for_transaction_receipt(self.w3.eth.send_transaction({"from": payer, "to": to, "value": value}))
+        sent = self.w3.eth.send_transaction({"from": payer, "to": to, "value": value})
+        self.w3.eth.wait_for_transaction_receipt(sent)
 
     def _nonce(self, address: str) -> int:
         return self.w3.eth.get_transaction_count(address, "pending")
@@ -211,7 +212,7 @@ class Web3Backend(_SignedChain):
     def _execute(self, message: dict) -> bytes:
         try:
             return bytes(self.w3.eth.call(message, "pending"))
-        except Exception as exc:  # noqa: BLE001 - anything that is not a revert is re-raised as it came
+        except Exception as exc:  # anything that is not a revert is re-raised as it came
             raw = revert_data(exc)
             if raw is None:
                 raise

@@ -19,7 +19,8 @@ settlement (its payment rule's weights, then ``ledger.kernels.distribute``), wri
 from __future__ import annotations
 
 import functools
-from typing import Callable, NamedTuple
+from typing import NamedTuple
+from collections.abc import Callable
 
 from ..jit import njit
 

@@ -12,7 +12,8 @@ here, so a change of a field is a change of this module only):
 * ``blk_live[b]``: slot b holds a block (the checkpoint or one made after it).  A block in a slot is
   known by its ``blk_hash``, ``blk_step`` and ``blk_signer``: a slot whose hash or step changed since
   the last look holds a new block.  ``blk_height``, ``blk_signer``, ``blk_step``, ``blk_ntx``,
-  ``blk_tx[blk_txoff[b]:][:ntx]`` (mempool slots, in the block's order) and ``blk_bal[blk_state[b]]`` (every robot's balance
+  ``blk_tx[blk_txoff[b]:][:ntx]`` (mempool slots, in the block's order) and ``blk_bal[blk_state[b]]`` (every
+  robot's balance
   after the block) are written once, when the block is made, and read here at the end of that step.
 * ``blk_parent[b]``: the parent's slot; the parent of a live block is live, except the checkpoint's
   (``checkpoint``), which is -1.  A block that was made and became the checkpoint in the same step (a

@@ -7,7 +7,7 @@ contract against the simulation: both feed the same purchases and deposits and c
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Iterable
+from collections.abc import Iterable
 
 import numpy as np
 

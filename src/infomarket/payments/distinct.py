@@ -3,7 +3,8 @@
 The paper's outlier scheme (eq. 7) counts transactions, so a seller that sells the same vector many
 times, or under many accounts, inflates the weight of its own sales.  ``outlier_distinct`` counts
 sellers instead: a transaction weighs as many *distinct sellers* as have a same-site transaction
-within ``theta`` degrees of it (its own seller included, once), and that weight is split across the seller's transactions for the
+within ``theta`` degrees of it (its own seller included, once), and that weight is split across the seller's
+transactions for the
 same site in the round trip, so repeating a sale earns nothing more than selling it once.
 Registered as ``outlier_distinct`` by ``infomarket.builtins``; the contract implements the same rule
 (``Scheme.OutlierDistinct`` in contracts/InformationMarket.sol).

@@ -58,7 +58,7 @@ def checked_actions(actions):
                              f"{ACTIONS}") from None
 
 
-def action_array(action, shape: tuple[int, ...], what: str) -> np.ndarray:
+def action_array(action, shape: tuple[int, ...] | None, what: str) -> np.ndarray:
     """``action`` as a float array of exactly ``shape``; None, text, a wrong shape or NaN are refused here
     (naming ``what``) rather than failing inside numpy or writing NaN into the run.  +-inf is clipped to
     the parameter's range like any value outside it."""
@@ -232,7 +232,7 @@ class AttackVectorEnv(Rebuilt, gym.vector.VectorEnv):
         """
         super().reset(seed=seed if isinstance(seed, (int, np.integer)) or seed is None else None)
         if seed is None:
-            seeds = [None] * self.num_envs
+            seeds: list[int | None] = [None] * self.num_envs
         elif isinstance(seed, (int, np.integer)):
             seeds = [int(seed) + i for i in range(self.num_envs)]
         else:

@@ -90,5 +90,5 @@ class Rebuilt:
 
     def __setstate__(self, state: dict) -> None:
         self._built_with = (state["args"], state["kwargs"])
-        self.__init__(*state["args"], **state["kwargs"])
+        type(self).__init__(self, *state["args"], **state["kwargs"])
         self._carry(state["carried"])

@@ -40,12 +40,12 @@ class AttackParallelEnv(Rebuilt, ParallelEnv):
         self._low = self.runs.low.astype(np.float32)
         self._high = self.runs.high.astype(np.float32)
 
-    @functools.lru_cache(maxsize=None)
+    @functools.cache  # noqa: B019 - PettingZoo's idiom: one space per agent, kept as long as the env
     def observation_space(self, agent):
         """Each agent's observation space: its observation row, every value in [0, 1]."""
         return spaces.Box(0.0, 1.0, (len(OBSERVATION),), np.float32)
 
-    @functools.lru_cache(maxsize=None)
+    @functools.cache  # noqa: B019 - PettingZoo's idiom: one space per agent, kept as long as the env
     def action_space(self, agent):
         """Each agent's action space: the attack parameters within their bounds."""
         return spaces.Box(self._low, self._high, (len(self.runs.actions),), np.float32)
@@ -81,7 +81,7 @@ class AttackParallelEnv(Rebuilt, ParallelEnv):
         if missing:  # every agent acts each step (PettingZoo's parallel API); {} is a mistake, not a no-op
             raise UsageError(f"actions: no action for {', '.join(missing[:5])}"
                              + (f" and {len(missing) - 5} more" if len(missing) > 5 else "")
-                             + f"; give one for every agent in env.agents")
+                             + "; give one for every agent in env.agents")
         shape = (len(self.runs.actions),)
         act = np.stack([action_array(actions[a], shape, f"actions[{a!r}]") for a in self.possible_agents])
         obs, _, _, truncated, info = self._env.step(act)

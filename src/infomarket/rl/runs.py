@@ -17,6 +17,8 @@ configuration's parameters (tests/rl/test_runs.py); chain runs included.
 """
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 
 from ..behaviours.attacks import POLICY
@@ -43,7 +45,7 @@ _KNOWN = ("theta", "theta_min", "adaptive")
 OBSERVE = "infomarket.rl.observe:observe_all"
 
 
-def select_cell(experiment, cell: dict | None = None) -> Experiment:
+def select_cell(experiment, cell: Mapping | None = None) -> Experiment:
     """The experiment to run: ``experiment`` (an Experiment, a shipped name, a file or a dict), or, when
     ``cell`` is given, the one condition of its sweep whose keys match ``cell`` (e.g. ``{"defence":
     "theta20", "byzantines": 3}`` of ``attack_search``)."""

@@ -66,6 +66,7 @@ class Adam:
     v: np.ndarray | None = None
 
     def step(self, grad: np.ndarray) -> np.ndarray:
+        if self.m is None or self.v is None:
         """The Adam step for gradient ``grad`` (bias-corrected moments); the caller applies it to the parameters."""
         if self.m is None:
             self.m, self.v = np.zeros_like(grad), np.zeros_like(grad)
@@ -85,7 +86,7 @@ def es_gradient(fitness: np.ndarray, eps: np.ndarray, sigma: float) -> np.ndarra
     return np.tensordot(diff, eps, axes=1) / (len(eps) * sigma)
 
 
-def episodes(env, thetas: np.ndarray, seeds, fixed: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+def episodes(env, thetas: np.ndarray | None, seeds, fixed: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Play one episode per (policy, seed) (policy ``thetas[i]``, or the ``fixed`` action when given) in
     chunks of the vector env's size; returns (returns, honest items per honest robot)."""
     runs, n, b = env.runs, len(seeds), env.num_envs
@@ -96,8 +97,11 @@ def episodes(env, thetas: np.ndarray, seeds, fixed: np.ndarray | None = None) ->
         obs, _ = env.reset(seed=[int(seeds[i]) for i in idx])
         total = np.zeros(b)
         for _ in range(calls):
-            act = np.broadcast_to(fixed, obs.shape[:2] + fixed.shape[-1:]) if fixed is not None else \
-                actions(runs, thetas[idx], obs)
+            if fixed is not None:
+                act = np.broadcast_to(fixed, obs.shape[:2] + fixed.shape[-1:])
+            else:
+                assert thetas is not None, "episodes: thetas or fixed"
+                act = actions(runs, thetas[idx], obs)
             obs, r, _, _, _ = env.step(act.astype(np.float32))
             total += r
         keep = slice(0, min(b, n - start))

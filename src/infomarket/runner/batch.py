@@ -41,7 +41,7 @@ class BatchResult:
 class BatchInterrupted(KeyboardInterrupt):
     """Ctrl-C during ``run_batch``: ``result`` holds the runs that had finished (None if none had)."""
 
-    def __init__(self, result: "BatchResult | None", planned: int):
+    def __init__(self, result: BatchResult | None, planned: int):
         super().__init__()
         self.result, self.planned = result, planned
 

@@ -205,7 +205,8 @@ def add_subcommand(sub) -> None:
             "sites, configs, chain, runs: docs/data.md); needs pip install 'infomarket[sql]'")
     a = ss.add_parser("sql", help=text, description=text)
     a.add_argument("store", metavar="STORE")
-    a.add_argument("query", metavar="QUERY", help="e.g. \"SELECT condition, avg(items_collected) FROM robots GROUP BY ALL\"")
+    a.add_argument("query", metavar="QUERY",
+                   help="e.g. \"SELECT condition, avg(items_collected) FROM robots GROUP BY ALL\"")
     a.add_argument("--csv", action="store_true", help="print CSV instead of a text table")
     a.set_defaults(func=cmd_store_sql)
 

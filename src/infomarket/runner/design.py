@@ -113,7 +113,7 @@ class Design:
         return df
 
     @classmethod
-    def from_spec(cls, spec: dict, X: np.ndarray) -> "Design":
+    def from_spec(cls, spec: dict, X: np.ndarray) -> Design:
         """The design back from its ``spec()`` (as the store's ``design.json`` holds it) and its matrix ``X``."""
         fields = {k: spec[k] for k in cls.__dataclass_fields__ if k != "X"}
         return cls(**fields, X=np.asarray(X, dtype=float))
@@ -125,7 +125,7 @@ class Design:
             s.pop(k)
         return s
 
-    def extends(self, old: "Design") -> bool:
+    def extends(self, old: Design) -> bool:
         """Whether this design is ``old`` grown: the same settings but more base samples, and ``old``'s
         points first.  Saltelli's scheme on a Sobol' sequence has that property, so a study whose
         intervals came out too wide grows in place and reruns none of its points (their seeds follow
@@ -179,7 +179,9 @@ def apply(base: dict, design_keys: list[str], also: list[list[str]], remainder: 
         for path in (key, *follow):
             set_path(data, path, v, where)
     if remainder is not None:
-        k = int(KEY_PART.match(remainder.split(".")[1]).group(2))
+        part = KEY_PART.match(remainder.split(".")[1])
+        assert part is not None, remainder  # checked where the sweep was read
+        k = int(part.group(2))
         others = sum(g["count"] for j, g in enumerate(data["swarm"]["groups"]) if j != k)
         data["swarm"]["groups"][k]["count"] = data["swarm"]["robots"] - others
     return data
@@ -214,6 +216,7 @@ def _check_both_kinds(cfg: Experiment, outputs: list[str], where: str) -> None:
 
 def make_design(exp: Experiment, seed: int | None = None) -> Design:
     """The design of ``exp``'s ``[sweep.sample]``, checked at every corner, drawn by SALib."""
+    assert exp.sweep is not None and exp.sweep.sample is not None, exp.name  # asked only of a sampled sweep
     sample: Sample = exp.sweep.sample
     master = exp.seed if seed is None else seed
     where = f"{exp.name}: sweep.sample"

@@ -142,7 +142,7 @@ def run_chunk(cfg: Experiment, items: list[tuple[int, int]], record_events: bool
     try:
         for entry in cfg.plugins:  # rules registered by plugins must exist in this worker too
             plugins.load(entry)
-    except Exception as exc:
+    except Exception as exc:  # noqa: BLE001 - a plugin that fails to load fails these runs, each recorded
         return [_failed(run, seed, exc) for run, seed in items]
     out: list[RunOutput] = []
     size = 1 if record_events else TOGETHER
@@ -163,7 +163,7 @@ def _alone(cfg: Experiment, items: list[tuple[int, int]], record_events: bool) -
     for run, seed in items:
         try:
             out.append(run_one(cfg, run, seed, record_events))
-        except Exception as exc:
+        except Exception as exc:  # noqa: BLE001 - a run's error is recorded with it, the others go on
             out.append(_failed(run, seed, exc))
     return out
 
@@ -256,7 +256,7 @@ class InlineExecutor(Executor):
         future.set_running_or_notify_cancel()
         try:
             future.set_result(fn(*args, **kwargs))
-        except Exception as exc:  # Ctrl-C (KeyboardInterrupt) propagates to the caller at once
+        except Exception as exc:  # noqa: BLE001 - held by the future; Ctrl-C (KeyboardInterrupt) propagates at once
             future.set_exception(exc)
         return future
 
@@ -339,8 +339,12 @@ def _compile_together(configs: list[Experiment]) -> None:
     the calls here then load them."""
     if not configs:  # nothing left to run: no child
         return
-    interrupts.compiled_together(lambda: [_try_warm(cfg) for cfg in configs],
-                                 [kernel_marker(cfg) for cfg in configs])
+
+    def warm_all() -> None:
+        for cfg in configs:
+            _try_warm(cfg)
+
+    interrupts.compiled_together(warm_all, [kernel_marker(cfg) for cfg in configs])
 
 
 def preflight(configs: Iterable[Experiment]) -> None:
@@ -355,7 +359,7 @@ def preflight(configs: Iterable[Experiment]) -> None:
             Simulation(cfg, 0)  # compiles or loads the kernel (what a warm-up then finds done)
         except InfomarketError:
             raise
-        except Exception as exc:  # noqa: BLE001
+        except Exception as exc:  # noqa: BLE001 - a compile error: the rule is named where it can be, else the runs report it
             why = explain_compile_failure(cfg, exc)
             if why:
                 raise RuleRunError(f"{cfg.name}: {why}; the step kernel cannot be compiled, nothing was run") from None
@@ -402,7 +406,7 @@ def execute(tasks: list[Task], finished: Callable[[Task, list[RunOutput]], None]
         for fut in as_completed(futures):  # the wait is interrupted by a signal at once
             finished(futures[fut], fut.result())
             interrupts.check()
-    except BaseException as exc:
+    except BaseException as exc:  # noqa: BLE001 - the pending runs are cancelled, then it is raised again as a stop
         for f in futures:
             f.cancel()
         interrupts.raise_stopped(exc)

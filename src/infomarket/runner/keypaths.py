@@ -42,4 +42,6 @@ def set_path(data: dict, path: str, value: Any, where: str) -> None:
 
 def label(path: str) -> str:
     """The column a key path names: its last key without an index (``swarm.groups[1].count`` -> ``count``)."""
-    return KEY_PART.match(path.split(".")[-1]).group(1)
+    part = KEY_PART.match(path.split(".")[-1])
+    assert part is not None, path  # every key path was checked against KEY_PART where it was read
+    return part.group(1)

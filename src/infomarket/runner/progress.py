@@ -46,7 +46,7 @@ class _Bar:
         # a reset forgets rich's speed samples and restarts its clock, so neither the runs already done
         # nor the time spent before the runs start (compiling, checking the store) inflate the time left
         task = next(t for t in self.progress.tasks if t.id == self.task)
-        self.progress.reset(self.task, total=task.total, completed=task.completed + k, rate="")
+        self.progress.reset(self.task, total=task.total, completed=int(task.completed) + k, rate="")
         self.t0 = time.monotonic()
 
     def advance(self, k: int = 1) -> None:

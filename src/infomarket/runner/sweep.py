@@ -115,7 +115,8 @@ def _frames(task: Task, outputs: list[RunOutput]) -> dict[str, pd.DataFrame | No
             parts.append(_frames(Task(c, runs), outputs[k:k + len(runs)]))
             k += len(runs)
         return {t: _concat([p[t] for p in parts if p[t] is not None]) for t in parts[0]}
-    frames = {t: ([], []) for t in _PER_RUN}  # table -> (the runs' frames, the condition of each)
+    # table -> (the runs' frames, the condition of each)
+    frames: dict[str, tuple[list, list]] = {t: ([], []) for t in _PER_RUN}
     rows, configs, k = [], [], 0
     for c, runs in members:
         for o, run in zip(outputs[k:k + len(runs)], runs):
@@ -253,8 +254,10 @@ def _run(conds, store, workers, executor, on_done, on_plan, record_events, on_pa
         store.write_part(task.part_id, **tables, keys=keys)
         if on_part:
             on_part(tables)
-        env_steps += int(tables["runs"].steps.sum())
-        run_seconds += float(tables["runs"].duration_s.sum())
+        runs = tables["runs"]
+        assert runs is not None  # a part always has its runs record
+        env_steps += int(runs.steps.sum())
+        run_seconds += float(runs.duration_s.sum())
         compile_seconds = max([compile_seconds] + [o.compile_seconds for o in outputs])
         failed.extend(o for o in outputs if o.error is not None)
         if on_done:
@@ -265,10 +268,10 @@ def _run(conds, store, workers, executor, on_done, on_plan, record_events, on_pa
     else:
         with local_executor(workers) as pool:
             warm = execute(tasks, finished, executor=pool, record_events=record_events)
-    first = failed[0].error.strip().splitlines()[-1] if failed else ""
+    first = (failed[0].error or "").strip().splitlines()[-1] if failed else ""
     rule_errors = [o for o in failed if o.rule_error]
     if rule_errors:  # the clearest message: a rule's, named with its file, line and step
-        first = rule_errors[0].error.strip()
+        first = (rule_errors[0].error or "").strip()
     return SweepReport(planned, planned - todo, todo, env_steps, time.perf_counter() - t0, len(failed), first,
                        compile_seconds=max(warm, compile_seconds), run_seconds=run_seconds,
                        rule_errors=len(rule_errors))

@@ -59,7 +59,8 @@ def _checked_actions(actions) -> tuple[str, ...]:
     actions = tuple(actions)
     bad = [a for a in actions if a not in NAMES]
     if not actions or bad or len(set(actions)) != len(actions):
-        raise ArgumentError(f"actions {actions}: each must be one of the attacker's parameters, once: {', '.join(NAMES)}")
+        raise ArgumentError(f"actions {actions}: each must be one of the attacker's parameters, once: "
+                            f"{', '.join(NAMES)}")
     return actions
 
 
@@ -100,7 +101,7 @@ class Policy:
         return np.array([_RANGES[a][1] for a in self.actions])
 
     @classmethod
-    def constant(cls, values: dict, actions=ACTIONS, interval: int = 10, base: dict | None = None) -> "Policy":
+    def constant(cls, values: dict, actions=ACTIONS, interval: int = 10, base: dict | None = None) -> Policy:
         """The policy that plays ``values`` (action -> parameter value, defaults where absent) whatever it
         observes."""
         actions = _checked_actions(actions)
@@ -131,7 +132,7 @@ class Policy:
         return path
 
     @classmethod
-    def load(cls, path) -> "Policy":
+    def load(cls, path) -> Policy:
         """A policy saved by ``save``.
 
         Raises:

@@ -88,7 +88,8 @@ def _markdown(s: dict) -> str:
     lines += [f"| {r['generation']} | {r['centre_items']:.3f} | {r['best_items']:.3f} |" for r in s["curve"]]
     e = s.get("evaluation")
     if e:
-        lines += ["", f"On {e['runs']} fresh seeds (paired): honest items per honest robot {e['learned_mean']:.3f} under "
+        lines += ["", f"On {e['runs']} fresh seeds (paired): honest items per honest robot "
+                      f"{e['learned_mean']:.3f} under "
                       f"the learned policy, {e['start_mean']:.3f} under its start; start minus learned "
                       f"{e['start_minus_learned_mean']:+.3f} (standard error {e['standard_error']:.3f}), positive "
                       f"in {100 * e['positive_share']:.0f} % of runs."]

@@ -108,7 +108,7 @@ class Player:
         self.batch, self.workers = int(batch), int(workers)
         self._pool = None
 
-    def __enter__(self) -> "Player":
+    def __enter__(self) -> Player:
         if self.workers > 1:  # load the kernels here: forked workers inherit them instead of each loading them
             _runs_for(self.cfg, 1, self.actions)
         self._executor = local_executor(self.workers)

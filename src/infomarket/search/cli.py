@@ -52,7 +52,8 @@ def _reductions(st, declared, exp, chosen, all_cells, args) -> list[str]:
         if have < want:
             out.append(f"--{key.replace('_', '-')} {have} (declared {want})")
     if st.settings.race != declared.settings.race:
-        out.append(f"--race {','.join(map(str, st.settings.race))} (declared {','.join(map(str, declared.settings.race))})")
+        out.append(f"--race {','.join(map(str, st.settings.race))} "
+                   f"(declared {','.join(map(str, declared.settings.race))})")
     if st.settings.grid_step > declared.settings.grid_step:
         out.append(f"--grid-step {st.settings.grid_step:g} (declared {declared.settings.grid_step:g})")
     return out
@@ -177,7 +178,8 @@ def _check_learner(learner: dict) -> None:
             (isinstance(v, (int, float)) and not isinstance(v, bool) and 0 < v < float("inf"))
         if not ok:
             raise UsageError(f"questions.toml [adaptive] {k} = {v!r}: must be "
-                             + ("a whole number >= " + ("0" if k == "budget" else "1") if whole else "a finite number > 0"))
+                             + ("a whole number >= " + ("0" if k == "budget" else "1") if whole
+                                else "a finite number > 0"))
 
 
 def _adaptive(adaptive, st, cell, r, learner: dict, out: Path, args, workers: int):
@@ -206,7 +208,8 @@ def add_subcommand(sub) -> None:
     p.add_argument("--restarts", type=at_least(1), help="CMA-ES restarts (default: declared)")
     p.add_argument("--runs", type=at_least(1), help="runs per candidate evaluation (default: declared)")
     p.add_argument("--finalists", type=at_least(1), help="best distinct points per searcher raced (default: declared)")
-    p.add_argument("--race", metavar="N,N,...", help="cumulative runs per raced attack at each stage (default: declared)")
+    p.add_argument("--race", metavar="N,N,...",
+                   help="cumulative runs per raced attack at each stage (default: declared)")
     p.add_argument("--keep", type=float, help="fraction of raced attacks kept after each stage (default: declared)")
     p.add_argument("--confirmation-runs", type=at_least(2), help="runs per chosen attack on the confirmation seeds "
                                                                  "(default: declared)")
@@ -214,7 +217,8 @@ def add_subcommand(sub) -> None:
     p.add_argument("--objective", choices=["items", "liar_wealth"], help="what the attack optimises (default: items)")
     p.add_argument("--seed", type=at_least(0), help="the search's seed: optimisers and seed sets (default: declared)")
     p.add_argument("--adaptive-budget", type=at_least(0), metavar="N",
-                   help="evaluations per cell of the adaptive attacker, the second searcher (0: none; default: declared)")
+                   help="evaluations per cell of the adaptive attacker, the second searcher "
+                        "(0: none; default: declared)")
     p.add_argument("--list-baselines", action="store_true", help="list the baselines (declared and rotation grid) "
                                                                  "and exit")
     p.add_argument("--steps", type=at_least(1), help="steps per run (default: the experiment's), for a reduced search")

@@ -125,7 +125,7 @@ def record_provenance(store: Store, questions=QUESTIONS, key: str = "attack_sear
     with store.writing():
         meta = store.meta()
         if key not in meta:
-            first = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%dT%H:%M:%SZ")
+            first = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%dT%H:%M:%SZ")
             meta[key] = {**provenance(questions), "first_run_utc": first}
             store._write_meta(meta)  # under the store's lock, as Store writes it
         return meta[key]

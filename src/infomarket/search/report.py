@@ -138,7 +138,8 @@ def analyse(study: Study, results: list) -> dict:
                        if cand is not None and "searcher" in getattr(cand, "columns", ()) else {})
         cells.append({"defence": r.cell.defence, "byzantines": r.cell.byzantines, "experiment": r.cell.experiment,
                       "share": r.cell.byzantines / study.experiment.swarm.robots, "runs": len(runs),
-                      "chosen": chosen, "params": {a: dict(r.params.get(a, {})) for a in dict.fromkeys(chosen.values())},
+                      "chosen": chosen,
+                      "params": {a: dict(r.params.get(a, {})) for a in dict.fromkeys(chosen.values())},
                       "medians": {role: float(np.median(v)) for role, v in items.items()},
                       "extra_attacks": {n: _only(df, n) for n, df in (getattr(r, "extra", None) or {}).items()},
                       "evaluations": evaluations, "cost": cost, "cost_total": _total(cost), "done": r.done,

@@ -97,7 +97,8 @@ class Restarts:
 
         leg = self.legs[self.r]
         x0 = np.clip(np.asarray(self.start(self.r), float), 0.0, 1.0)
-        opts = {"bounds": [0.0, 1.0], "popsize": leg.popsize, "seed": stream(self.seed, "cma", self.r) % (2**31 - 2) + 1,
+        opts = {"bounds": [0.0, 1.0], "popsize": leg.popsize,
+                "seed": stream(self.seed, "cma", self.r) % (2**31 - 2) + 1,
                 "verbose": -9, "verb_log": 0, "verb_disp": 0, "verb_filenameprefix": "", "tolfun": 0.0,
                 "tolx": 0.0, "tolfunhist": 0.0, "tolstagnation": 10**9, "tolflatfitness": 10**9}
         self.es = cma.CMAEvolutionStrategy(x0, self.s.sigma0, opts)

@@ -55,7 +55,7 @@ class BorrowedArray(types.Array):
                          name=f"{kind}({dtype}, {ndim}d, {layout})")
 
     @classmethod
-    def of(cls, t: types.Array, readonly: bool) -> "BorrowedArray":
+    def of(cls, t: types.Array, readonly: bool) -> BorrowedArray:
         """The borrowed twin of the array type ``t`` (read-only if asked, or if ``t`` is)."""
         return cls(t.dtype, t.ndim, t.layout, readonly=readonly or not t.mutable, aligned=t.aligned)
 
@@ -81,7 +81,7 @@ class GuardedArray(BorrowedArray):
                              name=f"guarded array({dtype}, {ndim}d, {layout})")
 
     @classmethod
-    def of(cls, t: types.Array, readonly: bool = True) -> "GuardedArray":
+    def of(cls, t: types.Array, readonly: bool = True) -> GuardedArray:
         """The guarded twin of the array type ``t`` (same dtype, dimensions and layout)."""
         return cls(t.dtype, t.ndim, t.layout, aligned=t.aligned)
 

@@ -15,7 +15,7 @@ from pathlib import Path
 import pandas as pd
 
 
-def write_atomic(path: str | Path, write: Callable[[Path], None]) -> Path:
+def write_atomic(path: str | Path, write: Callable[[Path], object]) -> Path:
     """Call ``write(tmp)`` on a fresh temporary file next to ``path``, then rename it to ``path``.
 
     The temporary file is created (empty) with the umask's permissions before ``write`` replaces its

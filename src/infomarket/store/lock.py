@@ -20,7 +20,7 @@ class StoreLock:
         self.path = root / "store.lock"
         self.fd: int | None = None
 
-    def __enter__(self) -> "StoreLock":
+    def __enter__(self) -> StoreLock:
         key = self.path.resolve()
         if key in _HELD:
             raise StoreError(f"{self.path.parent}: this process is already writing this store")

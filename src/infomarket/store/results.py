@@ -3,6 +3,7 @@ columns and integrity checks: the package docstring, ``infomarket.store``)."""
 from __future__ import annotations
 
 from collections.abc import Iterable
+import functools
 import json
 import os
 import time
@@ -16,7 +17,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from .. import __version__, interrupts
-from .errors import Inspection, Problem, RecordAltered, SqlError, StoreDamaged, StoreError  # noqa: F401
+from .errors import Inspection, Problem, RecordAltered, SqlError, StoreDamaged, StoreError  # noqa: F401 - re-exported: the store's errors, where callers import them
 from . import integrity
 from .tables import DATA_TABLES, OPTIONAL_TABLES, TABLES
 from .lock import StoreLock
@@ -113,7 +114,7 @@ class Store:
                              f"{type(meta).__name__})")
         return meta
 
-    def create(self) -> "Store":
+    def create(self) -> Store:
         """Create the folder layout (idempotent); refuse a folder that holds something else."""
         if self.exists():
             meta = self.meta()
@@ -218,7 +219,8 @@ class Store:
         return sorted(self._part_ids("runs"))
 
     def remove_orphans(self) -> int:
-        """Delete data parts (robots, history, events, payments) without a runs part (left by a crash); returns how many."""
+        """Delete data parts (robots, history, events, payments) without a runs part (left by a crash); returns
+        how many."""
         done = self._part_ids("runs")
         removed = 0
         for t in DATA_TABLES:
@@ -252,7 +254,7 @@ class Store:
             if df is not None and len(df):
                 path = self.part_path(t, part_id)
                 path.parent.mkdir(exist_ok=True)
-                write_atomic(path, lambda tmp, df=df, t=t: write_table(t, df, tmp, keys))
+                write_atomic(path, functools.partial(write_table, t, df, keys=keys))
                 sha, rows = sha256_file(path), len(df)
                 if self._cache is not None:  # the bytes it hashed are the file's: no need to read them again
                     self._cache.put("sha256", path, sha)
@@ -264,7 +266,8 @@ class Store:
         """The commit record, its content's digest in its metadata: the digest of the table written, which is
         the table a reader gets back (the file keeps the Arrow schema; every read checks the digest)."""
         table = annotate("runs", pa.Table.from_pandas(runs, preserve_index=False), keys)
-        table = table.replace_schema_metadata({**(table.schema.metadata or {}), RECORD_SHA: record_digest(table).encode()})
+        table = table.replace_schema_metadata({**(table.schema.metadata or {}),
+                                               RECORD_SHA: record_digest(table).encode()})
         path = write_atomic(self.part_path("runs", part_id),
                             lambda tmp: pq.write_table(table, tmp, write_page_checksum=True))
         if self._cache is not None:  # the record as a reader gets it back, verified: what was just written
@@ -296,7 +299,8 @@ class Store:
                 self._sums = False
         return self._sums
 
-    def _check_data_part(self, table: str, part_id: str, record: pd.DataFrame, present: bool | None = None) -> str | None:
+    def _check_data_part(self, table: str, part_id: str, record: pd.DataFrame,
+                         present: bool | None = None) -> str | None:
         """Why the ``table`` part of ``part_id`` does not match its commit record, or None.  ``present``:
         whether its file exists, where the caller listed the folder (a part that is not there needs no
         look).  When caching, a verdict stands while the record is the same object and the file the same."""
@@ -342,7 +346,7 @@ class Store:
             except RecordAltered as exc:
                 raise StoreDamaged(f"{self.root}: part {_rel(self.root, path)} is damaged: commit record {exc}; "
                                    f"{self._repair_hint()}") from None
-            except Exception as exc:  # noqa: BLE001
+            except Exception as exc:  # noqa: BLE001 - any reader error means damage
                 raise StoreDamaged(f"{self.root}: part {_rel(self.root, path)} is damaged: unreadable commit "
                                    f"record ({type(exc).__name__}); {self._repair_hint()}") from None
         return out

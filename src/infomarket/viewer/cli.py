@@ -1,6 +1,7 @@
 """The ``view`` and ``replay`` commands (added to ``infomarket`` by the main CLI).
 
-Bad input raises ``UsageError`` or ``ConfigError`` before anything runs or is written; the main CLI prints it in one line
+Bad input raises ``UsageError`` or ``ConfigError`` before anything runs or is written; the main CLI prints it in
+one line
 and exits 2.  Heavy imports (aiohttp, matplotlib) wait until a command actually needs them.
 """
 from __future__ import annotations
@@ -59,7 +60,7 @@ def _warm_up(cfg, seed: int | None) -> None:
         Simulation(cfg, seed)
     except InfomarketError:
         raise
-    except Exception as exc:  # a rule that keeps the kernel from compiling: named (checks.explain)
+    except Exception as exc:  # noqa: BLE001 - a rule that keeps the kernel from compiling: named (checks.explain)
         from ..checks import explain
 
         raise explain(cfg, seed, exc) from None

@@ -20,7 +20,7 @@ import numpy as np
 from ..engine import geometry as kernels  # to_world: the robot-frame rotation the engine uses
 from ..engine.world import EVENT_NAMES, FOOD, NEST, SITE_NAMES, STATE_NAMES, headings, open_transactions
 from ..errors import FormatError
-from ..ledger.blocklog import DROPPED, BranchNumbers, chain_views
+from ..ledger.blocklog import BranchNumbers, chain_views
 from ..registry import behaviours
 
 #: The engine's own robot-frame -> world rotation, as plain Python (it also takes arrays of robots).

@@ -62,7 +62,7 @@ def record(config: Experiment, seed: int | None = None, *, steps: int | None = N
         sim = Simulation(config, seed, record_events=True)
     except InfomarketError:
         raise
-    except Exception as exc:  # a rule that keeps the kernel from compiling: named (checks.explain)
+    except Exception as exc:  # noqa: BLE001 - a rule that keeps the kernel from compiling: named (checks.explain)
         raise explain(config, seed, exc) from None
     honest = honest_mask(sim)
     branches = BranchNumbers()  # a branch keeps its number from frame to frame while it lasts
@@ -70,7 +70,7 @@ def record(config: Experiment, seed: int | None = None, *, steps: int | None = N
     while sim.clock < steps:
         try:
             sim.step(min(every, steps - sim.clock))
-        except Exception as exc:  # a rule raised: named with its file, line and the step
+        except Exception as exc:  # noqa: BLE001 - a rule raised: named with its file, line and the step
             raise explain(config, sim.seed, exc, sim, record_events=True) from None
         frames.append(encode(sim, honest, branches))
         if on_progress:

@@ -107,7 +107,7 @@ class Session:
             self.sim = Simulation(self.config, self.seed, record_events=True)
         except InfomarketError:
             raise
-        except Exception as exc:  # a rule that keeps the kernel from compiling: named (checks.explain)
+        except Exception as exc:  # noqa: BLE001 - a rule that keeps the kernel from compiling: named (checks.explain)
             raise explain(self.config, self.seed, exc) from None
         self._honest = honest_mask(self.sim)
         self._branches = BranchNumbers()  # a branch keeps its number (its ring's colour) while it lasts
@@ -133,6 +133,6 @@ class Session:
         """Step ``k`` times; the new frame and the selected robot's details (run in a worker thread)."""
         try:
             self.sim.step(k)
-        except Exception as exc:  # a rule raised: the page is told which, at which step (checks.explain)
+        except Exception as exc:  # noqa: BLE001 - a rule raised: the page is told which, at which step (checks.explain)
             raise explain(self.config, self.seed, exc, self.sim, record_events=True) from None
         return self.frame(), self.detail()

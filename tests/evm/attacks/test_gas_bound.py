@@ -17,7 +17,8 @@ from infomarket.evm.market import DECLARED_MAX_TX_GAS
 from .helpers import sell
 
 REPORT = Path(__file__).resolve().parents[3] / "docs" / "gas.md"
-BOUND_ROW = re.compile(r"^\| ([a-z_ +]+) \| (\d+) \| (\d+) \| ([\d,]+) \| ([\d,]+) \| ([\d,]+) \| (\d+) \| ([\d,]+) \|$")
+BOUND_ROW = re.compile(r"^\| ([a-z_ +]+) \| (\d+) \| (\d+) \| ([\d,]+) \| ([\d,]+) \| ([\d,]+) \| (\d+) "
+                       r"\| ([\d,]+) \|$")
 
 
 def test_512_distinct_similar_sellers_stay_under_the_bound_under_outlier_distinct():

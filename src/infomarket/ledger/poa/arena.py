@@ -79,22 +79,27 @@ def build_chain(ledger: dict, *, period: int, delay: int, signers, backbone: boo
         "chn_gas_n": np.array(ns, np.float64), "chn_gas_deposit": np.array(gs, np.float64), "chn_seed": int(seed),
         "chn_final": int(finality),
         "chn_part_start": -1 if partition is None else int(partition[0]),
-        "chn_part_end": -1 if partition is None else int(partition[1]), "chn_cache": bool(cache_weights), "view_height": z(n, np.int64), "view_weight": z(n, np.int64),
+        "chn_part_end": -1 if partition is None else int(partition[1]), "chn_cache": bool(cache_weights),
+        "view_height": z(n, np.int64), "view_weight": z(n, np.int64),
         "view_hash": np.full(n, np.int64(int(seed) % (2**62)), np.int64), "view_bal": ledger["balance"].copy(),
         "view_head": z(n, np.int64), "view_head_before": z(n, np.int64), "view_avail": ledger["balance"].copy(),
-        "view_stale": z(n, np.bool_), "blk_count": np.ones(1, np.int64), "blk_free_from": np.ones(1, np.int64), "blk_slots_touched": np.ones(1, np.int64),
+        "view_stale": z(n, np.bool_), "blk_count": np.ones(1, np.int64), "blk_free_from": np.ones(1, np.int64),
+        "blk_slots_touched": np.ones(1, np.int64),
         "gas_paid": z(n),
         "blk_live": z(bc, np.bool_), "blk_parent": np.full(bc, -1, np.int64), "blk_height": z(bc, np.int64),
         "blk_weight": z(bc, np.int64), "blk_hash": z(bc, np.int64), "blk_signer": np.full(bc, -1, np.int64),
         "blk_step": z(bc, np.int64), "blk_children": z(bc, np.int64), "blk_by_backbone": z(bc, np.bool_),
         "blk_mark": z(bc, np.int8), "blk_state": z(bc, np.int64), "state_used": z(bc, np.bool_),
         "state_free_from": np.ones(1, np.int64),
-        "blk_ntx": z(bc, np.int64), "blk_txoff": z(bc, np.int64), "blk_tx": z(TX_ENTRIES + ENTRIES_PER_ROBOT * n, np.int64), "blk_bal": z((bc, n)), "blk_included": z((bc, _words(t)), np.uint64),
+        "blk_ntx": z(bc, np.int64), "blk_txoff": z(bc, np.int64),
+        "blk_tx": z(TX_ENTRIES + ENTRIES_PER_ROBOT * n, np.int64), "blk_bal": z((bc, n)),
+        "blk_included": z((bc, _words(t)), np.uint64),
         "checkpoint": z(1, np.int64), "chn_canon": z(1, np.int64), "state_block": z(1, np.int64),
         "mp_sent": z(1, np.int64),
         "settling_count": z(1, np.int64), "checkpoint_blocker": z(1, np.int64), "blk_tx_top": z(1, np.int64),
         "mp_live": z(t, np.bool_), "mp_cursor": z(1, np.int64), "mp_order": z(t, np.int64),
-        "mp_words_used": z(1, np.int64), "mp_own_next": np.full(t, -1, np.int64), "mp_own_prev": np.full(t, -1, np.int64),
+        "mp_words_used": z(1, np.int64), "mp_own_next": np.full(t, -1, np.int64),
+        "mp_own_prev": np.full(t, -1, np.int64),
         "own_first": np.full(n, -1, np.int64), "own_last": np.full(n, -1, np.int64), "mp_count": z(1, np.int64),
         "mp_for_buyer": z(n, np.int64), "mp_own": z(n, np.int64), "mp_kind": z(t, np.int64),
         "mp_origin": z(t, np.int64),
@@ -181,7 +186,8 @@ def _packed_entries(world, changes: dict, entries: int) -> dict:
 
 def _packed_lists(world, changes: dict, lists: int) -> dict:
     """The list nodes that live blocks and the ledger arrays use, packed in their order (``ls_prev``,
-    ``bs_list``, ``pool_list``, ``state_list`` renumbered; ``ls_first_child``, ``ls_next_sibling``, ``ls_roots`` rebuilt; the kept
+    ``bs_list``, ``pool_list``, ``state_list`` renumbered; ``ls_first_child``, ``ls_next_sibling``, ``ls_roots``
+    rebuilt; the kept
     nodes' cached weights packed too), grown when they and what the next step adds (``lists - ls_top``)
     do not fit twice."""
     rows = used_states(world)
@@ -272,8 +278,8 @@ def grow_chain(world, needs) -> dict:
     bc = world.blk_live.shape[0]
     if blocks > bc:
         size = max(2 * bc, blocks)
-        for f in ("blk_live", "blk_height", "blk_weight", "blk_hash", "blk_step", "blk_children", "blk_by_backbone", "blk_mark", "blk_ntx",
-                  "blk_txoff", "blk_state", "state_used"):
+        for f in ("blk_live", "blk_height", "blk_weight", "blk_hash", "blk_step", "blk_children", "blk_by_backbone",
+                  "blk_mark", "blk_ntx", "blk_txoff", "blk_state", "state_used"):
             changes[f] = _grown(getattr(world, f), 0, size)
         for f in ("blk_parent", "blk_signer"):
             changes[f] = _grown(getattr(world, f), 0, size, -1)
@@ -282,7 +288,8 @@ def grow_chain(world, needs) -> dict:
         # the live blocks' bits and the used state rows are copied
         rows = used_states(world)
         changes["blk_bal"] = _grown_rows(world.blk_bal, rows, size)
-        changes["blk_included"] = _grown_rows(changes.get("blk_included", world.blk_included), np.flatnonzero(world.blk_live), size)
+        changes["blk_included"] = _grown_rows(changes.get("blk_included", world.blk_included),
+                                              np.flatnonzero(world.blk_live), size)
         for f in BLOCK_STATE:
             changes[f"bs_{f}"] = _grown_rows(getattr(world, f"bs_{f}"), rows, size)
         changes["bs_list"] = _grown_rows(world.bs_list, rows, size)

@@ -28,7 +28,8 @@ _LEDGER_KINDS = {"balance": ("float64", "n"), "pot": ("float64", "n"), "burned":
                  "rep_earned": ("float64", "n"), "rep_stake_lost": ("float64", "n"),
                  "rep_deposits": ("int64", "n"), "gas_paid": ("float64", "n")}
 
-#: Shapes: ``Bc`` block slots, ``Bt`` entries of the blocks' transaction lists, ``T`` mempool slots (a multiple of 64), ``T/64`` words of known-bits,
+#: Shapes: ``Bc`` block slots, ``Bt`` entries of the blocks' transaction lists, ``T`` mempool slots (a multiple of
+#: 64), ``T/64`` words of known-bits,
 #: ``C`` open transactions a block's state can hold, ``S`` signers, ``G`` points of the deposit-gas table.
 SPEC = Spec("chain", [
     *fields("host", [
@@ -100,14 +101,16 @@ SPEC = Spec("chain", [
         ("ls_len", "int64", "L", "length of the list that ends with it"),
         ("ls_seq", "int64", "L", "sending order (mp_seq) of the reveal it records"),
         ("ls_buyer", "int64", "L", "the buyer whose list it is in"),
-        ("ls_first_child", "int64", "L", "first node made after it (-1: none); the others are its ls_next_sibling chain"),
+        ("ls_first_child", "int64", "L",
+         "first node made after it (-1: none); the others are its ls_next_sibling chain"),
         ("ls_next_sibling", "int64", "L", "next node with the same predecessor (-1: none)"),
         ("ls_weights_at", "int64", "L", "where the payment scheme's weights of the list ending here start in "
                                 "weight_store (-1: not weighed yet)"),
-        ("ls_roots", "int64", "n", "each buyer's first node of a list (-1: none); the others, its ls_next_sibling chain"),
+        ("ls_roots", "int64", "n",
+         "each buyer's first node of a list (-1: none); the others, its ls_next_sibling chain"),
         ("ls_top", "int64", "1", "first unused node (the host packs the nodes live blocks use)"),
-        ("weight_store", "float64", "W", "weights of settled lists, ls_len[v] of them from ls_weights_at[v] (the settlement "
-                                   "cache)"),
+        ("weight_store", "float64", "W",
+         "weights of settled lists, ls_len[v] of them from ls_weights_at[v] (the settlement cache)"),
         ("weight_top", "int64", "1", "first unused entry of weight_store"),
         ("state_list", "int64", "n", "each buyer's list (a node) in the state the ledger arrays hold, or in the "
                                    "block being applied"),
