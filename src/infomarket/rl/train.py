@@ -66,9 +66,8 @@ class Adam:
     v: np.ndarray | None = None
 
     def step(self, grad: np.ndarray) -> np.ndarray:
-        if self.m is None or self.v is None:
         """The Adam step for gradient ``grad`` (bias-corrected moments); the caller applies it to the parameters."""
-        if self.m is None:
+        if self.m is None or self.v is None:
             self.m, self.v = np.zeros_like(grad), np.zeros_like(grad)
         self.t += 1
         self.m = self.beta1 * self.m + (1 - self.beta1) * grad
