@@ -224,7 +224,8 @@ class MarketAgent:
         except Exception as exc:  # noqa: BLE001 - a signature that recovers to nothing
             return self.refuse("acceptance", f"task {task_id}: bad signature ({type(exc).__name__})")
         if lc.buyer != buyer or signer != buyer:
-            return self.refuse("acceptance", f"task {task_id}: signed by {signer} for {lc.buyer}, not the buyer {buyer}")
+            return self.refuse("acceptance",
+                               f"task {task_id}: signed by {signer} for {lc.buyer}, not the buyer {buyer}")
         if not rec.get("lc"):
             rec = {**rec, "lc": wire.lc_to_json(lc)}
             self.state.put(task_id, rec)

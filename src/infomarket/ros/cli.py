@@ -107,7 +107,8 @@ def run_swarm(args) -> int:
     from .swarm import Swarm, prepare, write_report
 
     if args.scheme not in (*DEMO_SCHEMES, FROM_EXPERIMENT):
-        return report_error(f"--scheme {args.scheme!r}: choose {', '.join(sorted(DEMO_SCHEMES))} or {FROM_EXPERIMENT}", 2)
+        return report_error(f"--scheme {args.scheme!r}: choose {', '.join(sorted(DEMO_SCHEMES))} "
+                            f"or {FROM_EXPERIMENT}", 2)
     faults = merge(args.fault)
     try:
         config, params = prepare(args.experiment, args.robots, args.steps, args.scheme, faults)

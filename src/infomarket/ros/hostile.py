@@ -33,7 +33,10 @@ class Hostile:
                                      lambda m, i=i: self.last.__setitem__(i, (world.step, bytes(m.data))), q)
 
     def __call__(self, buyer: int, seller: int, task_id: int, site: int, age: int) -> None:
-        send = lambda pub, data: (pub.publish(self._Bytes(data=list(data))), setattr(self, "sent", self.sent + 1))
+        def send(pub, data) -> None:
+            pub.publish(self._Bytes(data=list(data)))
+            self.sent += 1
+
         send(self.offers[buyer], secrets.token_bytes(37))  # malformed
         offer = Offer(self.addresses[seller], site, age, 2**40, secrets.token_bytes(32))
         sig = keys.PrivateKey(secrets.token_bytes(32)).sign_msg_hash(offer_digest(self.domain, offer))

@@ -33,7 +33,7 @@ def start(argv: list[str], log: Path, cwd: Path | None = None) -> subprocess.Pop
     with open(log, "ab") as out:
         return subprocess.Popen(argv, stdout=out, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
                                 cwd=cwd, env=env.child_env(),
-                                preexec_fn=_detached)  # noqa: PLW1509 - the command's own fork, as interrupts does
+                                preexec_fn=_detached)
 
 
 def stop(proc: subprocess.Popen | None) -> None:

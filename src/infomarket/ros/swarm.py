@@ -2,9 +2,10 @@
 ``report.json`` saying whether every robot's balance on chain equals its wealth in the engine.
 
 Faults: ``kill:R@S`` SIGKILLs robot R's agent at step S (in the middle of its sale when it sells then)
-and starts it again (same key, same state folder); ``drop:P`` makes every agent lose that share of the messages it sends; ``hostile`` sends
-malformed, forged and replayed messages before every sale (``hostile.py``). Ctrl-C (or SIGTERM) ends
-every process of the swarm at once: each is SIGKILLed by process group, and dies with the swarm anyway.
+and starts it again (same key, same state folder); ``drop:P`` makes every agent lose that share of the
+messages it sends; ``hostile`` sends malformed, forged and replayed messages before every sale
+(``hostile.py``). Ctrl-C (or SIGTERM) ends every process of the swarm at once: each is SIGKILLed by process
+group, and dies with the swarm anyway.
 """
 from __future__ import annotations
 
@@ -33,7 +34,8 @@ def prepare(experiment: str, robots: int, steps: int, scheme: str, faults: Fault
     """The scaled experiment and the contract's parameters, refused with a ConfigError when not runnable."""
     config = demo_config(load_experiment(experiment), robots, steps, scheme)
     if config.chain.enabled:
-        raise ConfigError("the ROS swarm runs the market on a real chain node: use an experiment without the chain model")
+        raise ConfigError("the ROS swarm runs the market on a real chain node: use an experiment without the "
+                          "chain model")
     params = market_params(config)
     if params.stake_expiry:
         raise ConfigError("stake expiry needs one block per step, and a chain node mines one block per "
@@ -157,11 +159,15 @@ class Swarm:
         sales = trader.sales
         gas_total = sum(tally.reveal_gas) + sum(tally.deposit_gas)
         protocol = sum(tally.messages[k] for k in ("offer", "acceptance", "deposit", "task", "done"))
-        avg = lambda xs: mean(xs) if xs else None
+
+        def avg(xs):
+            return mean(xs) if xs else None
+
         return {
             "robots": self.n, "steps": self.config.steps, "seed": self.seed, "rpc": self.rpc,
             "ros_domain_id": os.environ["ROS_DOMAIN_ID"],
-            "market": market.address, "processes": len({p.pid for p in self.agents}), "restarted_agents": self.restarted,
+            "market": market.address, "processes": len({p.pid for p in self.agents}),
+            "restarted_agents": self.restarted,
             "light_contracts": sales, "refusals_confirmed": tally.refusals_confirmed,
             "deposits": len(tally.deposit_gas),
             "messages": {**tally.messages, "protocol": protocol,

@@ -201,7 +201,8 @@ class Trader:
         if bool(out.get("refused")) != expected_refusal or out.get("error"):
             self.world.tally.disagreements.append(
                 f"step {ev['step']}: the engine {'refused' if expected_refusal else 'made'} a sale of robot {seller} "
-                f"to robot {buyer}; on chain it was {'refused' if out.get('refused') else 'made'} {out.get('error', '')}")
+                f"to robot {buyer}; on chain it was {'refused' if out.get('refused') else 'made'} "
+                f"{out.get('error', '')}")
         if out.get("refused"):
             self.world.tally.refusals_confirmed += expected_refusal
             return

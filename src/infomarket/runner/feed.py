@@ -133,6 +133,7 @@ class Feed:
             self._turn(True)
         if s.error is not None:
             raise s.error
+        assert s.report is not None  # planned before the sweep's first task, settled before done
         return s.report
 
     # ------------------------------------------------------------------------------ the main side
@@ -178,7 +179,7 @@ class Feed:
                     self._baton.acquire()
                 self._collect()
                 interrupts.check()
-        except BaseException as exc:
+        except BaseException as exc:  # noqa: BLE001 - any end, Ctrl-C included, stops every job, then goes on up
             self._stop(exc)
             interrupts.raise_stopped(exc)
         finally:
@@ -278,7 +279,9 @@ class Feed:
             self.store.write_part(task.part_id, **tables, keys=keys)
         if s.on_part:
             s.on_part(tables)
-        steps, seconds = int(tables["runs"].steps.sum()), float(tables["runs"].duration_s.sum())
+        runs = tables["runs"]
+        assert runs is not None  # every part records its runs
+        steps, seconds = int(runs.steps.sum()), float(runs.duration_s.sum())
         s.env_steps += steps
         s.run_seconds += seconds
         s.compile_seconds = max([s.compile_seconds] + [o.compile_seconds for o in outputs])
@@ -302,6 +305,7 @@ class Feed:
         for s in [s for s in self._open if not s.waiting]:
             self._open.remove(s)
             rep = s.report
+            assert rep is not None  # a sweep is open only once planned
             rep.env_steps, rep.run_seconds = s.env_steps, s.run_seconds
             rep.wall_seconds, rep.compile_seconds = time.perf_counter() - s.t0, s.compile_seconds
             rep.failed = len(s.failed)

@@ -338,7 +338,8 @@ def _robots(store: Store, cell: Cell) -> pd.DataFrame:
 
 def store_runner(store: Store, *, workers: int = 1, executor=None,
                  on_done: Callable[[int], None] | None = None,
-                 on_skip: Callable[[int], None] | None = None, feed=None) -> Callable[[list[Condition]], tuple[int, int]]:
+                 on_skip: Callable[[int], None] | None = None,
+                 feed=None) -> Callable[[list[Condition]], tuple[int, int]]:
     """``run(conds)`` for ``search_cell``: their missing runs into ``store`` on the sweep machinery.
     A condition run again with more runs (a race's next stage) counts only its new runs as made or found.
     ``run.robots(conds)``: the robots rows of ``conds``, kept from the parts just written when every run of

@@ -6,7 +6,8 @@ had expired and then deposited kept the whole reward, share included (+1 token i
 paper's terms), and its sellers got only their stakes back. Now every record of the round trip is
 paid at the deposit: an expired one an equal part of the share, share / n for the round trip's n
 records (its stake already went back), the live ones the rest (share * live / n, plus their stakes) by
-the scheme's weights, however late the settlement is finished. By hand (outlier_distinct, stake 0.04, share 0.5 of a reward of 1, wealth 1 each).
+the scheme's weights, however late the settlement is finished. By hand (outlier_distinct, stake 0.04, share 0.5
+of a reward of 1, wealth 1 each).
 """
 from __future__ import annotations
 

@@ -5,7 +5,8 @@ Weighed, the liar's records count as one voice against three and it loses most o
 nobody finished the weighing within `settlementDeadline` blocks of the deposit, the contract stopped
 weighing and paid every record an equal part of the share plus the stakes, so the liar's 10 records
 took 10 / 13 of the amount. Now weighing goes on whenever anyone settles, and the records are paid by
-weight however late (less the bounty, which past the deadline any caller earns). By hand, at the paper's terms (reward 1 token, share 0.5, stake 0.04), the amount
+weight however late (less the bounty, which past the deadline any caller earns). By hand, at the paper's terms
+(reward 1 token, share 0.5, stake 0.04), the amount
 is 0.5 + 13 * 0.04 = 1.02 token:
 
 - `outlier_distinct`: the liar's records weigh 1/10 of a voice each (1 in all), each honest record 3
