@@ -45,11 +45,11 @@ def missing() -> str | None:
     """Why the ROS 2 client cannot be used in this process (None when it can)."""
     os.environ.setdefault("RMW_IMPLEMENTATION", RMW)
     try:
-        import rclpy  # noqa: F401
-        from geometry_msgs.msg import PoseArray  # noqa: F401
-        from nav_msgs.msg import Odometry  # noqa: F401
-        from rosgraph_msgs.msg import Clock  # noqa: F401
-        from std_msgs.msg import String  # noqa: F401
+        import rclpy  # noqa: F401 - imported only to learn whether the wheels load
+        from geometry_msgs.msg import PoseArray  # noqa: F401 - likewise, each message package
+        from nav_msgs.msg import Odometry  # noqa: F401 - likewise, each message package
+        from rosgraph_msgs.msg import Clock  # noqa: F401 - likewise, each message package
+        from std_msgs.msg import String  # noqa: F401 - likewise, each message package
     except Exception as exc:  # noqa: BLE001 - an ImportError, a missing shared library (OSError), ...
         return f"{type(exc).__name__}: {exc}"
     return None

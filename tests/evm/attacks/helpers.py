@@ -3,6 +3,9 @@ from __future__ import annotations
 
 import math
 
+import pytest
+
+from infomarket.evm.errors import ContractRevert
 from infomarket.evm.protocol import FOOD, PathInfo
 
 #: Where every seller stands in its buyer's frame, and how long its vector is.
@@ -24,3 +27,10 @@ def settle_all(market, robot: str, batch: int, sender=None) -> list:
     while market.pending_settlement(robot)[0]:
         results.append(market.settle(robot, batch, sender=sender))
     return results
+
+
+def refused(call, name: str, **expected) -> None:
+    """``call()`` reverts with the contract's custom error ``name`` and exactly these arguments."""
+    with pytest.raises(ContractRevert) as info:
+        call()
+    assert (info.value.name, info.value.args_by_name) == (name, expected)

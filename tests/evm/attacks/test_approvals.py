@@ -10,13 +10,12 @@ back. By hand, at a quota of 2 per 100 blocks and a threshold of 2 of 3.
 """
 from __future__ import annotations
 
-from .test_trust import fresh, refused  # noqa: F401  (a fixture, and the refusal check)
-from .helpers import sell
+from .helpers import refused, sell
 
 GRANT = 2 * 10**9
 
 
-def test_an_approval_by_a_key_whose_role_moved_does_not_count(fresh):  # noqa: F811
+def test_an_approval_by_a_key_whose_role_moved_does_not_count(fresh):
     market, (robot, new_key, other, _) = fresh()
     r0, r1, _ = market.registrars
     market.approve(r0, robot.address, GRANT)
@@ -35,7 +34,7 @@ def test_an_approval_by_a_key_whose_role_moved_does_not_count(fresh):  # noqa: F
     assert market.view("approvals", other.address, GRANT) == 0
 
 
-def test_an_approval_lapses_after_its_window_and_can_be_cancelled(fresh):  # noqa: F811
+def test_an_approval_lapses_after_its_window_and_can_be_cancelled(fresh):
     market, (robot, other, _, _) = fresh(registrar_period=100)
     r0, r1, _ = market.registrars
     market.approve(r0, robot.address, GRANT)
@@ -51,7 +50,7 @@ def test_an_approval_lapses_after_its_window_and_can_be_cancelled(fresh):  # noq
             registrar=r0.address, robot=other.address)  # nothing standing to cancel
 
 
-def test_the_quota_holds_in_every_window_not_only_in_each_period(fresh):  # noqa: F811
+def test_the_quota_holds_in_every_window_not_only_in_each_period(fresh):
     """Two approvals at the last block of a period and a third at the first of the next: three within two
     blocks used to pass, over the quota of 2 per 100 blocks."""
     market, robots = fresh(accounts=4, registrar_quota=2, registrar_period=100)
@@ -68,7 +67,7 @@ def test_the_quota_holds_in_every_window_not_only_in_each_period(fresh):  # noqa
     market.approve(registrar, robots[2].address, GRANT)
 
 
-def test_revocations_count_against_the_quota_and_a_revoked_buyers_sellers_are_refunded_at_once(fresh):  # noqa: F811
+def test_revocations_count_against_the_quota_and_a_revoked_buyers_sellers_are_refunded_at_once(fresh):
     market, robots = fresh(accounts=4, registrar_quota=2, registrar_period=100, stake=0.04)
     buyer, seller, *others = robots
     for pair in (robots[:2], robots[2:]):  # two registrations per registrar and window

@@ -17,30 +17,10 @@ import pytest
 from eth_account import Account
 
 from infomarket.evm.errors import ContractRevert
-from infomarket.evm.market import ROLES, ChainMarket, MarketParams, derived_account
+from infomarket.evm.market import ROLES
 from infomarket.evm.protocol import SECP256K1_N
 
-from .helpers import sell, settle_all
-
-
-def refused(call, name: str, **expected) -> None:
-    with pytest.raises(ContractRevert) as info:
-        call()
-    assert (info.value.name, info.value.args_by_name) == (name, expected)
-
-
-@pytest.fixture
-def fresh(chain, artifact):
-    """Factory: a market with no robot registered yet, and fresh accounts funded with gas money."""
-
-    def make(scheme="outlier_distinct", stake=0.0, accounts=4, label="trust", **options):
-        params = MarketParams.from_floats(scheme, stake=stake, **options)
-        market = ChainMarket.deploy(params, backend=chain, artifact=artifact)
-        robots = [derived_account(label, i) for i in range(accounts)]
-        chain.fund([r.address for r in robots])
-        return market, robots
-
-    return make
+from .helpers import refused, sell, settle_all
 
 
 def test_one_registrar_cannot_register_a_robot_alone(fresh):
