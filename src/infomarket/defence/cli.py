@@ -4,7 +4,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from ..cliargs import UsageError, at_least, dask_client, workers_count
+from ..cliargs import UsageError, at_least, dask_client, seed_value, workers_count
 
 #: outer settings an option may make smaller than declared (the report is then marked reduced)
 SIZES = ("candidates", "refine", "cost_runs", "frontier", "confirmation_runs")
@@ -155,7 +155,7 @@ def add_subcommand(sub) -> None:
                    help="the inner search's rotation grid step (default: declared)")
     p.add_argument("--inner-race", metavar="N,N,...", help="the inner search's cumulative runs per raced attack "
                                                            "(default: declared)")
-    p.add_argument("--seed", type=at_least(0), help="the study's seed: designs and seed sets (default: declared)")
+    p.add_argument("--seed", type=seed_value, help="the study's seed: designs and seed sets (default: declared)")
     p.add_argument("--list-families", action="store_true", help="list the families and their parameters and exit")
     p.add_argument("--steps", type=at_least(1), help="steps per run (default: the experiment's), for a reduced study")
     p.add_argument("--transitory", type=at_least(0), help="steps not counted (default: the experiment's)")

@@ -8,7 +8,7 @@ import math
 import time
 from pathlib import Path
 
-from ..cliargs import UsageError, at_least
+from ..cliargs import UsageError, at_least, seed_value
 
 
 def _positive(text: str) -> float:
@@ -47,7 +47,7 @@ def add_subcommand(sub) -> None:
     t.add_argument("--sigma", type=_positive, default=0.5, help="perturbation scale, in logits (default 0.5)")
     t.add_argument("--lr", type=_positive, default=0.2, help="Adam's step size (default 0.2)")
     t.add_argument("--eval-runs", type=at_least(2), default=32, help="held-out seeds to compare on (default 32)")
-    t.add_argument("--seed", type=at_least(0), default=0, help="the training's seed (default 0)")
+    t.add_argument("--seed", type=seed_value, default=0, help="the training's seed (default 0)")
     t.add_argument("--out", help="write the learned policy, the learning curve and the comparison here (JSON)")
     t.add_argument("--json", action="store_true", help="print the result as one JSON object")
     t.add_argument("--quiet", action="store_true", help="no progress")

@@ -4,7 +4,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from ..cliargs import UsageError, at_least, dask_client, workers_count
+from ..cliargs import UsageError, at_least, dask_client, seed_value, workers_count
 from .baselines import rotation_grid
 
 
@@ -206,7 +206,7 @@ def add_subcommand(sub) -> None:
                                                                  "(default: declared)")
     p.add_argument("--grid-step", type=float, metavar="DEGREES", help="rotation grid's step (default: declared)")
     p.add_argument("--objective", choices=["items", "liar_wealth"], help="what the attack optimises (default: items)")
-    p.add_argument("--seed", type=at_least(0), help="the search's seed: optimisers and seed sets (default: declared)")
+    p.add_argument("--seed", type=seed_value, help="the search's seed: optimisers and seed sets (default: declared)")
     p.add_argument("--adaptive-budget", type=at_least(0), metavar="N",
                    help="evaluations per cell of the adaptive attacker, the second searcher (0: none; default: declared)")
     p.add_argument("--list-baselines", action="store_true", help="list the baselines (declared and rotation grid) "
