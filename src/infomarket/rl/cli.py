@@ -8,7 +8,7 @@ import math
 import time
 from pathlib import Path
 
-from ..cliargs import UsageError, at_least, seed_value
+from ..cliargs import UsageError, at_least, seed_value, writable_file
 
 
 def _positive(text: str) -> float:
@@ -67,9 +67,8 @@ def cmd_rl_train(args) -> int:
         raise UsageError(f"--transitory {args.transitory}: must be below --steps {args.steps}")
     if args.out is not None and not args.out.strip():  # a blank variable: not "no file", and not this folder
         raise UsageError(f"--out {args.out!r}: give a file for the result (or leave the option out)")
-    out = Path(args.out) if args.out else None
-    if out is not None and (out.is_dir() or not out.parent.is_dir()):
-        raise UsageError(f"--out {out}: must be a file in an existing folder")
+    # a file that can be written (its folder exists and takes files): checked before minutes of training
+    out = writable_file(args.out) if args.out else None
     if args.defence is not None and not args.defence.strip():
         raise UsageError(f"--defence {args.defence!r}: name one defence of the experiment's sweep, e.g. staking")
     cell = {k: v for k, v in (("defence", args.defence), ("byzantines", args.byzantines)) if v is not None}
