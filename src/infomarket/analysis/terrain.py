@@ -276,13 +276,15 @@ def answer(root: Path) -> dict:
     q = questions()
     sites = _two_food_sites(root)
     return {"chain_blocked": chain_blocked(_robots(root, "corridor", "world"), q["chain_blocked"]),
-            "waypoints_restore": (waypoints_restore(_robots(root, "corridor", "world"), _robots(root, "corridor_waypoints", "world"),
+            "waypoints_restore": (waypoints_restore(_robots(root, "corridor", "world"),
+                                                    _robots(root, "corridor_waypoints", "world"),
                                                     q["waypoints_restore"])
                                   if (root / "corridor_waypoints").exists() else
                                   {"answer": NOT_RUN, "why": "no corridor_waypoints store"}),
             "outlier_two_food": outlier_two_food(_robots(root, "two_food", "food_sites"), q["outlier_two_food"], sites),
             "crowd_collisions": crowd_collisions(_robots(root, "crowd", "collisions"), q["crowd_collisions"]),
-            **({"crowd_sensing": exploratory(crowd_collisions(_robots(root, "crowd_sensing", "collisions"), q["crowd_collisions"]))}
+            **({"crowd_sensing": exploratory(crowd_collisions(_robots(root, "crowd_sensing", "collisions"),
+                                                              q["crowd_collisions"]))}
                if (root / "crowd_sensing").exists() else {}),
             "declarations": _declarations(root, ("corridor", "corridor_waypoints", "two_food", "crowd"))}
 
