@@ -124,7 +124,10 @@ def cmd_adaptive_attack(args) -> int:
         raise UsageError(f"--transitory {transitory}: must be below --steps {steps} (items count after it)")
     cfg = cell.with_attack({}, steps=args.steps, transitory=args.transitory)  # the configuration is valid
     pop = 1 + 2 * args.pairs
-    generations = max(1, args.budget // pop)
+    if args.budget < pop:  # a generation is the smallest step: a smaller budget would be overspent
+        raise UsageError(f"--budget {args.budget}: one generation evaluates 1 + 2 x --pairs = {pop} candidates; give "
+                         f"--budget at least {pop} (or fewer --pairs)")
+    generations = args.budget // pop
     check_memory(cfg, min(BATCH, pop * args.runs), f"{pop} candidates x {args.runs} runs", pop * args.runs,
                  (len(OBSERVATION) + 1) * len(ACTIONS))
     writable_dir(out)
