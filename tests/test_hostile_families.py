@@ -109,7 +109,8 @@ def _device_link(path: Path) -> Path:
                                          (lambda p: _fifo(p / "pipe.toml"), "not a regular file"),
                                          (lambda p: _device_link(p / "zero.toml"), "not a regular file"),
                                          (lambda p: Path("/dev/zero"), "not a regular file"),
-                                         (lambda p: Path("/dev/null"), "not a regular file")])
+                                         (lambda p: Path("/dev/null"), "not a regular file")],
+                         ids=["big", "fifo", "devlink", "devzero", "devnull"])
 @pytest.mark.parametrize("command", [["check"], ["run", "--runs", "1", "--steps", "10", "--quiet"]])
 def test_an_experiment_that_is_not_a_regular_file_of_a_sane_size_is_refused_unread(make, words, command,
                                                                                     tmp_path, capsys, monkeypatch):
@@ -130,7 +131,7 @@ def test_load_experiment_refuses_the_same_in_python(tmp_path):
 
 
 @pytest.mark.parametrize("make", [lambda f: (f.unlink(), os.mkfifo(f)), lambda f: f.write_text(" " * (5 * 2**20) + "{}"),
-                                  lambda f: (f.unlink(), f.symlink_to("/dev/zero"))])
+                                  lambda f: (f.unlink(), f.symlink_to("/dev/zero"))], ids=["fifo", "big", "devlink"])
 @pytest.mark.parametrize("action", ["verify", "failed"])
 def test_a_store_json_that_is_not_a_regular_file_of_a_sane_size_is_refused_unread(make, action, tmp_path, capsys):
     from infomarket.store import Store
