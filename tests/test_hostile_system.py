@@ -41,6 +41,13 @@ def refused(capsys, argv: list[str], *words: str) -> str:
     return line
 
 
+@pytest.fixture(scope="module")
+def fig2b():
+    from infomarket.config import load_experiment
+
+    return load_experiment("fig2B").with_overrides(steps=200)
+
+
 def never(*args, **kwargs):
     pytest.fail("started work instead of refusing the input")
 
@@ -91,9 +98,9 @@ def test_a_name_too_long_for_the_file_system_is_one_message(argv, tmp_path, caps
     assert not any(tmp_path.iterdir())
 
 
-@pytest.mark.parametrize("table", ["robots", "runs", "commits"])
+@pytest.mark.parametrize("table", ["robots", "runs", "history", "configs"])
 @pytest.mark.parametrize("argv", [["store", "verify", "{}"], ["store", "sql", "{}", "SELECT count(*) FROM robots"],
-                                  ["store", "failed", "{}"], ["run", "fig2B", "--runs", "2", "--steps", "10", "--out", "{}"]])
+                                  ["run", "fig2B", "--runs", "2", "--steps", "10", "--out", "{}"]])
 def test_a_store_whose_table_folder_is_a_file_is_one_message(table, argv, tmp_path, capsys):
     if "sql" in argv:
         pytest.importorskip("duckdb")
