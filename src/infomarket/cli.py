@@ -218,7 +218,8 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     empty = [k for k, v in vars(args).items() if isinstance(v, str) and not v.strip() and k in PATH_OPTIONS]
     if empty:  # Path("") is the working folder: an empty path would silently write or read there
-        return report(f"--{empty[0].replace('_', '-')} is empty; give a path (or leave the option out)")
+        return report(f"--{empty[0].replace('_', '-')} {vars(args)[empty[0]]!r} is empty; give a path (or leave the "
+                      f"option out)")
     quiet = bool(getattr(args, "quiet", False))
     notice = os.environ.get("INFOMARKET_COMPILE_NOTICE")
     if quiet:  # the engine's "compiling the step kernel..." line too (workers inherit the variable)
