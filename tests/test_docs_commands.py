@@ -70,8 +70,8 @@ NOT_RUN = {
     "infomarket figures results/future --out results/future-report":
         "needs the future sweep's store; tests/analysis/test_future.py draws it from a synthetic one",
     # docs/terrain.md
-    "infomarket run two_food --runs 4 --out results/two_food":
-        "4 full runs; the store's sites table: tests/terrain/test_cli.py",
+    "infomarket sweep two_food --out results/two_food":
+        "128 full runs; the store's sites table: tests/terrain/test_cli.py",
     "infomarket sweep corridor --out results/corridor": "128 full runs; sweeps are tested in tests/runner",
     "infomarket sweep crowd --out results/crowd": "128 full runs (100 robots); sweeps are tested in tests/runner",
     "infomarket terrain-report results --out results/terrain":

@@ -14,8 +14,8 @@ from pathlib import Path
 
 from . import __version__, interrupts
 from .bench import cli as bench_cli
-from .cliargs import Parser, at_least, seed_value
-from .errors import EXIT_FAILED, EXIT_USAGE, ConfigWarning, InfomarketError, report, show_warning
+from .cliargs import Parser, at_least, seed_value, workers_count
+from .errors import EXIT_FAILED, EXIT_USAGE, ConfigWarning, InfomarketError, os_error_message, report, show_warning
 
 SUBCOMMAND_MODULES = ("infomarket.runner.cli", "infomarket.analysis.cli", "infomarket.viewer.cli",
                       "infomarket.evm.cli", "infomarket.analysis.sensitivity_cli")
@@ -25,6 +25,11 @@ SUBCOMMAND_MODULES += ("infomarket.rl.cli",)  # rl-train (docs/rl.md)
 SUBCOMMAND_MODULES += ("infomarket.search.adaptive_cli",)  # adaptive-attack (docs/rl.md)
 SUBCOMMAND_MODULES += ("infomarket.defence.cli",)  # defence-search (docs/defences.md)
 SUBCOMMAND_MODULES += ("infomarket.ros.cli",)  # ros agent, ros swarm (docs/ros.md)
+
+
+#: Options that name a file, a folder or an address: an empty value is refused, never taken as the working
+#: folder (``Path("")``) or as "not given".
+PATH_OPTIONS = frozenset({"out", "local", "movie", "questions", "scheduler", "dask"})
 
 
 def _print_summary(robots, title: str) -> None:
@@ -190,7 +195,7 @@ def build_parser() -> Parser:
     r.add_argument("--history", type=at_least(0), metavar="K",
                    help="also store the history table: every robot's wealth every K steps")
     r.add_argument("--out", help="results store folder (default: results/NAME); resumed if it holds these runs")
-    r.add_argument("--workers", type=at_least(1), help="processes (default: one per core)")
+    r.add_argument("--workers", type=workers_count, help="processes (default: one per core)")
     r.add_argument("--force", action="store_true",
                    help="replace this experiment's earlier runs in --out (made with another configuration or seed)")
     r.add_argument("--quiet", action="store_true", help="print nothing but errors")
@@ -200,7 +205,7 @@ def build_parser() -> Parser:
 
     d = sub.add_parser("demo", help="a short Fig. 2-like comparison: naive vs sceptical, with and without a saboteur")
     d.add_argument("--runs", type=at_least(1), default=8, help="runs per setup")
-    d.add_argument("--workers", type=at_least(1), help="processes (default: one per core)")
+    d.add_argument("--workers", type=workers_count, help="processes (default: one per core)")
     d.set_defaults(func=cmd_demo)
 
     ls = sub.add_parser("list", help="shipped experiments, behaviours and payment schemes")
@@ -232,6 +237,10 @@ def main(argv: list[str] | None = None) -> int:
     """
     parser = build_parser()
     args = parser.parse_args(argv)
+    empty = [k for k, v in vars(args).items() if isinstance(v, str) and not v.strip() and k in PATH_OPTIONS]
+    if empty:  # Path("") is the working folder: an empty path would silently write or read there
+        return report(f"--{empty[0].replace('_', '-')} {vars(args)[empty[0]]!r} is empty; give a path (or leave the "
+                      f"option out)")
     quiet = bool(getattr(args, "quiet", False))
     notice = os.environ.get("INFOMARKET_COMPILE_NOTICE")
     if quiet:  # the engine's "compiling the step kernel..." line too (workers inherit the variable)
@@ -267,6 +276,13 @@ def _run(args, quiet: bool = False) -> int:
     except BrokenPipeError:  # output piped into e.g. `head`: stop quietly, like other Unix tools
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+    except OSError as exc:  # a full disk, a read-only folder, a name too long, a file where a folder must be
+        if interrupts.requested():
+            return report("interrupted", interrupts.exit_code())
+        return report(os_error_message(exc), EXIT_USAGE)
+    except MemoryError:
+        return report("ran out of memory; ask for less (fewer robots, steps, runs or --workers), or free "
+                      "memory first", EXIT_USAGE)
     except Exception:
         if interrupts.requested():  # after a stop signal, an error on the way out is the stop's
             return report("interrupted", interrupts.exit_code())

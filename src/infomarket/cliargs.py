@@ -3,13 +3,15 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import sys
 import tempfile
 from pathlib import Path
 
-from .errors import UsageError, report
+from .errors import UsageError, printable, report
 
-__all__ = ["Parser", "UsageError", "at_least", "fraction", "seed_value", "writable_dir", "writable_file"]
+__all__ = ["Parser", "UsageError", "at_least", "fraction", "scheduler_address", "seed_value", "workers_count",
+           "writable_dir", "writable_file"]
 
 
 class Parser(argparse.ArgumentParser):
@@ -82,6 +84,25 @@ def at_least(low: int):
     return parse
 
 
+def max_workers() -> int:
+    """The most local processes a command may ask for: 8 per core, and at least 32 (more only queue for the
+    cores, each holding its own copy of the engine's memory)."""
+    return max(32, 8 * (os.cpu_count() or 1))
+
+
+def workers_count(text: str) -> int:
+    """A ``--workers`` value: an integer from 1 to ``max_workers()``.  Commands also use no more
+    processes than they have tasks (``--workers 100`` for 2 runs starts 2)."""
+    value = at_least(1)(text)
+    if value > max_workers():
+        raise argparse.ArgumentTypeError(f"must be at most {max_workers()} ({os.cpu_count() or 1} cores here), "
+                                         f"got {value}")
+    return value
+
+
+workers_count.__name__ = "number of processes"
+
+
 def fraction(text: str) -> float:
     """A number in (0, 1]."""
     try:
@@ -93,14 +114,45 @@ def fraction(text: str) -> float:
     return value
 
 
+#: Transports a Dask scheduler address may name (``tcp://host:8786``; no scheme means tcp).
+DASK_SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")
+_LABEL = r"[A-Za-z0-9](?:[A-Za-z0-9-]{0,62}[A-Za-z0-9])?"
+_HOST = rf"(?:{_LABEL}(?:\.{_LABEL})*|\[[0-9A-Fa-f:.]+\])"
+
+
+def scheduler_address(address: str, option: str = "--dask") -> str:
+    """``address`` if it reads as a Dask scheduler's address, ``[SCHEME://]HOST[:PORT]`` with a known
+    scheme and a port in 1..65535; else a UsageError naming ``option`` (before anything is imported or
+    started).  Whether a scheduler answers there is ``dask_client``'s to find out."""
+    def bad(why: str) -> UsageError:
+        return UsageError(f"{option} {printable(address)[:200]!r}: not a Dask scheduler address ({why}); "
+                          f"expected e.g. tcp://host:8786")
+
+    if not isinstance(address, str) or not address.strip():
+        raise bad("empty")
+    scheme, sep, rest = address.partition("://")
+    if not sep:
+        scheme, rest = "tcp", address
+    if scheme not in DASK_SCHEMES:
+        raise bad(f"unknown scheme {scheme!r}; allowed: {', '.join(DASK_SCHEMES)}")
+    m = re.fullmatch(rf"({_HOST})(?::([0-9]+))?/?", rest)
+    if not m:
+        raise bad("a host name or IP address, then an optional :PORT, is expected")
+    if m.group(2) is not None and not 1 <= int(m.group(2)) <= 65535:
+        raise bad(f"port {m.group(2)} is not in 1..65535")
+    return address
+
+
 def dask_client(address: str, option: str = "--dask"):
-    """A dask.distributed Client of the scheduler at ``address``; a missing Dask or a scheduler that does not
-    answer is a UsageError naming ``option``."""
+    """A dask.distributed Client of the scheduler at ``address``; a malformed address, a missing Dask or a
+    scheduler that does not answer is a UsageError naming ``option``."""
+    scheduler_address(address, option)
     try:
         from distributed import Client  # only when a command is sent to Dask: distributed is slow to import
     except ImportError:
         raise UsageError("Dask is not installed: pip install 'infomarket[dask]'") from None
     try:
         return Client(address, timeout="5s")
-    except (OSError, TimeoutError) as exc:
-        raise UsageError(f"{option} {address}: no Dask scheduler answers there ({exc})") from None
+    except (OSError, TimeoutError, ValueError, TypeError) as exc:  # a scheme Dask lacks, an address it cannot parse
+        raise UsageError(f"{option} {address}: no Dask scheduler answers there ({type(exc).__name__}: "
+                         f"{printable(str(exc))[:300]})") from None

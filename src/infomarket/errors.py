@@ -6,6 +6,7 @@ prints them with ``report`` (one line ``infomarket: error: ...`` on stderr, no t
 """
 from __future__ import annotations
 
+import errno
 import sys
 import warnings
 from typing import TextIO
@@ -81,6 +82,26 @@ def report(error: str | BaseException, code: int | None = None) -> int:
         code = exit_code(error) if isinstance(error, BaseException) else EXIT_USAGE
     print(f"infomarket: error: {printable(str(error))}", file=sys.stderr, flush=True)
     return code
+
+
+def os_error_message(exc: OSError) -> str:
+    """One line for an error of the operating system (a full disk, a read-only folder, a name too long, a
+    file where a folder must be): what failed, on which path, and why, each path once.  The command line
+    prints it with exit code 2: the fix (space, permissions, another path) is the user's; what was
+    committed before stays as it was, since every file is written whole and then renamed into place."""
+    why = exc.strerror or str(exc) or type(exc).__name__
+    paths = [str(p) for p in (exc.filename, exc.filename2) if p is not None]
+    where = " -> ".join(dict.fromkeys(paths))
+    hint = ""
+    if exc.errno in (errno.ENOSPC, errno.EDQUOT):
+        hint = "; free some space (what was finished is kept) and run the same command again"
+    elif exc.errno in (errno.EACCES, errno.EPERM, errno.EROFS):
+        hint = "; choose a folder you can write to"
+    elif exc.errno == errno.ENAMETOOLONG:
+        hint = "; choose a shorter name"
+    elif exc.errno in (errno.ENOTDIR, errno.EISDIR):
+        hint = "; a file stands where a folder must be (or the other way round): move it away or choose another path"
+    return f"{where}: {why}{hint}" if where else f"{why}{hint}"
 
 
 def show_warning(message: Warning | str, category: type[Warning], filename: str, lineno: int,

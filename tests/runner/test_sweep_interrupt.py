@@ -43,7 +43,7 @@ def test_ctrl_c_on_a_sweep_says_what_is_committed_and_how_to_resume(tmp_path, ca
     assert main(["sweep", "grid.toml", "--out", "my store", "--workers", "1", "--seed", "5", "--quiet"]) == 130
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "Traceback" not in err
-    expected = "infomarket sweep grid.toml --out 'my store' --seed 5"
+    expected = "infomarket sweep grid.toml --out 'my store' --seed 5 --workers 1 --quiet"  # every option kept
     assert err.strip() == f"infomarket: error: interrupted: 2 of 4 runs committed in my store; resume with: {expected}"
     assert len(Store(tmp_path / "my store").runs()) == 2
     monkeypatch.setattr(execute, "run_one", real)

@@ -74,6 +74,11 @@ def cmd_chain_study(args: argparse.Namespace) -> int:
     if runs.empty:
         raise UsageError(f"{', '.join(args.stores)}: no completed runs of the chain study")
     a = answer(runs, chain)
+    # stores of other experiments: nothing to answer
+    if all(str(v).startswith((study.NOT_RUN, study.PENDING, study.NO_DATA)) for v in a.table["answer"]):
+        raise UsageError(f"{', '.join(args.stores)}: no runs of the chain study's experiments (chain_paper, "
+                         f"chain_fig7, chain_sweep, chain_fig7_sweep, chain_partition), so no question can be "
+                         f"answered; run `infomarket sweep chain_paper --out STORE` first (docs/research.md)")
     a.locks = locks
     files = study.write(out, "chain-study", markdown(a, args.wall), table=a.table, figure=lambda p: figure(a, p))
     print(a.table[["question", "n", "answer"]].to_string(index=False))

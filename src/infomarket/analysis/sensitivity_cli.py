@@ -41,14 +41,14 @@ def cmd_sensitivity(args: argparse.Namespace) -> int:
     try:
         s = from_store(args.store, args.experiment)
     except MissingDataError as exc:
-        return report(f"{args.store}: {exc}", 2)
+        return report(_named(args.store, exc), 2)
     local = None
     if args.local:
         try:
             near = from_store(args.local)
             local = local_robustness(near, s.points)
         except MissingDataError as exc:
-            return report(f"--local {args.local}: {exc}", 2)
+            return report(f"--local {_named(args.local, exc)}", 2)
     table = declared_answers(s, Store(args.store), local)
     writable_dir(out)
     files = write(s, out, vector=args.vector, answers_table=table)
@@ -66,3 +66,10 @@ def cmd_sensitivity(args: argparse.Namespace) -> int:
         print(table[["question", "output", "answer"]].to_string(index=False))
     print(f"wrote {', '.join(str(p) for p in files)}")
     return 0
+
+
+def _named(path: str, exc: Exception) -> str:
+    """``PATH: message``, with the path once: a message that already starts with it is left as it is."""
+    text = str(exc)
+    bare = str(path).rstrip("/")
+    return text if bare and text.startswith(bare) else f"{path}: {text}"

@@ -54,12 +54,18 @@ def _two_food_sites(root: Path) -> pd.DataFrame | None:
     return None
 
 
-def _robots(root: Path, name: str) -> pd.DataFrame:
+def _robots(root: Path, name: str, axis: str | None = None) -> pd.DataFrame:
+    """The robots of the store ``root/name``, made by ``infomarket sweep name``: a store made by ``run``
+    holds only the base condition, without the sweep's ``axis`` the question compares."""
     path = root / name
     store = Store(path)
     if not store.exists():
         raise UsageError(f"{path}: no results store; run `infomarket sweep {name} --out {path}` first")
-    return store.robots()
+    robots = store.robots()
+    if axis is not None and axis not in robots.columns:
+        raise UsageError(f"{path}: holds no runs of the sweep's {axis} conditions (`infomarket run` stores only "
+                         f"the base condition); run `infomarket sweep {name} --out {path}`")
+    return robots
 
 
 def _ratio(a: float, b: float) -> float:
@@ -275,14 +281,16 @@ def answer(root: Path) -> dict:
     store is absent is answered 'not run'."""
     q = questions()
     sites = _two_food_sites(root)
-    return {"chain_blocked": chain_blocked(_robots(root, "corridor"), q["chain_blocked"]),
-            "waypoints_restore": (waypoints_restore(_robots(root, "corridor"), _robots(root, "corridor_waypoints"),
+    return {"chain_blocked": chain_blocked(_robots(root, "corridor", "world"), q["chain_blocked"]),
+            "waypoints_restore": (waypoints_restore(_robots(root, "corridor", "world"),
+                                                    _robots(root, "corridor_waypoints", "world"),
                                                     q["waypoints_restore"])
                                   if (root / "corridor_waypoints").exists() else
                                   {"answer": NOT_RUN, "why": "no corridor_waypoints store"}),
-            "outlier_two_food": outlier_two_food(_robots(root, "two_food"), q["outlier_two_food"], sites),
-            "crowd_collisions": crowd_collisions(_robots(root, "crowd"), q["crowd_collisions"]),
-            **({"crowd_sensing": exploratory(crowd_collisions(_robots(root, "crowd_sensing"), q["crowd_collisions"]))}
+            "outlier_two_food": outlier_two_food(_robots(root, "two_food", "food_sites"), q["outlier_two_food"], sites),
+            "crowd_collisions": crowd_collisions(_robots(root, "crowd", "collisions"), q["crowd_collisions"]),
+            **({"crowd_sensing": exploratory(crowd_collisions(_robots(root, "crowd_sensing", "collisions"),
+                                                              q["crowd_collisions"]))}
                if (root / "crowd_sensing").exists() else {}),
             "declarations": _declarations(root, ("corridor", "corridor_waypoints", "two_food", "crowd"))}
 

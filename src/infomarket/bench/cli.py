@@ -59,6 +59,10 @@ def run(args) -> int:
     if args.chain and not args.robots:  # the default bench times fig4C+chain already; --chain alone did nothing
         raise UsageError("--chain goes with --robots (every robot a blockchain node at each swarm size); the "
                          "default bench already times fig4C+chain")
+    if args.many and (args.robots or args.scaling or args.env):  # --many adds to the setups' bench only
+        other = "--robots" if args.robots else "--scaling" if args.scaling else "--env"
+        raise UsageError(f"--many goes with the setups' bench (no --robots, --scaling or --env); {other} is "
+                         f"another bench: give one of them")
     if args.env:
         return _env(args)
     if args.batch is not None or args.interval is not None:

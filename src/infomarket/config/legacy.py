@@ -51,6 +51,16 @@ def _check_keys(where: str, got: dict, allowed) -> None:
                           f"allowed: {', '.join(sorted(allowed))}")
 
 
+def _class_name(where: str, value: Any, allowed) -> str:
+    """A ``class`` entry: a string naming one of ``allowed`` (a list or an object there is a type error)."""
+    if value is None:
+        raise ConfigError(f"{where}: missing; allowed: {', '.join(allowed)}")
+    if not isinstance(value, str):
+        raise ConfigError(f"{where}: expected the name of a class (a string), got {type(value).__name__} "
+                          f"{str(value)[:80]}; allowed: {', '.join(allowed)}")
+    return value
+
+
 def from_legacy(data: dict[str, Any], name: str) -> dict[str, Any]:
     """Translate an original-format dictionary into our schema's dictionary (validated afterwards)."""
     _check_keys("", data, TOP_KEYS)
@@ -81,14 +91,18 @@ def from_legacy(data: dict[str, Any], name: str) -> dict[str, Any]:
         raise ConfigError("behaviors: expected a list of {class, population_size, parameters}")
     for k, b in enumerate(behaviors):
         _check_keys(f"behaviors[{k}]", b, {"class", "population_size", "parameters"})
-        cls = b.get("class")
+        cls = _class_name(f"behaviors[{k}].class", b.get("class"), BEHAVIOUR_CLASSES)
         if cls not in BEHAVIOUR_CLASSES:
             raise ConfigError(f"behaviors[{k}].class: unknown class {cls!r}; allowed: "
                               f"{', '.join(BEHAVIOUR_CLASSES)}")
         count = b.get("population_size", 0)
         if count == 0:
             continue  # the original lists every class, most with population 0
-        groups.append({"behaviour": BEHAVIOUR_CLASSES[cls], "count": count, "params": b.get("parameters", {})})
+        params = b.get("parameters", {})
+        if not isinstance(params, dict):
+            raise ConfigError(f"behaviors[{k}].parameters: expected a JSON object of parameter values, got "
+                              f"{type(params).__name__}")
+        groups.append({"behaviour": BEHAVIOUR_CLASSES[cls], "count": count, "params": params})
     if groups:
         total = sum(g["count"] for g in groups if isinstance(g["count"], int))
         out["swarm"] = {"robots": total, "groups": groups}
@@ -98,12 +112,13 @@ def from_legacy(data: dict[str, Any], name: str) -> dict[str, Any]:
     if "payment_system" in data:
         ps = data["payment_system"]
         _check_keys("payment_system", ps, {"class", "initial_reward", "parameters"})
-        cls = ps.get("class")
+        cls = _class_name("payment_system.class", ps.get("class"), PAYMENT_CLASSES)
         if cls not in PAYMENT_CLASSES:
             raise ConfigError(f"payment_system.class: unknown class {cls!r}; allowed: {', '.join(PAYMENT_CLASSES)}")
         scheme, default_stake = PAYMENT_CLASSES[cls]
-        params = dict(ps.get("parameters", {}))
+        params = ps.get("parameters", {})
         _check_keys("payment_system.parameters", params, PAYMENT_PARAMETERS[cls])
+        params = dict(params)
         payment = {"scheme": scheme, "stake": params.pop("stake_amount", default_stake)}
         if "information_share" in params:
             payment["information_share"] = params["information_share"]
@@ -112,7 +127,7 @@ def from_legacy(data: dict[str, Any], name: str) -> dict[str, Any]:
     if "market" in data:
         m = data["market"]
         _check_keys("market", m, {"class", "parameters"})
-        if m.get("class", "FixedPriceMarket") != "FixedPriceMarket":
+        if _class_name("market.class", m.get("class", "FixedPriceMarket"), ["FixedPriceMarket"]) != "FixedPriceMarket":
             raise ConfigError(f"market.class: unknown class {m.get('class')!r}; allowed: FixedPriceMarket")
         mp = m.get("parameters", {})
         _check_keys("market.parameters", mp, {"reward"})

@@ -11,6 +11,7 @@ from importlib import resources
 from pathlib import Path
 
 from ..errors import ConfigError
+from ..userfiles import read_text
 from .legacy import from_legacy, is_legacy
 from .messages import key_path  # noqa: F401  (where callers have found it)
 from .schema import NAME_MAX, Experiment, validate
@@ -69,10 +70,9 @@ def load_experiment(what: str | Path) -> Experiment:
         other = (f"; the shipped experiment {path.name} is named without a folder or a trailing /: `{path.name}`"
                  if path.name in shipped else "")
         raise ConfigError(f"{path}: is a directory, not an experiment file (.toml or .json){other}")
-    try:
-        text = path.read_text(encoding="utf-8-sig")  # a byte-order mark (some editors write one) is not TOML
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ConfigError(f"{path}: cannot read: {exc}") from None
+    # a regular file of a sane size only (a device or a FIFO named by mistake is never read whole); a
+    # byte-order mark (some editors write one) is dropped: it is not TOML
+    text = read_text(path, ConfigError, "experiment file")
     try:
         return _parse(path, text)
     except RecursionError:

@@ -32,11 +32,23 @@ from ..seeds import MAX_SEED  # one definition, infomarket.seeds
 NAME_MAX = 100
 NAME_PATTERN = r"^[A-Za-z0-9_][A-Za-z0-9_.+=,-]*$"
 
-PosFloat = Annotated[float, Field(gt=0, allow_inf_nan=False)]
-NonNegFloat = Annotated[float, Field(ge=0, allow_inf_nan=False)]
-Finite = Annotated[float, Field(allow_inf_nan=False)]
-NonNegInt = Annotated[int, Field(ge=0, strict=True)]
-PosInt = Annotated[int, Field(gt=0, strict=True)]
+#: Bounds where the model needs them: a number that passes validation must run without overflowing or
+#: dividing by zero.  Lengths (the arena, radii, speed, ranges, coordinates, noise) are at most MAX_LENGTH
+#: (a million arenas of the paper's 1200: a step of 1e300 overflows the geometry); amounts of money at most
+#: MAX_MONEY (so the swarm's total wealth, summed over a run's every reward, stays a finite float64); counts
+#: of steps at most MAX_STEPS (so a clock plus any of them stays an int64); rule parameters at most
+#: MAX_PARAM in size.
+MAX_LENGTH = 1e9
+MAX_MONEY = 1e12
+MAX_STEPS = 10**12
+MAX_PARAM = 1e12
+PosFloat = Annotated[float, Field(gt=0, le=MAX_LENGTH, allow_inf_nan=False)]
+NonNegFloat = Annotated[float, Field(ge=0, le=MAX_LENGTH, allow_inf_nan=False)]
+Finite = Annotated[float, Field(ge=-MAX_LENGTH, le=MAX_LENGTH, allow_inf_nan=False)]
+Money = Annotated[float, Field(ge=0, le=MAX_MONEY, allow_inf_nan=False)]
+Param = Annotated[float, Field(ge=-MAX_PARAM, le=MAX_PARAM, allow_inf_nan=False)]
+NonNegInt = Annotated[int, Field(ge=0, le=MAX_STEPS, strict=True)]
+PosInt = Annotated[int, Field(gt=0, le=MAX_STEPS, strict=True)]
 
 
 class _Strict(BaseModel):
@@ -111,7 +123,7 @@ class Robot(_Strict):
     noise_sd: NonNegFloat = 0.05
     stop_time: NonNegInt = 0
     cooldown: NonNegInt = 0
-    fuel_cost: NonNegFloat = 0.0
+    fuel_cost: Money = 0.0
     #: Two robots communicate only if no obstacle cuts the segment between them (space.obstacles).
     line_of_sight: StrictBool = False
     #: Robots are discs that cannot overlap: a move that would overlap another robot is not made.
@@ -123,7 +135,8 @@ class Robot(_Strict):
 class RandomWalk(_Strict):
     """``[random_walk]``: the exploration walk, turning angles wrapped Cauchy (``rho``), run lengths Lévy
     (``alpha``)."""
-    rho: Annotated[float, Field(gt=0, lt=1)] = 0.9
+    #: below 1 - 1e-6: at 1 the turning angle's wrapped Cauchy density divides by zero
+    rho: Annotated[float, Field(gt=0, le=0.999999)] = 0.9
     alpha: Annotated[float, Field(gt=0, le=2)] = 1.4
 
 
@@ -131,7 +144,7 @@ class Group(_Strict):
     """One group of the swarm: ``count`` robots of ``behaviour``, its parameters overridden by ``params``."""
     behaviour: str
     count: NonNegInt
-    params: dict[str, Finite] = Field(default_factory=dict)
+    params: dict[str, Param] = Field(default_factory=dict)
 
 
 class Swarm(_Strict):
@@ -155,16 +168,16 @@ class Payment(_Strict):
     """``[payment]``: the payment ``scheme`` and its ``params``, the robots' initial wealth, the reward and the
     stake."""
     scheme: str = "delayed"
-    initial_wealth: NonNegFloat = 1.0
-    reward: NonNegFloat = 1.0
+    initial_wealth: Money = 1.0
+    reward: Money = 1.0
     information_share: Annotated[float, Field(ge=0, le=1)] = 0.5
-    stake: NonNegFloat = 0.0
+    stake: Money = 0.0
     #: Steps after which an open purchase's stake goes back to its seller (0 = never; docs/chain.md).
     stake_expiry: NonNegInt = 0
     #: Reputation that decays: each earlier settled sale of a seller counts this many times less at each
     #: later one in the reputation rules read (1 = never; docs/defences.md).
     reputation_decay: Annotated[float, Field(gt=0, le=1)] = 1.0
-    params: dict[str, Finite] = Field(default_factory=dict)
+    params: dict[str, Param] = Field(default_factory=dict)
 
 
 class Chain(_Strict):
@@ -186,7 +199,7 @@ class Chain(_Strict):
     #: step) is lost.
     loss: Annotated[float, Field(ge=0, lt=1)] = 0.0
     #: Money per unit of gas; each reveal, deposit and settlement costs its measured gas (docs/gas.md).
-    gas_price: NonNegFloat = 0.0
+    gas_price: Money = 0.0
     #: A block this many blocks below the canonical head is final (earlier, once every robot's head is
     #: on it); branches that do not contain it are dropped.
     finality: PosInt = 32

@@ -85,7 +85,8 @@ def limit() -> tuple[int, str]:
 def neighbour_slots(cfg) -> int:
     """Most robots whose discs fit within communication range of one robot (a packing bound), at most n - 1."""
     n, r, reach = cfg.swarm.robots, cfg.robot.radius, cfg.robot.communication_range
-    return int(min(n - 1, math.ceil(((reach + r) / r) ** 2)))
+    ratio = min((reach + r) / r, float(n))  # capped first: a huge range must not overflow the square
+    return int(min(n - 1, math.ceil(ratio ** 2)))
 
 
 def run_bytes(cfg, *, record_events: bool = False, history_every: int | None = None) -> dict[str, int]:

@@ -4,7 +4,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from ..cliargs import UsageError, at_least, dask_client
+from ..cliargs import UsageError, at_least, dask_client, seed_value, workers_count
 
 #: outer settings an option may make smaller than declared (the report is then marked reduced)
 SIZES = ("candidates", "refine", "cost_runs", "frontier", "confirmation_runs")
@@ -162,12 +162,12 @@ def add_subcommand(sub) -> None:
                    help="the inner search's rotation grid step (default: declared)")
     p.add_argument("--inner-race", metavar="N,N,...", help="the inner search's cumulative runs per raced attack "
                                                            "(default: declared)")
-    p.add_argument("--seed", type=at_least(0), help="the study's seed: designs and seed sets (default: declared)")
+    p.add_argument("--seed", type=seed_value, help="the study's seed: designs and seed sets (default: declared)")
     p.add_argument("--list-families", action="store_true", help="list the families and their parameters and exit")
     p.add_argument("--steps", type=at_least(1), help="steps per run (default: the experiment's), for a reduced study")
     p.add_argument("--transitory", type=at_least(0), help="steps not counted (default: the experiment's)")
     p.add_argument("--out", help="folder: the results store (OUT/store) and the report")
-    p.add_argument("--workers", type=at_least(1), help="local processes (default: one per core)")
+    p.add_argument("--workers", type=workers_count, help="local processes (default: one per core)")
     p.add_argument("--dask", metavar="ADDRESS", help="run on a Dask scheduler, e.g. tcp://host:8786")
     p.add_argument("--reduced", metavar="TEXT", help="label the report as a reduced run (what was reduced)")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")

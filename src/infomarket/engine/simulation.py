@@ -24,6 +24,7 @@ import pandas as pd
 from numba.core.errors import NumbaPedanticWarning
 
 from ..config.schema import Experiment
+from ..config import sizes
 from ..config.load import load_experiment
 from ..errors import ArgumentError, ConfigError, InputTypeError, SimulationError
 from ..registry import behaviours
@@ -145,6 +146,30 @@ class Simulation:
         self.world = world
         self._view = kernel_view(world) if self._kernel is not None else None
         self.run_seconds = 0.0
+
+    def __copy__(self) -> Simulation:
+        """A shallow copy sharing this one's world arrays and loaded kernel (``another`` resets it at once)."""
+        sim = object.__new__(type(self))
+        sim.__dict__.update(self.__dict__)
+        return sim
+
+    def __getstate__(self) -> dict:
+        """What a pickle (or a deep copy) keeps: the configuration, the seed, the random generator and the world
+        at its step; the loaded kernel (a module) is left out and loaded again from the cache on unpickling."""
+        state = self.__dict__.copy()
+        state.pop("_kernel", None)
+        state.pop("_view", None)
+        return state
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        with compile_notice(self.kinds, self.config.payment.scheme):
+            self._kernel = _kernel_for(self.kinds, self.config)
+            self._view = interrupts.compiled_apart(self._resumed_view, compile_marker(self._kernel, "simulation"))
+
+    def _resumed_view(self):
+        """The kernel view of the world as it stands (an unpickled simulation's, at its step): no step runs."""
+        return kernel_view(self.world)
 
     def another(self, seed: int) -> Simulation:
         """A new run of the same configuration with ``seed``, sharing this one's loaded kernel."""
@@ -489,5 +514,10 @@ def simulate(config: Experiment | str | Path, seed: int | None = None, *, steps:
     if steps is not None:
         if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 1:
             raise ConfigError(f"steps must be a positive integer number of steps, got {steps!r}")
+        if steps > MAX_SEED:  # an int64 on the kernel's side
+            raise ConfigError(f"steps must be at most 2**63 - 1, got {steps!r}")
         config = config.model_copy(update={"steps": int(steps)})
+        too_big = sizes.run_too_big(config, record_events=record_events, history_every=history_every)
+        if too_big:  # the Lévy table alone is 16 bytes a step: named before it is allocated
+            raise ConfigError(f"steps={steps}: {too_big}")
     return Simulation(config, seed, record_events=record_events, history_every=history_every).run()

@@ -6,9 +6,8 @@ from __future__ import annotations
 import json
 import math
 import time
-from pathlib import Path
 
-from ..cliargs import UsageError, at_least
+from ..cliargs import UsageError, at_least, seed_value, writable_file
 
 
 def _positive(text: str) -> float:
@@ -49,7 +48,7 @@ def add_subcommand(sub) -> None:
     t.add_argument("--sigma", type=_positive, default=0.5, help="perturbation scale, in logits (default 0.5)")
     t.add_argument("--lr", type=_positive, default=0.2, help="Adam's step size (default 0.2)")
     t.add_argument("--eval-runs", type=at_least(2), default=32, help="held-out seeds to compare on (default 32)")
-    t.add_argument("--seed", type=at_least(0), default=0, help="the training's seed (default 0)")
+    t.add_argument("--seed", type=seed_value, default=0, help="the training's seed (default 0)")
     t.add_argument("--out", help="write the learned policy, the learning curve and the comparison here (JSON)")
     t.add_argument("--json", action="store_true", help="print the result as one JSON object")
     t.add_argument("--quiet", action="store_true", help="no progress")
@@ -75,9 +74,8 @@ def cmd_rl_train(args) -> int:
         raise UsageError(f"--transitory {args.transitory}: must be below --steps {args.steps}")
     if args.out is not None and not args.out.strip():  # a blank variable: not "no file", and not this folder
         raise UsageError(f"--out {args.out!r}: give a file for the result (or leave the option out)")
-    out = Path(args.out) if args.out else None
-    if out is not None and (out.is_dir() or not out.parent.is_dir()):
-        raise UsageError(f"--out {out}: must be a file in an existing folder")
+    # a file that can be written (its folder exists and takes files): checked before minutes of training
+    out = writable_file(args.out) if args.out else None
     if args.defence is not None and not args.defence.strip():
         raise UsageError(f"--defence {args.defence!r}: name one defence of the experiment's sweep, e.g. staking")
     cell = {k: v for k, v in (("defence", args.defence), ("byzantines", args.byzantines)) if v is not None}

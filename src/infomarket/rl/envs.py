@@ -20,7 +20,7 @@ from gymnasium.vector.utils import batch_space
 
 from ..config import sizes
 from ..errors import ArgumentError, ConfigError, InputTypeError, UsageError
-from ..seeds import MAX_SEED
+from ..seeds import MAX_SEED, checked_seed_arg
 from .interop import RENDER_MODES, ArenaRenderer, Rebuilt, checked_render_mode
 from .observe import OBSERVATION
 from .runs import ACTIONS, Runs, select_cell
@@ -157,7 +157,7 @@ class AttackEnv(Rebuilt, gym.Env):
 
         It returns the first observation and ``{"seed": the run's seed}``.
         """
-        super().reset(seed=seed)
+        super().reset(seed=None if seed is None else checked_seed_arg(seed, "reset(seed=...)"))
         s = episode_seed(self.np_random)
         self.runs.reset([0], [s])
         self._rewards.mark()
@@ -230,15 +230,22 @@ class AttackVectorEnv(Rebuilt, gym.vector.VectorEnv):
         Raises:
             UsageError: a list of seeds of the wrong length.
         """
-        super().reset(seed=seed if isinstance(seed, (int, np.integer)) or seed is None else None)
         if seed is None:
             seeds: list[int | None] = [None] * self.num_envs
-        elif isinstance(seed, (int, np.integer)):
+        elif isinstance(seed, (int, np.integer)) and not isinstance(seed, bool):
+            checked_seed_arg(seed, "reset(seed=...)")
+            checked_seed_arg(int(seed) + self.num_envs - 1, f"reset(seed=...) + {self.num_envs - 1} (the last "
+                                                            f"environment's seed)")
             seeds = [int(seed) + i for i in range(self.num_envs)]
-        else:
+        elif isinstance(seed, (list, tuple, np.ndarray)):
             seeds = list(seed)
             if len(seeds) != self.num_envs:
                 raise UsageError(f"reset(seed=[...]): {len(seeds)} seeds for {self.num_envs} environments")
+            seeds = [None if s is None else checked_seed_arg(s, f"reset(seed=[...])[{k}]") for k, s in enumerate(seeds)]
+        else:  # a string is a sequence too: it is not a list of seeds
+            raise InputTypeError(f"reset(seed=...): an integer seed, a list of {self.num_envs} seeds, or None; got "
+                                 f"{type(seed).__name__} {str(seed)[:80]!r}")
+        super().reset(seed=seeds[0] if isinstance(seed, (int, np.integer)) else None)
         self._env_rngs = [seeding.np_random(s)[0] for s in seeds]
         self.runs.reset(np.arange(self.num_envs), [episode_seed(r) for r in self._env_rngs])
         self._rewards.mark()

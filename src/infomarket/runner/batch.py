@@ -84,7 +84,7 @@ def run_conditions(conds: list[Condition], *, workers: int = 1, on_done=None,
         if executor is not None:
             warm_seconds = execute(tasks, finished, executor=executor)
         else:
-            with local_executor(workers) as pool:
+            with local_executor(max(1, min(workers, len(tasks)))) as pool:  # never more processes than tasks
                 warm_seconds = execute(tasks, finished, executor=pool)
     except KeyboardInterrupt:
         first = outputs[(conds[0].experiment, conds[0].id)]

@@ -4,7 +4,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from .. import interrupts
-from ..cliargs import UsageError, at_least, dask_client, fraction, seed_value
+from ..cliargs import UsageError, at_least, dask_client, fraction, seed_value, workers_count
 from ..errors import EXIT_FAILED, EXIT_USAGE, report
 
 PAPER = ("fig2A", "fig2B", "fig2C", "fig2D", "fig3A", "fig3B", "fig3C", "fig4A", "fig4B", "fig4C",
@@ -38,6 +38,10 @@ def _execute(experiments, args, label: str) -> int:
     from ..runner.sweep import plan, run_sweep
     from ..store import Store
 
+    if args.workers is not None and (args.scheduler or args.dask_local):  # local processes, or Dask's: not both
+        other = f"--scheduler {args.scheduler}" if args.scheduler else f"--dask-local {args.dask_local}"
+        raise UsageError(f"--workers {args.workers} and {other}: --workers sets local processes, which a Dask "
+                         f"run does not use; give one of them")
     conds = plan(experiments, runs=getattr(args, "runs", None), seed=getattr(args, "seed", None),
                  scale=getattr(args, "scale", 1.0))
     need = sum(sizes.results_bytes(c.config, c.runs) for c in conds)
@@ -104,10 +108,14 @@ def _interrupted(store, conds, total: int, args) -> str:
     words += [args.what] if args.command == "reproduce" else [args.experiment]
     words += ["--out", str(args.out)]
     for flag, value in (("--runs", getattr(args, "runs", None)), ("--scale", getattr(args, "scale", 1.0)),
-                        ("--seed", getattr(args, "seed", None)), ("--samples", getattr(args, "samples", None))):
+                        ("--seed", getattr(args, "seed", None)), ("--samples", getattr(args, "samples", None)),
+                        ("--workers", args.workers), ("--scheduler", args.scheduler),
+                        ("--dask-local", args.dask_local)):
         if value is not None and not (flag == "--scale" and value == 1.0):
             words += [flag, str(value)]
     words += ["--events"] if args.events else []
+    words += ["--retry-failed"] if args.retry_failed else []
+    words += ["--quiet"] if args.quiet else []
     return f"interrupted: {kept}; resume with: {shlex.join(words)}"
 
 
@@ -159,7 +167,7 @@ def cmd_reproduce(args) -> int:
 
 def _executor_options(p) -> None:
     p.add_argument("--out", required=True, help="results store folder (created; resumed if it exists)")
-    p.add_argument("--workers", type=at_least(1), help="local processes (default: one per core)")
+    p.add_argument("--workers", type=workers_count, help="local processes (default: one per core)")
     g = p.add_mutually_exclusive_group()
     g.add_argument("--scheduler", metavar="ADDRESS", help="run on a Dask scheduler, e.g. tcp://host:8786")
     g.add_argument("--dask-local", type=at_least(1), metavar="N", help="run on a local Dask cluster of N workers")

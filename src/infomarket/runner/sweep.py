@@ -266,7 +266,7 @@ def _run(conds, store, workers, executor, on_done, on_plan, record_events, on_pa
     if executor is not None:
         warm = execute(tasks, finished, executor=executor, record_events=record_events)
     else:
-        with local_executor(workers) as pool:
+        with local_executor(max(1, min(workers, len(tasks)))) as pool:  # never more processes than tasks
             warm = execute(tasks, finished, executor=pool, record_events=record_events)
     first = (failed[0].error or "").strip().splitlines()[-1] if failed else ""
     rule_errors = [o for o in failed if o.rule_error]

@@ -9,7 +9,7 @@ import math
 import time
 from pathlib import Path
 
-from ..cliargs import UsageError, at_least, seed_value
+from ..cliargs import UsageError, at_least, seed_value, workers_count
 
 #: The policy's and the summaries' file names in ``--out``.
 POLICY_FILE, SUMMARY_JSON, SUMMARY_MD = "policy.npz", "summary.json", "summary.md"
@@ -54,7 +54,7 @@ def add_subcommand(sub) -> None:
     p.add_argument("--seed", type=seed_value, default=0, help="the training's seed (default 0)")
     p.add_argument("--eval-runs", type=at_least(0), default=16,
                    help="runs on fresh seeds comparing the learned policy with its start, paired (default 16; 0: none)")
-    p.add_argument("--workers", type=at_least(1), default=1, help="local processes (default 1)")
+    p.add_argument("--workers", type=workers_count, default=1, help="local processes (default 1)")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.set_defaults(func=cmd_adaptive_attack)
 
@@ -128,7 +128,10 @@ def cmd_adaptive_attack(args) -> int:
         raise UsageError(f"--transitory {transitory}: must be below --steps {steps} (items count after it)")
     cfg = cell.with_attack({}, steps=args.steps, transitory=args.transitory)  # the configuration is valid
     pop = 1 + 2 * args.pairs
-    generations = max(1, args.budget // pop)
+    if args.budget < pop:  # a generation is the smallest step: a smaller budget would be overspent
+        raise UsageError(f"--budget {args.budget}: one generation evaluates 1 + 2 x --pairs = {pop} candidates; give "
+                         f"--budget at least {pop} (or fewer --pairs)")
+    generations = args.budget // pop
     check_memory(cfg, min(BATCH, pop * args.runs), f"{pop} candidates x {args.runs} runs", pop * args.runs,
                  (len(OBSERVATION) + 1) * len(ACTIONS))
     writable_dir(out)

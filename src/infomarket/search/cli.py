@@ -5,7 +5,7 @@ import functools
 import time
 from pathlib import Path
 
-from ..cliargs import UsageError, at_least, dask_client
+from ..cliargs import UsageError, at_least, dask_client, seed_value, workers_count
 from .baselines import rotation_grid
 
 
@@ -215,7 +215,7 @@ def add_subcommand(sub) -> None:
                                                                  "(default: declared)")
     p.add_argument("--grid-step", type=float, metavar="DEGREES", help="rotation grid's step (default: declared)")
     p.add_argument("--objective", choices=["items", "liar_wealth"], help="what the attack optimises (default: items)")
-    p.add_argument("--seed", type=at_least(0), help="the search's seed: optimisers and seed sets (default: declared)")
+    p.add_argument("--seed", type=seed_value, help="the search's seed: optimisers and seed sets (default: declared)")
     p.add_argument("--adaptive-budget", type=at_least(0), metavar="N",
                    help="evaluations per cell of the adaptive attacker, the second searcher "
                         "(0: none; default: declared)")
@@ -224,7 +224,7 @@ def add_subcommand(sub) -> None:
     p.add_argument("--steps", type=at_least(1), help="steps per run (default: the experiment's), for a reduced search")
     p.add_argument("--transitory", type=at_least(0), help="steps not counted (default: the experiment's)")
     p.add_argument("--out", help="folder: the results store (OUT/store) and the report")
-    p.add_argument("--workers", type=at_least(1), help="local processes (default: one per core)")
+    p.add_argument("--workers", type=workers_count, help="local processes (default: one per core)")
     p.add_argument("--dask", metavar="ADDRESS", help="run on a Dask scheduler, e.g. tcp://host:8786")
     p.add_argument("--reduced", metavar="TEXT", help="label the report as a reduced run (what was reduced)")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")

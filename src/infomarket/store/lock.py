@@ -33,7 +33,8 @@ class StoreLock:
         except OSError:
             os.close(fd)
             raise StoreError(f"{self.path.parent}: another infomarket process is writing this store (it holds "
-                             f"{self.path.name}); wait for it to finish, or use another --out") from None
+                             f"{self.path.name}); wait for it to finish and run this command again (a run or sweep "
+                             f"can also write a new store elsewhere)") from None
         self.fd = fd
         _HELD.add(key)
         return self

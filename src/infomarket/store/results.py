@@ -27,6 +27,7 @@ from .dictionary import annotate
 from .files import sha256_file, write_atomic, write_text_atomic
 from .read_cache import ReadCache, sort_rows
 from ..config.load import validate
+from ..userfiles import read_text
 
 FORMAT = 1
 OK, FAILED = "ok", "failed"
@@ -105,9 +106,10 @@ class Store:
         Raises:
             StoreError: it cannot be read or is not a JSON object.
         """
+        text = read_text(self.meta_path, StoreError, "store.json")  # a regular file of a sane size only
         try:
-            meta = json.loads(self.meta_path.read_text())
-        except (OSError, ValueError) as exc:
+            meta = json.loads(text)
+        except ValueError as exc:
             raise StoreError(f"{self.meta_path}: unreadable ({exc})") from None
         if not isinstance(meta, dict):
             raise StoreError(f"{self.meta_path}: not an infomarket store.json (a JSON object is expected, found "

@@ -245,14 +245,31 @@ def write_movie(rec: Recording, path: str | Path, *, fps: int | None = None, max
         writer = animation.FFMpegWriter(fps=fps, codec="libx264", extra_args=["-pix_fmt", "yuv420p"])
     picks = pick_frames(len(rec.frames), max_frames or MAX_FRAMES[ext])
     tmp = path.with_name(path.stem + ".part" + path.suffix)
-    with writer.saving(picture.fig, str(tmp), dpi):
+    try:  # not ``writer.saving``: on Ctrl-C or an error its exit would still encode every frame grabbed
+        writer.setup(picture.fig, str(tmp), dpi)
         for j, k in enumerate(picks):
             picture.draw(rec.frame(int(k)))
             writer.grab_frame()
             if on_progress:
                 on_progress(j + 1, len(picks))
-    tmp.replace(path)
+        writer.finish()
+        tmp.replace(path)
+    except BaseException:  # stopped or failed: no half-written movie is left behind, no encoder left running
+        _abandon(writer)
+        tmp.unlink(missing_ok=True)
+        raise
     return path
+
+
+def _abandon(writer) -> None:
+    """Stop a movie writer without encoding what it holds: ffmpeg (a child process) is killed and reaped;
+    Pillow's frames are dropped."""
+    proc = getattr(writer, "_proc", None)
+    if proc is not None and proc.poll() is None:
+        proc.kill()
+        proc.wait()
+    if hasattr(writer, "_frames"):
+        writer._frames = []
 
 
 def _legend(fig, band: tuple[float, float], collisions: bool, byzantines: bool = True, chain: bool = False) -> None:

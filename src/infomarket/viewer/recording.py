@@ -116,6 +116,10 @@ def write_html(rec: Recording, path: str | Path) -> Path:
     """Write the replay page to ``path`` (atomically: a half-written file never appears)."""
     path = Path(path)
     tmp = path.with_name(path.name + ".part")
-    tmp.write_text(html(rec), encoding="utf-8")
-    tmp.replace(path)
+    try:
+        tmp.write_text(html(rec), encoding="utf-8")
+        tmp.replace(path)
+    except BaseException:  # a full disk, Ctrl-C: no .part file is left behind
+        tmp.unlink(missing_ok=True)
+        raise
     return path
