@@ -173,7 +173,7 @@ def test_a_shipped_name_in_the_wrong_case_suggests_the_right_one(tmp_path, monke
 def test_a_slow_kernel_load_is_announced_on_stderr_unless_quiet(capsys, monkeypatch):
     import time
 
-    from infomarket.engine.simulation import compile_notice
+    from infomarket.engine.compiling import compile_notice
 
     monkeypatch.delenv("INFOMARKET_COMPILE_NOTICE", raising=False)
     err = ""

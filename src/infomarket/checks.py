@@ -14,7 +14,8 @@ import numba
 import numpy as np
 
 from .config import validate
-from .engine.simulation import Simulation, quiet_compiles
+from .engine.compiling import quiet_compiles
+from .engine.simulation import Simulation
 from .errors import InfomarketError, RuleRunError
 from .jit import njit
 from .ledger import LedgerEvent, replay_events

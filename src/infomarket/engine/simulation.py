@@ -9,19 +9,14 @@ from __future__ import annotations
 
 import copy
 import functools
-import os
-import sys
 import threading
 import time
-import warnings
-from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
-from numba.core.errors import NumbaPedanticWarning
 
 from ..config.schema import Experiment
 from ..config import sizes
@@ -33,6 +28,7 @@ from .. import interrupts
 from ..generated import compile_marker
 from ..seeds import MAX_SEED
 from ..state.flags import ErrorFlags
+from .compiling import compile_notice, kernel_for
 from .build import build_world, make_room, room_of, with_room
 from .lists import typed_list
 from .params import behaviour_kinds, behaviour_table, build_params
@@ -121,7 +117,7 @@ class Simulation:
         t0 = time.perf_counter()
         try:
             with compile_notice(self.kinds, config.payment.scheme):
-                self._kernel = _kernel_for(self.kinds, config)
+                self._kernel = kernel_for(self.kinds, config)
                 self._view = interrupts.compiled_apart(self._load, compile_marker(self._kernel, "simulation"))
         except Exception as exc:  # a rule that keeps the kernel from compiling: named
             raise _explained(config, self.seed, exc) from exc
@@ -164,7 +160,7 @@ class Simulation:
     def __setstate__(self, state: dict) -> None:
         self.__dict__.update(state)
         with compile_notice(self.kinds, self.config.payment.scheme):
-            self._kernel = _kernel_for(self.kinds, self.config)
+            self._kernel = kernel_for(self.kinds, self.config)
             self._view = interrupts.compiled_apart(self._resumed_view, compile_marker(self._kernel, "simulation"))
 
     def _resumed_view(self):
@@ -395,67 +391,6 @@ def _explained(cfg, seed: int, exc: Exception, sim=None) -> Exception:
         return _EXPLAINERS[0](cfg, seed, exc, sim, record_events=bool(getattr(sim, "record_events", False)))
     finally:
         _explaining.on = False
-
-
-#: Seconds after which loading the step kernel is taken to be compiling it, and said so on stderr; the
-#: environment variable INFOMARKET_COMPILE_NOTICE=0 (set by the command line's --quiet) silences it.
-COMPILE_NOTICE_AFTER = 1.0
-
-
-@contextmanager
-def quiet_compiles():
-    """Compile inside without numba's pedantic warnings: its IR checks flag the inlined ledger closures
-    ("variable ... is not in scope"), a note to numba's developers about its own IR, dozens of lines per
-    kernel or rule, nothing a user can act on.  Every other warning passes."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", NumbaPedanticWarning)
-        yield
-
-
-def _kernel_for(kinds: tuple[str, ...], config: Experiment):
-    """The generated kernel module that runs ``config`` with these behaviours in kind order."""
-    return specialise.kernel_module(kinds, config.payment.scheme, config.terrain, config.chain.enabled)
-
-
-def kernel_marker(config: Experiment) -> Path | None:
-    """The marker (``generated.compile_marker``) that says the kernel ``Simulation(config)`` runs on is
-    compiled and in the cache; None where it cannot say (a kernel outside the cache folder, or one whose
-    module does not load: ``Simulation`` then meets the error)."""
-    try:
-        kernel = _kernel_for(behaviour_kinds(config), config)
-    except Exception:  # noqa: BLE001 - Simulation(config) reports it, named
-        return None
-    return compile_marker(kernel, "simulation")
-
-
-@contextmanager
-def compile_notice(kinds, scheme: str, after: float | None = None):
-    """Say on stderr, once ``after`` seconds have gone by inside the block, that the step kernel is being
-    compiled (the first run of a behaviour mix waits 10-20 s with nothing else to show)."""
-    after = COMPILE_NOTICE_AFTER if after is None else after
-    with quiet_compiles():
-        if os.environ.get("INFOMARKET_COMPILE_NOTICE", "1") == "0":
-            yield
-            return
-        with _notice(kinds, scheme, after):
-            yield
-
-
-@contextmanager
-def _notice(kinds, scheme: str, after: float):
-    names = "+".join(str(k) for k in dict.fromkeys(kinds))
-
-    def say() -> None:
-        print(f"compiling the step kernel for {names} / {scheme} (once on this machine: later runs load it "
-              f"from the cache)...", file=sys.stderr, flush=True)
-
-    timer = threading.Timer(after, say)
-    timer.daemon = True
-    timer.start()
-    try:
-        yield
-    finally:
-        timer.cancel()
 
 
 def as_experiment(config) -> Experiment:

@@ -25,7 +25,8 @@ from ..behaviours.attacks import POLICY
 from ..config.schema import Experiment
 from ..engine.params import behaviour_kinds
 from ..engine.batch import Simulations
-from ..engine.simulation import as_experiment, compile_notice
+from ..engine.compiling import compile_notice
+from ..engine.simulation import as_experiment
 from ..errors import ConfigError
 from .. import interrupts
 from ..generated import compile_marker

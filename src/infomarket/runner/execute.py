@@ -32,7 +32,8 @@ import pandas as pd
 from .. import interrupts, plugins
 from ..config.schema import Experiment
 from ..engine.batch import Simulations
-from ..engine.simulation import Simulation, kernel_marker
+from ..engine.compiling import kernel_marker
+from ..engine.simulation import Simulation
 from ..engine.specialise import kernel_id
 from ..checks import explain, explain_compile_failure
 from ..errors import InfomarketError, RuleRunError
