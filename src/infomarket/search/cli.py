@@ -59,13 +59,13 @@ def _reductions(st, declared, exp, chosen, all_cells, args) -> list[str]:
 
 def refuse_declared_seed(seed: int, declared: int, reductions: list[str]) -> None:
     """A study's declared seed keys its confirmation seeds, which no run may touch before the study's own
-    (questions.toml [seed_sets]): a run with smaller settings than declared (a pilot, a reduced search)
-    must take another ``--seed``.  Running some of the declared cells with the declared settings is the
-    study itself, in parts, and is allowed."""
+    (questions.toml [seed_sets]): any run that is not the whole declared study (a pilot, a reduced search,
+    some of its cells) must take another ``--seed``.  The whole study may still be made in several
+    invocations: it resumes from its store, every invocation the whole study."""
     if reductions and seed == declared:
-        raise UsageError(f"--seed {seed} is the study's declared seed, and this run is reduced "
-                         f"({'; '.join(reductions)}): its confirmation runs would be the study's own, seen before "
-                         f"the study; give another --seed (the declared settings alone may use the declared seed)")
+        raise UsageError(f"--seed {seed} is the study's declared seed, and this run is not the whole declared "
+                         f"study ({'; '.join(reductions)}): its confirmation runs would be the study's own, seen "
+                         f"before the study; give another --seed (only the whole declared study may use it)")
 
 
 def _list_baselines(st) -> int:
@@ -86,7 +86,7 @@ def cmd_attack_search(args) -> int:
     from .driver import planned_runs, search_cell, store_runner
     from .study import cells
     from .summary import write
-    from . import adaptive, report
+    from . import adaptive, provenance, report
 
     exp = load_experiment(args.experiment)
     st = study_mod.load(exp, budget=args.budget, popsize=args.popsize, restarts=args.restarts, runs=args.runs,
@@ -109,7 +109,7 @@ def cmd_attack_search(args) -> int:
     declared = study_mod.load(exp)
     smaller = _reductions(st, declared, exp, chosen, cells(st), args)
     refuse_declared_seed(st.settings.seed, declared.settings.seed,
-                         ([args.reduced] if args.reduced else []) + [r for r in smaller if not r.endswith(" cells")])
+                         ([args.reduced] if args.reduced else []) + smaller)
     reduced = "; ".join(([args.reduced] if args.reduced else []) + smaller)
     out = Path(args.out)
     if out.exists() and not out.is_dir():
@@ -123,6 +123,7 @@ def cmd_attack_search(args) -> int:
     if args.adaptive_budget is not None:
         learner["budget"] = args.adaptive_budget
     _check_learner(learner)  # before any run: a bad value must not surface after a cell's search
+    validation: dict = {}
     t0 = time.perf_counter()
     results = []
     try:
@@ -146,9 +147,11 @@ def cmd_attack_search(args) -> int:
                           transitory=first.transitory)
     analysis = report.analyse(st, results)
     length = {"steps": first.steps, "transitory": first.transitory}
-    written += report.write(out, analysis, reduced=reduced, wall_seconds=wall,
-                            provenance=store.meta().get("attack_search"), **length)
-    text = report.markdown(analysis, reduced=reduced, wall_seconds=wall, **length)
+    first_run = store.meta().get("attack_search")
+    header = {**provenance.report_header(first_run, study_mod.QUESTIONS), "validation": validation}
+    written += report.write(out, analysis, reduced=reduced, wall_seconds=wall, provenance=first_run,
+                            header=header, **length)
+    text = report.markdown(analysis, reduced=reduced, wall_seconds=wall, header=header, **length)
     if not args.quiet:
         print(text)
         made = sum(r.done for r in results)

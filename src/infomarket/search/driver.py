@@ -29,8 +29,6 @@ questions file's commit and the time of the study's first run (``record_provenan
 from __future__ import annotations
 
 import datetime
-import hashlib
-import subprocess
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -44,6 +42,7 @@ from ..runner.plan import Condition, condition_number
 from ..runner.sweep import run_sweep
 from ..seeds import run_seed
 from ..store import Store
+from . import provenance as _prov
 from . import space
 from .objective import loss, per_run
 from .racing import race, survivors
@@ -99,27 +98,15 @@ def confirmation_seeds(study: Study, cell: Cell, runs: int | None = None) -> lis
     return [run_seed(cell.config.seed, k, crn) for k in range(s.confirmation_runs if runs is None else runs)]
 
 
-def _git(folder, *args) -> str | None:
-    try:
-        out = subprocess.run(["git", "-C", str(folder), *args], capture_output=True, text=True, timeout=30)
-    except (OSError, subprocess.SubprocessError):
-        return None
-    return out.stdout.strip() if out.returncode == 0 else None
-
-
 def provenance(questions=QUESTIONS) -> dict:
-    """The questions file's identity: its last commit (when the package is a git checkout; ``modified``
-    says whether the file differs from it) and its SHA-256."""
-    folder = questions.parent
-    commit = _git(folder, "log", "-1", "--format=%H", "--", questions.name) or None
-    modified = bool(_git(folder, "status", "--porcelain", "--", questions.name)) if commit else None
-    return {"questions_file": questions.name, "questions_commit": commit, "questions_modified": modified,
-            "questions_sha256": hashlib.sha256(questions.read_bytes()).hexdigest()}
+    """The questions file's identity (its last commit, whether it differs from it, its SHA-256) and the
+    code's commit with whether the tree was clean (``search.provenance``)."""
+    return {**_prov.questions(questions), **_prov.code()}
 
 
 def record_provenance(store: Store, questions=QUESTIONS, key: str = "attack_search") -> dict:
     """Record in the store's metadata (``store.json``, under ``key``), once, before the study's first run:
-    the questions file's commit and hash, and the UTC time of the first run."""
+    the questions file's commit and hash, the code's commit, and the UTC time of the first run."""
     with store.writing():
         meta = store.meta()
         if key not in meta:
