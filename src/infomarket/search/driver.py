@@ -46,14 +46,16 @@ from . import provenance as _prov
 from . import space
 from .objective import loss, per_run
 from .racing import race, survivors
-from .restarts import Restarts, design, evaluations, random_batches, spread_points, stream
+from . import structured
+from .restarts import Restarts, design, evaluations, gate_points, random_batches, spread_points, stream
 from .study import QUESTIONS, Cell, Settings, Study
 
 PHASES = ("start", "search", "random", "selection", "confirmation")
 SEED_SET = {"start": "search", "search": "search", "random": "search", "selection": "selection",
             "confirmation": "confirmation"}
 #: the race's groups: the searcher whose points each holds (the start points belong to the global search)
-GROUPS = {"search": ("start", "cma"), "random": ("random",)}
+GROUPS = {"search": ("start", "gates", "cma"), "random": ("random",)}
+POOLED = ("baseline",)  # with ``pool_baselines``, the baselines race in the search's pool too
 ROLES = ("search", "random", "baseline")
 DEFAULTS = {p[0]: float(p[1]) for p in POLICY}
 
@@ -199,9 +201,25 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
     add("start", -1, -1, frames[len(base):], spread, list(points))
     scores = [ev.fitness(f) for f in frames]
     firsts = [space.to_unit(p) for p in hand.values()] + list(points)
+    # the structured start: each gate opened alone on the best point not yet opened from (search.structured)
+    opened: list[int] = []
+    for g in range(s.gate_rounds):
+        left = gate_points(s) - (len(firsts) - len(base) - len(points))
+        best = min((k for k in range(len(scores)) if k not in opened), key=lambda k: (scores[k], k), default=None)
+        if best is None or left <= 0:
+            break
+        opened.append(best)
+        X = structured.openings(firsts[best])[:left]
+        conds = [ev.condition(space.to_params(x), "start", "gates", g, 0, i, f"gate_g{g}c{i}", s.runs, crn)
+                 for i, x in enumerate(X)]
+        fr = ev.evaluate(conds)
+        add("gates", g, 0, fr, conds, X)
+        scores += [ev.fitness(f) for f in fr]
+        firsts += X
     order = sorted(range(len(scores)), key=lambda k: (scores[k], k))  # ties: baselines first, then in order
-    # restart 0 at the best point of the start phase, the others at the next best spread points
-    origins = order[:1] + [k for k in order[1:] if k >= len(base)]
+    # restart 0 (or the first `local` ones) at the best points so far, the others at the next best spread points
+    top = order[:max(1, s.local)]
+    origins = top + [k for k in order if k >= len(base) and k not in top]
 
     def start(r: int) -> np.ndarray:
         return firsts[origins[r % len(origins)]] if origins else np.full(dim, 0.5)
@@ -239,6 +257,7 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
     ranked = candidates.assign(order=np.arange(len(candidates))).sort_values(["fitness", "order"], kind="stable")
     groups = {}
     for role, members in GROUPS.items():
+        members = members + (POOLED if role == "search" and s.pool_baselines else ())
         mine = ranked[ranked.searcher.isin(members)].drop_duplicates(list(space.NAMES))
         if len(mine):
             groups[role] = list(mine.label.head(s.finalists))
@@ -256,6 +275,7 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
     selected: dict[str, pd.DataFrame] = {}
 
     def on_selection(labels: list[str], runs: int) -> dict[str, np.ndarray]:
+        labels = list(dict.fromkeys(labels))  # a pooled baseline races in two groups, on the same runs
         conds = [_raced(ev, params[a], a, searcher[a], row.get(a), runs, crn) for a in labels]
         for a, f in zip(labels, ev.evaluate(conds)):
             selected[a] = f
@@ -287,7 +307,8 @@ def planned_runs(study: Study) -> int:
     s = study.settings
     hand = len([n for n in study.baselines if n != study.reference])
     n_eval = evaluations(s)
-    sizes = [min(s.finalists, n_eval), min(s.finalists, n_eval), hand, int(bool(study.reference))]
+    sizes = [min(s.finalists, n_eval + (hand if s.pool_baselines else 0)), min(s.finalists, n_eval), hand,
+             int(bool(study.reference))]
     selection = 0
     for n in sizes:
         before = 0
