@@ -92,9 +92,11 @@ def cmd_attack_search(args) -> int:
     st = study_mod.load(exp, budget=args.budget, popsize=args.popsize, restarts=args.restarts, runs=args.runs,
                         finalists=args.finalists, race=_race(args.race) if args.race is not None else None,
                         keep=args.keep, confirmation_runs=args.confirmation_runs, grid_step=args.grid_step,
-                        objective=args.objective, seed=args.seed)
+                        objective=args.objective, seed=args.seed, validation=args.validation_repeats)
     if args.list_baselines:
         return _list_baselines(st)
+    if args.validate:
+        return _validate(st, args)
     if args.out is None:
         raise UsageError("attack-search needs --out FOLDER (the store and the report go there)")
     if not args.out.strip():  # Path("") is the current folder: a blank variable must not write there
@@ -123,7 +125,7 @@ def cmd_attack_search(args) -> int:
     if args.adaptive_budget is not None:
         learner["budget"] = args.adaptive_budget
     _check_learner(learner)  # before any run: a bad value must not surface after a cell's search
-    validation: dict = {}
+    validation = _study_validation(st, out, args.quiet)
     t0 = time.perf_counter()
     results = []
     try:
@@ -161,6 +163,48 @@ def cmd_attack_search(args) -> int:
     return 0
 
 
+def _validate(st, args) -> int:
+    """``--validate``: the planted weaknesses searched with the study's settings, the recovery rate per
+    searcher printed (and written to OUT/validation.json with --out)."""
+    from . import validate
+
+    repeats = args.validation_repeats if args.validation_repeats is not None else (st.settings.validation or 3)
+    if repeats < 1:
+        raise UsageError(f"--validation-repeats {repeats}: --validate needs at least 1")
+    kinds = _names(args.kinds) if args.kinds is not None else None
+    for k in kinds or []:
+        if k not in validate.planted.KINDS:
+            raise UsageError(f"--kinds {k}: not a planted weakness; allowed: {', '.join(validate.planted.KINDS)}")
+    result = validate.validate(st, repeats, kinds=kinds, echo=None if args.quiet else lambda r: print(validate.line(r)))
+    print(validate.text(result))
+    if args.out:
+        print(f"wrote {validate.write(Path(args.out), result)}")
+    return 0
+
+
+def _study_validation(st, out: Path, quiet: bool) -> dict:
+    """The planted suite's recovery rates for a study's report: ``validation`` seeds per planted weakness
+    with the study's settings (none when 0), kept in OUT/validation.json so a resumed study reuses them."""
+    import json
+
+    from . import validate
+
+    n = st.settings.validation
+    if not n:
+        return {}
+    path = out / "validation.json"
+    key = {"settings": repr(st.settings)}
+    if path.exists():
+        kept = json.loads(path.read_text())
+        if kept.get("key") == key:
+            return kept["rates"]
+    result = {**validate.validate(st, n), "key": key}
+    validate.write(out, result)
+    if not quiet:
+        print(validate.text(result))
+    return result["rates"]
+
+
 #: the adaptive attacker's training when questions.toml declares no ``[adaptive]`` table (budget 0: not run)
 ADAPTIVE = {"budget": 0, "pairs": 8, "runs": 4, "sigma": 0.05, "lr": 0.02}
 
@@ -194,7 +238,8 @@ def _adaptive(adaptive, st, cell, r, learner: dict, out: Path, args, workers: in
 def add_subcommand(sub) -> None:
     p = sub.add_parser("attack-search", help="the worst attack found against each defence: CMA-ES "
                                              "restarts and a random search, raced, confirmed on fresh seeds; resumable")
-    p.add_argument("experiment", help="a study experiment (the shipped attack_search, or a file like it)")
+    p.add_argument("experiment", nargs="?", default="attack_search",
+                   help="a study experiment (default: the shipped attack_search, or a file like it)")
     p.add_argument("--defence", help="defence(s) to search, comma-separated (default: every one of the study)")
     p.add_argument("--byzantines", metavar="K", help="Byzantine count(s), comma-separated (default: the study's)")
     p.add_argument("--budget", type=at_least(1), metavar="N",
@@ -212,6 +257,13 @@ def add_subcommand(sub) -> None:
     p.add_argument("--seed", type=at_least(0), help="the search's seed: optimisers and seed sets (default: declared)")
     p.add_argument("--adaptive-budget", type=at_least(0), metavar="N",
                    help="evaluations per cell of the adaptive attacker, the second searcher (0: none; default: declared)")
+    p.add_argument("--validate", action="store_true",
+                   help="search the planted weaknesses (known optima) with the study's settings and print the recovery "
+                        "rate per searcher, then exit (docs/attack-search.md, \"Planted weaknesses\")")
+    p.add_argument("--validation-repeats", type=at_least(0), metavar="N",
+                   help="seeds per planted weakness: of --validate (default: declared, else 3), and of the validation a "
+                        "study runs before its cells (0: none; default: declared)")
+    p.add_argument("--kinds", help="with --validate: planted weaknesses to search, comma-separated (default: all)")
     p.add_argument("--list-baselines", action="store_true", help="list the baselines (declared and rotation grid) "
                                                                  "and exit")
     p.add_argument("--steps", type=at_least(1), help="steps per run (default: the experiment's), for a reduced search")

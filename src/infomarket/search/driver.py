@@ -201,9 +201,16 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
     add("start", -1, -1, frames[len(base):], spread, list(points))
     scores = [ev.fitness(f) for f in frames]
     firsts = [space.to_unit(p) for p in hand.values()] + list(points)
+    every = base + spread  # the start phase's conditions, by index (the openings join them)
+
+    def leaders() -> None:  # the best points so far run again on more of the start seeds (search.structured)
+        if s.leaders:
+            structured.reevaluate(ev, every, scores, rows, s.leaders, s.leader_runs)
+
     # the structured start: each gate opened alone on the best point not yet opened from (search.structured)
     opened: list[int] = []
     for g in range(s.gate_rounds):
+        leaders()
         left = gate_points(s) - (len(firsts) - len(base) - len(points))
         best = min((k for k in range(len(scores)) if k not in opened), key=lambda k: (scores[k], k), default=None)
         if best is None or left <= 0:
@@ -216,6 +223,8 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
         add("gates", g, 0, fr, conds, X)
         scores += [ev.fitness(f) for f in fr]
         firsts += X
+        every += conds
+    leaders()
     order = sorted(range(len(scores)), key=lambda k: (scores[k], k))  # ties: baselines first, then in order
     # restart 0 (or the first `local` ones) at the best points so far, the others at the next best spread points
     top = order[:max(1, s.local)]
@@ -318,7 +327,8 @@ def planned_runs(study: Study) -> int:
             if i < len(s.race) - 1:
                 n = survivors(n, s.keep)
     roles = len([n for n in sizes[:3] if n]) + int(bool(study.reference))
-    return (hand + 2 * n_eval) * s.runs + selection + roles * s.confirmation_runs
+    leaders = (s.gate_rounds + 1) * s.leaders * max(0, s.leader_runs - s.runs)  # re-evaluations, at most
+    return (hand + 2 * n_eval) * s.runs + leaders + selection + roles * s.confirmation_runs
 
 
 def _raced(ev: _Evaluator, params: dict, label: str, group: str, row, runs: int, crn: int) -> CRNCondition:

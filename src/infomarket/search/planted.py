@@ -82,7 +82,7 @@ KINDS = {k.name: k for k in (
          ("fresh_record",), {"rot_base": 30.0, "fresh_record": 25.0}),
     Kind("two_gates", "lie 20°+ only with at most one confirmer in range AND capped at 0.7 Θ (half the damage "
          "with the first gate alone)",
-         lambda p: OPTIMUM * tri(p["max_confirmers"], 1.0, 10.0) * (0.6 + 0.4 * tri(p["cap_theta"], 0.7, 1.0))
+         lambda p: OPTIMUM * tri(p["max_confirmers"], 1.0, 10.0) * (0.6 + 0.4 * tri(p["cap_theta"], 0.7, 2.0))
          * ramp(p["rot_base"], 5.0, 20.0),
          ("max_confirmers", "cap_theta"), {"rot_base": 30.0, "max_confirmers": 1.0, "cap_theta": 0.7}),
 )}

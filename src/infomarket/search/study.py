@@ -51,6 +51,9 @@ class Settings:
     gate_rounds: int = 0           # rounds of opening one gate at a time on the best point (search.structured)
     local: int = 0                 # the first restarts are local: from the best points found, step local_sigma
     local_sigma: float = 0.05      # CMA-ES step size of a local restart, in the unit cube
+    leaders: int = 0               # the best start-phase points run again on leader_runs seeds before each choice
+    leader_runs: int = 16          # (cumulative) runs of a re-evaluated leader, on the start phase's seeds
+    validation: int = 0            # seeds per planted weakness searched before the study (search.validate)
 
     @property
     def generations(self) -> int:
@@ -74,13 +77,14 @@ def settings(table: dict, overrides: dict | None = None,
     if "race" in base:
         base["race"] = tuple(base["race"]) if isinstance(base["race"], (list, tuple)) else base["race"]
     s = Settings(**base)
-    ints = ("budget", "popsize", "restarts", "runs", "finalists", "confirmation_runs", "seed", "gate_rounds", "local")
+    ints = ("budget", "popsize", "restarts", "runs", "finalists", "confirmation_runs", "seed", "gate_rounds", "local",
+            "leaders", "leader_runs", "validation")
     for k in ints:
         v = getattr(s, k)
         if isinstance(v, bool) or not isinstance(v, int):
             raise UsageError(f"{source}: {k} = {v!r}: a whole number is expected")
     for k, v in (("budget", 1), ("popsize", 2), ("restarts", 1), ("runs", 1), ("finalists", 1),
-                 ("confirmation_runs", 2), ("seed", 0), ("gate_rounds", 0), ("local", 0)):
+                 ("confirmation_runs", 2), ("seed", 0), ("gate_rounds", 0), ("local", 0), ("leaders", 0), ("leader_runs", 1), ("validation", 0)):
         if getattr(s, k) < v:
             raise UsageError(f"{source}: {k} = {getattr(s, k)}: must be at least {v}")
     race = s.race
