@@ -94,6 +94,11 @@ NOT_RUN = {
     "results/chain/chain_fig7_sweep results/chain/chain_partition --out results/chain/report":
         "needs the study's stores; tests/analysis/test_chain_study.py runs it on a synthetic one",
     # docs/attack-search.md
+    "infomarket attack-search --validate --kinds trust_gate --validation-repeats 1 --budget 64 --runs 4 "
+    "--race 4,8,16 --pool-baselines --gate-rounds 1 --local 1 --leaders 4":
+        "a planted search of a few seconds' CPU; tests/search/test_validate.py runs one like it",
+    "infomarket attack-search --validate --validation-repeats 6 --pool-baselines --gate-rounds 2 --local 1 "
+    "--restarts 2 --spread 0.125 --leaders 6": "36 planted searches at the study's budget (CPU minutes)",
     "infomarket attack-search attack_search --out results/attack_search": "the full study, about 64 000 runs",
     "infomarket attack-search attack_search --defence staking --byzantines 3 --budget 48 --runs 4 "
     "--confirmation-runs 16 --seed 7 --out /tmp/attack-reduced": "~2 500 full runs; tests/search runs a tiny search",
@@ -178,13 +183,21 @@ SMALL_DOCS = ("attack-search.md", "rl.md", "chain-model.md")
 SIZE_OPTIONS = frozenset({"steps", "transitory", "budget", "popsize", "runs", "restarts", "finalists", "race",
                           "keep", "confirmation_runs", "grid_step", "adaptive_budget", "iterations",
                           "pairs", "eval_runs", "repeats", "batch", "robots", "out", "workers", "defence",
-                          "byzantines", "store", "chain_period",
+                          "byzantines", "store", "chain_period", "validation_repeats",
                           # a reduced form of a declared study must take another seed than the study's
                           # (search/questions.toml [seed_sets]; the CLI refuses it otherwise)
                           "seed"})
 TINY_SEARCH = ("--defence staking --byzantines 3 --budget 2 --popsize 2 --restarts 1 --runs 1 --finalists 1 "
                "--race 2 --confirmation-runs 2 --grid-step 90 --adaptive-budget 0 --steps 60 --transitory 20 --workers 1")
 SMALL = {
+    "infomarket attack-search --validate --kinds trust_gate --validation-repeats 1 --budget 64 --runs 4 "
+    "--race 4,8,16 --pool-baselines --gate-rounds 1 --local 1 --leaders 4":
+        "infomarket attack-search --validate --kinds trust_gate --validation-repeats 1 --budget 24 --popsize 4 "
+        "--runs 2 --race 2,4 --grid-step 90 --pool-baselines --gate-rounds 1 --local 1 --leaders 4",
+    "infomarket attack-search --validate --validation-repeats 6 --pool-baselines --gate-rounds 2 --local 1 "
+    "--restarts 2 --spread 0.125 --leaders 6":
+        "infomarket attack-search --validate --validation-repeats 1 --budget 24 --popsize 4 --runs 2 --race 2,4 "
+        "--grid-step 90 --pool-baselines --gate-rounds 2 --local 1 --restarts 2 --spread 0.125 --leaders 6",
     "infomarket check attack_search": "infomarket check attack_search",
     "infomarket check chain_partition": "infomarket check chain_partition",
     "infomarket attack-search attack_search --out results/attack_search":
@@ -225,6 +238,7 @@ SMALL_NOT_RUN = {
     "infomarket view": "a web server that runs until stopped; tests/viewer",
     "infomarket replay --movie": "the command's name in the text (rl.md's rendering); tests/viewer/test_movie.py runs it",
     "infomarket attack-search": "the command's name in the text; its commands are the ones above",
+    "infomarket attack-search --validate": "the command's name in a heading; its commands are the ones above",
     "infomarket adaptive-attack": "the command's name in the text (rl.md); its command is the one above",
     "infomarket sweep attack_search": "sweep has no --steps: 24 runs of 30 000 steps at the least; `check "
                                       "attack_search` (run above) builds and validates each of its conditions",

@@ -1,6 +1,7 @@
 """``infomarket attack-search``: the worst attack found against each defence (docs/attack-search.md)."""
 from __future__ import annotations
 
+import argparse
 import time
 from pathlib import Path
 
@@ -35,6 +36,7 @@ def _race(text: str) -> list[int]:
 
 
 SIZES = ("budget", "popsize", "restarts", "runs", "finalists", "confirmation_runs")
+DESIGN = ("sigma0", "spread", "keep", "pool_baselines", "gate_rounds", "local", "local_sigma", "leaders", "leader_runs")
 
 
 def _reductions(st, declared, exp, chosen, all_cells, args) -> list[str]:
@@ -54,6 +56,10 @@ def _reductions(st, declared, exp, chosen, all_cells, args) -> list[str]:
         out.append(f"--race {','.join(map(str, st.settings.race))} (declared {','.join(map(str, declared.settings.race))})")
     if st.settings.grid_step > declared.settings.grid_step:
         out.append(f"--grid-step {st.settings.grid_step:g} (declared {declared.settings.grid_step:g})")
+    for key in DESIGN:  # another search design is not the declared study either
+        have, want = getattr(st.settings, key), getattr(declared.settings, key)
+        if have != want:
+            out.append(f"--{key.replace('_', '-')} {have} (declared {want})")
     return out
 
 
@@ -92,7 +98,10 @@ def cmd_attack_search(args) -> int:
     st = study_mod.load(exp, budget=args.budget, popsize=args.popsize, restarts=args.restarts, runs=args.runs,
                         finalists=args.finalists, race=_race(args.race) if args.race is not None else None,
                         keep=args.keep, confirmation_runs=args.confirmation_runs, grid_step=args.grid_step,
-                        objective=args.objective, seed=args.seed, validation=args.validation_repeats)
+                        objective=args.objective, seed=args.seed, validation=args.validation_repeats,
+                        pool_baselines=args.pool_baselines, gate_rounds=args.gate_rounds, local=args.local,
+                        local_sigma=args.local_sigma, leaders=args.leaders, leader_runs=args.leader_runs,
+                        spread=args.spread, sigma0=args.sigma0)
     if args.list_baselines:
         return _list_baselines(st)
     if args.validate:
@@ -253,6 +262,18 @@ def add_subcommand(sub) -> None:
     p.add_argument("--confirmation-runs", type=at_least(2), help="runs per chosen attack on the confirmation seeds "
                                                                  "(default: declared)")
     p.add_argument("--grid-step", type=float, metavar="DEGREES", help="rotation grid's step (default: declared)")
+    p.add_argument("--sigma0", type=float, help="CMA-ES step of a global restart, in the unit cube (default: declared)")
+    p.add_argument("--spread", type=float, help="share of the budget on spread start points (default: declared)")
+    p.add_argument("--pool-baselines", action=argparse.BooleanOptionalAction, default=None,
+                   help="race the baselines in the search's own pool (default: declared)")
+    p.add_argument("--gate-rounds", type=at_least(0), metavar="N",
+                   help="rounds of opening one gate at a time on the best point (default: declared)")
+    p.add_argument("--local", type=at_least(0), metavar="N",
+                   help="restarts that refine the best points found, with step --local-sigma (default: declared)")
+    p.add_argument("--local-sigma", type=float, help="CMA-ES step of a local restart (default: declared)")
+    p.add_argument("--leaders", type=at_least(0), metavar="N",
+                   help="best start points run again on --leader-runs seeds before each choice (default: declared)")
+    p.add_argument("--leader-runs", type=at_least(1), metavar="N", help="runs of a re-evaluated leader (default: declared)")
     p.add_argument("--objective", choices=["items", "liar_wealth"], help="what the attack optimises (default: items)")
     p.add_argument("--seed", type=at_least(0), help="the search's seed: optimisers and seed sets (default: declared)")
     p.add_argument("--adaptive-budget", type=at_least(0), metavar="N",
