@@ -175,7 +175,7 @@ def cmd_attack_search(args) -> int:
 def _validate(st, args) -> int:
     """``--validate``: the planted weaknesses searched with the study's settings, the recovery rate per
     searcher printed (and written to OUT/validation.json with --out)."""
-    from . import validate
+    from . import validate  # with the command: `infomarket --help` does not import the search
 
     repeats = args.validation_repeats if args.validation_repeats is not None else (st.settings.validation or 3)
     if repeats < 1:
@@ -196,7 +196,7 @@ def _study_validation(st, out: Path, quiet: bool) -> dict:
     with the study's settings (none when 0), kept in OUT/validation.json so a resumed study reuses them."""
     import json
 
-    from . import validate
+    from . import validate  # with the command: `infomarket --help` does not import the search
 
     n = st.settings.validation
     if not n:

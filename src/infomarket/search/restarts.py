@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .structured import per_round
 from .study import Settings
 
 #: the fewest generations a restart's population is capped to allow (when its share of the budget allows)
@@ -61,8 +62,6 @@ def spread_points(s: Settings) -> int:
 
 def gate_points(s: Settings) -> int:
     """Evaluations of the structured start (``search.structured``): its rounds' openings, within the budget."""
-    from .structured import per_round
-
     return min(s.gate_rounds * per_round(), max(0, s.budget - spread_points(s)))
 
 

@@ -23,7 +23,7 @@ from ..store import Store
 from . import planted, space
 from .driver import DEFAULTS, search_cell
 from .restarts import stream
-from .study import Cell, Study
+from .study import Cell, Study, cells
 
 SEARCHERS = ("search", "random", "baseline")
 
@@ -63,8 +63,6 @@ def planted_runner(kind: planted.Kind):
 def planted_cell(study: Study, kind: planted.Kind) -> Cell:
     """A cell named after the planted kind, on the study's first cell's configuration (whose seed keys
     the runs; its simulation is never run)."""
-    from .study import cells
-
     first = cells(study)[0]
     return Cell(f"planted_{kind.name}", first.byzantines, first.config)
 
