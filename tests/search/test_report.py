@@ -265,3 +265,18 @@ def test_write_gives_strict_json_markdown_and_the_figure(analysis, tmp_path):
     one = report.analyse(study(), [few])["cells"][0]
     assert math.isinf(one["worst_case_bounded"]["low"])   # 5 pairs bound no 95 % interval
     assert "unbounded" in report.markdown(report.analyse(study(), [few]))
+
+
+def test_a_second_confirmed_baseline_can_be_the_worst_case():
+    """The race's second baseline (confirmed with confirm_top 2) loses 34 % where the selection's pick
+    loses 24 %: the worst case is the second one, and it is confirmed more damaging than the search's."""
+    cell = search("theta20", 3, worst=np.full(N, 8.0) - 0.01 * I, base=np.full(N, 7.6) - 0.01 * I,
+                  rand=np.full(N, 9.0) - 0.01 * I)
+    extra = frame({"base_two": np.full(N, 6.6) - 0.01 * I})
+    cell.confirmation = pd.concat([cell.confirmation, extra], ignore_index=True)
+    cell.chosen["baseline_2"] = "base_two"
+    c = report.analyse(study(), [cell])["cells"][0]
+    # per-seed loss 1 - (6.6 - 0.01 i) / 10 = 0.34 + 0.001 i: Walsh median 0.34 + 0.0045
+    assert c["worst"] == {"role": "baseline_2", "loss": pytest.approx(0.3445)}
+    assert c["roles"]["baseline_2"]["attack"] == "base_two" and c["bounded"] == "no"
+    assert set(c["more_damaging_than_search"]) == {"baseline", "baseline_2"}

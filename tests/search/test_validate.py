@@ -94,3 +94,34 @@ def test_an_unknown_planted_kind_is_refused(capsys):
     assert main(["attack-search", "--validate", "--kinds", "nope"]) == 2
     err = capsys.readouterr().err
     assert "--kinds nope" in err and "window" in err and "Traceback" not in err
+
+
+def _search(kind: str, seed: int, **settings):
+    import dataclasses
+    import tempfile
+    from pathlib import Path
+
+    from infomarket.search.driver import search_cell
+    from infomarket.store import Store
+
+    st = _study(**settings)
+    st = dataclasses.replace(st, settings=dataclasses.replace(st.settings, seed=seed))
+    with tempfile.TemporaryDirectory() as folder:
+        return search_cell(st, validate.planted_cell(st, planted.KINDS[kind]), Store(Path(folder) / "s"),
+                           run=validate.planted_runner(planted.KINDS[kind]))
+
+
+def test_pooled_baselines_race_for_the_search_and_the_top_k_are_confirmed():
+    """With a budget of 4 evaluations nothing the search samples beats ``scaboteur_40`` (2.1 items against
+    the decoy's 1.0 at most, 0.6 at 22.5 or 72.5): pooled, the best baseline becomes the search's own attack;
+    with confirm_top 2 each group's two best are confirmed on every confirmation run."""
+    tiny = dict(budget=4, popsize=2, restarts=1, runs=4, finalists=2, race=[4, 8], grid_step=30.0,
+                confirmation_runs=4)
+    pooled = _search("window", 3, **tiny, pool_baselines=True, confirm_top=2)
+    assert pooled.chosen["search"] == pooled.chosen["baseline"] == "scaboteur_40"
+    assert {"search_2", "random_2", "baseline_2"} <= set(pooled.chosen)
+    conf = pooled.confirmation
+    assert set(conf.attack) == set(pooled.chosen.values())
+    assert all(sorted(g.run) == [0, 1, 2, 3] for _, g in conf.groupby("attack"))
+    alone = _search("window", 3, **tiny)
+    assert alone.chosen["search"] != "scaboteur_40" and "search_2" not in alone.chosen

@@ -36,7 +36,8 @@ def _race(text: str) -> list[int]:
 
 
 SIZES = ("budget", "popsize", "restarts", "runs", "finalists", "confirmation_runs")
-DESIGN = ("sigma0", "spread", "keep", "pool_baselines", "gate_rounds", "local", "local_sigma", "leaders", "leader_runs")
+DESIGN = ("sigma0", "spread", "keep", "pool_baselines", "gate_rounds", "local", "local_sigma", "leaders", "leader_runs",
+          "confirm_top")
 
 
 def _reductions(st, declared, exp, chosen, all_cells, args) -> list[str]:
@@ -101,7 +102,7 @@ def cmd_attack_search(args) -> int:
                         objective=args.objective, seed=args.seed, validation=args.validation_repeats,
                         pool_baselines=args.pool_baselines, gate_rounds=args.gate_rounds, local=args.local,
                         local_sigma=args.local_sigma, leaders=args.leaders, leader_runs=args.leader_runs,
-                        spread=args.spread, sigma0=args.sigma0)
+                        spread=args.spread, sigma0=args.sigma0, confirm_top=args.confirm_top)
     if args.list_baselines:
         return _list_baselines(st)
     if args.validate:
@@ -273,6 +274,8 @@ def add_subcommand(sub) -> None:
     p.add_argument("--local-sigma", type=float, help="CMA-ES step of a local restart (default: declared)")
     p.add_argument("--leaders", type=at_least(0), metavar="N",
                    help="best start points run again on --leader-runs seeds before each choice (default: declared)")
+    p.add_argument("--confirm-top", type=at_least(1), metavar="K",
+                   help="the race's K best attacks of each searcher and of the baselines confirmed (default: declared)")
     p.add_argument("--leader-runs", type=at_least(1), metavar="N", help="runs of a re-evaluated leader (default: declared)")
     p.add_argument("--objective", choices=["items", "liar_wealth"], help="what the attack optimises (default: items)")
     p.add_argument("--seed", type=at_least(0), help="the search's seed: optimisers and seed sets (default: declared)")

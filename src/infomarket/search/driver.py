@@ -295,6 +295,9 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
     median = {a: float(np.median(loss(selected[a][s.objective].to_numpy(float), s.objective))) for a in chosen.values()}
     if chosen:
         chosen["worst"] = min((chosen[r] for r in ROLES if r in chosen), key=lambda a: median[a])
+    for role in ROLES:  # with confirm_top k, each group's next best attacks are confirmed too: role_2 .. role_k
+        for k, a in enumerate(result.ranking.get(role, [])[1:s.confirm_top], start=2):
+            chosen[f"{role}_{k}"] = a
     if study.reference:
         chosen["reference"] = study.reference
     selection = _frame(selected)
@@ -326,7 +329,7 @@ def planned_runs(study: Study) -> int:
             before = runs
             if i < len(s.race) - 1:
                 n = survivors(n, s.keep)
-    roles = len([n for n in sizes[:3] if n]) + int(bool(study.reference))
+    roles = sum(min(n, s.confirm_top) for n in sizes[:3] if n) + int(bool(study.reference))
     leaders = (s.gate_rounds + 1) * s.leaders * max(0, s.leader_runs - s.runs)  # re-evaluations, at most
     return (hand + 2 * n_eval) * s.runs + leaders + selection + roles * s.confirmation_runs
 

@@ -54,6 +54,7 @@ class Settings:
     leaders: int = 0               # the best start-phase points run again on leader_runs seeds before each choice
     leader_runs: int = 16          # (cumulative) runs of a re-evaluated leader, on the start phase's seeds
     validation: int = 0            # seeds per planted weakness searched before the study (search.validate)
+    confirm_top: int = 1           # the race's best attacks of each group confirmed (role, role_2 .. role_k)
 
     @property
     def generations(self) -> int:
@@ -78,13 +79,13 @@ def settings(table: dict, overrides: dict | None = None,
         base["race"] = tuple(base["race"]) if isinstance(base["race"], (list, tuple)) else base["race"]
     s = Settings(**base)
     ints = ("budget", "popsize", "restarts", "runs", "finalists", "confirmation_runs", "seed", "gate_rounds", "local",
-            "leaders", "leader_runs", "validation")
+            "leaders", "leader_runs", "validation", "confirm_top")
     for k in ints:
         v = getattr(s, k)
         if isinstance(v, bool) or not isinstance(v, int):
             raise UsageError(f"{source}: {k} = {v!r}: a whole number is expected")
     for k, v in (("budget", 1), ("popsize", 2), ("restarts", 1), ("runs", 1), ("finalists", 1),
-                 ("confirmation_runs", 2), ("seed", 0), ("gate_rounds", 0), ("local", 0), ("leaders", 0), ("leader_runs", 1), ("validation", 0)):
+                 ("confirmation_runs", 2), ("seed", 0), ("gate_rounds", 0), ("local", 0), ("leaders", 0), ("leader_runs", 1), ("validation", 0), ("confirm_top", 1)):
         if getattr(s, k) < v:
             raise UsageError(f"{source}: {k} = {getattr(s, k)}: must be at least {v}")
     race = s.race
