@@ -40,8 +40,11 @@ def test_the_truthful_reference_does_no_damage():
 def test_gates_are_opened_one_at_a_time_and_an_open_one_is_closed():
     closed = space.to_unit({})
     pts = structured.openings(closed)
-    # by hand: 3 slopes x 2 values, 7 range gates x 3 values, withhold on: 28 points, each one gate off its default
-    assert len(pts) == structured.per_round() == 28
+    # by hand: 6 rotation steps, collusion switched, 2 other sites, then 3 slopes x 2 values, 7 range gates
+    # x 3 values, withhold on: 9 + 28 = 37 points, each one coordinate off its default
+    assert len(pts) == structured.per_round() == 37
+    rot = sorted(space.to_params(p)["rot_base"] for p in pts[:6])
+    assert rot == pytest.approx([5.0, 10.0, 15.0, 25.0, 30.0, 35.0])  # around the default 20°
     assert all(sum(a != b for a, b in zip(space.to_params(p).values(), space.to_params(closed).values())) == 1
                for p in pts)
     # a farmer's point (lie_min_record 10 open): its nearest opening value (0.583 -> 6.67) becomes "closed"
@@ -125,3 +128,21 @@ def test_pooled_baselines_race_for_the_search_and_the_top_k_are_confirmed():
     assert all(sorted(g.run) == [0, 1, 2, 3] for _, g in conf.groupby("attack"))
     alone = _search("window", 3, **tiny)
     assert alone.chosen["search"] != "scaboteur_40" and "search_2" not in alone.chosen
+
+
+def test_a_study_whose_search_fails_its_declared_validation_is_not_run(tmp_path, capsys):
+    """A questions file (passed with --questions) declaring min_recovery 0.9, with a search too small to
+    recover anything: the validation runs, is written, and the study's cells are not searched."""
+    text = (study.QUESTIONS.with_name("questions_v3.toml")).read_text()
+    head, rest = text.split("[search]", 1)
+    rest = rest.split("\n[adaptive]", 1)[1]
+    small = ('[search]\nbudget = 4\npopsize = 2\nrestarts = 1\nruns = 2\nfinalists = 2\nrace = [2, 4]\n'
+             'grid_step = 90.0\nconfirmation_runs = 4\nvalidation = 1\nseed = 99\n\n[adaptive]')
+    questions = tmp_path / "q.toml"
+    questions.write_text(head + small + rest)
+    out = tmp_path / "study"
+    assert main(["attack-search", "--questions", str(questions), "--quiet", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "planted validation gives the search a recovery rate of" in err and "q.toml" in err, err
+    assert "Traceback" not in err
+    assert (out / "validation.json").exists() and not (out / "store").exists()

@@ -96,7 +96,9 @@ def cmd_attack_search(args) -> int:
     from . import adaptive, provenance, report
 
     exp = load_experiment(args.experiment)
-    st = study_mod.load(exp, budget=args.budget, popsize=args.popsize, restarts=args.restarts, runs=args.runs,
+    path = Path(args.questions) if args.questions else study_mod.QUESTIONS
+    decl = study_mod.Declaration.read(path, path.name)
+    st = study_mod.load(exp, decl.data, path=path, budget=args.budget, popsize=args.popsize, restarts=args.restarts, runs=args.runs,
                         finalists=args.finalists, race=_race(args.race) if args.race is not None else None,
                         keep=args.keep, confirmation_runs=args.confirmation_runs, grid_step=args.grid_step,
                         objective=args.objective, seed=args.seed, validation=args.validation_repeats,
@@ -118,7 +120,7 @@ def cmd_attack_search(args) -> int:
     for c in chosen:  # every configuration is checked before anything runs
         c.with_attack({}, steps=args.steps, transitory=args.transitory)
     first = chosen[0].with_attack({}, steps=args.steps, transitory=args.transitory)
-    declared = study_mod.load(exp)
+    declared = study_mod.load(exp, decl.data, path=path)
     smaller = _reductions(st, declared, exp, chosen, cells(st), args)
     refuse_declared_seed(st.settings.seed, declared.settings.seed,
                          ([args.reduced] if args.reduced else []) + smaller)
@@ -131,11 +133,16 @@ def cmd_attack_search(args) -> int:
     total = planned_runs(st) * len(chosen)
     client = dask_client(args.dask) if args.dask else None
     workers = args.workers or default_workers()
-    learner = {**ADAPTIVE, **study_mod.DECLARATION.data.get("adaptive", {})}
+    learner = {**ADAPTIVE, **decl.data.get("adaptive", {})}
     if args.adaptive_budget is not None:
         learner["budget"] = args.adaptive_budget
     _check_learner(learner)  # before any run: a bad value must not surface after a cell's search
     validation = _study_validation(st, out, args.quiet)
+    need = decl.data.get("validation", {}).get("min_recovery")
+    if need is not None and not reduced and validation.get("search", 0.0) < need:
+        raise UsageError(f"the planted validation gives the search a recovery rate of {validation.get('search', 0.0):.0%}"
+                         f", below the {need:.0%} that {path.name} declares before its study runs (OUT/validation.json "
+                         f"has every search); the study is not run")
     t0 = time.perf_counter()
     results = []
     try:
@@ -160,10 +167,11 @@ def cmd_attack_search(args) -> int:
     analysis = report.analyse(st, results)
     length = {"steps": first.steps, "transitory": first.transitory}
     first_run = store.meta().get("attack_search")
-    header = {**provenance.report_header(first_run, study_mod.QUESTIONS), "validation": validation}
+    header = {**provenance.report_header(first_run, path), "validation": validation}
     written += report.write(out, analysis, reduced=reduced, wall_seconds=wall, provenance=first_run,
-                            header=header, **length)
-    text = report.markdown(analysis, reduced=reduced, wall_seconds=wall, header=header, **length)
+                            header=header, records=decl.record_markdown(), **length)
+    text = report.markdown(analysis, reduced=reduced, wall_seconds=wall, header=header,
+                           records=decl.record_markdown(), **length)
     if not args.quiet:
         print(text)
         made = sum(r.done for r in results)
@@ -250,6 +258,8 @@ def add_subcommand(sub) -> None:
                                              "restarts and a random search, raced, confirmed on fresh seeds; resumable")
     p.add_argument("experiment", nargs="?", default="attack_search",
                    help="a study experiment (default: the shipped attack_search, or a file like it)")
+    p.add_argument("--questions", metavar="FILE",
+                   help="the study's questions file: settings, baselines, questions (default: the package's questions.toml)")
     p.add_argument("--defence", help="defence(s) to search, comma-separated (default: every one of the study)")
     p.add_argument("--byzantines", metavar="K", help="Byzantine count(s), comma-separated (default: the study's)")
     p.add_argument("--budget", type=at_least(1), metavar="N",

@@ -64,7 +64,7 @@ def bounded(losses: list[dict[str, np.ndarray]], groups: list[list[int]], margin
     p_in = {c: {r: pr.wilcoxon_p(v - margin, "less") for r, v in ls.items()} for c, ls in enumerate(losses)}
     p_out = {c: {r: pr.wilcoxon_p(v - margin, "greater") for r, v in ls.items()} for c, ls in enumerate(losses)}
     for idx in groups:
-        iut = [max(p_in[c].values()) for c in idx]
+        iut = [max(p_in[c].values(), default=1.0) for c in idx]  # a cell with no attack shows nothing
         rej, lev = holm_levels(iut, alpha)
         pairs = [(c, r) for c in idx for r in losses[c]]
         rej_b, lev_b = holm_levels([p_out[c][r] for c, r in pairs], alpha)
@@ -76,6 +76,10 @@ def bounded(losses: list[dict[str, np.ndarray]], groups: list[list[int]], margin
                 roles[r] = {"loss": pr.hodges_lehmann(v), "interval": [bound(v, lvb, "lower"), bound(v, lv, "upper")],
                             "p_within": p_in[c][r], "p_beyond": p_out[c][r], "level_within": lv,
                             "level_beyond": lvb, "beyond": b}
+            if not roles:
+                out[c] = {"answer": stats.INCONCLUSIVE, "max_loss": margin, "worst": {}, "roles": {},
+                          "p_within": p, "level_within": lv}
+                continue
             no = any(x["beyond"] for x in roles.values())
             worst = max(roles, key=lambda r: (roles[r]["loss"], -list(roles).index(r)))
             out[c] = {"answer": stats.answer(yes, no), "max_loss": margin, "worst": {"role": worst,

@@ -8,14 +8,18 @@ which set every run belongs to):
 1. **start** (search seeds): every baseline (the declared hand-written attacks and the rotation grid,
    ``search.baselines``) and the global search's start points, spread over the cube (``restarts.design``,
    a share of its budget), all on one seed set;
+   then, with ``gate_rounds``, the structured start (``search.structured``): the best point's rotation
+   moved, collusion switched, site changed and each gate opened or closed alone, on the same seeds, the
+   leaders re-evaluated on ``leader_runs`` of them before each choice (``leaders``);
 2. **search** and **random** (search seeds): CMA-ES restarted from the start points (``restarts``;
    restart 0 from the best point of the start phase, the others from the next best spread points), and
    beside it a random search with as many evaluations as the global search (start points included); all
    candidates of one generation share seeds (common random numbers), stream ("search", searcher,
    restart, generation);
 3. **selection** (one shared seed set): the best distinct points of each searcher (the best point it ever
-   evaluated first) and every baseline race by successive halving (``racing``); each role of
-   ``CellSearch.chosen`` is decided here, on these seeds only;
+   evaluated first; with ``pool_baselines`` the baselines among the search's) and every baseline race by
+   successive halving (``racing``); each role of ``CellSearch.chosen`` is decided here, on these seeds
+   only (with ``confirm_top`` k, each group's k best: ``search_2`` ...);
 4. **confirmation** (one shared seed set no other phase uses): the chosen attacks and the truthful
    reference, every one on every run, paired by run.  The worst case is reported from these runs only.
 
@@ -179,7 +183,7 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
     points (default: ``restarts.design``, spread over the cube)."""
     s: Settings = study.settings
     ev = _Evaluator(study, cell, store, run, steps, transitory)
-    record_provenance(store)
+    record_provenance(store, getattr(study, "declaration_path", QUESTIONS))
     dim, seed = space.dimension(), stream(s.seed, cell.experiment)
     points = design(spread_points(s), dim, stream(seed, "design")) if starts is None else np.asarray(starts, float)
     rows: list[dict] = []

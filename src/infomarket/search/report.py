@@ -175,6 +175,10 @@ def _decide(study: Study, cells: list[dict], frames: list, extras: list[dict]) -
     losses = [{r: 1.0 - v / frames[i][1]["reference"] for r, v in roles[i].items()} for i in ok]
     groups = [[ok.index(i) for i in g if i in ok] for g in _groups(cells, rule["family"])]
     for i, b in zip(ok, decision.bounded(losses, [g for g in groups if g], rule["max_loss"], rule["alpha"])):
+        if not b["roles"]:
+            cells[i]["worst_case_bounded"] = {**b, "loss": math.nan, "low": math.nan, "high": math.nan}
+            cells[i]["bounded"] = b["answer"]
+            continue
         w = b["roles"][b["worst"]["role"]]
         labels = {**cells[i]["chosen"], **cells[i]["extra_attacks"]}
         for r, v in b["roles"].items():
@@ -278,7 +282,7 @@ def figure(analysis: dict):
 
 def write(out: Path, analysis: dict, *, reduced: str = "", wall_seconds: float | None = None,
           steps: int | None = None, transitory: int | None = None, provenance: dict | None = None,
-          header: dict | None = None) -> list[Path]:
+          header: dict | None = None, records: list[str] | None = None) -> list[Path]:
     """``report.json``, ``report.md`` and ``loss.png`` into ``out``; ``steps`` and ``transitory``: the runs'
     length, recorded so a shortened search reads as one; ``provenance``: e.g. the questions file's commit
     and the first run's time, printed as they are; ``header``: ``commit``, ``tree_clean``,
@@ -291,7 +295,7 @@ def write(out: Path, analysis: dict, *, reduced: str = "", wall_seconds: float |
             "provenance": provenance or {}}
     paths[0].write_text(json.dumps(json_ready({**meta, **analysis}), indent=2) + "\n")
     paths[1].write_text(markdown(analysis, reduced=reduced, wall_seconds=wall_seconds, steps=steps,
-                                 transitory=transitory, provenance=provenance, header=top))
+                                 transitory=transitory, provenance=provenance, header=top, records=records))
     if analysis["cells"]:
         import matplotlib.pyplot as plt  # only when a figure is drawn: matplotlib is slow to import
 
@@ -375,7 +379,8 @@ def _duel_cell(a: dict | None) -> str:
 
 
 def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, steps: int | None = None,
-             transitory: int | None = None, provenance: dict | None = None, header: dict | None = None) -> str:
+             transitory: int | None = None, provenance: dict | None = None, header: dict | None = None,
+             records: list[str] | None = None) -> str:
     s = a["settings"]
     lines = ["# Attack search", "", *header_lines(header or {})]
     if reduced:
@@ -450,5 +455,6 @@ def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, s
                          f"{v.get('env_steps', 0):.3g} | {v.get('seconds', 0):.0f} |")
     total = {k: sum(c["cost_total"][k] for c in a["cells"]) for k in ("runs", "env_steps", "seconds")}
     lines += ["", f"All cells: {total['runs']:.0f} runs, {total['env_steps']:.3g} env-steps, "
-                  f"{total['seconds']:.0f} s of run time.", "", *DECLARATION.record_markdown()]
+                  f"{total['seconds']:.0f} s of run time.", "",
+              *(DECLARATION.record_markdown() if records is None else records)]
     return "\n".join(lines) + "\n"

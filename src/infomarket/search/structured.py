@@ -4,7 +4,8 @@ A hand-written attack or a rotation-grid point has every gate closed; a weakness
 (lie only once trusted, only to a fresh identity's buyers, only with few confirmers) sits where a sample
 around it almost never goes: with CMA-ES's step sigma a sample keeps a closed gate closed, and a uniform
 point has all of them closed with a probability of a few in a thousand.  So, before CMA-ES, the search
-takes the best point it has (on the start phase's seeds: a baseline or a spread point) and opens each
+takes the best point it has (on the start phase's seeds: a baseline or a spread point), moves its rotation
+by 5-15° either way, switches its collusion and tries each other lie site (``choices``), and opens each
 restricting gate alone at a few values spread over its range, and closes each one open (``openings``);
 a second round opens each
 gate again on the best point of the first, so a weakness that needs two gates open is reached in two
@@ -40,10 +41,38 @@ def is_open(name: str, u: float) -> bool:
     return {"above": u > 0.5, "below": u < 0.5, "signed": not 0.4 <= u <= 0.6, "switch": u >= 0.5}[kind]
 
 
-def openings(z: np.ndarray) -> list[np.ndarray]:
-    """``z`` with one gate changed at a time: a closed gate opened at each of its ``AT`` values, an open
-    one moved to them and closed (in place of the ``AT`` value nearest its own): ``per_round`` points."""
+#: the rotation's steps around the best point (degrees), a fine sweep between the grid's angles
+TURNS = (-15.0, -10.0, -5.0, 5.0, 10.0, 15.0)
+
+
+def choices(z: np.ndarray) -> list[np.ndarray]:
+    """``z`` with its rotation moved by each of ``TURNS`` (kept in 0..180°), collusion switched, and each
+    other lie site: the fine sweep of rotation x colluding x site around the best point."""
     out = []
+    k = space.NAMES.index("rot_base")
+    lo, hi = space.SHAPES["rot_base"][1:]
+    for t in TURNS:
+        x = np.array(z, float)
+        x[k] = float(np.clip(x[k] + t / (hi - lo), 0.0, 1.0))
+        out.append(x)
+    c = space.NAMES.index("collude")
+    x = np.array(z, float)
+    x[c] = 0.25 if x[c] >= 0.5 else 0.75
+    out.append(x)
+    s = space.NAMES.index("lie_site")
+    here = min(int(z[s] * 3), 2)
+    for other in (v for v in range(3) if v != here):
+        x = np.array(z, float)
+        x[s] = (other + 0.5) / 3
+        out.append(x)
+    return out
+
+
+def openings(z: np.ndarray) -> list[np.ndarray]:
+    """``z`` with one choice or one gate changed at a time: the ``choices`` (rotation, collusion, site),
+    then each closed gate opened at each of its ``AT`` values, each open one moved to them and closed (in
+    place of the ``AT`` value nearest its own): ``per_round`` points."""
+    out = choices(z)
     for name in GATES:
         k = space.NAMES.index(name)
         kind = space.SHAPES[name][0]
@@ -58,7 +87,7 @@ def openings(z: np.ndarray) -> list[np.ndarray]:
 
 
 def per_round() -> int:
-    return sum(len(AT[space.SHAPES[n][0]]) for n in GATES)
+    return len(TURNS) + 1 + 2 + sum(len(AT[space.SHAPES[n][0]]) for n in GATES)
 
 
 def reevaluate(ev, conds: list, scores: list[float], rows: list[dict], count: int, runs: int) -> None:

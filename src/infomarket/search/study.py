@@ -145,14 +145,16 @@ class Study:
     reference: str | None
     questions: dict = field(default_factory=dict)
     pending: dict = field(default_factory=dict)
+    declaration_path: Path = QUESTIONS  # the questions file declaring it (its commit goes into the report)
 
 
 def load_declarations(path: Path = QUESTIONS) -> dict:
     return tomllib.loads(Path(path).read_text())
 
 
-def load(experiment: Experiment, declarations: dict | None = None, **overrides) -> Study:
-    """The study of ``experiment`` with the declared settings, ``overrides`` (None values ignored) applied."""
+def load(experiment: Experiment, declarations: dict | None = None, *, path: Path = QUESTIONS, **overrides) -> Study:
+    """The study of ``experiment`` with the declared settings, ``overrides`` (None values ignored) applied;
+    ``path``: the questions file the declarations were read from."""
     d = load_declarations() if declarations is None else declarations
     settings_ = settings(d.get("search", {}), overrides)
     baselines, reference = {}, None
@@ -168,7 +170,8 @@ def load(experiment: Experiment, declarations: dict | None = None, **overrides) 
             raise ConfigError(f"{QUESTIONS.name}: baseline {name}: the name of a rotation-grid baseline "
                               f"(search.baselines); give the declared one another name")
         baselines[name] = params
-    return Study(experiment, settings_, baselines, reference, d.get("questions", {}), d.get("pending_defences", {}))
+    return Study(experiment, settings_, baselines, reference, d.get("questions", {}), d.get("pending_defences", {}),
+                 Path(path))
 
 
 def _with_pending(exp: Experiment, pending: dict) -> Experiment:
