@@ -95,12 +95,11 @@ NOT_RUN = {
         "needs the study's stores; tests/analysis/test_chain_study.py runs it on a synthetic one",
     # docs/attack-search.md
     "infomarket attack-search attack_search --questions src/infomarket/search/questions_v3.toml "
-    "--out results/attack_search_v3": "the third version's declared study, about 83 000 runs",
-    "infomarket attack-search --validate --kinds trust_gate --validation-repeats 1 --budget 64 --runs 4 "
-    "--race 4,8,16 --pool-baselines --gate-rounds 1 --local 1 --leaders 4":
-        "a planted search of a few seconds' CPU; tests/search/test_validate.py runs one like it",
-    "infomarket attack-search --validate --validation-repeats 6 --pool-baselines --gate-rounds 2 --local 1 "
-    "--restarts 2 --spread 0.125 --leaders 6": "36 planted searches at the study's budget (CPU minutes)",
+    "--out results/attack_search_v3": "the third version's declared study, about 82 000 runs",
+    "infomarket attack-search --validate --questions src/infomarket/search/questions_v3.toml --kinds trust_gate "
+    "--validation-repeats 1": "one planted search at the study's budget (10-40 s); run below at a small size",
+    "infomarket attack-search --validate --questions src/infomarket/search/questions_v3.toml":
+        "36 planted searches at the study's budget (CPU minutes)",
     "infomarket attack-search attack_search --out results/attack_search": "the full study, about 64 000 runs",
     "infomarket attack-search attack_search --defence staking --byzantines 3 --budget 48 --runs 4 "
     "--confirmation-runs 16 --seed 7 --out /tmp/attack-reduced": "~2 500 full runs; tests/search runs a tiny search",
@@ -192,14 +191,13 @@ SIZE_OPTIONS = frozenset({"steps", "transitory", "budget", "popsize", "runs", "r
 TINY_SEARCH = ("--defence staking --byzantines 3 --budget 2 --popsize 2 --restarts 1 --runs 1 --finalists 1 "
                "--race 2 --confirmation-runs 2 --grid-step 90 --adaptive-budget 0 --steps 60 --transitory 20 --workers 1")
 SMALL = {
-    "infomarket attack-search --validate --kinds trust_gate --validation-repeats 1 --budget 64 --runs 4 "
-    "--race 4,8,16 --pool-baselines --gate-rounds 1 --local 1 --leaders 4":
-        "infomarket attack-search --validate --kinds trust_gate --validation-repeats 1 --budget 24 --popsize 4 "
-        "--runs 2 --race 2,4 --grid-step 90 --pool-baselines --gate-rounds 1 --local 1 --leaders 4",
-    "infomarket attack-search --validate --validation-repeats 6 --pool-baselines --gate-rounds 2 --local 1 "
-    "--restarts 2 --spread 0.125 --leaders 6":
-        "infomarket attack-search --validate --validation-repeats 1 --budget 24 --popsize 4 --runs 2 --race 2,4 "
-        "--grid-step 90 --pool-baselines --gate-rounds 2 --local 1 --restarts 2 --spread 0.125 --leaders 6",
+    "infomarket attack-search --validate --questions src/infomarket/search/questions_v3.toml --kinds trust_gate "
+    "--validation-repeats 1":
+        "infomarket attack-search --validate --questions src/infomarket/search/questions_v3.toml --kinds trust_gate "
+        "--validation-repeats 1 --budget 24 --popsize 4 --runs 2 --race 2,4 --grid-step 90",
+    "infomarket attack-search --validate --questions src/infomarket/search/questions_v3.toml":
+        "infomarket attack-search --validate --questions src/infomarket/search/questions_v3.toml "
+        "--validation-repeats 1 --budget 24 --popsize 4 --runs 2 --race 2,4 --grid-step 90",
     "infomarket check attack_search": "infomarket check attack_search",
     "infomarket check chain_partition": "infomarket check chain_partition",
     "infomarket attack-search attack_search --out results/attack_search":
@@ -302,10 +300,16 @@ def test_documented_command_runs_at_a_small_size(documented, tmp_path, monkeypat
     if "chainstore" in words:  # the store the page's `STORE` stands for
         _chain_store(tmp_path / "chainstore")
         capsys.readouterr()
+    if "--questions" in words:  # a path of the repository, relative to its root as the page shows it
+        rel = Path(words[words.index("--questions") + 1])
+        (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / rel).write_text((ROOT / rel).read_text())
     assert main(words[1:]) == 0, capsys.readouterr().err
     out = capsys.readouterr().out
     assert out.strip()
-    if words[1] == "attack-search":
+    if words[1] == "attack-search" and "--validate" in words:
+        assert "Recovery rate per searcher: search " in out
+    elif words[1] == "attack-search":
         report = json.loads((tmp_path / "as" / "report.json").read_text())
         assert report["steps"] == 60 and report["transitory"] == 20 and report["reduced"]
     if words[1] == "check":

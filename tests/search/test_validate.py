@@ -65,7 +65,7 @@ def test_a_planted_landscape_run_is_a_pure_function_of_its_seed():
     assert np.std(d) == pytest.approx(planted.OWN_SD * np.sqrt(2), rel=0.15)
 
 
-SMALL = dict(budget=64, popsize=6, restarts=2, runs=4, finalists=3, race=[4, 8, 16], grid_step=30.0, spread=0.125)
+SMALL = dict(budget=80, popsize=6, restarts=2, runs=4, finalists=3, race=[4, 8, 16], grid_step=30.0, spread=0.125)
 BETTER = dict(pool_baselines=True, gate_rounds=1, local=1, leaders=4)
 
 
