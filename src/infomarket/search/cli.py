@@ -98,7 +98,8 @@ def cmd_attack_search(args) -> int:
     exp = load_experiment(args.experiment)
     path = Path(args.questions) if args.questions else study_mod.QUESTIONS
     decl = study_mod.Declaration.read(path, path.name)
-    st = study_mod.load(exp, decl.data, path=path, budget=args.budget, popsize=args.popsize, restarts=args.restarts, runs=args.runs,
+    data = decl.data if args.questions else study_mod.load_declarations()  # the package's, read as the study reads it
+    st = study_mod.load(exp, data, path=path, budget=args.budget, popsize=args.popsize, restarts=args.restarts, runs=args.runs,
                         finalists=args.finalists, race=_race(args.race) if args.race is not None else None,
                         keep=args.keep, confirmation_runs=args.confirmation_runs, grid_step=args.grid_step,
                         objective=args.objective, seed=args.seed, validation=args.validation_repeats,
@@ -120,7 +121,7 @@ def cmd_attack_search(args) -> int:
     for c in chosen:  # every configuration is checked before anything runs
         c.with_attack({}, steps=args.steps, transitory=args.transitory)
     first = chosen[0].with_attack({}, steps=args.steps, transitory=args.transitory)
-    declared = study_mod.load(exp, decl.data, path=path)
+    declared = study_mod.load(exp, data, path=path)
     smaller = _reductions(st, declared, exp, chosen, cells(st), args)
     refuse_declared_seed(st.settings.seed, declared.settings.seed,
                          ([args.reduced] if args.reduced else []) + smaller)
@@ -133,12 +134,12 @@ def cmd_attack_search(args) -> int:
     total = planned_runs(st) * len(chosen)
     client = dask_client(args.dask) if args.dask else None
     workers = args.workers or default_workers()
-    learner = {**ADAPTIVE, **decl.data.get("adaptive", {})}
+    learner = {**ADAPTIVE, **data.get("adaptive", {})}
     if args.adaptive_budget is not None:
         learner["budget"] = args.adaptive_budget
     _check_learner(learner)  # before any run: a bad value must not surface after a cell's search
     validation = _study_validation(st, out, args.quiet)
-    need = decl.data.get("validation", {}).get("min_recovery")
+    need = data.get("validation", {}).get("min_recovery")
     if need is not None and not reduced and validation.get("search", 0.0) < need:
         raise UsageError(f"the planted validation gives the search a recovery rate of {validation.get('search', 0.0):.0%}"
                          f", below the {need:.0%} that {path.name} declares before its study runs (OUT/validation.json "
