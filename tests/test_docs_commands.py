@@ -103,6 +103,12 @@ NOT_RUN = {
     "results/chain/chain_fig7_sweep results/chain/chain_partition --out results/chain/report":
         "needs the study's stores; tests/analysis/test_chain_study.py runs it on a synthetic one",
     # docs/attack-search.md
+    "infomarket attack-search attack_search --questions src/infomarket/search/questions_v3.toml "
+    "--out results/attack_search_v3": "the third version's declared study, about 82 000 runs",
+    "infomarket attack-search --validate --questions src/infomarket/search/questions_v3.toml --kinds trust_gate "
+    "--validation-repeats 1": "one planted search at the study's budget (10-40 s); run below at a small size",
+    "infomarket attack-search --validate --questions src/infomarket/search/questions_v3.toml":
+        "36 planted searches at the study's budget (CPU minutes)",
     "infomarket attack-search attack_search --out results/attack_search": "the full study, about 64 000 runs",
     "infomarket attack-search attack_search --defence staking --byzantines 3 --budget 48 --runs 4 "
     "--confirmation-runs 16 --seed 7 --out /tmp/attack-reduced": "~2 500 full runs; tests/search runs a tiny search",
@@ -189,7 +195,7 @@ SMALL_DOCS = ("attack-search.md", "rl.md", "chain-model.md")
 SIZE_OPTIONS = frozenset({"steps", "transitory", "budget", "popsize", "runs", "restarts", "finalists", "race",
                           "keep", "confirmation_runs", "grid_step", "adaptive_budget", "iterations",
                           "pairs", "eval_runs", "repeats", "batch", "robots", "out", "workers", "defence",
-                          "byzantines", "store", "chain_period",
+                          "byzantines", "store", "chain_period", "validation_repeats",
                           # a reduced form of a declared study must take another seed than the study's
                           # (search/questions.toml [seed_sets]; the CLI refuses it otherwise)
                           "seed"})
@@ -197,6 +203,13 @@ TINY_SEARCH = ("--defence staking --byzantines 3 --budget 2 --popsize 2 --restar
                "--race 2 --confirmation-runs 2 --grid-step 90 --adaptive-budget 0 --steps 60 --transitory 20 "
                "--workers 1")
 SMALL = {
+    "infomarket attack-search --validate --questions src/infomarket/search/questions_v3.toml --kinds trust_gate "
+    "--validation-repeats 1":
+        "infomarket attack-search --validate --questions src/infomarket/search/questions_v3.toml --kinds trust_gate "
+        "--validation-repeats 1 --budget 24 --popsize 4 --runs 2 --race 2,4 --grid-step 90",
+    "infomarket attack-search --validate --questions src/infomarket/search/questions_v3.toml":
+        "infomarket attack-search --validate --questions src/infomarket/search/questions_v3.toml "
+        "--validation-repeats 1 --budget 24 --popsize 4 --runs 2 --race 2,4 --grid-step 90",
     "infomarket check attack_search": "infomarket check attack_search",
     "infomarket check chain_partition": "infomarket check chain_partition",
     "infomarket attack-search attack_search --out results/attack_search":
@@ -233,12 +246,16 @@ SMALL = {
 }
 #: Shown in these pages but not run here, with the reason.
 SMALL_NOT_RUN = {
+    "infomarket attack-search attack_search --questions src/infomarket/search/questions_v3.toml "
+    "--out results/attack_search_v3": "its small form would change the questions file's sizes, not an option; "
+                                      "tests/search/test_validate.py runs a study from a small questions file",
     "infomarket attack-search attack_search --defence staking,theta20 --byzantines 3 --dask tcp://head:8786 "
     "--out results/as-dask": "needs a Dask scheduler at that address; tests/search runs one on a LocalCluster",
     "infomarket view": "a web server that runs until stopped; tests/viewer",
     "infomarket replay --movie":
         "the command's name in the text (rl.md's rendering); tests/viewer/test_movie.py runs it",
     "infomarket attack-search": "the command's name in the text; its commands are the ones above",
+    "infomarket attack-search --validate": "the command's name in a heading; its commands are the ones above",
     "infomarket adaptive-attack": "the command's name in the text (rl.md); its command is the one above",
     "infomarket sweep attack_search": "sweep has no --steps: 24 runs of 30 000 steps at the least; `check "
                                       "attack_search` (run above) builds and validates each of its conditions",
@@ -297,10 +314,16 @@ def test_documented_command_runs_at_a_small_size(documented, tmp_path, monkeypat
     if "chainstore" in words:  # the store the page's `STORE` stands for
         _chain_store(tmp_path / "chainstore")
         capsys.readouterr()
+    if "--questions" in words:  # a path of the repository, relative to its root as the page shows it
+        rel = Path(words[words.index("--questions") + 1])
+        (tmp_path / rel).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / rel).write_text((ROOT / rel).read_text())
     assert main(words[1:]) == 0, capsys.readouterr().err
     out = capsys.readouterr().out
     assert out.strip()
-    if words[1] == "attack-search":
+    if words[1] == "attack-search" and "--validate" in words:
+        assert "Recovery rate per searcher: search " in out
+    elif words[1] == "attack-search":
         report = json.loads((tmp_path / "as" / "report.json").read_text())
         assert report["steps"] == 60 and report["transitory"] == 20 and report["reduced"]
     if words[1] == "check":

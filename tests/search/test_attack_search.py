@@ -107,6 +107,14 @@ def test_the_store_records_the_questions_file_and_the_first_run_time(inline):
     first = datetime.datetime.strptime(meta["first_run_utc"], "%Y-%m-%dT%H:%M:%SZ")
     assert first <= datetime.datetime.now(datetime.UTC).replace(tzinfo=None)
     assert first >= datetime.datetime.now(datetime.UTC).replace(tzinfo=None) - datetime.timedelta(hours=2)
+    # the report's first keys: the code's commit now (this checkout's HEAD) and the questions file's
+    head = subprocess.run(["git", "-C", str(study.QUESTIONS.parent), "rev-parse", "HEAD"], capture_output=True,
+                          text=True).stdout.strip() or None
+    data = json.loads((inline / "report.json").read_text())
+    assert list(data)[:4] == ["commit", "tree_clean", "questions_commit", "validation"]
+    assert data["commit"] == head and data["questions_commit"] == meta["questions_commit"]
+    assert meta["commit"] == head and isinstance(data["tree_clean"], bool) == (head is not None)
+    assert f"Code: commit `{head}`" in (inline / "report.md").read_text()
 
 
 def test_a_second_search_into_another_store_is_the_same_bit_for_bit(inline, tmp_path):
@@ -249,7 +257,13 @@ def test_a_reduced_search_with_the_declared_seed_is_refused_and_some_cells_are_n
     st = study.load(load_experiment("attack_search"))
     from infomarket.search.cli import refuse_declared_seed
 
-    refuse_declared_seed(st.settings.seed, st.settings.seed, [])  # some cells, declared settings: allowed
+    refuse_declared_seed(st.settings.seed, st.settings.seed, [])  # the whole declared study: allowed
+    # some of the declared cells with the declared settings is not the whole study: refused
+    args = ["attack-search", "attack_search", "--defence", "staking", "--seed", declared, "--out", str(tmp_path / "p")]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert f"--seed {declared} is the study's declared seed" in err and "cells" in err and "Traceback" not in err
+    assert not (tmp_path / "p").exists()
 
 
 def test_a_rerun_over_a_finished_store_makes_no_run_and_compiles_nothing(inline, tmp_path, monkeypatch):

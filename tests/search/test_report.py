@@ -96,19 +96,29 @@ def analysis():
     return report.analyse(study(), [A, B])
 
 
-def test_the_worst_cases_loss_is_paired_by_seed_with_its_interval(analysis):
+def test_the_worst_case_is_the_most_damaging_confirmed_attack_decided_over_all(analysis):
     a, b = analysis["cells"]
-    # Walsh averages of 0.01 i, i = 1..8: median 0.045; 8 pairs: the 4th smallest and 4th largest
-    # (signed-rank null: P(T+ <= 3) = 5/256 <= 0.025 < 7/256), 0.02 and 0.07
-    assert a["worst_case_bounded"]["loss"] == pytest.approx(0.045)
-    assert (a["worst_case_bounded"]["low"], a["worst_case_bounded"]["high"]) == pytest.approx((0.02, 0.07))
-    assert b["worst_case_bounded"]["loss"] == pytest.approx(0.295)
-    # every loss below 10 % on each of 8 seeds: p = 1/256, Holm over the 2 cells 2/256: within, "yes";
-    # cell B every loss above: "no"
-    w = a["worst_case_bounded"]["within"]
-    assert (w["p"], w["p_adjusted"], w["family"]) == (pytest.approx(1 / 256), pytest.approx(2 / 256), 2)
-    assert [c["worst_case_bounded"]["answer"] for c in (a, b)] == ["yes", "no"]
+    # cell A's confirmed attacks, per-seed loss: search 0.01 i, random 0.01 i + 0.02 (-1)^i, baseline
+    # -(0.1 + 0.01 i) + 0.01 i = -0.1, adaptive 0.05 + 0.015 i: the adaptive attacker is the worst (Walsh
+    # median 0.05 + 0.015 x 4.5), and it straddles the 10 % margin (0.065 .. 0.17): neither shown within
+    # nor beyond, so the cell is inconclusive although the selection's worst (the search's) is within
+    assert a["worst"] == {"role": "adaptive", "loss": pytest.approx(0.1175)}
+    assert a["worst_case_bounded"]["loss"] == pytest.approx(0.1175) and a["bounded"] == "inconclusive"
+    assert set(a["roles"]) == {"search", "random", "baseline", "adaptive"}
+    assert a["roles"]["adaptive"]["attack"] == "policy1" and a["roles"]["search"]["attack"] == "cma_best"
+    # the search's interval at the decision's levels: "beyond" over the 7 (cell, attack) of the family,
+    # Holm rejects B's random (p 0.0023 < 0.05/7) and B's search (1/256 < 0.05/6), stops at 0.05/5 = 0.01:
+    # the lower bound at 0.01 is the 2nd smallest Walsh average (P(T+ <= 1) = 2/256 <= 0.01 < 3/256):
+    # 0.015; the upper at A's "within" level: its intersection-union p (0.90, the adaptive's) and B's (1)
+    # stop Holm at its first step, 0.05 / 2: the 4th largest Walsh average, 0.07
+    assert a["roles"]["search"]["interval"] == pytest.approx([0.015, 0.07])
+    assert a["worst_case_bounded"]["level_within"] == 0.05 / 2
+    # cell B: the search's attack loses 0.25 + 0.01 i on every seed: shown beyond, "no"
+    assert b["bounded"] == "no" and b["worst_case_bounded"]["roles"]["search"]["beyond"]
+    assert b["worst"]["loss"] == pytest.approx(max(v["loss"] for v in b["roles"].values()))
     assert analysis["bounded_by_defence"]["staking"]["answer"] == "no"
+    # the adaptive attacker is confirmed more damaging than the search's attack in A (1/256 each seed, Holm)
+    assert a["more_damaging_than_search"] == ["adaptive"] and b["more_damaging_than_search"] == []
 
 
 def test_search_vs_best_baseline_and_random_search(analysis):
@@ -195,6 +205,7 @@ def test_the_loss_is_the_worst_roles_attack():
     c = report.analyse(study(), [cell])["cells"][0]
     assert c["worst_case_bounded"]["loss"] == pytest.approx(0.1)
     assert c["medians"]["worst"] == 9.0 and c["chosen"]["worst"] == "base_best"
+    assert c["worst"]["role"] == "baseline" and c["more_damaging_than_search"] == ["baseline"]
 
 
 def test_a_reference_with_no_items_leaves_the_loss_undefined():
@@ -202,13 +213,14 @@ def test_a_reference_with_no_items_leaves_the_loss_undefined():
     "inconclusive" with a note and left out of the Holm family, the other cell keeps its answer."""
     empty = search("outlier", 1, worst=np.zeros(N), base=np.zeros(N), rand=np.zeros(N))
     empty.confirmation.loc[empty.confirmation.attack == "truthful", "items"] = [0.0, 1.0] * (N // 2)
-    a = report.analyse(study(), [empty, A])
+    plain = search("staking", 1, worst=W_A, base=W_A + 1.0 + 0.1 * I, rand=W_A - 0.01 * I)
+    a = report.analyse(study(), [empty, plain])
     undefined, fine = a["cells"]
     assert undefined["worst_case_bounded"]["answer"] == "inconclusive"
     assert "no items on 4 of 8 seeds" in undefined["worst_case_bounded"]["note"]
-    assert fine["worst_case_bounded"]["within"]["family"] == 1 and fine["worst_case_bounded"]["answer"] == "yes"
+    assert fine["worst_case_bounded"]["level_within"] == 0.05 and fine["worst_case_bounded"]["answer"] == "yes"
     md = report.markdown(a)
-    assert "| outlier | 1 | 8 | 0.50 | cma_best (0.00) | undefined | inconclusive |" in md
+    assert "| outlier | 1 | 8 | 0.50 | – | undefined | inconclusive |" in md
     assert "- outlier, 1: the truthful reference collected no items on 4 of 8 seeds" in md
     assert "| +0.00 unbounded (share undefined) | inconclusive (power 0.00) |" in md  # d = 0, medians 0
     assert report.figure(a) is not None
@@ -226,21 +238,45 @@ def test_confirmation_runs_must_pair(analysis):
 
 def test_write_gives_strict_json_markdown_and_the_figure(analysis, tmp_path):
     paths = report.write(tmp_path, analysis, reduced="one cell", steps=2500, transitory=0,
-                         provenance={"questions commit": "abc123"})
+                         provenance={"questions commit": "abc123"},
+                         header={"commit": "c0ffee", "tree_clean": False, "questions_commit": "abc123",
+                                 "validation": {"search": 0.9, "random": 0.25}})
     assert [p.name for p in paths] == ["report.json", "report.md", "loss.png"]
 
     def refuse(name):
         raise ValueError(name)
 
     data = json.loads(paths[0].read_text(), parse_constant=refuse)  # no NaN or Infinity
-    assert data["cells"][0]["worst_case_bounded"]["loss"] == pytest.approx(0.045)
+    assert data["cells"][0]["worst_case_bounded"]["loss"] == pytest.approx(0.1175)
+    assert list(data)[:4] == ["commit", "tree_clean", "questions_commit", "validation"]
+    assert (data["commit"], data["questions_commit"], data["validation"]) == ("c0ffee", "abc123",
+                                                                               {"search": 0.9, "random": 0.25})
+    c = data["cells"][0]
+    assert (c["defence"], c["byzantines"], c["bounded"]) == ("staking", 1, "inconclusive")
+    assert c["worst"]["role"] == "adaptive" and set(c["roles"]["search"]) == {"attack", "loss", "interval"}
     md = paths[1].read_text()
     assert "REDUCED RUN (one cell)" in md and "questions commit: abc123" in md
     assert "All cells: 4160 runs" in md   # (2048 + 32) x 2
-    assert "| staking | 1 | 8 | 10.00 | cma_best (9.55) | 4.5% [2.0%, 7.0%] | yes |" in md
+    assert "| staking | 1 | 8 | 10.00 | adaptive: policy1 | 11.8% [" in md
+    assert "commit `c0ffee` (MODIFIED tree" in md and "search 90%, random 25%" in md
     assert "(evaluations: cma 3, random 2)" in md
     few = search("outlier", 1, worst=W_A[:5], base=W_A[:5], rand=W_A[:5])
     few.confirmation = few.confirmation[few.confirmation.run < 5]
     one = report.analyse(study(), [few])["cells"][0]
     assert math.isinf(one["worst_case_bounded"]["low"])   # 5 pairs bound no 95 % interval
     assert "unbounded" in report.markdown(report.analyse(study(), [few]))
+
+
+def test_a_second_confirmed_baseline_can_be_the_worst_case():
+    """The race's second baseline (confirmed with confirm_top 2) loses 34 % where the selection's pick
+    loses 24 %: the worst case is the second one, and it is confirmed more damaging than the search's."""
+    cell = search("theta20", 3, worst=np.full(N, 8.0) - 0.01 * I, base=np.full(N, 7.6) - 0.01 * I,
+                  rand=np.full(N, 9.0) - 0.01 * I)
+    extra = frame({"base_two": np.full(N, 6.6) - 0.01 * I})
+    cell.confirmation = pd.concat([cell.confirmation, extra], ignore_index=True)
+    cell.chosen["baseline_2"] = "base_two"
+    c = report.analyse(study(), [cell])["cells"][0]
+    # per-seed loss 1 - (6.6 - 0.01 i) / 10 = 0.34 + 0.001 i: Walsh median 0.34 + 0.0045
+    assert c["worst"] == {"role": "baseline_2", "loss": pytest.approx(0.3445)}
+    assert c["roles"]["baseline_2"]["attack"] == "base_two" and c["bounded"] == "no"
+    assert set(c["more_damaging_than_search"]) == {"baseline", "baseline_2"}

@@ -1,6 +1,7 @@
 """``infomarket attack-search``: the worst attack found against each defence (docs/attack-search.md)."""
 from __future__ import annotations
 
+import argparse
 import functools
 import time
 from pathlib import Path
@@ -36,6 +37,8 @@ def _race(text: str) -> list[int]:
 
 
 SIZES = ("budget", "popsize", "restarts", "runs", "finalists", "confirmation_runs")
+DESIGN = ("sigma0", "spread", "keep", "pool_baselines", "gate_rounds", "local", "local_sigma", "leaders", "leader_runs",
+          "confirm_top")
 
 
 def _reductions(st, declared, exp, chosen, all_cells, args) -> list[str]:
@@ -56,18 +59,22 @@ def _reductions(st, declared, exp, chosen, all_cells, args) -> list[str]:
                    f"(declared {','.join(map(str, declared.settings.race))})")
     if st.settings.grid_step > declared.settings.grid_step:
         out.append(f"--grid-step {st.settings.grid_step:g} (declared {declared.settings.grid_step:g})")
+    for key in DESIGN:  # another search design is not the declared study either
+        have, want = getattr(st.settings, key), getattr(declared.settings, key)
+        if have != want:
+            out.append(f"--{key.replace('_', '-')} {have} (declared {want})")
     return out
 
 
 def refuse_declared_seed(seed: int, declared: int, reductions: list[str]) -> None:
     """A study's declared seed keys its confirmation seeds, which no run may touch before the study's own
-    (questions.toml [seed_sets]): a run with smaller settings than declared (a pilot, a reduced search)
-    must take another ``--seed``.  Running some of the declared cells with the declared settings is the
-    study itself, in parts, and is allowed."""
+    (questions.toml [seed_sets]): any run that is not the whole declared study (a pilot, a reduced search,
+    some of its cells) must take another ``--seed``.  The whole study may still be made in several
+    invocations: it resumes from its store, every invocation the whole study."""
     if reductions and seed == declared:
-        raise UsageError(f"--seed {seed} is the study's declared seed, and this run is reduced "
-                         f"({'; '.join(reductions)}): its confirmation runs would be the study's own, seen before "
-                         f"the study; give another --seed (the declared settings alone may use the declared seed)")
+        raise UsageError(f"--seed {seed} is the study's declared seed, and this run is not the whole declared "
+                         f"study ({'; '.join(reductions)}): its confirmation runs would be the study's own, seen "
+                         f"before the study; give another --seed (only the whole declared study may use it)")
 
 
 def _list_baselines(st) -> int:
@@ -91,15 +98,23 @@ def cmd_attack_search(args) -> int:
     from .driver import planned_runs, search_cell, store_runner
     from .study import cells
     from .summary import write
-    from . import adaptive, report
+    from . import adaptive, provenance, report
 
     exp = load_experiment(args.experiment)
-    st = study_mod.load(exp, budget=args.budget, popsize=args.popsize, restarts=args.restarts, runs=args.runs,
+    path = Path(args.questions) if args.questions else study_mod.QUESTIONS
+    decl = study_mod.Declaration.read(path, path.name)
+    data = decl.data if args.questions else study_mod.load_declarations()  # the package's, read as the study reads it
+    st = study_mod.load(exp, data, path=path, budget=args.budget, popsize=args.popsize, restarts=args.restarts, runs=args.runs,
                         finalists=args.finalists, race=_race(args.race) if args.race is not None else None,
                         keep=args.keep, confirmation_runs=args.confirmation_runs, grid_step=args.grid_step,
-                        objective=args.objective, seed=args.seed)
+                        objective=args.objective, seed=args.seed, validation=args.validation_repeats,
+                        pool_baselines=args.pool_baselines, gate_rounds=args.gate_rounds, local=args.local,
+                        local_sigma=args.local_sigma, leaders=args.leaders, leader_runs=args.leader_runs,
+                        spread=args.spread, sigma0=args.sigma0, confirm_top=args.confirm_top)
     if args.list_baselines:
         return _list_baselines(st)
+    if args.validate:
+        return _validate(st, args)
     if args.out is None:
         raise UsageError("attack-search needs --out FOLDER (the store and the report go there)")
     if not args.out.strip():  # Path("") is the current folder: a blank variable must not write there
@@ -111,10 +126,10 @@ def cmd_attack_search(args) -> int:
     for c in chosen:  # every configuration is checked before anything runs
         c.with_attack({}, steps=args.steps, transitory=args.transitory)
     first = chosen[0].with_attack({}, steps=args.steps, transitory=args.transitory)
-    declared = study_mod.load(exp)
+    declared = study_mod.load(exp, data, path=path)
     smaller = _reductions(st, declared, exp, chosen, cells(st), args)
     refuse_declared_seed(st.settings.seed, declared.settings.seed,
-                         ([args.reduced] if args.reduced else []) + [r for r in smaller if not r.endswith(" cells")])
+                         ([args.reduced] if args.reduced else []) + smaller)
     reduced = "; ".join(([args.reduced] if args.reduced else []) + smaller)
     out = Path(args.out)
     if out.exists() and not out.is_dir():
@@ -124,10 +139,16 @@ def cmd_attack_search(args) -> int:
     total = planned_runs(st) * len(chosen)
     client = dask_client(args.dask) if args.dask else None
     workers = args.workers or default_workers()
-    learner = {**ADAPTIVE, **study_mod.DECLARATION.data.get("adaptive", {})}
+    learner = {**ADAPTIVE, **data.get("adaptive", {})}
     if args.adaptive_budget is not None:
         learner["budget"] = args.adaptive_budget
     _check_learner(learner)  # before any run: a bad value must not surface after a cell's search
+    validation = _study_validation(st, out, args.quiet)
+    need = data.get("validation", {}).get("min_recovery")
+    if need is not None and not reduced and validation.get("search", 0.0) < need:
+        raise UsageError(f"the planted validation gives the search a recovery rate of {validation.get('search', 0.0):.0%}"
+                         f", below the {need:.0%} that {path.name} declares before its study runs (OUT/validation.json "
+                         f"has every search); the study is not run")
     t0 = time.perf_counter()
     results = []
     try:
@@ -152,9 +173,12 @@ def cmd_attack_search(args) -> int:
                           transitory=first.transitory)
     analysis = report.analyse(st, results)
     length = {"steps": first.steps, "transitory": first.transitory}
-    written += report.write(out, analysis, reduced=reduced, wall_seconds=wall,
-                            provenance=store.meta().get("attack_search"), busy=busy, **length)
-    text = report.markdown(analysis, reduced=reduced, wall_seconds=wall, busy=busy, **length)
+    first_run = store.meta().get("attack_search")
+    header = {**provenance.report_header(first_run, path), "validation": validation}
+    written += report.write(out, analysis, reduced=reduced, wall_seconds=wall, provenance=first_run,
+                            header=header, records=decl.record_markdown(), busy=busy, **length)
+    text = report.markdown(analysis, reduced=reduced, wall_seconds=wall, header=header,
+                           records=decl.record_markdown(), busy=busy, **length)
     if not args.quiet:
         print(text)
         made = sum(r.done for r in results)
@@ -162,6 +186,48 @@ def cmd_attack_search(args) -> int:
         print(f"attack-search: {made} runs made now, {kept} found in the store; {wall:.1f} s wall; "
               f"wrote {', '.join(str(p) for p in written)}")
     return 0
+
+
+def _validate(st, args) -> int:
+    """``--validate``: the planted weaknesses searched with the study's settings, the recovery rate per
+    searcher printed (and written to OUT/validation.json with --out)."""
+    from . import validate  # with the command: `infomarket --help` does not import the search
+
+    repeats = args.validation_repeats if args.validation_repeats is not None else (st.settings.validation or 3)
+    if repeats < 1:
+        raise UsageError(f"--validation-repeats {repeats}: --validate needs at least 1")
+    kinds = _names(args.kinds) if args.kinds is not None else None
+    for k in kinds or []:
+        if k not in validate.planted.KINDS:
+            raise UsageError(f"--kinds {k}: not a planted weakness; allowed: {', '.join(validate.planted.KINDS)}")
+    result = validate.validate(st, repeats, kinds=kinds, echo=None if args.quiet else lambda r: print(validate.line(r)))
+    print(validate.text(result))
+    if args.out:
+        print(f"wrote {validate.write(Path(args.out), result)}")
+    return 0
+
+
+def _study_validation(st, out: Path, quiet: bool) -> dict:
+    """The planted suite's recovery rates for a study's report: ``validation`` seeds per planted weakness
+    with the study's settings (none when 0), kept in OUT/validation.json so a resumed study reuses them."""
+    import json
+
+    from . import validate  # with the command: `infomarket --help` does not import the search
+
+    n = st.settings.validation
+    if not n:
+        return {}
+    path = out / "validation.json"
+    key = {"settings": repr(st.settings)}
+    if path.exists():
+        kept = json.loads(path.read_text())
+        if kept.get("key") == key:
+            return kept["rates"]
+    result = {**validate.validate(st, n), "key": key}
+    validate.write(out, result)
+    if not quiet:
+        print(validate.text(result))
+    return result["rates"]
 
 
 #: the adaptive attacker's training when questions.toml declares no ``[adaptive]`` table (budget 0: not run)
@@ -199,7 +265,10 @@ def add_subcommand(sub) -> None:
     """Add ``infomarket attack-search`` (the worst attack found against each defence) to the command line."""
     p = sub.add_parser("attack-search", help="the worst attack found against each defence: CMA-ES "
                                              "restarts and a random search, raced, confirmed on fresh seeds; resumable")
-    p.add_argument("experiment", help="a study experiment (the shipped attack_search, or a file like it)")
+    p.add_argument("experiment", nargs="?", default="attack_search",
+                   help="a study experiment (default: the shipped attack_search, or a file like it)")
+    p.add_argument("--questions", metavar="FILE",
+                   help="the study's questions file: settings, baselines, questions (default: the package's questions.toml)")
     p.add_argument("--defence", help="defence(s) to search, comma-separated (default: every one of the study)")
     p.add_argument("--byzantines", metavar="K", help="Byzantine count(s), comma-separated (default: the study's)")
     p.add_argument("--budget", type=at_least(1), metavar="N",
@@ -214,11 +283,31 @@ def add_subcommand(sub) -> None:
     p.add_argument("--confirmation-runs", type=at_least(2), help="runs per chosen attack on the confirmation seeds "
                                                                  "(default: declared)")
     p.add_argument("--grid-step", type=float, metavar="DEGREES", help="rotation grid's step (default: declared)")
+    p.add_argument("--sigma0", type=float, help="CMA-ES step of a global restart, in the unit cube (default: declared)")
+    p.add_argument("--spread", type=float, help="share of the budget on spread start points (default: declared)")
+    p.add_argument("--pool-baselines", action=argparse.BooleanOptionalAction, default=None,
+                   help="race the baselines in the search's own pool (default: declared)")
+    p.add_argument("--gate-rounds", type=at_least(0), metavar="N",
+                   help="rounds of opening one gate at a time on the best point (default: declared)")
+    p.add_argument("--local", type=at_least(0), metavar="N",
+                   help="restarts that refine the best points found, with step --local-sigma (default: declared)")
+    p.add_argument("--local-sigma", type=float, help="CMA-ES step of a local restart (default: declared)")
+    p.add_argument("--leaders", type=at_least(0), metavar="N",
+                   help="best start points run again on --leader-runs seeds before each choice (default: declared)")
+    p.add_argument("--confirm-top", type=at_least(1), metavar="K",
+                   help="the race's K best attacks of each searcher and of the baselines confirmed (default: declared)")
+    p.add_argument("--leader-runs", type=at_least(1), metavar="N", help="runs of a re-evaluated leader (default: declared)")
     p.add_argument("--objective", choices=["items", "liar_wealth"], help="what the attack optimises (default: items)")
     p.add_argument("--seed", type=seed_value, help="the search's seed: optimisers and seed sets (default: declared)")
     p.add_argument("--adaptive-budget", type=at_least(0), metavar="N",
-                   help="evaluations per cell of the adaptive attacker, the second searcher "
-                        "(0: none; default: declared)")
+                   help="evaluations per cell of the adaptive attacker, the second searcher (0: none; default: declared)")
+    p.add_argument("--validate", action="store_true",
+                   help="search the planted weaknesses (known optima) with the study's settings and print the recovery "
+                        "rate per searcher, then exit (docs/attack-search.md, \"Planted weaknesses\")")
+    p.add_argument("--validation-repeats", type=at_least(0), metavar="N",
+                   help="seeds per planted weakness: of --validate (default: declared, else 3), and of the validation a "
+                        "study runs before its cells (0: none; default: declared)")
+    p.add_argument("--kinds", help="with --validate: planted weaknesses to search, comma-separated (default: all)")
     p.add_argument("--list-baselines", action="store_true", help="list the baselines (declared and rotation grid) "
                                                                  "and exit")
     p.add_argument("--steps", type=at_least(1), help="steps per run (default: the experiment's), for a reduced search")

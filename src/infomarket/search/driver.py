@@ -8,14 +8,18 @@ which set every run belongs to):
 1. **start** (search seeds): every baseline (the declared hand-written attacks and the rotation grid,
    ``search.baselines``) and the global search's start points, spread over the cube (``restarts.design``,
    a share of its budget), all on one seed set;
+   then, with ``gate_rounds``, the structured start (``search.structured``): the best point's rotation
+   moved, collusion switched, site changed and each gate opened or closed alone, on the same seeds, the
+   leaders re-evaluated on ``leader_runs`` of them before each choice (``leaders``);
 2. **search** and **random** (search seeds): CMA-ES restarted from the start points (``restarts``;
    restart 0 from the best point of the start phase, the others from the next best spread points), and
    beside it a random search with as many evaluations as the global search (start points included); all
    candidates of one generation share seeds (common random numbers), stream ("search", searcher,
    restart, generation);
 3. **selection** (one shared seed set): the best distinct points of each searcher (the best point it ever
-   evaluated first) and every baseline race by successive halving (``racing``); each role of
-   ``CellSearch.chosen`` is decided here, on these seeds only;
+   evaluated first; with ``pool_baselines`` the baselines among the search's) and every baseline race by
+   successive halving (``racing``); each role of ``CellSearch.chosen`` is decided here, on these seeds
+   only (with ``confirm_top`` k, each group's k best: ``search_2`` ...);
 4. **confirmation** (one shared seed set no other phase uses): the chosen attacks and the truthful
    reference, every one on every run, paired by run.  The worst case is reported from these runs only.
 
@@ -29,8 +33,6 @@ questions file's commit and the time of the study's first run (``record_provenan
 from __future__ import annotations
 
 import datetime
-import hashlib
-import subprocess
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -44,17 +46,20 @@ from ..runner.plan import Condition, condition_number
 from ..runner.sweep import run_sweep
 from ..seeds import run_seed
 from ..store import Store
+from . import provenance as _prov
 from . import space
 from .objective import loss, per_run
 from .racing import race, survivors
-from .restarts import Restarts, design, evaluations, random_batches, spread_points, stream
+from . import structured
+from .restarts import Restarts, design, evaluations, gate_points, random_batches, spread_points, stream
 from .study import QUESTIONS, Cell, Settings, Study
 
 PHASES = ("start", "search", "random", "selection", "confirmation")
 SEED_SET = {"start": "search", "search": "search", "random": "search", "selection": "selection",
             "confirmation": "confirmation"}
 #: the race's groups: the searcher whose points each holds (the start points belong to the global search)
-GROUPS = {"search": ("start", "cma"), "random": ("random",)}
+GROUPS = {"search": ("start", "gates", "cma"), "random": ("random",)}
+POOLED = ("baseline",)  # with ``pool_baselines``, the baselines race in the search's pool too
 ROLES = ("search", "random", "baseline")
 DEFAULTS = {p[0]: float(p[1]) for p in POLICY}
 
@@ -101,27 +106,15 @@ def confirmation_seeds(study: Study, cell: Cell, runs: int | None = None) -> lis
     return [run_seed(cell.config.seed, k, crn) for k in range(s.confirmation_runs if runs is None else runs)]
 
 
-def _git(folder, *args) -> str | None:
-    try:
-        out = subprocess.run(["git", "-C", str(folder), *args], capture_output=True, text=True, timeout=30)
-    except (OSError, subprocess.SubprocessError):
-        return None
-    return out.stdout.strip() if out.returncode == 0 else None
-
-
 def provenance(questions=QUESTIONS) -> dict:
-    """The questions file's identity: its last commit (when the package is a git checkout; ``modified``
-    says whether the file differs from it) and its SHA-256."""
-    folder = questions.parent
-    commit = _git(folder, "log", "-1", "--format=%H", "--", questions.name) or None
-    modified = bool(_git(folder, "status", "--porcelain", "--", questions.name)) if commit else None
-    return {"questions_file": questions.name, "questions_commit": commit, "questions_modified": modified,
-            "questions_sha256": hashlib.sha256(questions.read_bytes()).hexdigest()}
+    """The questions file's identity (its last commit, whether it differs from it, its SHA-256) and the
+    code's commit with whether the tree was clean (``search.provenance``)."""
+    return {**_prov.questions(questions), **_prov.code()}
 
 
 def record_provenance(store: Store, questions=QUESTIONS, key: str = "attack_search") -> dict:
     """Record in the store's metadata (``store.json``, under ``key``), once, before the study's first run:
-    the questions file's commit and hash, and the UTC time of the first run."""
+    the questions file's commit and hash, the code's commit, and the UTC time of the first run."""
     with store.writing():
         meta = store.meta()
         if key not in meta:
@@ -195,7 +188,7 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
     points (default: ``restarts.design``, spread over the cube)."""
     s: Settings = study.settings
     ev = _Evaluator(study, cell, store, run, steps, transitory)
-    record_provenance(store)
+    record_provenance(store, getattr(study, "declaration_path", QUESTIONS))
     dim, seed = space.dimension(), stream(s.seed, cell.experiment)
     points = design(spread_points(s), dim, stream(seed, "design")) if starts is None else np.asarray(starts, float)
     rows: list[dict] = []
@@ -217,9 +210,34 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
     add("start", -1, -1, frames[len(base):], spread, list(points))
     scores = [ev.fitness(f) for f in frames]
     firsts = [space.to_unit(p) for p in hand.values()] + list(points)
+    every = base + spread  # the start phase's conditions, by index (the openings join them)
+
+    def leaders() -> None:  # the best points so far run again on more of the start seeds (search.structured)
+        if s.leaders:
+            structured.reevaluate(ev, every, scores, rows, s.leaders, s.leader_runs)
+
+    # the structured start: each gate opened alone on the best point not yet opened from (search.structured)
+    opened: list[int] = []
+    for g in range(s.gate_rounds):
+        leaders()
+        left = gate_points(s) - (len(firsts) - len(base) - len(points))
+        best = min((k for k in range(len(scores)) if k not in opened), key=lambda k: (scores[k], k), default=None)
+        if best is None or left <= 0:
+            break
+        opened.append(best)
+        X = structured.openings(firsts[best])[:left]
+        conds = [ev.condition(space.to_params(x), "start", "gates", g, 0, i, f"gate_g{g}c{i}", s.runs, crn)
+                 for i, x in enumerate(X)]
+        fr = ev.evaluate(conds)
+        add("gates", g, 0, fr, conds, X)
+        scores += [ev.fitness(f) for f in fr]
+        firsts += X
+        every += conds
+    leaders()
     order = sorted(range(len(scores)), key=lambda k: (scores[k], k))  # ties: baselines first, then in order
-    # restart 0 at the best point of the start phase, the others at the next best spread points
-    origins = order[:1] + [k for k in order[1:] if k >= len(base)]
+    # restart 0 (or the first `local` ones) at the best points so far, the others at the next best spread points
+    top = order[:max(1, s.local)]
+    origins = top + [k for k in order if k >= len(base) and k not in top]
 
     def start(r: int) -> np.ndarray:
         return firsts[origins[r % len(origins)]] if origins else np.full(dim, 0.5)
@@ -257,6 +275,7 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
     ranked = candidates.assign(order=np.arange(len(candidates))).sort_values(["fitness", "order"], kind="stable")
     groups = {}
     for role, members in GROUPS.items():
+        members = members + (POOLED if role == "search" and s.pool_baselines else ())
         mine = ranked[ranked.searcher.isin(members)].drop_duplicates(list(space.NAMES))
         if len(mine):
             groups[role] = list(mine.label.head(s.finalists))
@@ -274,6 +293,7 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
     selected: dict[str, pd.DataFrame] = {}
 
     def on_selection(labels: list[str], runs: int) -> dict[str, np.ndarray]:
+        labels = list(dict.fromkeys(labels))  # a pooled baseline races in two groups, on the same runs
         conds = [_raced(ev, params[a], a, searcher[a], row.get(a), runs, crn) for a in labels]
         for a, f in zip(labels, ev.evaluate(conds)):
             selected[a] = f
@@ -284,6 +304,9 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
     median = {a: float(np.median(loss(selected[a][s.objective].to_numpy(float), s.objective))) for a in chosen.values()}
     if chosen:
         chosen["worst"] = min((chosen[r] for r in ROLES if r in chosen), key=lambda a: median[a])
+    for role in ROLES:  # with confirm_top k, each group's next best attacks are confirmed too: role_2 .. role_k
+        for k, a in enumerate(result.ranking.get(role, [])[1:s.confirm_top], start=2):
+            chosen[f"{role}_{k}"] = a
     if study.reference:
         chosen["reference"] = study.reference
     selection = _frame(selected)
@@ -305,7 +328,8 @@ def planned_runs(study: Study) -> int:
     s = study.settings
     hand = len([n for n in study.baselines if n != study.reference])
     n_eval = evaluations(s)
-    sizes = [min(s.finalists, n_eval), min(s.finalists, n_eval), hand, int(bool(study.reference))]
+    sizes = [min(s.finalists, n_eval + (hand if s.pool_baselines else 0)), min(s.finalists, n_eval), hand,
+             int(bool(study.reference))]
     selection = 0
     for n in sizes:
         before = 0
@@ -314,8 +338,9 @@ def planned_runs(study: Study) -> int:
             before = runs
             if i < len(s.race) - 1:
                 n = survivors(n, s.keep)
-    roles = len([n for n in sizes[:3] if n]) + int(bool(study.reference))
-    return (hand + 2 * n_eval) * s.runs + selection + roles * s.confirmation_runs
+    roles = sum(min(n, s.confirm_top) for n in sizes[:3] if n) + int(bool(study.reference))
+    leaders = (s.gate_rounds + 1) * s.leaders * max(0, s.leader_runs - s.runs)  # re-evaluations, at most
+    return (hand + 2 * n_eval) * s.runs + leaders + selection + roles * s.confirmation_runs
 
 
 def _raced(ev: _Evaluator, params: dict, label: str, group: str, row, runs: int, crn: int) -> CRNCondition:

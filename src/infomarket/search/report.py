@@ -27,6 +27,7 @@ from ..analysis import stats
 from ..analysis.declared import size_note
 from ..errors import ArgumentError
 from ..runner.progress import busy_markdown
+from . import decision
 from .objective import loss
 from .study import DECLARATION, Study
 
@@ -100,29 +101,12 @@ def _pct(v: float, ref: float) -> float:
     return -v / abs(ref) if ref else math.nan
 
 
-def _bounded(losses, cells, rule: dict) -> list[dict]:
-    """The per-seed loss within ``max_loss``: yes when shown below it, no when shown above it (Holm over
-    the family, each direction), else inconclusive."""
-    m = rule["max_loss"]
-    sizes = {i: len(g) for g in _groups(cells, rule["family"]) for i in g}
-    kw = {"alpha": rule["alpha"], "confidence": rule["confidence"]}
-    within = _holm([pr.compare(ls, np.zeros_like(ls), alternative="less", shift=-m, family=sizes[i],
-                               label=f"{c['experiment']}: loss < {m:.0%}", **kw)
-                    for i, (ls, c) in enumerate(zip(losses, cells))], cells, rule["family"])
-    beyond = _holm([pr.compare(ls, np.zeros_like(ls), alternative="greater", shift=-m, family=sizes[i],
-                               label=f"{c['experiment']}: loss > {m:.0%}", **kw)
-                    for i, (ls, c) in enumerate(zip(losses, cells))], cells, rule["family"])
-    return [{"answer": stats.answer(w.significant, b.significant), "max_loss": m, "loss": w.hl, "low": w.low,
-             "high": w.high, "coverage": w.coverage, "within": _row(w), "beyond": _row(b)}
-            for w, b in zip(within, beyond)]
-
-
 def analyse(study: Study, results: list) -> dict:
     """Every cell's paired comparisons on its confirmation seeds and every declared question's answer (a
     JSON-ready dict).  ``results``: one search result per cell (``driver.CellSearch``)."""
     s = study.settings
     obj = s.objective
-    cells, frames = [], []
+    cells, frames, extras = [], [], []
     for r in results:
         conf, chosen = r.confirmation, dict(r.chosen)
         runs = sorted(int(v) for v in conf.run.unique())
@@ -145,26 +129,14 @@ def analyse(study: Study, results: list) -> dict:
                       "evaluations": evaluations, "cost": cost, "cost_total": _total(cost), "done": r.done,
                       "skipped": r.skipped})
         frames.append((damage, items, extra))
+        extras.append({name: _per_run(df, _only(df, name), "items", runs)
+                       for name, df in (getattr(r, "extra", None) or {}).items()})
     out = {"objective": obj, "settings": _settings(s), "cells": cells}
     if not cells:
         return {**out, "bounded_by_defence": {}}
     out["size_note"] = size_note(getattr(s, "confirmation_runs", None), [c["runs"] for c in cells])
-    if all("reference" in c["chosen"] and "worst" in c["chosen"] for c in cells):
-        rule = _rule(study, "worst_case_bounded")
-        rule.setdefault("max_loss", 0.10)
-        # the per-seed loss is undefined on a seed where the reference collected nothing (a run too short
-        # to count items): such a cell is left unanswered, and out of the Holm family
-        zero = [int(np.sum(it["reference"] <= 0)) for _, it, _ in frames]
-        ok = [i for i, z in enumerate(zero) if z == 0]
-        losses = [1.0 - frames[i][1]["worst"] / frames[i][1]["reference"] for i in ok]
-        for i, b in zip(ok, _bounded(losses, [cells[i] for i in ok], rule)):
-            cells[i]["worst_case_bounded"] = b
-        for i, z in enumerate(zero):
-            if z:
-                cells[i]["worst_case_bounded"] = {
-                    "answer": stats.INCONCLUSIVE, "max_loss": rule["max_loss"], "loss": math.nan, "low": math.nan,
-                    "high": math.nan, "note": f"the truthful reference collected no items on {z} of "
-                                              f"{cells[i]['runs']} seeds: the per-seed loss is undefined"}
+    if all("reference" in c["chosen"] for c in cells):
+        _decide(study, cells, frames, extras)
         out["bounded_by_defence"] = _by_defence(cells)
     for q, xr, yr in DUELS:
         if all(xr in c["chosen"] and yr in c["chosen"] for c in cells):
@@ -183,6 +155,56 @@ def analyse(study: Study, results: list) -> dict:
                                     rule, f"{n} - search")):
             cells[i].setdefault(EXTRA_QUESTION, {})[n] = a
     return out
+
+
+def _confirmed(items: dict, extra_items: dict) -> dict[str, np.ndarray]:
+    """Every confirmed attack of a cell by role (the reference and the selection's "worst" pointer left
+    out), the extra searchers (the adaptive attacker) among them: items per run."""
+    out = {r: v for r, v in items.items() if r not in ("reference", "worst")}
+    return {**out, **extra_items}
+
+
+def _decide(study: Study, cells: list[dict], frames: list, extras: list[dict]) -> None:
+    """``worst_case_bounded`` per cell, decided over every confirmed role (``decision.bounded``), and which
+    roles are confirmed more damaging than the search's own attack (Holm over the family's cells x roles)."""
+    rule = _rule(study, "worst_case_bounded")
+    rule.setdefault("max_loss", 0.10)
+    # the per-seed loss is undefined on a seed where the reference collected nothing (a run too short to
+    # count items): such a cell is left unanswered, and out of the Holm family
+    zero = [int(np.sum(it["reference"] <= 0)) for _, it, _ in frames]
+    ok = [i for i, z in enumerate(zero) if z == 0]
+    roles = [_confirmed(frames[i][1], extras[i]) for i in range(len(cells))]
+    losses = [{r: 1.0 - v / frames[i][1]["reference"] for r, v in roles[i].items()} for i in ok]
+    groups = [[ok.index(i) for i in g if i in ok] for g in _groups(cells, rule["family"])]
+    for i, b in zip(ok, decision.bounded(losses, [g for g in groups if g], rule["max_loss"], rule["alpha"])):
+        if not b["roles"]:
+            cells[i]["worst_case_bounded"] = {**b, "loss": math.nan, "low": math.nan, "high": math.nan}
+            cells[i]["bounded"] = b["answer"]
+            continue
+        w = b["roles"][b["worst"]["role"]]
+        labels = {**cells[i]["chosen"], **cells[i]["extra_attacks"]}
+        for r, v in b["roles"].items():
+            v["attack"] = labels.get(r, r)
+        cells[i]["worst_case_bounded"] = {**b, "loss": w["loss"], "low": w["interval"][0], "high": w["interval"][1]}
+        cells[i]["worst"] = dict(b["worst"])
+        cells[i]["roles"] = {r: {"attack": v["attack"], "loss": v["loss"], "interval": list(v["interval"])}
+                             for r, v in b["roles"].items()}
+        cells[i]["bounded"] = b["answer"]
+    for i, z in enumerate(zero):
+        if z:
+            cells[i]["worst_case_bounded"] = {
+                "answer": stats.INCONCLUSIVE, "max_loss": rule["max_loss"], "loss": math.nan, "low": math.nan,
+                "high": math.nan, "note": f"the truthful reference collected no items on {z} of "
+                                          f"{cells[i]['runs']} seeds: the per-seed loss is undefined"}
+            cells[i]["bounded"] = stats.INCONCLUSIVE
+    for idx in _groups(cells, rule["family"]):
+        damage = {i: {**{r: v for r, v in frames[i][0].items() if r not in ("reference", "worst")}, **frames[i][2]}
+                  for i in idx}
+        pairs = [(i, r, p) for i in idx for r, p in decision.dominated(damage[i])]
+        rejected, _ = decision.holm_levels([p for _, _, p in pairs], rule["alpha"])
+        for i in idx:
+            if "search" in damage[i]:
+                cells[i]["more_damaging_than_search"] = [r for (j, r, _), y in zip(pairs, rejected) if j == i and y]
 
 
 def _only(df, name: str) -> str:
@@ -262,17 +284,21 @@ def figure(analysis: dict):
 
 def write(out: Path, analysis: dict, *, reduced: str = "", wall_seconds: float | None = None,
           steps: int | None = None, transitory: int | None = None, provenance: dict | None = None,
-          busy: dict | None = None) -> list[Path]:
+          busy: dict | None = None, header: dict | None = None, records: list[str] | None = None) -> list[Path]:
     """``report.json``, ``report.md`` and ``loss.png`` into ``out``; ``steps`` and ``transitory``: the runs'
     length, recorded so a shortened search reads as one; ``provenance``: e.g. the questions file's commit
-    and the first run's time, printed as they are."""
+    and the first run's time, printed as they are; ``header``: ``commit``, ``tree_clean``,
+    ``questions_commit`` and ``validation`` (the planted suite's recovery rate per searcher), the first
+    keys of ``report.json`` and the first lines of ``report.md``."""
     out = Path(out)
     paths = [out / "report.json", out / "report.md"]
-    meta = {"reduced": reduced, "wall_seconds": wall_seconds, "steps": steps, "transitory": transitory,
+    top = {"commit": None, "tree_clean": None, "questions_commit": None, "validation": {}, **(header or {})}
+    meta = {**top, "reduced": reduced, "wall_seconds": wall_seconds, "steps": steps, "transitory": transitory,
             "provenance": provenance or {}, "busy": busy or {}}
     paths[0].write_text(json.dumps(json_ready({**meta, **analysis}), indent=2) + "\n")
     paths[1].write_text(markdown(analysis, reduced=reduced, wall_seconds=wall_seconds, steps=steps,
-                                 transitory=transitory, provenance=provenance, busy=busy))
+                                 transitory=transitory, provenance=provenance, header=top, records=records,
+                                 busy=busy))
     if analysis["cells"]:
         import matplotlib.pyplot as plt  # only when a figure is drawn: matplotlib is slow to import
 
@@ -305,6 +331,41 @@ def interval_text(lo: float, hi: float, fmt: str) -> str:
     return "unbounded" if not (math.isfinite(lo) and math.isfinite(hi)) else f"[{lo:{fmt}}, {hi:{fmt}}]"
 
 
+def _role_table(cells: list[dict]) -> list[str]:
+    """Every confirmed attack of every cell: its loss, its interval at the decision's levels, and whether
+    it is shown beyond the margin or more damaging than the search's own attack."""
+    if not any("roles" in c for c in cells):
+        return []
+    out = ["", "Every confirmed attack (lower bound at the level of its \"beyond the margin\" test, upper bound at "
+           "the level of its cell's \"within\" test, both one-sided):", "",
+           "| defence | Byz. | role | attack | loss | bounds | levels (beyond / within) | beyond the margin? | "
+           "more damaging than the search's? |", "|---|---|---|---|---|---|---|---|---|"]
+    for c in cells:
+        full = c.get("worst_case_bounded", {}).get("roles", {})
+        for r, v in c.get("roles", {}).items():
+            f = full.get(r, {})
+            more = "yes" if r in c.get("more_damaging_than_search", []) else ("–" if r == "search" else "no")
+            out.append(f"| {c['defence']} | {c['byzantines']} | {r} | {v['attack']} | {v['loss']:.1%} | "
+                       f"{interval_text(v['interval'][0], v['interval'][1], '.1%')} | "
+                       f"{f.get('level_beyond', math.nan):.2g} / {f.get('level_within', math.nan):.2g} | "
+                       f"{'yes' if f.get('beyond') else 'no'} | {more} |")
+    return out
+
+
+def header_lines(h: dict) -> list[str]:
+    """The code's commit (and whether the tree matched it), the questions file's commit, and the planted
+    suite's recovery rate per searcher, as a report's first lines."""
+    clean = {True: "clean tree", False: "MODIFIED tree: no commit replays these runs", None: "tree state unknown"}
+    lines = [f"Code: commit `{h.get('commit')}` ({clean[h.get('tree_clean')]})"
+             + (f"; the store's first run was made at commit `{h['first_run_commit']}`" if h.get("first_run_commit")
+                else "") + f". Questions file: commit `{h.get('questions_commit')}`"
+             + (" (modified since)" if h.get("questions_modified") else "") + "."]
+    v = h.get("validation") or {}
+    lines.append("Planted-weakness validation (recovery rate per searcher): "
+                 + (", ".join(f"{k} {r:.0%}" for k, r in v.items()) if v else "not run with this report") + ".")
+    return [*lines, ""]
+
+
 def _answer(a: dict | None) -> str:
     if not a:
         return "–"
@@ -321,11 +382,12 @@ def _duel_cell(a: dict | None) -> str:
 
 
 def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, steps: int | None = None,
-             transitory: int | None = None, provenance: dict | None = None, busy: dict | None = None) -> str:
+             transitory: int | None = None, provenance: dict | None = None, header: dict | None = None,
+             records: list[str] | None = None, busy: dict | None = None) -> str:
     """The attack search's answers ``a`` as Markdown: objective and settings, the answers from the confirmation
     seeds (each search paired with the baselines), the chosen attacks and the cost; a reduced run says so first."""
     s = a["settings"]
-    lines = ["# Attack search", ""]
+    lines = ["# Attack search", "", *header_lines(header or {})]
     if reduced:
         lines += [f"**REDUCED RUN ({reduced}): not the declared study; no answer here is the study's.**", ""]
     length = "" if steps is None else (f"Runs of {steps} steps, items counted after step {transitory}. "
@@ -340,12 +402,16 @@ def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, s
     if a.get("size_note"):
         lines += [f"Confirmation: {a['size_note']}.", ""]
     lines += ["Every number below is from the CONFIRMATION seeds (never used to choose an attack), paired by "
-              "seed. Loss: Hodges-Lehmann estimate of the per-seed loss 1 − items(worst) / items(truthful), "
-              "with its distribution-free 95 % interval. Search − baseline, search − random: Hodges-Lehmann "
+              "seed. Worst: the most damaging of every confirmed attack (search, random search, baselines, "
+              "adaptive), by the Hodges-Lehmann estimate of its per-seed loss 1 − items(attack) / items(truthful). "
+              "Within the margin: yes only when EVERY confirmed attack is shown within it (intersection-union, "
+              "Holm over the cells), no when ANY is shown beyond it (Holm over cells x attacks); each loss "
+              "interval is one-sided bound to one-sided bound at the level its test was judged at (the "
+              "per-attack table below). Search − baseline, search − random: Hodges-Lehmann "
               "of the per-seed differences of the objective's damage value (negative: the search's attack "
               "does more damage), with the interval, and as a share of the other's median (positive: more "
               "damage). A \"no\" to a \"beats\" question needs the power shown.", "",
-              "| defence | Byz. | runs | truthful | worst (median) | loss [95 % CI] | within 10 %? | "
+              "| defence | Byz. | runs | truthful | worst confirmed (role: attack) | loss [decision-level bounds] | within 10 %? | "
               "search − best baseline | beats baseline? | search − random | beats random? | runs / CPU s |",
               "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for c in a["cells"]:
@@ -353,13 +419,15 @@ def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, s
         loss_txt = "–" if not b else ("undefined" if math.isnan(b["loss"]) else
                                       f"{b['loss']:.1%} {interval_text(b['low'], b['high'], '.1%')}")
         m, ch = c["medians"], c["chosen"]
-        worst = f"{ch.get('worst', '–')} ({m['worst']:.2f})" if "worst" in m else "–"
+        wr = c.get("worst", {}).get("role")
+        worst = f"{wr}: {c['roles'][wr]['attack']}" if wr else "–"
         ref = f"{m['reference']:.2f}" if "reference" in m else "–"
         t = c["cost_total"]
         lines.append(f"| {c['defence']} | {c['byzantines']} | {c['runs']} | {ref} | {worst} | {loss_txt} | "
                      f"{_answer(b)} | {_duel_cell(c.get('search_beats_baseline'))} | "
                      f"{_answer(c.get('search_beats_baseline'))} | {_duel_cell(c.get('search_beats_random'))} | "
                      f"{_answer(c.get('search_beats_random'))} | {t['runs']:.0f} / {t['seconds']:.0f} |")
+    lines += _role_table(a["cells"])
     notes = [f"- {c['defence']}, {c['byzantines']}: {c['worst_case_bounded']['note']}" for c in a["cells"]
              if c.get("worst_case_bounded", {}).get("note")]
     if notes:
@@ -393,5 +461,5 @@ def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, s
     total = {k: sum(c["cost_total"][k] for c in a["cells"]) for k in ("runs", "env_steps", "seconds")}
     lines += ["", f"All cells: {total['runs']:.0f} runs, {total['env_steps']:.3g} env-steps, "
                   f"{total['seconds']:.0f} s of run time.", *(["", busy_markdown(busy).rstrip()] if busy else []),
-              "", *DECLARATION.record_markdown()]
+              "", *(DECLARATION.record_markdown() if records is None else records)]
     return "\n".join(lines) + "\n"

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .structured import per_round
 from .study import Settings
 
 #: the fewest generations a restart's population is capped to allow (when its share of the budget allows)
@@ -60,12 +61,17 @@ def spread_points(s: Settings) -> int:
     return min(s.budget, max(s.restarts, round(s.spread * s.budget)))
 
 
+def gate_points(s: Settings) -> int:
+    """Evaluations of the structured start (``search.structured``): its rounds' openings, within the budget."""
+    return min(s.gate_rounds * per_round(), max(0, s.budget - spread_points(s)))
+
+
 def plan(s: Settings) -> list[Leg]:
     """The restarts' populations and generations: equal shares of the budget left after the start points
-    (what a restart cannot use goes to the next), the population doubled per restart and capped at
-    share / ``MIN_GENERATIONS``."""
+    and the structured start (what a restart cannot use goes to the next), the population doubled per
+    restart and capped at share / ``MIN_GENERATIONS``."""
     legs, spent = [], 0
-    budget = s.budget - spread_points(s)
+    budget = s.budget - spread_points(s) - gate_points(s)
     for r in range(s.restarts):
         share = budget * (r + 1) // s.restarts - spent
         pop = max(2, min(s.popsize * 2 ** r, max(s.popsize, share // MIN_GENERATIONS)))
@@ -78,14 +84,16 @@ def plan(s: Settings) -> list[Leg]:
 
 
 def evaluations(s: Settings) -> int:
-    """Candidate evaluations of the global search, start points included (and of the random search)."""
-    return spread_points(s) + sum(leg.evaluations for leg in plan(s))
+    """Candidate evaluations of the global search, start points and openings included (and of the random
+    search)."""
+    return spread_points(s) + gate_points(s) + sum(leg.evaluations for leg in plan(s))
 
 
 class Restarts:
     """CMA-ES restarted per ``plan``: ``ask()`` gives (restart, generation, points) or None when the
     budget is spent; ``tell(fitness)`` the values of the points last asked.  Restart ``r`` starts at
-    ``start(r)``, called when the restart begins (so it may depend on what was found before)."""
+    ``start(r)``, called when the restart begins (so it may depend on what was found before); the first
+    ``s.local`` restarts step ``s.local_sigma`` (local refinements), the others ``s.sigma0``."""
 
     def __init__(self, s: Settings, dim: int, seed: int, start):
         self.s, self.dim, self.seed, self.start = s, dim, seed, start
@@ -101,7 +109,8 @@ class Restarts:
                 "seed": stream(self.seed, "cma", self.r) % (2**31 - 2) + 1,
                 "verbose": -9, "verb_log": 0, "verb_disp": 0, "verb_filenameprefix": "", "tolfun": 0.0,
                 "tolx": 0.0, "tolfunhist": 0.0, "tolstagnation": 10**9, "tolflatfitness": 10**9}
-        self.es = cma.CMAEvolutionStrategy(x0, self.s.sigma0, opts)
+        sigma = self.s.local_sigma if self.r < self.s.local else self.s.sigma0
+        self.es = cma.CMAEvolutionStrategy(x0, sigma, opts)
 
     def ask(self) -> tuple[int, int, np.ndarray] | None:
         """The next points to evaluate, as (restart, generation, points in [0, 1]^dim); None once the budget is

@@ -47,6 +47,14 @@ class Settings:
     grid_step: float = 15.0        # degrees between the rotation grid's baselines (search.baselines)
     objective: str = "items"
     seed: int = 23023
+    pool_baselines: bool = False   # the baselines race in the search's own pool (the search keeps the best)
+    gate_rounds: int = 0           # rounds of opening one gate at a time on the best point (search.structured)
+    local: int = 0                 # the first restarts are local: from the best points found, step local_sigma
+    local_sigma: float = 0.05      # CMA-ES step size of a local restart, in the unit cube
+    leaders: int = 0               # the best start-phase points run again on leader_runs seeds before each choice
+    leader_runs: int = 16          # (cumulative) runs of a re-evaluated leader, on the start phase's seeds
+    validation: int = 0            # seeds per planted weakness searched before the study (search.validate)
+    confirm_top: int = 1           # the race's best attacks of each group confirmed (role, role_2 .. role_k)
 
     @property
     def generations(self) -> int:
@@ -70,13 +78,14 @@ def settings(table: dict, overrides: dict | None = None,
     if "race" in base:
         base["race"] = tuple(base["race"]) if isinstance(base["race"], (list, tuple)) else base["race"]
     s = Settings(**base)
-    ints = ("budget", "popsize", "restarts", "runs", "finalists", "confirmation_runs", "seed")
+    ints = ("budget", "popsize", "restarts", "runs", "finalists", "confirmation_runs", "seed", "gate_rounds", "local",
+            "leaders", "leader_runs", "validation", "confirm_top")
     for k in ints:
         v = getattr(s, k)
         if isinstance(v, bool) or not isinstance(v, int):
             raise UsageError(f"{source}: {k} = {v!r}: a whole number is expected")
     for k, v in (("budget", 1), ("popsize", 2), ("restarts", 1), ("runs", 1), ("finalists", 1),
-                 ("confirmation_runs", 2), ("seed", 0)):
+                 ("confirmation_runs", 2), ("seed", 0), ("gate_rounds", 0), ("local", 0), ("leaders", 0), ("leader_runs", 1), ("validation", 0), ("confirm_top", 1)):
         if getattr(s, k) < v:
             raise UsageError(f"{source}: {k} = {getattr(s, k)}: must be at least {v}")
     race = s.race
@@ -86,7 +95,11 @@ def settings(table: dict, overrides: dict | None = None,
                          f"stage, whole numbers from 2 up, each above the one before (e.g. [8, 16, 32])")
     if isinstance(s.spread, bool) or not isinstance(s.spread, (int, float)) or not 0.0 <= s.spread < 1.0:
         raise UsageError(f"{source}: spread = {s.spread!r}: a share of the budget in [0, 1) is expected")
-    for k, lo, hi in (("keep", 0.0, 1.0), ("sigma0", 0.0, 1.0), ("grid_step", 0.0, 180.0)):
+    if not isinstance(s.pool_baselines, bool):
+        raise UsageError(f"{source}: pool_baselines = {s.pool_baselines!r}: true or false is expected")
+    if s.local > s.restarts:
+        raise UsageError(f"{source}: local = {s.local}: at most restarts ({s.restarts}) restarts can be local")
+    for k, lo, hi in (("keep", 0.0, 1.0), ("sigma0", 0.0, 1.0), ("grid_step", 0.0, 180.0), ("local_sigma", 0.0, 1.0)):
         v = getattr(s, k)
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not lo < v <= hi:
             raise UsageError(f"{source}: {k} = {v!r}: a number in ({lo:g}, {hi:g}] is expected")
@@ -133,6 +146,7 @@ class Study:
     reference: str | None
     questions: dict = field(default_factory=dict)
     pending: dict = field(default_factory=dict)
+    declaration_path: Path = QUESTIONS  # the questions file declaring it (its commit goes into the report)
 
 
 def load_declarations(path: Path = QUESTIONS) -> dict:
@@ -140,8 +154,9 @@ def load_declarations(path: Path = QUESTIONS) -> dict:
     return tomllib.loads(Path(path).read_text())
 
 
-def load(experiment: Experiment, declarations: dict | None = None, **overrides) -> Study:
-    """The study of ``experiment`` with the declared settings, ``overrides`` (None values ignored) applied."""
+def load(experiment: Experiment, declarations: dict | None = None, *, path: Path = QUESTIONS, **overrides) -> Study:
+    """The study of ``experiment`` with the declared settings, ``overrides`` (None values ignored) applied;
+    ``path``: the questions file the declarations were read from."""
     d = load_declarations() if declarations is None else declarations
     settings_ = settings(d.get("search", {}), overrides)
     baselines, reference = {}, None
@@ -157,7 +172,8 @@ def load(experiment: Experiment, declarations: dict | None = None, **overrides) 
             raise ConfigError(f"{QUESTIONS.name}: baseline {name}: the name of a rotation-grid baseline "
                               f"(search.baselines); give the declared one another name")
         baselines[name] = params
-    return Study(experiment, settings_, baselines, reference, d.get("questions", {}), d.get("pending_defences", {}))
+    return Study(experiment, settings_, baselines, reference, d.get("questions", {}), d.get("pending_defences", {}),
+                 Path(path))
 
 
 def _with_pending(exp: Experiment, pending: dict) -> Experiment:
