@@ -7,7 +7,7 @@ import pytest
 
 from infomarket.search import decision
 
-I = np.arange(1, 9)  # 8 confirmation seeds
+IDX = np.arange(1, 9)  # 8 confirmation seeds
 
 
 def test_holm_levels_by_hand():
@@ -23,7 +23,7 @@ def test_one_sided_bounds_by_hand():
     # d = 1, 2, 4 ... 128: Walsh averages from the bottom 1, 1.5, 2, 2.5 ..., from the top 128, 96, 80, 72 ...
     # Signed-rank null of 8: P(T+ <= 2) = 3/256 <= 1/60 < P(T+ <= 3) = 5/256 <= 0.025, so at level 1/60 the
     # bounds are the 3rd smallest and 3rd largest (2, 80), at 0.025 the 4th (2.5, 72)
-    d = 2.0 ** (I - 1)
+    d = 2.0 ** (IDX - 1)
     assert decision.bound(d, 0.05 / 3, "lower") == 2.0 and decision.bound(d, 0.05 / 3, "upper") == 80.0
     assert decision.bound(d, 0.025, "lower") == 2.5 and decision.bound(d, 0.025, "upper") == 72.0
 
@@ -34,7 +34,7 @@ def test_one_sided_bounds_by_hand():
 # intersection-union p: cell 0 max(1/256, 1/256) = 1/256, cell 1 max(1, 1/256) = 1; Holm over the 2 cells:
 # 1/256 < 0.025 (cell 0 "within", judged at 0.025), then 1 >= 0.05: stop (cell 1 judged at 0.05).
 # "Beyond" over the 4 (cell, attack): 1/256 < 0.0125 (cell 1's a, judged at 0.0125), then 1 >= 0.05/3: stop.
-LOSSES = [{"a": 0.01 * I, "b": 0.05 + 0.001 * I}, {"a": 0.20 + 0.01 * I, "b": 0.01 * I}]
+LOSSES = [{"a": 0.01 * IDX, "b": 0.05 + 0.001 * IDX}, {"a": 0.20 + 0.01 * IDX, "b": 0.01 * IDX}]
 
 
 def test_within_by_intersection_union_beyond_by_holm_over_cells_and_attacks():
@@ -54,12 +54,12 @@ def test_within_by_intersection_union_beyond_by_holm_over_cells_and_attacks():
 def test_one_attack_not_shown_within_keeps_the_cell_from_yes():
     """The search's attack is within, the random search's straddles the margin: not "yes" (the selection's
     pick alone would have said yes), and not "no" either."""
-    straddle = 0.1 + 0.02 * (-1.0) ** I * I  # above on even seeds, below on odd ones
-    (c,) = decision.bounded([{"search": 0.01 * I, "random": straddle}], [[0]], 0.10, 0.05)
+    straddle = 0.1 + 0.02 * (-1.0) ** IDX * IDX  # above on even seeds, below on odd ones
+    (c,) = decision.bounded([{"search": 0.01 * IDX, "random": straddle}], [[0]], 0.10, 0.05)
     assert c["answer"] == "inconclusive"
     assert c["worst"]["role"] == "random"
 
 
 def test_a_more_damaging_role_than_the_search_is_named():
-    got = dict(decision.dominated({"search": 9.0 + 0.0 * I, "baseline": 8.0 + 0.01 * I, "random": 9.5 + 0 * I}))
+    got = dict(decision.dominated({"search": 9.0 + 0.0 * IDX, "baseline": 8.0 + 0.01 * IDX, "random": 9.5 + 0 * IDX}))
     assert got["baseline"] == pytest.approx(1 / 256) and got["random"] > 0.5

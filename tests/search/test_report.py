@@ -213,7 +213,7 @@ def test_a_reference_with_no_items_leaves_the_loss_undefined():
     "inconclusive" with a note and left out of the Holm family, the other cell keeps its answer."""
     empty = search("outlier", 1, worst=np.zeros(N), base=np.zeros(N), rand=np.zeros(N))
     empty.confirmation.loc[empty.confirmation.attack == "truthful", "items"] = [0.0, 1.0] * (N // 2)
-    plain = search("staking", 1, worst=W_A, base=W_A + 1.0 + 0.1 * I, rand=W_A - 0.01 * I)
+    plain = search("staking", 1, worst=W_A, base=W_A + 1.0 + 0.1 * IDX, rand=W_A - 0.01 * IDX)
     a = report.analyse(study(), [empty, plain])
     undefined, fine = a["cells"]
     assert undefined["worst_case_bounded"]["answer"] == "inconclusive"
@@ -270,9 +270,9 @@ def test_write_gives_strict_json_markdown_and_the_figure(analysis, tmp_path):
 def test_a_second_confirmed_baseline_can_be_the_worst_case():
     """The race's second baseline (confirmed with confirm_top 2) loses 34 % where the selection's pick
     loses 24 %: the worst case is the second one, and it is confirmed more damaging than the search's."""
-    cell = search("theta20", 3, worst=np.full(N, 8.0) - 0.01 * I, base=np.full(N, 7.6) - 0.01 * I,
-                  rand=np.full(N, 9.0) - 0.01 * I)
-    extra = frame({"base_two": np.full(N, 6.6) - 0.01 * I})
+    cell = search("theta20", 3, worst=np.full(N, 8.0) - 0.01 * IDX, base=np.full(N, 7.6) - 0.01 * IDX,
+                  rand=np.full(N, 9.0) - 0.01 * IDX)
+    extra = frame({"base_two": np.full(N, 6.6) - 0.01 * IDX})
     cell.confirmation = pd.concat([cell.confirmation, extra], ignore_index=True)
     cell.chosen["baseline_2"] = "base_two"
     c = report.analyse(study(), [cell])["cells"][0]

@@ -104,7 +104,8 @@ def cmd_attack_search(args) -> int:
     path = Path(args.questions) if args.questions else study_mod.QUESTIONS
     decl = study_mod.Declaration.read(path, path.name)
     data = decl.data if args.questions else study_mod.load_declarations()  # the package's, read as the study reads it
-    st = study_mod.load(exp, data, path=path, budget=args.budget, popsize=args.popsize, restarts=args.restarts, runs=args.runs,
+    st = study_mod.load(exp, data, path=path, budget=args.budget, popsize=args.popsize, restarts=args.restarts,
+                        runs=args.runs,
                         finalists=args.finalists, race=_race(args.race) if args.race is not None else None,
                         keep=args.keep, confirmation_runs=args.confirmation_runs, grid_step=args.grid_step,
                         objective=args.objective, seed=args.seed, validation=args.validation_repeats,
@@ -146,7 +147,8 @@ def cmd_attack_search(args) -> int:
     validation = _study_validation(st, out, args.quiet)
     need = data.get("validation", {}).get("min_recovery")
     if need is not None and not reduced and validation.get("search", 0.0) < need:
-        raise UsageError(f"the planted validation gives the search a recovery rate of {validation.get('search', 0.0):.0%}"
+        raise UsageError(f"the planted validation gives the search a recovery rate of "
+                         f"{validation.get('search', 0.0):.0%}"
                          f", below the {need:.0%} that {path.name} declares before its study runs (OUT/validation.json "
                          f"has every search); the study is not run")
     t0 = time.perf_counter()
@@ -268,7 +270,8 @@ def add_subcommand(sub) -> None:
     p.add_argument("experiment", nargs="?", default="attack_search",
                    help="a study experiment (default: the shipped attack_search, or a file like it)")
     p.add_argument("--questions", metavar="FILE",
-                   help="the study's questions file: settings, baselines, questions (default: the package's questions.toml)")
+                   help="the study's questions file: settings, baselines, questions (default: the package's "
+                        "questions.toml)")
     p.add_argument("--defence", help="defence(s) to search, comma-separated (default: every one of the study)")
     p.add_argument("--byzantines", metavar="K", help="Byzantine count(s), comma-separated (default: the study's)")
     p.add_argument("--budget", type=at_least(1), metavar="N",
@@ -296,16 +299,19 @@ def add_subcommand(sub) -> None:
                    help="best start points run again on --leader-runs seeds before each choice (default: declared)")
     p.add_argument("--confirm-top", type=at_least(1), metavar="K",
                    help="the race's K best attacks of each searcher and of the baselines confirmed (default: declared)")
-    p.add_argument("--leader-runs", type=at_least(1), metavar="N", help="runs of a re-evaluated leader (default: declared)")
+    p.add_argument("--leader-runs", type=at_least(1), metavar="N",
+                   help="runs of a re-evaluated leader (default: declared)")
     p.add_argument("--objective", choices=["items", "liar_wealth"], help="what the attack optimises (default: items)")
     p.add_argument("--seed", type=seed_value, help="the search's seed: optimisers and seed sets (default: declared)")
     p.add_argument("--adaptive-budget", type=at_least(0), metavar="N",
-                   help="evaluations per cell of the adaptive attacker, the second searcher (0: none; default: declared)")
+                   help="evaluations per cell of the adaptive attacker, the second searcher "
+                        "(0: none; default: declared)")
     p.add_argument("--validate", action="store_true",
                    help="search the planted weaknesses (known optima) with the study's settings and print the recovery "
                         "rate per searcher, then exit (docs/attack-search.md, \"Planted weaknesses\")")
     p.add_argument("--validation-repeats", type=at_least(0), metavar="N",
-                   help="seeds per planted weakness: of --validate (default: declared, else 3), and of the validation a "
+                   help="seeds per planted weakness: of --validate (default: declared, else 3), and of the "
+                        "validation a "
                         "study runs before its cells (0: none; default: declared)")
     p.add_argument("--kinds", help="with --validate: planted weaknesses to search, comma-separated (default: all)")
     p.add_argument("--list-baselines", action="store_true", help="list the baselines (declared and rotation grid) "

@@ -69,7 +69,8 @@ KINDS = {k.name: k for k in (
     Kind("window", "a rotation window at 47.5° (35°-60° damages more than the decoy), every gate closed",
          lambda p: OPTIMUM * tri(p["rot_base"], 47.5, 25.0), (), {"rot_base": 47.5}),
     Kind("trust_gate", "lie 20°+ only from a reputation of 0.7 (a farmer's gate, open at the right value)",
-         lambda p: OPTIMUM * tri(p["lie_from_rep"], 0.7, 0.4) * ramp(p["rot_base"], 5.0, 20.0) * (p["lie_from_rep"] > 0),
+         lambda p: (OPTIMUM * tri(p["lie_from_rep"], 0.7, 0.4) * ramp(p["rot_base"], 5.0, 20.0)
+                    * (p["lie_from_rep"] > 0)),
          ("lie_from_rep",), {"rot_base": 30.0, "lie_from_rep": 0.7}),
     Kind("collusion", "colluding liars at 70° (the grid has 60° and 90°)",
          lambda p: OPTIMUM * (p["collude"] >= 0.5) * tri(p["rot_base"], 70.0, 25.0), (),
@@ -78,7 +79,8 @@ KINDS = {k.name: k for k in (
          lambda p: OPTIMUM * (0.5 <= p["lie_site"] < 1.5) * tri(p["rot_base"], 110.0, 30.0), (),
          {"rot_base": 110.0, "lie_site": 1.0}),
     Kind("timing", "lie 20°+ only over an identity's first 25 sales (the newcomer's is 10)",
-         lambda p: OPTIMUM * tri(p["fresh_record"], 25.0, 20.0) * ramp(p["rot_base"], 5.0, 20.0) * (p["fresh_record"] > 0),
+         lambda p: (OPTIMUM * tri(p["fresh_record"], 25.0, 20.0) * ramp(p["rot_base"], 5.0, 20.0)
+                    * (p["fresh_record"] > 0)),
          ("fresh_record",), {"rot_base": 30.0, "fresh_record": 25.0}),
     Kind("two_gates", "lie 20°+ only with at most one confirmer in range AND capped at 0.7 Θ (half the damage "
          "with the first gate alone)",

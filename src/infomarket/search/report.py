@@ -411,14 +411,15 @@ def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, s
               "of the per-seed differences of the objective's damage value (negative: the search's attack "
               "does more damage), with the interval, and as a share of the other's median (positive: more "
               "damage). A \"no\" to a \"beats\" question needs the power shown.", "",
-              "| defence | Byz. | runs | truthful | worst confirmed (role: attack) | loss [decision-level bounds] | within 10 %? | "
+              "| defence | Byz. | runs | truthful | worst confirmed (role: attack) | loss [decision-level bounds] "
+              "| within 10 %? | "
               "search − best baseline | beats baseline? | search − random | beats random? | runs / CPU s |",
               "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for c in a["cells"]:
         b = c.get("worst_case_bounded")
         loss_txt = "–" if not b else ("undefined" if math.isnan(b["loss"]) else
                                       f"{b['loss']:.1%} {interval_text(b['low'], b['high'], '.1%')}")
-        m, ch = c["medians"], c["chosen"]
+        m = c["medians"]
         wr = c.get("worst", {}).get("role")
         worst = f"{wr}: {c['roles'][wr]['attack']}" if wr else "–"
         ref = f"{m['reference']:.2f}" if "reference" in m else "–"

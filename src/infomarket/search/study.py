@@ -85,7 +85,8 @@ def settings(table: dict, overrides: dict | None = None,
         if isinstance(v, bool) or not isinstance(v, int):
             raise UsageError(f"{source}: {k} = {v!r}: a whole number is expected")
     for k, v in (("budget", 1), ("popsize", 2), ("restarts", 1), ("runs", 1), ("finalists", 1),
-                 ("confirmation_runs", 2), ("seed", 0), ("gate_rounds", 0), ("local", 0), ("leaders", 0), ("leader_runs", 1), ("validation", 0), ("confirm_top", 1)):
+                 ("confirmation_runs", 2), ("seed", 0), ("gate_rounds", 0), ("local", 0), ("leaders", 0),
+                 ("leader_runs", 1), ("validation", 0), ("confirm_top", 1)):
         if getattr(s, k) < v:
             raise UsageError(f"{source}: {k} = {getattr(s, k)}: must be at least {v}")
     race = s.race
