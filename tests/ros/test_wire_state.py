@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 from eth_account import Account
 
+from infomarket.errors import UsageError
 from infomarket.evm.protocol import Domain, Offer, PathInfo, accept_offer, sign_offer
 from infomarket.ros import wire
 from infomarket.ros.state import AgentState, load_or_create_key
@@ -18,7 +19,7 @@ def test_key_file_is_private_and_kept(tmp_path):
     assert path.stat().st_mode & 0o777 == 0o600
     assert load_or_create_key(tmp_path / "r") == key  # a restart finds the same key
     path.chmod(0o644)
-    with pytest.raises(PermissionError, match="chmod 600"):
+    with pytest.raises(UsageError, match="chmod 600"):
         load_or_create_key(tmp_path / "r")
 
 

@@ -51,7 +51,8 @@ def refused(capsys, argv, *words) -> str:
     (["--defence", "staking", "--byzantines", "3", "--budget", "5", "--transitory", "40000"], ["--transitory 40000"]),
     (["--defence", "staking", "--byzantines", "3", "--budget", "5", "--objective", "gold"], ["--objective"]),
     (["--defence", "staking", "--byzantines", "3", "--budget", "5", "--seed", "-1"], ["--seed"]),
-    (["--defence", "staking", "--byzantines", "3", "--budget", "5", "--pairs", "100000000", "--runs", "1000"],
+    # a budget of at least one generation (1 + 2 x pairs), so the memory check is what refuses it
+    (["--defence", "staking", "--byzantines", "3", "--budget", "300000000", "--pairs", "100000000", "--runs", "1000"],
      ["200000001 candidates x 1000 runs", "memory"]),
 ])
 def test_bad_input_is_one_error_and_nothing_written(extra, words, tmp_path, capsys):

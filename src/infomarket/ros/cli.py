@@ -100,7 +100,7 @@ def run_swarm(args) -> int:
     if reason:
         return report_error(reason, 2)
     # after ensure(): the engine, the chain client and ROS 2 load with the command only
-    from ..errors import ConfigError
+    from ..errors import ConfigError, UsageError
     from ..evm.cli import DEMO_SCHEMES, FROM_EXPERIMENT
     from ..evm.errors import ChainError
     from .faults import merge
@@ -117,7 +117,9 @@ def run_swarm(args) -> int:
     swarm = Swarm(config, params, args.seed, args.out, args.rpc, faults)
     try:
         report = swarm.run()
-    except (FileNotFoundError, RuntimeError, ChainError) as exc:
+    except UsageError as exc:  # no chain node to start: the user's to set up
+        return report_error(exc, 2)
+    except (RuntimeError, ChainError) as exc:
         return report_error(exc, 1)
     finally:
         swarm.close()

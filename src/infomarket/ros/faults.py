@@ -4,6 +4,8 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
+from ..errors import ArgumentError
+
 
 @dataclass(frozen=True)
 class Faults:
@@ -27,8 +29,8 @@ def parse_fault(text: str) -> Faults:
             p = -1.0
         if 0 <= p < 1:
             return Faults(drop=p)
-        raise ValueError(f"--fault drop:P needs 0 <= P < 1, not {m[1]}")
-    raise ValueError(f"--fault {text!r}: expected kill:ROBOT@STEP, drop:P or hostile")
+        raise ArgumentError(f"--fault drop:P needs 0 <= P < 1, not {m[1]}")
+    raise ArgumentError(f"--fault {text!r}: expected kill:ROBOT@STEP, drop:P or hostile")
 
 
 def merge(faults: list[Faults]) -> Faults:

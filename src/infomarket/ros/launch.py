@@ -17,6 +17,7 @@ import sys
 import time
 from pathlib import Path
 
+from ..errors import SimulationError, UsageError
 from .. import interrupts
 from . import env
 
@@ -60,7 +61,7 @@ def start_node(log: Path) -> tuple[subprocess.Popen, str]:
     """A Hardhat node (``make node`` installs it in tools/node) on a free port; its URL once it answers."""
     binary = NODE_TOOLS / "node_modules" / ".bin" / "hardhat"
     if not binary.exists() or shutil.which("node") is None:
-        raise FileNotFoundError(f"no chain node: run `make node` (needs node and npm), or give --rpc URL "
+        raise UsageError(f"no chain node: run `make node` (needs node and npm), or give --rpc URL "
                                 f"(looked for {binary})")
     port = _free_port()
     url = f"http://127.0.0.1:{port}"
@@ -70,7 +71,7 @@ def start_node(log: Path) -> tuple[subprocess.Popen, str]:
     w3 = Web3(Web3.HTTPProvider(url))
     while not w3.is_connected():
         if proc.poll() is not None:
-            raise RuntimeError(f"the chain node exited (see {log})")
+            raise SimulationError(f"the chain node exited (see {log})")
         time.sleep(0.2)
     return proc, url
 

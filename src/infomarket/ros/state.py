@@ -14,6 +14,8 @@ from pathlib import Path
 
 from eth_account import Account
 
+from ..errors import UsageError
+
 KEY_FILE = "key"
 STATE_FILE = "state.json"
 
@@ -27,7 +29,7 @@ def load_or_create_key(folder: Path) -> bytes:
         fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
     except FileExistsError:
         if path.stat().st_mode & 0o077:
-            raise PermissionError(f"{path} is readable by other users: chmod 600 it") from None
+            raise UsageError(f"{path} is readable by other users: chmod 600 it") from None
         key = bytes.fromhex(path.read_text().strip())
         Account.from_key(key)  # a corrupt key file fails here, named
         return key

@@ -19,7 +19,7 @@ from statistics import mean
 from .. import load_experiment
 from ..engine.simulation import Simulation
 from ..engine.world import EVENT_NAMES, headings
-from ..errors import ConfigError
+from ..errors import ConfigError, SimulationError
 from ..evm.cli import demo_config
 from ..evm.evm_replay import REPLAY_NO_EXPIRY, BalanceRow, market_params
 from ..evm.market import ChainMarket, connect
@@ -69,12 +69,12 @@ class Swarm:
         for robot, hello in list(self.world.hellos.items()):
             del self.world.hellos[robot]
             if robot in self.welcomed and hello["address"] != self.welcomed[robot]:
-                raise RuntimeError(f"robot {robot}'s agent came back with another key ({hello['address']})")
+                raise SimulationError(f"robot {robot}'s agent came back with another key ({hello['address']})")
             self.welcomed.setdefault(robot, hello["address"])
             self.world.send_task(robot, {"kind": "welcome"})
         for robot, proc in enumerate(self.agents):
             if proc.poll() is not None:
-                raise RuntimeError(f"robot {robot}'s agent exited with status {proc.returncode}; see "
+                raise SimulationError(f"robot {robot}'s agent exited with status {proc.returncode}; see "
                                    f"{self.out / 'agents' / f'robot_{robot}.log'}")
 
     def run(self, say=print) -> dict:

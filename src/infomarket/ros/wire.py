@@ -13,6 +13,7 @@ import json
 from eth_abi import decode as abi_decode
 from eth_abi import encode as abi_encode
 
+from ..errors import FormatError
 from ..evm.protocol import LightContract, Offer, checksum
 
 CLOCK = "/clock"
@@ -54,7 +55,7 @@ def qos():
     return QoSProfile(depth=100, history=HistoryPolicy.KEEP_LAST, reliability=ReliabilityPolicy.RELIABLE)
 
 
-class WireError(ValueError):
+class WireError(FormatError):
     """A message that is not what its topic carries."""
 
 
