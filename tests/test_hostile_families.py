@@ -231,7 +231,7 @@ def test_chain_demo_refuses_a_swarm_beyond_its_memory_before_simulating(robots, 
 
 # ------------------------------------------------------------------ scheduler addresses
 BAD_ADDRESSES = ["tcp://", "tcp://head:99999", "tcp://head:port", "http://head:8786", "::::", "tcp://he ad:8786",
-                 "tcp://[::1", "tcp://head:8786:1", "tcp:/head:8786", "\x1b[31m"]
+                 "tcp://[::1", "tcp://head:8786:1", "tcp:/head:8786", "\x1b[31m", "inproc://head", "inproc://head/1/x"]
 
 
 @pytest.mark.parametrize("address", BAD_ADDRESSES)
@@ -250,7 +250,7 @@ def test_a_malformed_scheduler_address_is_refused_before_work(argv, option, addr
 
 
 @pytest.mark.parametrize("address", ["tcp://head:8786", "head:8786", "tls://10.0.0.1:8786", "tcp://[::1]:8786",
-                                     "ws://scheduler.example.org:80"])
+                                     "ws://scheduler.example.org:80", "inproc://192.0.2.2/23131/1"])
 def test_well_formed_scheduler_addresses_pass_the_check(address):
     from infomarket.cliargs import scheduler_address
 

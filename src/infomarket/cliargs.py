@@ -117,7 +117,8 @@ def fraction(text: str) -> float:
 
 
 #: Transports a Dask scheduler address may name (``tcp://host:8786``; no scheme means tcp).
-DASK_SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")
+#: ``inproc://HOST/PID/N`` names a scheduler in this very process (a local cluster started with processes=False).
+DASK_SCHEMES = ("tcp", "tls", "ws", "wss", "ucx", "inproc")
 _LABEL = r"[A-Za-z0-9](?:[A-Za-z0-9-]{0,62}[A-Za-z0-9])?"
 _HOST = rf"(?:{_LABEL}(?:\.{_LABEL})*|\[[0-9A-Fa-f:.]+\])"
 
@@ -137,6 +138,10 @@ def scheduler_address(address: str, option: str = "--dask") -> str:
         scheme, rest = "tcp", address
     if scheme not in DASK_SCHEMES:
         raise bad(f"unknown scheme {scheme!r}; allowed: {', '.join(DASK_SCHEMES)}")
+    if scheme == "inproc":
+        if not re.fullmatch(rf"{_HOST}/[0-9]+/[0-9]+", rest):
+            raise bad("an in-process address reads inproc://HOST/PID/N")
+        return address
     m = re.fullmatch(rf"({_HOST})(?::([0-9]+))?/?", rest)
     if not m:
         raise bad("a host name or IP address, then an optional :PORT, is expected")
