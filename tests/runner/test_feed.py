@@ -53,11 +53,17 @@ def test_a_jobs_error_is_raised_and_ends_the_others(conds, tmp_path):
     feed = Feed(Store(tmp_path / "s", cache=True))
     after = []
 
+    failed = threading.Event()
+
     def fails():
+        failed.set()
         raise ValueError("the optimiser's own error")
 
     def sweeps():
-        feed.sweep(conds[:1])
+        # every sweep hands the turn on, so the failing job runs at some point: whichever thread the error
+        # reaches first, the sweep asked after it must raise and end this job (no timing decides it)
+        while not failed.is_set():
+            feed.sweep(conds[:1])
         feed.sweep(conds[1:2])
         after.append("kept going")
 
