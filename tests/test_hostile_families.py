@@ -13,31 +13,12 @@ import pytest
 
 from infomarket.cli import main
 from infomarket.config import sizes
-
-ERROR = "infomarket: error: "
+from .refusals import refused, never
 
 
 @pytest.fixture(autouse=True)
 def limit(monkeypatch):
     monkeypatch.setenv(sizes.ENV, "16GiB")  # the same memory limit on every machine
-
-
-def refused(capsys, argv: list[str], *words: str) -> str:
-    """``main(argv)`` exits 2 with one error line holding ``words``, and no traceback."""
-    try:
-        code = main(argv)
-    except SystemExit as exc:  # argparse's errors leave through the parser
-        code = exc.code
-    err = capsys.readouterr().err
-    assert code == 2, err
-    assert err.count(ERROR) == 1 and "Traceback" not in err, err
-    line = err[err.index(ERROR):]
-    assert all(w in line for w in words), line
-    return line
-
-
-def never(*args, **kwargs):
-    pytest.fail("started work instead of refusing the input")
 
 
 MINIMAL = """name = "tiny"

@@ -18,8 +18,8 @@ import pytest
 from infomarket.cli import main
 from infomarket.config import sizes
 from infomarket.errors import InfomarketError
+from .refusals import refused, never
 
-ERROR = "infomarket: error: "
 ROOT = Path(__file__).parents[1]
 
 
@@ -28,28 +28,11 @@ def limit(monkeypatch):
     monkeypatch.setenv(sizes.ENV, "16GiB")
 
 
-def refused(capsys, argv: list[str], *words: str) -> str:
-    try:
-        code = main(argv)
-    except SystemExit as exc:
-        code = exc.code
-    err = capsys.readouterr().err
-    assert code == 2, err
-    assert err.count(ERROR) == 1 and "Traceback" not in err, err
-    line = err[err.index(ERROR):]
-    assert all(w in line for w in words), line
-    return line
-
-
 @pytest.fixture(scope="module")
 def fig2b():
     from infomarket.config import load_experiment
 
     return load_experiment("fig2B").with_overrides(steps=200)
-
-
-def never(*args, **kwargs):
-    pytest.fail("started work instead of refusing the input")
 
 
 def small_store(folder: Path, runs: int = 1) -> Path:

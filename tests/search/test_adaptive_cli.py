@@ -15,8 +15,8 @@ from infomarket.search.adaptive import CHECKPOINT, Policy, resumed_generations
 from infomarket.search.adaptive_cli import POLICY_FILE, SUMMARY_JSON, SUMMARY_MD
 
 from ..procs import HANG
+from ..refusals import ERROR, refused
 
-ERROR = "infomarket: error: "
 CELL = ["adaptive-attack", "attack_search", "--defence", "staking", "--byzantines", "3"]
 TINY = CELL + ["--budget", "10", "--pairs", "2", "--runs", "1", "--steps", "1000", "--transitory", "0",
                "--eval-runs", "2", "--seed", "3"]
@@ -25,19 +25,6 @@ TINY = CELL + ["--budget", "10", "--pairs", "2", "--runs", "1", "--steps", "1000
 @pytest.fixture(autouse=True)
 def limit(monkeypatch):
     monkeypatch.setenv(sizes.ENV, "16GiB")  # the same memory limit on every machine
-
-
-def refused(capsys, argv, *words) -> str:
-    try:
-        code = main(argv)
-    except SystemExit as exc:  # argparse's errors leave through the parser
-        code = exc.code
-    err = capsys.readouterr().err
-    assert code == 2, err
-    assert err.count(ERROR) == 1 and "Traceback" not in err, err
-    line = err[err.index(ERROR):]
-    assert all(w in line for w in words), line
-    return line
 
 
 @pytest.mark.parametrize("extra, words", [
