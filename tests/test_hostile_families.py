@@ -306,18 +306,3 @@ def test_a_message_names_its_path_once(tmp_path, capsys):
     assert main(["run", "fig2B", "--runs", "1", "--steps", "10", "--out", str(tmp_path / "s"), "--quiet"]) == 0
     line = refused(capsys, ["sensitivity", str(tmp_path / "s"), "--out", str(tmp_path / "r")], "sampled design")
     assert line.count(str(tmp_path / "s")) == 1, line
-
-
-def test_the_declared_seed_refusal_is_one_short_line_naming_the_seed_and_what_differs():
-    """Every difference listed with its declared value ran to about 300 characters: now as many differences as
-    fit in 160 and how many more."""
-    from infomarket.search.cli import seed_refusal
-
-    reductions = ["2 of 8 cells", "--steps 1500 (declared 15000)", "--budget 4 (declared 96)",
-                  "--transitory 100 (declared 5000)", "--race 2,4 (declared 2,4,8)"]
-    line = seed_refusal(61001, reductions)
-    assert line == ("--seed 61001 is the study's declared seed, kept for the whole study; this run differs: "
-                    "2 of 8 cells, --steps 1500, --budget 4 and 2 more; give another --seed")
-    assert len(line) == 157
-    long = seed_refusal(2**63 - 1, ["--race " + ",".join(["12"] * 60)])
-    assert len(long) <= 160 and str(2**63 - 1) in long and "--race 12,12" in long

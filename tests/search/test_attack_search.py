@@ -252,8 +252,7 @@ def test_a_reduced_search_with_the_declared_seed_is_refused_and_some_cells_are_n
     args[args.index("--seed") + 1] = declared
     assert main(args + ["--out", str(tmp_path / "o")]) == 2
     err = capsys.readouterr().err
-    assert f"--seed {declared} is the study's declared seed" in err and "--steps 400 and 9 more" in err
-    assert len(err.strip()) <= len("infomarket: error: ") + 160  # one short line, however many differences
+    assert f"--seed {declared} is the study's declared seed" in err and "--budget 4" in err
     assert not (tmp_path / "o").exists()
     st = study.load(load_experiment("attack_search"))
     from infomarket.search.cli import refuse_declared_seed

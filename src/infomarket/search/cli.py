@@ -72,25 +72,9 @@ def refuse_declared_seed(seed: int, declared: int, reductions: list[str]) -> Non
     some of its cells) must take another ``--seed``.  The whole study may still be made in several
     invocations: it resumes from its store, every invocation the whole study."""
     if reductions and seed == declared:
-        raise UsageError(seed_refusal(seed, reductions))
-
-
-def seed_refusal(seed: int, reductions: list[str], most: int = 160) -> str:
-    """The refusal in one short line (at most ``most`` characters): the seed and what differs from the declared
-    study, as many of the differences as fit and how many more; the declared values are in the docs."""
-    head = f"--seed {seed} is the study's declared seed, kept for the whole study; this run differs: "
-    tail = "; give another --seed"
-    what = [r.split(" (declared")[0] for r in reductions]
-    first = most - len(head) - len(tail) - len(f" and {len(what)} more")
-    shown = [what[0] if len(what[0]) <= first else what[0][:first - 1] + "…"]  # a long list (--race) is cut
-    for w in what[1:]:
-        more = len(what) - len(shown) - 1
-        room = most - len(head) - len(tail) - (len(f" and {more} more") if more else 0)
-        if len(", ".join([*shown, w])) > room:
-            break
-        shown.append(w)
-    more = len(what) - len(shown)
-    return head + ", ".join(shown) + (f" and {more} more" if more else "") + tail
+        raise UsageError(f"--seed {seed} is the study's declared seed, and this run is not the whole declared "
+                         f"study ({'; '.join(reductions)}): its confirmation runs would be the study's own, seen "
+                         f"before the study; give another --seed (only the whole declared study may use it)")
 
 
 def _list_baselines(st) -> int:
