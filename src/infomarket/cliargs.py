@@ -46,8 +46,6 @@ def writable_file(path: str | Path, option: str = "--out") -> Path:
     if path.is_dir():
         raise UsageError(f"{option} {path}: is a directory; give a file name")
     folder = path.parent
-    if folder.exists() and not folder.is_dir():
-        raise UsageError(f"{option} {path}: {folder} is not a folder; give a file name in an existing folder")
     if not folder.is_dir():
         raise UsageError(f"{option} {path}: the folder {folder} does not exist; give a file name in an existing folder")
     try:

@@ -7,9 +7,6 @@ same ``Report`` so they never disagree.
 from __future__ import annotations
 
 import html
-import os
-import shutil
-import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -70,27 +67,7 @@ def build_report(source, out: str | Path, *, vector: str = "svg", label: str | N
     ``store`` (or ``source`` when it is a store): its sampled designs get a global-sensitivity section."""
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
-    # drawn in a staging folder inside ``out`` and moved in at the end: a full disk or a stop half-way leaves
-    # ``out`` as it was, never a part of a new set of figures beside an older report
-    staging = Path(tempfile.mkdtemp(prefix=".report-", suffix=".part", dir=out))
-    try:
-        report = _draw(source, staging, vector, label or _label(source), echo, store)
-        for path in sorted(staging.iterdir()):
-            os.replace(path, out / path.name)
-    finally:
-        shutil.rmtree(staging, ignore_errors=True)
-    for r in report.figures:
-        r.files = [out / p.name for p in r.files]
-    if report.future is not None:
-        report.future.figures = [(n, c, [out / p.name for p in files], note)
-                                 for n, c, files, note in report.future.figures]
-    report.files = [out / p.name for p in report.files]
-    echo(f"wrote {', '.join(str(p) for p in report.files)}")
-    return report
-
-
-def _draw(source, out: Path, vector: str, label: str, echo: Callable[[str], None], store: Store | None) -> Report:
-    """``build_report``'s work, every file written into ``out`` (its staging folder)."""
+    label = label or _label(source)
     frames = Frames.of(source)
     incomplete = gaps(frames.runs)
     for gap in incomplete.values():
@@ -123,6 +100,7 @@ def _draw(source, out: Path, vector: str, label: str, echo: Callable[[str], None
     for name, text in (("report.md", to_markdown(report)), ("report.html", to_html(report))):
         (out / name).write_text(text, encoding="utf-8")
         report.files.append(out / name)
+    echo(f"wrote {', '.join(str(p) for p in report.files)}")
     return report
 
 
