@@ -271,7 +271,10 @@ class Pause:
         if name == MODULE:
             sys.meta_path.remove(self)
             os.write(1, b"importing " + name.encode() + b"\\n")
-            time.sleep({HANG!r})  # the signal comes meanwhile
+            # the signal comes meanwhile; short sleeps, as an import runs code all along: a signal that the
+            # kernel hands to another thread (numpy's BLAS threads) is then run by this one within 0.1 s
+            for _ in range(int({HANG!r} * 10)):
+                time.sleep(0.1)
         return None
 
 sys.meta_path.insert(0, Pause())

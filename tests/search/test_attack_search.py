@@ -100,7 +100,7 @@ def test_each_run_belongs_to_its_seed_set_and_confirmation_seeds_are_fresh(inlin
     assert len(confirm) == 3 and not confirm & others
 
 
-def test_the_store_records_the_questions_file_and_the_first_run_time(inline):
+def test_the_store_records_the_questions_file_and_the_first_run_time(inline, procs):
     meta = Store(inline / "store").meta()["attack_search"]
     assert meta["questions_sha256"] == hashlib.sha256(study.QUESTIONS.read_bytes()).hexdigest()
     assert meta["questions_commit"] is None or len(meta["questions_commit"]) == 40
@@ -108,8 +108,7 @@ def test_the_store_records_the_questions_file_and_the_first_run_time(inline):
     assert first <= datetime.datetime.now(datetime.UTC).replace(tzinfo=None)
     assert first >= datetime.datetime.now(datetime.UTC).replace(tzinfo=None) - datetime.timedelta(hours=2)
     # the report's first keys: the code's commit now (this checkout's HEAD) and the questions file's
-    head = subprocess.run(["git", "-C", str(study.QUESTIONS.parent), "rev-parse", "HEAD"], capture_output=True,
-                          text=True).stdout.strip() or None
+    head = procs.run(["git", "-C", str(study.QUESTIONS.parent), "rev-parse", "HEAD"]).stdout.strip() or None
     data = json.loads((inline / "report.json").read_text())
     assert list(data)[:4] == ["commit", "tree_clean", "questions_commit", "validation"]
     assert data["commit"] == head and data["questions_commit"] == meta["questions_commit"]
