@@ -29,7 +29,6 @@ RUN = {
 NOT_RUN = {
     "make demo": "the same as `infomarket demo`, run with --runs 1 in tests/test_commands.py",
     "make test": "the test suite itself",
-    "make lint": "ruff and mypy, which CI runs before the suite; tests/test_lint.py checks how",
     "infomarket run fig2B --runs 16 --out results/2b": "16 full runs; `run` is tested in tests/test_cli.py",
     "infomarket run my.toml --history 100": "16 full runs; --history is tested in tests/test_cli.py",
     "infomarket run path/to/original/fig4C.json": "a placeholder path; the format is tested in tests/config",
