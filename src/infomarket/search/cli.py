@@ -38,7 +38,7 @@ def _race(text: str) -> list[int]:
 
 SIZES = ("budget", "popsize", "restarts", "runs", "finalists", "confirmation_runs")
 DESIGN = ("sigma0", "spread", "keep", "pool_baselines", "gate_rounds", "local", "local_sigma", "leaders", "leader_runs",
-          "confirm_top")
+          "confirm_top", "refine", "refine_step")
 
 
 def _reductions(st, declared, exp, chosen, all_cells, args) -> list[str]:
@@ -111,7 +111,8 @@ def cmd_attack_search(args) -> int:
                         objective=args.objective, seed=args.seed, validation=args.validation_repeats,
                         pool_baselines=args.pool_baselines, gate_rounds=args.gate_rounds, local=args.local,
                         local_sigma=args.local_sigma, leaders=args.leaders, leader_runs=args.leader_runs,
-                        spread=args.spread, sigma0=args.sigma0, confirm_top=args.confirm_top)
+                        spread=args.spread, sigma0=args.sigma0, confirm_top=args.confirm_top,
+                        refine=args.refine, refine_step=args.refine_step)
     if args.list_baselines:
         return _list_baselines(st)
     if args.validate:
@@ -294,6 +295,9 @@ def add_subcommand(sub) -> None:
                    help="rounds of opening one gate at a time on the best point (default: declared)")
     p.add_argument("--local", type=at_least(0), metavar="N",
                    help="restarts that refine the best points found, with step --local-sigma (default: declared)")
+    p.add_argument("--refine", type=at_least(0), metavar="N",
+                   help="widest rounds of the last phase's moves (search.refine) in the budget (default: declared)")
+    p.add_argument("--refine-step", type=float, help="its first step, in the unit cube (default: declared)")
     p.add_argument("--local-sigma", type=float, help="CMA-ES step of a local restart (default: declared)")
     p.add_argument("--leaders", type=at_least(0), metavar="N",
                    help="best start points run again on --leader-runs seeds before each choice (default: declared)")

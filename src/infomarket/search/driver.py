@@ -15,11 +15,13 @@ which set every run belongs to):
    restart 0 from the best point of the start phase, the others from the next best spread points), and
    beside it a random search with as many evaluations as the global search (start points included); all
    candidates of one generation share seeds (common random numbers), stream ("search", searcher,
-   restart, generation);
+   restart, generation); then, with ``refine``, the refinement (``search.refine``): the best points on a
+   stream of their own, ("search", "refine", 0, 0), and rounds of moves around the best on it;
 3. **selection** (one shared seed set): the best distinct points of each searcher (the best point it ever
-   evaluated first; with ``pool_baselines`` the baselines among the search's) and every baseline race by
-   successive halving (``racing``); each role of ``CellSearch.chosen`` is decided here, on these seeds
-   only (with ``confirm_top`` k, each group's k best: ``search_2`` ...);
+   evaluated first; with ``pool_baselines`` the baselines among the search's, and the search keeping a
+   baseline that raced better than its finalists) and every baseline race by successive halving
+   (``racing``); each role of ``CellSearch.chosen`` is decided here, on these seeds only (with
+   ``confirm_top`` k, each group's k best: ``search_2`` ...);
 4. **confirmation** (one shared seed set no other phase uses): the chosen attacks and the truthful
    reference, every one on every run, paired by run.  The worst case is reported from these runs only.
 
@@ -49,16 +51,17 @@ from ..store import Store
 from . import provenance as _prov
 from . import space
 from .objective import loss, per_run
-from .racing import race, survivors
-from . import structured
-from .restarts import Restarts, design, evaluations, gate_points, random_batches, spread_points, stream
+from .racing import merged, race, survivors
+from . import refine, structured
+from .restarts import (Restarts, design, evaluations, gate_points, random_batches, refine_points, spread_points,
+                       stream)
 from .study import QUESTIONS, Cell, Settings, Study
 
 PHASES = ("start", "search", "random", "selection", "confirmation")
 SEED_SET = {"start": "search", "search": "search", "random": "search", "selection": "selection",
             "confirmation": "confirmation"}
 #: the race's groups: the searcher whose points each holds (the start points belong to the global search)
-GROUPS = {"search": ("start", "gates", "cma"), "random": ("random",)}
+GROUPS = {"search": ("start", "gates", "cma", "refine"), "random": ("random",)}
 POOLED = ("baseline",)  # with ``pool_baselines``, the baselines race in the search's pool too
 ROLES = ("search", "random", "baseline")
 DEFAULTS = {p[0]: float(p[1]) for p in POLICY}
@@ -269,6 +272,7 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
             if searcher == "cma":
                 cma.tell([ev.fitness(f) for f in frames[k:k + n]])
             k += n
+    centre = _refine(ev, s, rows, add) if s.refine else None
     candidates = pd.DataFrame(rows)
 
     # 3. the race on the selection seeds: each searcher's best distinct points, every baseline
@@ -279,6 +283,8 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
         mine = ranked[ranked.searcher.isin(members)].drop_duplicates(list(space.NAMES))
         if len(mine):
             groups[role] = list(mine.label.head(s.finalists))
+            if role == "search" and centre and centre not in groups[role]:  # the refined point, on more runs
+                groups[role] = [centre, *groups[role][:s.finalists - 1]]
     if hand:
         groups["baseline"] = list(ranked[ranked.searcher == "baseline"].label)
     if study.reference:
@@ -300,6 +306,8 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
         return {a: loss(selected[a][s.objective].to_numpy(float), s.objective) for a in labels}
 
     result = race(groups, tuple(s.race), s.keep, on_selection)
+    if s.pool_baselines:  # the search keeps the best attack it raced beside: a baseline that beat it too
+        result.ranking["search"] = merged(result, "search", "baseline")
     chosen = {role: result.ranking[role][0] for role in ROLES if result.ranking.get(role)}
     median = {a: float(np.median(loss(selected[a][s.objective].to_numpy(float), s.objective))) for a in chosen.values()}
     if chosen:
@@ -322,6 +330,53 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
                       confirmation_seeds(study, cell))
 
 
+#: the best points of a refinement round run again on ``leader_runs`` seeds before the centre may move to one
+GROW = 3
+
+
+def _refine(ev: _Evaluator, s: Settings, rows: list[dict], add) -> str:
+    """The last phase (``search.refine``): the search's best distinct points (twice ``leaders``) on a seed
+    set of their own, ``leader_runs`` each; then rounds of moves around the best until the evaluations kept
+    for them (``restarts.refine_points``) are spent, each round's ``GROW`` best grown to ``leader_runs`` runs
+    on the same seeds, the centre moved to one only if it beats the centre there, the step halved after a
+    round that does not.  Returns the label of the last centre."""
+    group = GROUPS["search"] + (POOLED if s.pool_baselines else ())
+    lead: list[np.ndarray] = []
+    for r in sorted((r for r in rows if r["searcher"] in group), key=lambda r: r["fitness"]):  # stable: ties in order
+        z = space.to_unit({n: r[n] for n in space.NAMES})
+        if not any(np.allclose(z, y) for y in lead):
+            lead.append(z)
+        if len(lead) == max(1, 2 * s.leaders):
+            break
+    crn = seed_stream(s, "search", "refine", 0, 0)
+    conds = [ev.condition(space.to_params(z), "search", "refine", -1, 0, i, f"refine_l{i}", s.leader_runs, crn)
+             for i, z in enumerate(lead)]
+    frames = ev.evaluate(conds)
+    add("refine", -1, 0, frames, conds, lead)
+    scores = [ev.fitness(f) for f in frames]
+    c = int(np.argmin(scores))
+    centre, best, step, label = lead[c], scores[c], s.refine_step, conds[c].keys["attack"]
+    left, g = refine_points(s), 0
+    while True:
+        X = refine.moves(centre, step)[:left]
+        if not X:
+            break
+        conds = [ev.condition(space.to_params(x), "search", "refine", g, 0, i, f"refine_r{g}c{i}", s.runs, crn)
+                 for i, x in enumerate(X)]
+        frames = ev.evaluate(conds)
+        add("refine", g, 0, frames, conds, X)
+        scores = [ev.fitness(f) for f in frames]
+        structured.reevaluate(ev, conds, scores, rows[len(rows) - len(X):], min(GROW, len(X)), s.leader_runs)
+        grown = [k for k in range(len(X)) if conds[k].runs >= s.leader_runs]
+        k = min(grown, key=lambda k: (scores[k], k), default=None)
+        if k is not None and scores[k] < best:
+            centre, best, label = X[k], scores[k], conds[k].keys["attack"]
+        else:
+            step /= 2
+        left, g = left - len(X), g + 1
+    return label
+
+
 def planned_runs(study: Study) -> int:
     """The runs of one cell's search (at most: fewer when two roles choose the same attack, or a searcher
     found fewer distinct points than ``finalists``)."""
@@ -340,6 +395,9 @@ def planned_runs(study: Study) -> int:
                 n = survivors(n, s.keep)
     roles = sum(min(n, s.confirm_top) for n in sizes[:3] if n) + int(bool(study.reference))
     leaders = (s.gate_rounds + 1) * s.leaders * max(0, s.leader_runs - s.runs)  # re-evaluations, at most
+    if s.refine:  # the refinement's leaders, and its rounds' best grown (its moves are in n_eval)
+        rounds = -(-refine_points(s) // 2)  # a round moves two points at the fewest (the rotation's)
+        leaders += max(1, 2 * s.leaders) * s.leader_runs + rounds * GROW * max(0, s.leader_runs - s.runs)
     return (hand + 2 * n_eval) * s.runs + leaders + selection + roles * s.confirmation_runs
 
 

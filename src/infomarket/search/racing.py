@@ -52,3 +52,12 @@ def race(groups: dict[str, list[str]], stages: tuple[int, ...], keep: float,
                 ranked = ranked[:n]
             alive[g] = ranked
     return Race(alive, dropped, means)
+
+
+def merged(result: Race, group: str, other: str) -> list[str]:
+    """``group``'s last survivors and ``other``'s, one ranking by mean loss (ties: ``group``'s first, then in
+    order).  Both groups' last survivors ran every stage on the same runs, so their means compare: the
+    ranking of a searcher that keeps the best attack it raced beside (the search, beside the baselines)."""
+    mine = result.ranking.get(group, [])
+    both = mine + [a for a in result.ranking.get(other, []) if a not in mine]
+    return sorted(both, key=lambda a: (result.means[a], both.index(a)))

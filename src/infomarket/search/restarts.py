@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from . import refine
 from .structured import per_round
 from .study import Settings
 
@@ -66,12 +67,18 @@ def gate_points(s: Settings) -> int:
     return min(s.gate_rounds * per_round(), max(0, s.budget - spread_points(s)))
 
 
+def refine_points(s: Settings) -> int:
+    """Evaluations kept for the last phase's moves (``search.refine``): its rounds' points at most, within the
+    budget."""
+    return min(s.refine * refine.per_round(), max(0, s.budget - spread_points(s) - gate_points(s)))
+
+
 def plan(s: Settings) -> list[Leg]:
     """The restarts' populations and generations: equal shares of the budget left after the start points
     and the structured start (what a restart cannot use goes to the next), the population doubled per
     restart and capped at share / ``MIN_GENERATIONS``."""
     legs, spent = [], 0
-    budget = s.budget - spread_points(s) - gate_points(s)
+    budget = s.budget - spread_points(s) - gate_points(s) - refine_points(s)
     for r in range(s.restarts):
         share = budget * (r + 1) // s.restarts - spent
         pop = max(2, min(s.popsize * 2 ** r, max(s.popsize, share // MIN_GENERATIONS)))
@@ -84,9 +91,9 @@ def plan(s: Settings) -> list[Leg]:
 
 
 def evaluations(s: Settings) -> int:
-    """Candidate evaluations of the global search, start points and openings included (and of the random
-    search)."""
-    return spread_points(s) + gate_points(s) + sum(leg.evaluations for leg in plan(s))
+    """Candidate evaluations of the global search, start points, openings and the refinement's moves included
+    (and of the random search)."""
+    return spread_points(s) + gate_points(s) + refine_points(s) + sum(leg.evaluations for leg in plan(s))
 
 
 class Restarts:

@@ -55,6 +55,8 @@ class Settings:
     leader_runs: int = 16          # (cumulative) runs of a re-evaluated leader, on the start phase's seeds
     validation: int = 0            # seeds per planted weakness searched before the study (search.validate)
     confirm_top: int = 1           # the race's best attacks of each group confirmed (role, role_2 .. role_k)
+    refine: int = 0                # widest rounds of the last phase's moves kept in the budget (search.refine)
+    refine_step: float = 0.08      # its first step, in the unit cube (halved after a round that finds nothing)
 
     @property
     def generations(self) -> int:
@@ -79,14 +81,14 @@ def settings(table: dict, overrides: dict | None = None,
         base["race"] = tuple(base["race"]) if isinstance(base["race"], (list, tuple)) else base["race"]
     s = Settings(**base)
     ints = ("budget", "popsize", "restarts", "runs", "finalists", "confirmation_runs", "seed", "gate_rounds", "local",
-            "leaders", "leader_runs", "validation", "confirm_top")
+            "leaders", "leader_runs", "validation", "confirm_top", "refine")
     for k in ints:
         v = getattr(s, k)
         if isinstance(v, bool) or not isinstance(v, int):
             raise UsageError(f"{source}: {k} = {v!r}: a whole number is expected")
     for k, v in (("budget", 1), ("popsize", 2), ("restarts", 1), ("runs", 1), ("finalists", 1),
                  ("confirmation_runs", 2), ("seed", 0), ("gate_rounds", 0), ("local", 0), ("leaders", 0),
-                 ("leader_runs", 1), ("validation", 0), ("confirm_top", 1)):
+                 ("leader_runs", 1), ("validation", 0), ("confirm_top", 1), ("refine", 0)):
         if getattr(s, k) < v:
             raise UsageError(f"{source}: {k} = {getattr(s, k)}: must be at least {v}")
     race = s.race
@@ -100,7 +102,8 @@ def settings(table: dict, overrides: dict | None = None,
         raise UsageError(f"{source}: pool_baselines = {s.pool_baselines!r}: true or false is expected")
     if s.local > s.restarts:
         raise UsageError(f"{source}: local = {s.local}: at most restarts ({s.restarts}) restarts can be local")
-    for k, lo, hi in (("keep", 0.0, 1.0), ("sigma0", 0.0, 1.0), ("grid_step", 0.0, 180.0), ("local_sigma", 0.0, 1.0)):
+    for k, lo, hi in (("keep", 0.0, 1.0), ("sigma0", 0.0, 1.0), ("grid_step", 0.0, 180.0), ("local_sigma", 0.0, 1.0),
+                      ("refine_step", 0.0, 0.5)):
         v = getattr(s, k)
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not lo < v <= hi:
             raise UsageError(f"{source}: {k} = {v!r}: a number in ({lo:g}, {hi:g}] is expected")
