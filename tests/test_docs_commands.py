@@ -102,8 +102,8 @@ NOT_RUN = {
     "results/chain/chain_fig7_sweep results/chain/chain_partition --out results/chain/report":
         "needs the study's stores; tests/analysis/test_chain_study.py runs it on a synthetic one",
     # docs/attack-search.md
-    "infomarket attack-search attack_search --questions src/infomarket/search/questions_v3.toml "
-    "--out results/attack_search_v3": "the third version's declared study, about 82 000 runs",
+    "infomarket attack-search attack_search --questions src/infomarket/search/questions_v4.toml "
+    "--out results/attack_search_v4": "the fourth version's declared study, about 100 000 runs",
     "infomarket attack-search --validate --questions src/infomarket/search/questions_v3.toml --kinds trust_gate "
     "--validation-repeats 1": "one planted search at the study's budget (10-40 s); run below at a small size",
     "infomarket attack-search --validate --questions src/infomarket/search/questions_v3.toml":
@@ -245,8 +245,8 @@ SMALL = {
 }
 #: Shown in these pages but not run here, with the reason.
 SMALL_NOT_RUN = {
-    "infomarket attack-search attack_search --questions src/infomarket/search/questions_v3.toml "
-    "--out results/attack_search_v3": "its small form would change the questions file's sizes, not an option; "
+    "infomarket attack-search attack_search --questions src/infomarket/search/questions_v4.toml "
+    "--out results/attack_search_v4": "its small form would change the questions file's sizes, not an option; "
                                       "tests/search/test_validate.py runs a study from a small questions file",
     "infomarket attack-search attack_search --defence staking,theta20 --byzantines 3 --dask tcp://head:8786 "
     "--out results/as-dask": "needs a Dask scheduler at that address; tests/search runs one on a LocalCluster",
