@@ -117,3 +117,27 @@ def test_a_pooled_search_keeps_the_baseline_that_beat_its_finalists(monkeypatch)
     mean = alone.selection.groupby("attack")["items"].mean()
     assert alone.chosen["search"] != "selective_liar"
     assert mean[alone.chosen["search"]] > mean["selective_liar"] + 0.5
+
+
+def test_a_refined_point_equal_to_a_baseline_is_raced_and_confirmed_once(tmp_path):
+    """A budget of one evaluation leaves the refinement no move: its centre is its best leader re-run,
+    ``scaboteur_40`` (the window's best baseline) under the label ``refine_l0``.  The search's finalists and
+    its two confirmed roles hold that attack once, not under two labels (before, ``search`` and ``search_2``
+    were the same attack)."""
+    import dataclasses
+
+    import infomarket as im
+    from infomarket.search import driver, planted, study, validate
+    from infomarket.store import Store
+
+    tiny = dict(budget=1, popsize=2, restarts=1, runs=4, finalists=2, race=[4, 8], grid_step=30.0, spread=0.125,
+                pool_baselines=True, confirm_top=2, confirmation_runs=4, refine=1, leaders=1)
+    st = study.load(im.load_experiment("attack_search"), **tiny)
+    st = dataclasses.replace(st, settings=dataclasses.replace(st.settings, seed=3))
+    kind = planted.KINDS["window"]
+    r = driver.search_cell(st, validate.planted_cell(st, kind), Store(tmp_path / "s"),
+                           run=validate.planted_runner(kind))
+    assert r.candidates.label.str.startswith("refine_r").sum() == 0      # no move: the centre is a leader
+    assert r.params["refine_l0"] == r.params["scaboteur_40"]
+    attacks = {tuple(sorted(r.params[r.chosen[k]].items())) for k in ("search", "search_2")}
+    assert len(attacks) == 2, r.chosen

@@ -277,19 +277,20 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
 
     # 3. the race on the selection seeds: each searcher's best distinct points, every baseline
     ranked = candidates.assign(order=np.arange(len(candidates))).sort_values(["fitness", "order"], kind="stable")
+    row = {r.label: r for r in candidates.itertuples(index=False)}
     groups = {}
     for role, members in GROUPS.items():
         members = members + (POOLED if role == "search" and s.pool_baselines else ())
         mine = ranked[ranked.searcher.isin(members)].drop_duplicates(list(space.NAMES))
         if len(mine):
             groups[role] = list(mine.label.head(s.finalists))
-            if role == "search" and centre and centre not in groups[role]:  # the refined point, on more runs
-                groups[role] = [centre, *groups[role][:s.finalists - 1]]
+            if role == "search" and centre:  # the refined point (on more runs) first, its twins left out
+                twin = {lab for lab in groups[role] if _key(row[lab]) == _key(row[centre])}
+                groups[role] = [centre, *[lab for lab in groups[role] if lab not in twin][:s.finalists - 1]]
     if hand:
         groups["baseline"] = list(ranked[ranked.searcher == "baseline"].label)
     if study.reference:
         groups["reference"] = [study.reference]
-    row = {r.label: r for r in candidates.itertuples(index=False)}
     params = {lab: {n: float(getattr(row[lab], n)) for n in space.NAMES} for g in groups.values() for lab in g
               if lab in row}
     if study.reference:
@@ -307,7 +308,10 @@ def search_cell(study: Study, cell: Cell, store: Store, *, run: Callable[[list[C
 
     result = race(groups, tuple(s.race), s.keep, on_selection)
     if s.pool_baselines:  # the search keeps the best attack it raced beside: a baseline that beat it too
-        result.ranking["search"] = merged(result, "search", "baseline")
+        keys: dict = {}
+        for a in merged(result, "search", "baseline"):  # one label per attack (a refined twin of a baseline)
+            keys.setdefault(_key(row[a]) if a in row else a, a)
+        result.ranking["search"] = list(keys.values())
     chosen = {role: result.ranking[role][0] for role in ROLES if result.ranking.get(role)}
     median = {a: float(np.median(loss(selected[a][s.objective].to_numpy(float), s.objective))) for a in chosen.values()}
     if chosen:
@@ -399,6 +403,12 @@ def planned_runs(study: Study) -> int:
         rounds = -(-refine_points(s) // 2)  # a round moves two points at the fewest (the rotation's)
         leaders += max(1, 2 * s.leaders) * s.leader_runs + rounds * GROW * max(0, s.leader_runs - s.runs)
     return (hand + 2 * n_eval) * s.runs + leaders + selection + roles * s.confirmation_runs
+
+
+def _key(row) -> tuple:
+    """An attack's parameters as a key: two labels of one attack (a refined point equal to a baseline) are
+    one attack, raced and confirmed once."""
+    return tuple(float(getattr(row, n)) for n in space.NAMES)
 
 
 def _raced(ev: _Evaluator, params: dict, label: str, group: str, row, runs: int, crn: int) -> CRNCondition:
