@@ -217,6 +217,13 @@ def test_the_ledger_and_config_do_not_import_the_engine():
     assert "engine" not in graph["state"] and "ledger" not in graph["state"]
 
 
+def test_the_attack_search_does_not_stand_on_the_rl_layer():
+    """The runs, observation and optimiser both use live in ``agents``; rl and search each import it."""
+    graph = package_graph()
+    assert "agents" in graph["search"] and "agents" in graph["rl"]
+    assert "rl" not in graph["search"] and "rl" not in graph["agents"]
+
+
 STEP_PIECES = ("find_neighbours", "begin_communication", "install_table", "forage", "sense_sites",
                "behaviour_step", "move", "record_history")  # (those of a variant are defined in engine.step.variant)
 

@@ -9,7 +9,7 @@ Quick use::
 
 New behaviours and payment schemes: ``im.register_behaviour`` / ``im.register_payment`` (docs/extending.md).
 """
-from ._version import __version__  # written in _version.py only; pyproject.toml reads it there
+from ._version import __version__ as __version__  # written in _version.py only (pyproject.toml reads it)
 
 # First: numba caches the package's own compiled functions by its source (compiled_cache), so each must be
 # decorated after this.

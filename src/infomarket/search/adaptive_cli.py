@@ -108,8 +108,8 @@ def cmd_adaptive_attack(args) -> int:
     from ..errors import report
     from ..runner.progress import progress
     from . import study as study_mod
-    from ..rl.observe import OBSERVATION
-    from ..rl.runs import ACTIONS
+    from ..agents.observe import OBSERVATION
+    from ..agents.runs import ACTIONS
     from .adaptive import resumed_generations, train
     from .adaptive_play import BATCH, check_memory
 
