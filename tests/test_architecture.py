@@ -224,6 +224,23 @@ def test_the_attack_search_does_not_stand_on_the_rl_layer():
     assert "rl" not in graph["search"] and "rl" not in graph["agents"]
 
 
+STUDIES = ("analysis", "search", "defence")
+
+
+def test_no_study_imports_another_studys_report_or_command_line():
+    """Each study writes its report and reads its options through ``analysis`` (``study``, ``formats``):
+    a study's own report and CLI modules are imported only from inside its package."""
+    def own_only(module: str) -> bool:
+        leaf = module.split(".")[-1]
+        return _unit(module) in STUDIES and (leaf in ("report", "cli") or leaf.endswith(("_report", "_cli")))
+
+    graph = file_graph()
+    crossing = sorted((src, dst) for src, targets in graph.items() for dst in targets
+                      if own_only(dst) and _unit(src) != _unit(dst) and _unit(src) in STUDIES)
+    assert crossing == []
+    assert "infomarket.analysis.study" in graph["infomarket.defence.cli"]  # the graph is really drawn
+
+
 STEP_PIECES = ("find_neighbours", "begin_communication", "install_table", "forage", "sense_sites",
                "behaviour_step", "move", "record_history")  # (those of a variant are defined in engine.step.variant)
 
