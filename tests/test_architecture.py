@@ -55,12 +55,13 @@ def _imports(tree: ast.AST):
     yield from walk(tree, False)
 
 
-def file_graph(sources: dict[str, tuple[str, bool]] | None = None) -> dict[str, set[str]]:
-    """module -> the project modules it imports (at the top or inside a function), per file."""
+def file_graph(sources: dict[str, tuple[str, bool]] | None = None, with_root: bool = False) -> dict[str, set[str]]:
+    """module -> the project modules it imports (at the top or inside a function), per file; the package
+    root's own imports only ``with_root``."""
     sources = sources or {m: (p.read_text(), p.name == "__init__.py") for m, p in MODULES.items()}
     graph: dict[str, set[str]] = defaultdict(set)
     for module, (text, is_package) in sources.items():
-        if module == ROOT:
+        if module == ROOT and not with_root:
             continue
         for node, _ in _imports(ast.parse(text)):
             graph[module] |= {t for t in _targets(module, is_package, node) if t != module}
@@ -151,6 +152,14 @@ def test_no_import_circle_between_files():
     assert [c for c in _cycles(graph) if tuple(c) not in KNOWN_CIRCLES] == []
 
 
+def test_no_import_circle_through_the_package_root():
+    """A module that reads something through the root (``from . import __version__``) while the root
+    imports it closes a circle through ``__init__.py``: the version is read from ``_version`` instead."""
+    graph = file_graph(with_root=True)
+    assert "infomarket.engine" in graph[ROOT]  # the root's edges are really drawn
+    assert _cycles(graph) == []
+
+
 def test_the_known_circles_are_still_there():
     """Once a branch removes its circle, take it out of KNOWN_CIRCLES (so it cannot come back unseen)."""
     found = {tuple(c) for c in _cycles(file_graph())}
@@ -206,6 +215,30 @@ def test_the_ledger_and_config_do_not_import_the_engine():
     assert "engine" not in graph["ledger"]
     assert "engine" not in graph["config"]
     assert "engine" not in graph["state"] and "ledger" not in graph["state"]
+
+
+def test_the_attack_search_does_not_stand_on_the_rl_layer():
+    """The runs, observation and optimiser both use live in ``agents``; rl and search each import it."""
+    graph = package_graph()
+    assert "agents" in graph["search"] and "agents" in graph["rl"]
+    assert "rl" not in graph["search"] and "rl" not in graph["agents"]
+
+
+STUDIES = ("analysis", "search", "defence")
+
+
+def test_no_study_imports_another_studys_report_or_command_line():
+    """Each study writes its report and reads its options through ``analysis`` (``study``, ``formats``):
+    a study's own report and CLI modules are imported only from inside its package."""
+    def own_only(module: str) -> bool:
+        leaf = module.split(".")[-1]
+        return _unit(module) in STUDIES and (leaf in ("report", "cli") or leaf.endswith(("_report", "_cli")))
+
+    graph = file_graph()
+    crossing = sorted((src, dst) for src, targets in graph.items() for dst in targets
+                      if own_only(dst) and _unit(src) != _unit(dst) and _unit(src) in STUDIES)
+    assert crossing == []
+    assert "infomarket.analysis.study" in graph["infomarket.defence.cli"]  # the graph is really drawn
 
 
 STEP_PIECES = ("find_neighbours", "begin_communication", "install_table", "forage", "sense_sites",

@@ -125,7 +125,7 @@ def test_rl_train_refuses_a_blank_defence_or_out(monkeypatch, capsys):
 def test_rl_train_takes_every_defence_the_search_takes():
     """The cells rl-train and the environments pick are the search's cells, `distinct` included."""
     import infomarket as im
-    from infomarket.rl.runs import select_cell
+    from infomarket.agents.runs import select_cell
     from infomarket.search import study
 
     s = study.load(im.load_experiment("attack_search"))

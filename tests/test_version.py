@@ -1,4 +1,4 @@
-"""The version is written in one place, ``src/infomarket/__init__.py``; pyproject.toml reads it from there."""
+"""The version is written in one place, ``src/infomarket/_version.py``; pyproject.toml reads it from there."""
 from __future__ import annotations
 
 import re
@@ -16,13 +16,13 @@ def test_pyproject_takes_the_version_from_the_package():
     assert "version" not in project["project"], "pyproject.toml writes a version of its own"
     assert "version" in project["project"].get("dynamic", [])
     source = ROOT / project["tool"]["hatch"]["version"]["path"]
-    assert source == ROOT / "src" / "infomarket" / "__init__.py"
+    assert source == ROOT / "src" / "infomarket" / "_version.py"
     assert VERSION_LINE.findall(source.read_text()) == [infomarket.__version__]
 
 
 def test_no_other_file_writes_a_version():
     writers = [str(p.relative_to(ROOT)) for p in (ROOT / "src").rglob("*.py") if VERSION_LINE.search(p.read_text())]
-    assert writers == ["src/infomarket/__init__.py"]
+    assert writers == ["src/infomarket/_version.py"]
 
 
 def test_the_package_says_it_is_typed_and_offers_a_sql_extra():

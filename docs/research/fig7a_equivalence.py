@@ -1,4 +1,4 @@
-"""Exploratory (issue 24, not a declared rule): Fig. 7A's "no apparent advantage" as an equivalence test.
+"""Exploratory (from the 2026-11-24 statistics review, not a declared rule): Fig. 7A's "no apparent advantage" as an equivalence test.
 
 Per rotation angle, one Byzantine: per-run swarm throughput with staking vs without, TOST (two one-sided
 Mann-Whitney tests) within +/- 10 % of the no-staking median, Holm over the angles.

@@ -1,4 +1,4 @@
-"""The open questions' answers from several stores read together (docs/research.md, issue 24).
+"""The open questions' answers from several stores read together (docs/research.md, the 2026-11-24 statistics review).
 
 ``infomarket figures STORE`` answers them from one ``sweep future`` store; this does the same from the
 per-experiment stores of ``infomarket sweep future_honest --out A``, ``... future_liar --out B`` and so

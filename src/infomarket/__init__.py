@@ -9,9 +9,7 @@ Quick use::
 
 New behaviours and payment schemes: ``im.register_behaviour`` / ``im.register_payment`` (docs/extending.md).
 """
-#: The package version, written only here: pyproject.toml reads it (``[tool.hatch.version]``), and the
-#: compiled-kernel cache, stores and the command line take it from here, so it holds in a fresh clone too.
-__version__ = "0.1.0"
+from ._version import __version__ as __version__  # written in _version.py only (pyproject.toml reads it)
 
 # First: numba caches the package's own compiled functions by its source (compiled_cache), so each must be
 # decorated after this.

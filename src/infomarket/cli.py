@@ -12,7 +12,8 @@ import sys
 import warnings
 from pathlib import Path
 
-from . import __version__, interrupts
+from . import interrupts
+from ._version import __version__
 from .bench import cli as bench_cli
 from .cliargs import Parser, at_least, seed_value, workers_count
 from .errors import EXIT_FAILED, EXIT_USAGE, ConfigWarning, InfomarketError, os_error_message, report, show_warning

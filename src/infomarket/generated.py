@@ -16,7 +16,7 @@ from types import ModuleType
 
 import numba
 
-from . import __version__
+from ._version import __version__
 
 _PACKAGE = Path(__file__).resolve().parent
 _LOADED: dict[str, ModuleType] = {}

@@ -1,10 +1,13 @@
 """Every declared study's report, generated from the tests' synthetic stores, to compare before and after a
 change to the analysis (the verdicts, numbers, CSV and JSON must not move):
 
-    PYTHONPATH=src python tests/analysis/generate_reports.py OUT [STORES] [headline future chain terrain sens]
+    PYTHONPATH=src python tests/analysis/generate_reports.py OUT [STORES] [headline future chain terrain sens
+                                                                           search defence]
 
 STORES (default /tmp/infomarket-report-stores) keeps the stores between calls: the terrain and sensitivity
-ones run short sweeps, the others are written directly.  Run it on both trees and ``diff -r`` the OUTs.
+ones run short sweeps, the others are written directly.  The attack and defence searches' reports are
+written from their tests' hand-built results (tests/search/test_report.py, tests/defence/test_report.py).
+Run it on both trees and ``diff -r`` the OUTs.
 """
 import shutil
 import sys
@@ -19,7 +22,13 @@ from tests.analysis.synthetic import _runs, paper_like, write_store
 
 OUT = Path(sys.argv[1]) if __name__ == "__main__" else None
 STORES = Path(sys.argv[2]) if len(sys.argv) > 2 and "/" in sys.argv[2] else Path("/tmp/infomarket-report-stores")
-what = [w for w in sys.argv[2:] if "/" not in w] or ["headline", "future", "chain", "terrain", "sens"]
+what = [w for w in sys.argv[2:] if "/" not in w] or ["headline", "future", "chain", "terrain", "sens", "search",
+                                                     "defence"]
+
+#: how busy a study kept the machine, as the search and defence reports print it
+BUSY = {"wall_seconds": 10.0, "workers": 2, "runs": 40, "run_seconds": 15.0, "compile_seconds": 1.5,
+        "share_in_runs": 0.75, "plan_seconds": 1.0, "write_seconds": 0.5, "search_seconds": 2.0}
+
 
 def fresh(p):
     if p.exists():
@@ -88,6 +97,32 @@ def run():
         if not st2.exists():
             assert main(["sweep", "sensitivity", "--samples", "2", "--out", str(st2), "--quiet"]) == 0
         assert main(["sensitivity", str(st2), "--out", str(fresh(OUT / "sens-shipped"))]) == 0
+    if "search" in what:
+        from tests.search import test_report as tsr
+        from infomarket.search import report as sr
+        a = sr.analyse(tsr.study(), [tsr.A, tsr.B])
+        out = fresh(OUT / "search")
+        out.mkdir(parents=True)
+        sr.write(out, a, reduced="one cell", steps=2500, transitory=0,
+                 provenance={"questions commit": "abc123"}, busy=BUSY,
+                 header={"commit": "c0ffee", "tree_clean": False, "questions_commit": "abc123",
+                         "validation": {"search": 0.9, "random": 0.25}},
+                 records=["## Amendments", "", "- one", ""])
+    if "defence" in what:
+        from tests.defence import test_report as tdr
+        from infomarket.config import load_experiment
+        from infomarket.defence import report as dr
+        from infomarket.defence import study as ds
+        st = ds.load(load_experiment("attack_search"))
+        judged = [tdr._judged("good", cost=0.01, loss=0.04), tdr._judged("broken", cost=0.01, loss=0.5),
+                  tdr._judged("staking", "existing", cost=0.0, loss=0.35)]
+        result = tdr._result({"staking": (0.0, 0.35), "good": (0.01, 0.04), "broken": (0.01, 0.5)}, judged)
+        a = dr.analyse(st, result)
+        out = fresh(OUT / "defence")
+        out.mkdir(parents=True)
+        dr.write_frames(out, result)
+        dr.write(out, a, reduced="tiny", wall_seconds=12.5, provenance={"questions commit": "abc123"},
+                 records=["## Amendments", "", "- one", ""], busy=BUSY)
     print("done", what)
 
 

@@ -119,6 +119,56 @@ def test_out_must_be_a_folder(tmp_path):
     assert [f.name for f in files] == ["s.md", "s.csv", "s.json"] and (tmp_path / "o" / "s.csv").read_text() == "a\n1\n"
 
 
+def test_out_is_checked_once_for_every_study_command(tmp_path):
+    with pytest.raises(study.UsageError, match=r"^attack-search needs --out FOLDER \(the store and the report go"):
+        study.out_dir(None, "attack-search")
+    with pytest.raises(study.UsageError, match=r"^--out ' ': give a folder for the checkpoint"):
+        study.out_dir(" ", holds="the checkpoint")
+    with pytest.raises(study.UsageError, match=r"^--questions .*nope.toml: no such file$"):
+        study.questions_path(str(tmp_path / "nope.toml"), tmp_path)
+    assert study.questions_path(None, tmp_path / "shipped.toml") == tmp_path / "shipped.toml"
+    study.refuse_declared_seed(7, 7, [])  # the whole declared study may use its seed
+    with pytest.raises(study.UsageError, match=r"^--seed 7 is the study's declared seed.*\(2 of 4 cells\)"):
+        study.refuse_declared_seed(7, 7, ["2 of 4 cells"])
+
+
+def test_a_report_is_written_whole_or_not_at_all(tmp_path):
+    """Each part by its kind; a part that fails leaves the files before it, no half-written file and no
+    temporary one behind."""
+    def broken(path):
+        path.write_text("half")
+        raise RuntimeError("the figure failed")
+
+    frame = pd.DataFrame({"a": [1, 2]})
+    report = study.Report([("r.md", "# é\n"), ("r.parquet", frame), ("r.png", broken)])
+    with pytest.raises(RuntimeError, match="the figure failed"):
+        report.write(tmp_path / "o")
+    assert sorted(p.name for p in (tmp_path / "o").iterdir()) == ["r.md", "r.parquet"]
+    assert (tmp_path / "o" / "r.md").read_bytes() == "# é\n".encode()
+    assert pd.read_parquet(tmp_path / "o" / "r.parquet").equals(frame)
+
+
+def test_the_settings_parser_names_the_key_and_what_it_expects():
+    from dataclasses import dataclass
+
+    @dataclass(frozen=True)
+    class Plan:
+        runs: int = 8
+        share: float = 0.5
+        paired: bool = True
+
+    rules = {"whole": {"runs": 2}, "flags": ("paired",), "numbers": (("share", 0.0, 1.0),)}
+    assert study.settings(Plan, {"runs": 4}, {"runs": 16, "share": None}, "q.toml [plan]", **rules) == Plan(16)
+    for table, message in (({"run": 4}, "q.toml [plan]: unknown key 'run'; allowed: runs, share, paired"),
+                           ({"runs": 1}, "q.toml [plan]: runs = 1: a whole number of at least 2 is expected"),
+                           ({"runs": True}, "q.toml [plan]: runs = True: a whole number of at least 2 is expected"),
+                           ({"paired": 1}, "q.toml [plan]: paired = 1: true or false is expected"),
+                           ({"share": 0.0}, "q.toml [plan]: share = 0.0: a number in (0, 1] is expected")):
+        with pytest.raises(study.UsageError) as err:
+            study.settings(Plan, table, None, "q.toml [plan]", **rules)
+        assert str(err.value) == message
+
+
 # ------------------------------------------------------------------------------------------ verdicts
 def test_a_one_sided_rule_answers_no_only_with_the_power_to_have_said_yes():
     assert study.by_power(True, 0.0) == "yes"          # met: yes whatever the power

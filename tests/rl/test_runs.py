@@ -1,4 +1,4 @@
-"""rl.runs: B runs stepped in one compiled call are the engine's own runs, actions reach the compiled
+"""agents.runs: B runs stepped in one compiled call are the engine's own runs, actions reach the compiled
 rules, and the observation is what the world holds (checked against simulate() and plain Python)."""
 import sys
 
@@ -9,8 +9,8 @@ from infomarket.behaviours.attacks import NO_ENTRY_AGE
 from infomarket.config import load_experiment
 from infomarket.engine.simulation import simulate
 from infomarket.errors import ConfigError
-from infomarket.rl.observe import OBSERVATION
-from infomarket.rl.runs import Runs, select_cell
+from infomarket.agents.observe import OBSERVATION
+from infomarket.agents.runs import Runs, select_cell
 
 SEEDS = [5, 17, 123]
 

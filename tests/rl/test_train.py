@@ -3,7 +3,8 @@ setting is deterministic and improves the attack it starts from."""
 import numpy as np
 import pytest
 
-from infomarket.rl.train import Adam, centred_ranks, es_gradient, initial_theta, sigmoid
+from infomarket.agents.optim import Adam
+from infomarket.rl.train import centred_ranks, es_gradient, initial_theta, sigmoid
 
 
 def test_centred_ranks_by_hand():
@@ -31,7 +32,7 @@ def test_the_antithetic_estimate_points_along_the_better_perturbation():
     np.testing.assert_allclose(g, [(0.5 + 1 / 6) / 1.0, (-0.5 - 1 / 6) / 1.0])
 
 
-class _Runs:  # what initial_theta reads of rl.runs.Runs
+class _Runs:  # what initial_theta reads of agents.runs.Runs
     actions = ("rot_base", "collude")
     low, high = np.array([0.0, 0.0]), np.array([180.0, 1.0])
     default_action = np.array([[20.0, 0.0]] * 3)

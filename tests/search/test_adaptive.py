@@ -10,7 +10,7 @@ from infomarket.config import load_experiment
 from infomarket.config.load import validate
 from infomarket.engine.simulation import simulate
 from infomarket.errors import ArgumentError, UsageError
-from infomarket.rl.observe import OBSERVATION
+from infomarket.agents.observe import OBSERVATION
 from infomarket.search import adaptive, study
 from infomarket.search.adaptive import Policy, centred_ranks, confirm, es_gradient, train
 from infomarket.search.objective import per_run

@@ -254,7 +254,7 @@ def test_a_reduced_search_with_the_declared_seed_is_refused_and_some_cells_are_n
     assert f"--seed {declared} is the study's declared seed" in err and "--budget 4" in err
     assert not (tmp_path / "o").exists()
     st = study.load(load_experiment("attack_search"))
-    from infomarket.search.cli import refuse_declared_seed
+    from infomarket.analysis.study import refuse_declared_seed
 
     refuse_declared_seed(st.settings.seed, st.settings.seed, [])  # the whole declared study: allowed
     # some of the declared cells with the declared settings is not the whole study: refused

@@ -80,7 +80,8 @@ def cmd_chain_study(args: argparse.Namespace) -> int:
                          f"chain_fig7, chain_sweep, chain_fig7_sweep, chain_partition), so no question can be "
                          f"answered; run `infomarket sweep chain_paper --out STORE` first (docs/research.md)")
     a.locks = locks
-    files = study.write(out, "chain-study", markdown(a, args.wall), table=a.table, figure=lambda p: figure(a, p))
+    files = study.Report.of("chain-study", markdown(a, args.wall), table=a.table,
+                            figure=lambda p: figure(a, p)).write(out)
     print(a.table[["question", "n", "answer"]].to_string(index=False))
     print(f"wrote {', '.join(str(f) for f in files)}")
     return 0

@@ -18,6 +18,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
+from ..store.files import write_atomic
 from . import metrics, stats
 from .headline import load_rules
 from .metrics import THETA_DEG
@@ -350,9 +351,10 @@ FIGURES: tuple[FigureSpec, ...] = (
 
 def save(fig: Figure, out: Path, name: str, vector: str = "svg") -> list[Path]:
     """Write ``name.png`` and ``name.svg`` (or ``.pdf``) under ``out``, without timestamps or random ids,
-    so the same data give the same files."""
+    so the same data give the same files; each whole or not at all (the store's atomic writer)."""
     paths = [out / f"{name}.png", out / f"{name}.{vector}"]
+    vector_meta = {"svg": {"Date": None}, "pdf": {"CreationDate": None}}[vector]
     with matplotlib.rc_context({"svg.hashsalt": "infomarket"}):
-        fig.savefig(paths[0], dpi=150, metadata={"Software": None})
-        fig.savefig(paths[1], metadata={"svg": {"Date": None}, "pdf": {"CreationDate": None}}[vector])
+        write_atomic(paths[0], lambda tmp: fig.savefig(tmp, dpi=150, metadata={"Software": None}), keep_suffix=True)
+        write_atomic(paths[1], lambda tmp: fig.savefig(tmp, metadata=vector_meta), keep_suffix=True)
     return paths

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import pandas as pd
 
-from .. import __version__
+from .._version import __version__
 from .frames import Frames
 
 LISTED = 3  # list up to this many distinct values in a cell; beyond, give the count

@@ -14,6 +14,7 @@ from pathlib import Path
 import pandas as pd
 
 from ..store import Store
+from ..store.files import write_text_atomic
 from . import future
 from .completeness import gaps
 from .figures import FIGURES, save
@@ -98,8 +99,7 @@ def build_report(source, out: str | Path, *, vector: str = "svg", label: str | N
         report.sections = report_section(store, out, vector, echo)
     echo(f"paper vs this store: {_counts_text(report)}")
     for name, text in (("report.md", to_markdown(report)), ("report.html", to_html(report))):
-        (out / name).write_text(text, encoding="utf-8")
-        report.files.append(out / name)
+        report.files.append(write_text_atomic(text, out / name, "utf-8"))
     echo(f"wrote {', '.join(str(p) for p in report.files)}")
     return report
 

@@ -54,13 +54,9 @@ def cmd_sensitivity(args: argparse.Namespace) -> int:
     files = write(s, out, vector=args.vector, answers_table=table)
     print(summary_table(s).to_string(index=False))
     if local is not None:
-        path = out / f"{stem(s.design.experiment)}-robustness.csv"
-        local[0].to_csv(path, index=False)
-        files.append(path)
+        files.append(study.write_csv(local[0], out / f"{stem(s.design.experiment)}-robustness.csv"))
         if len(local[1]):
-            path = out / f"{stem(s.design.experiment)}-local-mu-star.csv"
-            local[1].to_csv(path, index=False)
-            files.append(path)
+            files.append(study.write_csv(local[1], out / f"{stem(s.design.experiment)}-local-mu-star.csv"))
         print(local[0].to_string(index=False))
     if table is not None:
         print(table[["question", "output", "answer"]].to_string(index=False))

@@ -10,12 +10,13 @@ import numpy as np
 import pandas as pd
 
 from ..runner import design as designs
+from ..store.files import write_parquet_atomic, write_text_atomic
 from .declared import status_of
 from .figures import save
 from .frames import MissingDataError
 from . import sensitivity as sens  # module-level knobs (PAWN_PERMUTATIONS) read when drawing
 from .sensitivity import TITLES, Sensitivity, floor_of, from_store, morris_noise
-from .study import INCONCLUSIVE, NO, YES, Declaration, html_table, md_table, packaged
+from .study import INCONCLUSIVE, NO, YES, Declaration, html_table, md_table, packaged, write_csv
 
 DECLARATION = packaged("sensitivity_questions.toml")
 QUESTIONS = DECLARATION.path
@@ -295,13 +296,13 @@ def write(s: Sensitivity, out: str | Path, *, vector: str = "svg",
     out.mkdir(parents=True, exist_ok=True)
     name = stem(s.design.experiment)
     files = [out / f"{name}.csv", out / f"{name}.parquet"]
-    s.table.to_csv(files[0], index=False)
-    s.table.to_parquet(files[1], index=False)
+    write_csv(s.table, files[0])
+    write_parquet_atomic(s.table, files[1])
     figs = save(_bars(s), out, f"{name}-indices", vector)
     if s.design.method == "sobol" and s.design.second_order:
         figs += save(_heatmap(s), out, f"{name}-S2", vector)
     md = out / f"{name}.md"
-    md.write_text(markdown(s, [p.name for p in figs], answers_table), encoding="utf-8")
+    write_text_atomic(markdown(s, [p.name for p in figs], answers_table), md, "utf-8")
     s.files = files + figs + [md]
     return s.files
 

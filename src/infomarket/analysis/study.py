@@ -26,11 +26,13 @@ import tomllib
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TypeVar
 
 import pandas as pd
 
 from ..cliargs import UsageError, writable_dir
 from ..errors import ConfigError
+from ..store.files import write_atomic, write_parquet_atomic, write_text_atomic
 from . import declared
 from . import stats as st
 from .declared import NOTES, Lock, check, status_of, summary
@@ -42,6 +44,7 @@ NO_DATA, NOT_RUN, PENDING = "no data", "not run", "pending"
 #: the arrays of a declaration file that record its history (see the module's docstring)
 RECORDS = NOTES
 _FIELDS = ("date", "seen", "what", "why")
+S = TypeVar("S")
 
 
 @dataclass(frozen=True)
@@ -144,6 +147,59 @@ class Declaration:
         return {status_of(locks, self.name, f"questions.{q}") for q in self.questions}
 
 
+# ------------------------------------------------------------------------------------------ settings
+def settings(cls: type[S], table: dict, overrides: dict | None = None, source: str = "settings", *,
+             whole: dict[str, int] | None = None, flags: Iterable[str] = (),
+             numbers: Iterable[tuple[str, float, float]] = ()) -> S:
+    """A study's settings: the dataclass ``cls`` from its declaration's ``table`` with ``overrides`` (the
+    command line's options; None values ignored) over it, each value checked, so that every study refuses
+    a bad setting with the same words whether it came from the file or an option.
+
+    Args:
+        cls: the study's settings dataclass (its fields are the keys allowed).
+        table: the declaration file's table of settings.
+        overrides: settings given on the command line (None: not given).
+        source: where the values come from, the start of every error message.
+        whole: key -> the least whole number allowed.
+        flags: keys that take true or false.
+        numbers: (key, low, high): a number in (low, high].
+
+    Raises:
+        UsageError: an unknown key (the allowed ones named), or a value of the wrong kind or out of range.
+
+    Example:
+        >>> from dataclasses import dataclass
+        >>> from infomarket.analysis.study import settings
+        >>> @dataclass(frozen=True)
+        ... class Plan:
+        ...     runs: int = 8
+        >>> settings(Plan, {"runs": 16}, {"runs": None}, whole={"runs": 2})
+        Plan(runs=16)
+        >>> settings(Plan, {"run": 16})
+        Traceback (most recent call last):
+        ...
+        infomarket.errors.UsageError: settings: unknown key 'run'; allowed: runs
+    """
+    known = cls.__dataclass_fields__  # type: ignore[attr-defined]
+    given = {**table, **{k: v for k, v in (overrides or {}).items() if v is not None}}
+    for k in given:
+        if k not in known:
+            raise UsageError(f"{source}: unknown key {k!r}; allowed: {', '.join(known)}")
+    s = cls(**given)
+    for k, lo in (whole or {}).items():
+        v = getattr(s, k)
+        if isinstance(v, bool) or not isinstance(v, int) or v < lo:
+            raise UsageError(f"{source}: {k} = {v!r}: a whole number of at least {lo} is expected")
+    for k in flags:
+        if not isinstance(getattr(s, k), bool):
+            raise UsageError(f"{source}: {k} = {getattr(s, k)!r}: true or false is expected")
+    for k, lo, hi in numbers:
+        v = getattr(s, k)
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not lo < v <= hi:
+            raise UsageError(f"{source}: {k} = {v!r}: a number in ({lo:g}, {hi:g}] is expected")
+    return s
+
+
 def packaged(name: str) -> Declaration:
     """One of the analysis package's declaration files, by file name (``chain_questions.toml``)."""
     return Declaration.read(HERE / name)
@@ -222,28 +278,107 @@ def html_table(df: pd.DataFrame, verdicts: bool = False) -> str:
 
 
 # ------------------------------------------------------------------------------------------ files
-def out_dir(path: str | Path) -> Path:
-    """``--out``: refused before anything runs when it exists and is not a folder."""
+def out_dir(path: str | Path | None, command: str = "", holds: str = "the store and the report") -> Path:
+    """``--out``, the one check every study's command makes of it before anything runs.
+
+    Args:
+        path: the option's value (None: not given).
+        command: the command that needs it, named when it is missing (a command whose parser requires
+            ``--out`` never passes None).
+        holds: what the folder will hold, named when the value is blank.
+
+    Raises:
+        UsageError: it is missing, blank (``Path("")`` would be the current folder), or exists and is not
+            a folder.
+    """
+    if path is None:
+        raise UsageError(f"{command} needs --out FOLDER ({holds} go there)")
+    if not str(path).strip():
+        raise UsageError(f"--out {str(path)!r}: give a folder for {holds}")
     out = Path(path)
     if out.exists() and not out.is_dir():
         raise UsageError(f"--out {out}: exists and is not a directory")
     return out
 
 
+def refuse_declared_seed(seed: int, declared: int, reductions: list[str]) -> None:
+    """``--seed``: a study's declared seed keys its confirmation seeds, which no run may touch before the
+    study's own, so any run that is not the whole declared study (a pilot, a reduced study, some of its
+    cells: ``reductions`` says how) must take another seed.  The whole study may still be made in several
+    invocations: it resumes from its store, every invocation the whole study."""
+    if reductions and seed == declared:
+        raise UsageError(f"--seed {seed} is the study's declared seed, and this run is not the whole declared "
+                         f"study ({'; '.join(reductions)}): its confirmation runs would be the study's own, seen "
+                         f"before the study; give another --seed (only the whole declared study may use it)")
+
+
+def questions_path(value: str | Path | None, default: Path) -> Path:
+    """``--questions``: the study's questions file, the shipped ``default`` when the option is not given;
+    a file that is not there is refused (a UsageError naming the option) before anything is read."""
+    if value is None:
+        return default
+    if not Path(value).is_file():
+        raise UsageError(f"--questions {value}: no such file")
+    return Path(value)
+
+
+def write_csv(table: pd.DataFrame, path: Path) -> Path:
+    """``table`` as CSV (no index) at ``path``, whole or not at all; returns the path."""
+    return write_atomic(path, lambda tmp: table.to_csv(tmp, index=False))
+
+
+@dataclass
+class Report:
+    """A study's answer as the files it writes, in order: each ``(name, part)`` is text (written as UTF-8),
+    a table (``.csv``, or ``.parquet`` by the name) or a figure (a function that draws into the path it is
+    given, its format read from the name).  Every study's report is written by ``write``, through the
+    store's atomic writers: a stopped or failed report leaves the old file or the new one, never half of one.
+    """
+
+    parts: list[tuple[str, str | pd.DataFrame | Callable[[Path], object]]]
+
+    @classmethod
+    def of(cls, stem: str, markdown: str, *, table: pd.DataFrame | None = None,
+           figure: Callable[[Path], object] | None = None, extra: Iterable[tuple[str, str]] = ()) -> Report:
+        """The usual shape: ``stem.md``, then ``stem.csv`` of ``table``, each ``(name, text)`` of ``extra``
+        and ``stem.png`` drawn by ``figure(path)``, those given."""
+        parts: list[tuple[str, str | pd.DataFrame | Callable[[Path], object]]] = [(f"{stem}.md", markdown)]
+        parts += [(f"{stem}.csv", table)] if table is not None else []
+        parts += list(extra)
+        parts += [(f"{stem}.png", figure)] if figure is not None else []
+        return cls(parts)
+
+    def write(self, out: str | Path) -> list[Path]:
+        """Write every part into ``out`` (created when missing); returns the files, in the parts' order."""
+        folder = writable_dir(Path(out))
+        files = []
+        for name, part in self.parts:
+            path = folder / name
+            if isinstance(part, str):
+                files.append(write_text_atomic(part, path, "utf-8"))
+            elif isinstance(part, pd.DataFrame):
+                files.append(write_parquet_atomic(part, path) if path.suffix == ".parquet" else write_csv(part, path))
+            else:
+                files.append(write_atomic(path, part, keep_suffix=True))
+        return files
+
+
+def drawn(make: Callable[[], object], **options) -> Callable[[Path], None]:
+    """A figure part of a ``Report``: ``make()`` builds the matplotlib figure when the report is written,
+    ``savefig(path, **options)`` saves it and it is closed (pyplot keeps every open figure alive)."""
+    def draw(path: Path) -> None:
+        import matplotlib.pyplot as plt  # only when a figure is drawn: matplotlib is slow to import
+
+        fig = make()
+        try:
+            fig.savefig(path, **options)  # type: ignore[attr-defined]
+        finally:
+            plt.close(fig)  # type: ignore[arg-type]
+    return draw
+
+
 def write(out: Path, stem: str, markdown: str, *, table: pd.DataFrame | None = None,
           figure: Callable[[Path], object] | None = None, extra: Iterable[tuple[str, str]] = ()) -> list[Path]:
-    """``stem.md`` (and ``stem.csv`` of ``table``, ``stem.png`` by ``figure(path)``, each ``(name, text)`` of
-    ``extra``) in ``out``, created when missing: the study's files, written once its answers exist."""
-    out = writable_dir(out)
-    files = [out / f"{stem}.md"]
-    files[0].write_text(markdown, encoding="utf-8")
-    if table is not None:
-        files.append(out / f"{stem}.csv")
-        table.to_csv(files[-1], index=False)
-    for name, text in extra:
-        files.append(out / name)
-        files[-1].write_text(text, encoding="utf-8")
-    if figure is not None:
-        files.append(out / f"{stem}.png")
-        figure(files[-1])
-    return files
+    """``Report.of(...).write(out)``: ``stem.md`` (and ``stem.csv`` of ``table``, each ``(name, text)`` of
+    ``extra``, ``stem.png`` by ``figure(path)``) in ``out``, written once the study's answers exist."""
+    return Report.of(stem, markdown, table=table, figure=figure, extra=extra).write(out)

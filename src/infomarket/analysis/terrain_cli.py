@@ -27,8 +27,8 @@ def cmd_terrain_report(args: argparse.Namespace) -> int:
     out = study.out_dir(args.out)
     a = answer(Path(args.results))
     text = markdown(a)
-    files = study.write(out, "terrain", text, extra=[("terrain.json", json.dumps(jsonable(a), indent=1))],
-                        figure=lambda p: figure(a, p))
+    files = study.Report.of("terrain", text, extra=[("terrain.json", json.dumps(jsonable(a), indent=1))],
+                            figure=lambda p: figure(a, p)).write(out)
     print(text)
     print(f"wrote {', '.join(str(f) for f in files)}")
     return 0

@@ -21,7 +21,7 @@ import time
 
 import numpy as np
 
-from .. import __version__
+from .._version import __version__
 from ..engine.simulation import Simulation
 from ..seeds import run_seed
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 import statistics
 import time
 
-from .. import __version__
+from .._version import __version__
 from ..config import load_experiment
 from ..seeds import run_seed
 from ..engine.simulation import Simulation

@@ -2,8 +2,8 @@
 from __future__ import annotations
 
 import time
-from pathlib import Path
 
+from ..analysis.study import out_dir, refuse_declared_seed
 from ..cliargs import UsageError, at_least, dask_client, seed_value, workers_count
 
 #: outer settings an option may make smaller than declared (the report is then marked reduced)
@@ -64,7 +64,6 @@ def cmd_defence_search(args) -> int:
     from ..runner.execute import default_workers, local_executor
     from ..runner.feed import Feed, dask_threads
     from ..runner.progress import progress
-    from ..search.cli import refuse_declared_seed
     from ..search.driver import store_runner
     from ..store import Store
     from . import driver, report
@@ -83,10 +82,7 @@ def cmd_defence_search(args) -> int:
                         confirmation_runs=args.confirmation_runs, seed=args.seed)
     if args.list_families:
         return _list_families(st)
-    if args.out is None:
-        raise UsageError("defence-search needs --out FOLDER (the store and the report go there)")
-    if not args.out.strip():  # Path("") is the current folder: a blank variable must not write there
-        raise UsageError(f"--out {args.out!r}: give a folder for the store and the report")
+    out = out_dir(args.out, "defence-search")
     if args.steps is not None and args.transitory is not None and args.transitory >= args.steps:
         raise UsageError(f"--transitory {args.transitory}: must be below --steps {args.steps}")
     st = study_mod.with_length(st, args.steps, args.transitory)
@@ -98,9 +94,6 @@ def cmd_defence_search(args) -> int:
     refuse_declared_seed(st.settings.seed, declared.settings.seed,
                          ([args.reduced] if args.reduced else []) + [r for r in smaller if not r.startswith(parts)])
     reduced = "; ".join(([args.reduced] if args.reduced else []) + smaller)
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise UsageError(f"--out {out}: exists and is not a directory")
     client = dask_client(args.dask) if args.dask else None
     store = Store(out / "store", cache=True)
     store.refuse_foreign()

@@ -16,9 +16,9 @@ import numpy as np
 
 from ..analysis import paired_runs as pr
 from ..analysis import stats
+from ..analysis.formats import interval_text, json_ready
+from ..analysis.study import Report, drawn
 from ..runner.progress import busy_markdown
-from ..search.report import interval_text, json_ready
-from ..store.files import write_atomic, write_parquet_atomic, write_text_atomic
 from .driver import Judged, Result, pareto
 from .study import Study, floor
 
@@ -307,24 +307,18 @@ def _kappa(v) -> str:
 def write_frames(out: Path, result: Result) -> list[Path]:
     """The confirmation runs as Parquet frames (``defence_cost.parquet``: label, run, items, undefended;
     ``defence_attacks.parquet``: label, byzantines, run, worst, reference), for DuckDB or pandas."""
-    return [write_parquet_atomic(result.cost_runs, Path(out) / "defence_cost.parquet"),
-            write_parquet_atomic(result.attack_runs, Path(out) / "defence_attacks.parquet")]
+    return Report([("defence_cost.parquet", result.cost_runs),
+                   ("defence_attacks.parquet", result.attack_runs)]).write(out)
 
 
 def write(out: Path, a: dict, *, reduced: str = "", wall_seconds: float | None = None,
           provenance: dict | None = None, records: list[str] | None = None, busy: dict | None = None) -> list[Path]:
     """``defence.json``, ``defence.md`` and ``frontier.png`` into ``out``, each written whole or not at all;
     ``busy``: how busy the study kept its workers (``runner.feed.Busy.as_dict``)."""
-    out = Path(out)
     meta = {"reduced": reduced, "wall_seconds": wall_seconds, "provenance": provenance or {}, "busy": busy or {}}
-    text = json.dumps(json_ready({**meta, **a}), indent=2) + "\n"
-    paths = [write_text_atomic(text, out / "defence.json")]
-    md = markdown(a, reduced=reduced, wall_seconds=wall_seconds, provenance=provenance, records=records, busy=busy)
-    paths.append(write_text_atomic(md, out / "defence.md"))
+    parts: list = [("defence.json", json.dumps(json_ready({**meta, **a}), indent=2) + "\n"),
+                   ("defence.md", markdown(a, reduced=reduced, wall_seconds=wall_seconds, provenance=provenance,
+                                           records=records, busy=busy))]
     if a["confirmed"]:
-        import matplotlib.pyplot as plt  # only when a figure is drawn
-
-        fig = figure(a)
-        paths.append(write_atomic(out / "frontier.png", lambda p: fig.savefig(p, dpi=120, format="png")))
-        plt.close(fig)
-    return paths
+        parts.append(("frontier.png", drawn(lambda: figure(a), dpi=120)))
+    return Report(parts).write(out)

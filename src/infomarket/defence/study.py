@@ -11,7 +11,8 @@ import re
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from ..analysis.study import Declaration
+from ..analysis.study import Declaration, questions_path
+from ..analysis.study import settings as study_settings
 from ..config.load import validate
 from ..config.schema import Experiment
 from ..errors import ConfigError, UsageError
@@ -48,25 +49,10 @@ WHOLE = {"candidates": 1, "refine": 0, "cost_runs": 2, "target": 0, "frontier": 
 
 def settings(table: dict, overrides: dict | None = None,
              source: str = "defence/questions.toml [defence] or an option") -> Settings:
-    """``Settings`` from ``table`` with ``overrides`` (None ignored); a bad key or value is a UsageError."""
-    known = Settings.__dataclass_fields__
-    base = {}
-    for k, v in {**table, **{k: v for k, v in (overrides or {}).items() if v is not None}}.items():
-        if k not in known:
-            raise UsageError(f"{source}: unknown key {k!r}; allowed: {', '.join(known)}")
-        base[k] = v
-    s = Settings(**base)
-    for k, lo in WHOLE.items():
-        v = getattr(s, k)
-        if isinstance(v, bool) or not isinstance(v, int) or v < lo:
-            raise UsageError(f"{source}: {k} = {v!r}: a whole number of at least {lo} is expected")
-    if not isinstance(s.every_count, bool):
-        raise UsageError(f"{source}: every_count = {s.every_count!r}: true or false is expected")
-    for k, lo, hi in (("refine_sigma", 0.0, 1.0), ("max_cost", 0.0, 1.0)):
-        v = getattr(s, k)
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not lo < v <= hi:
-            raise UsageError(f"{source}: {k} = {v!r}: a number in ({lo:g}, {hi:g}] is expected")
-    return s
+    """``Settings`` from ``table`` with ``overrides`` (None ignored); a bad key or value is a UsageError
+    (the studies' one parser, ``analysis.study.settings``)."""
+    return study_settings(Settings, table, overrides, source, whole=WHOLE, flags=("every_count",),
+                          numbers=(("refine_sigma", 0.0, 1.0), ("max_cost", 0.0, 1.0)))
 
 
 @dataclass(frozen=True)
@@ -115,10 +101,7 @@ def read(path: str | Path | None) -> Declaration:
     """The study's questions file: the shipped one, or a file like it (a user's own families and rules)."""
     if path is None:
         return DECLARATION
-    p = Path(path)
-    if not p.is_file():
-        raise UsageError(f"--questions {path}: no such file")
-    return Declaration.read(p)
+    return Declaration.read(questions_path(path, QUESTIONS))
 
 
 def load(experiment: Experiment, declaration: Declaration | None = None, *, families: list[str] | None = None,

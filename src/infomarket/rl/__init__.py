@@ -1,8 +1,9 @@
 """Reinforcement-learning interfaces over the compiled engine, the Byzantine robots as agents (docs/rl.md).
 
 ``AttackParallelEnv`` (PettingZoo), ``AttackEnv`` and ``AttackVectorEnv`` (Gymnasium) need the ``rl``
-extra (``pip install 'infomarket[rl]'``); ``rl.runs`` (B runs stepped in one compiled call) and
-``rl.train`` (evolution strategies in numpy) need only the core.
+extra (``pip install 'infomarket[rl]'``); ``rl.train`` (evolution strategies in numpy) and the runs under
+the environments (``infomarket.agents.runs``: B runs stepped in one compiled call, which the attack search
+uses too) need only the core.
 
 Importing this package registers ``ENV_ID`` with Gymnasium, when it is installed:
 ``gymnasium.make(ENV_ID, **kwargs)`` builds ``AttackEnv(**kwargs)`` and ``gymnasium.make_vec(ENV_ID,

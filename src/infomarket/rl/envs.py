@@ -22,8 +22,8 @@ from ..config import sizes
 from ..errors import ArgumentError, ConfigError, InputTypeError, UsageError
 from ..seeds import MAX_SEED, checked_seed_arg
 from .interop import RENDER_MODES, ArenaRenderer, Rebuilt, checked_render_mode
-from .observe import OBSERVATION
-from .runs import ACTIONS, Runs, select_cell
+from ..agents.observe import OBSERVATION
+from ..agents.runs import ACTIONS, Runs, select_cell
 
 #: Rewards by name, per decision interval (docs/rl.md).  ``items``: minus the items the honest robots
 #: deposited in the interval, per honest robot (the attack-search objective ``items``, negated so the

@@ -12,8 +12,8 @@ from pettingzoo import ParallelEnv
 from ..errors import InputTypeError, UsageError
 from .envs import AttackEnv, action_array
 from .interop import RENDER_MODES, Rebuilt
-from .observe import OBSERVATION
-from .runs import ACTIONS
+from ..agents.observe import OBSERVATION
+from ..agents.runs import ACTIONS
 
 
 class AttackParallelEnv(Rebuilt, ParallelEnv):

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..agents.optim import Adam
 from ..errors import ArgumentError
 from ..seeds import MAX_SEED
 
@@ -51,30 +52,6 @@ def centred_ranks(x: np.ndarray) -> np.ndarray:
     r = np.empty(len(x))
     r[np.argsort(x, kind="stable")] = np.arange(len(x))
     return r / max(len(x) - 1, 1) - 0.5
-
-
-@dataclass
-class Adam:
-    """Adam (Kingma & Ba 2015) ascending a gradient estimate."""
-
-    lr: float
-    beta1: float = 0.9
-    beta2: float = 0.999
-    eps: float = 1e-8
-    t: int = 0
-    m: np.ndarray | None = None
-    v: np.ndarray | None = None
-
-    def step(self, grad: np.ndarray) -> np.ndarray:
-        """The Adam step for gradient ``grad`` (bias-corrected moments); the caller applies it to the parameters."""
-        if self.m is None or self.v is None:
-            self.m, self.v = np.zeros_like(grad), np.zeros_like(grad)
-        self.t += 1
-        self.m = self.beta1 * self.m + (1 - self.beta1) * grad
-        self.v = self.beta2 * self.v + (1 - self.beta2) * grad * grad
-        mh = self.m / (1 - self.beta1 ** self.t)
-        vh = self.v / (1 - self.beta2 ** self.t)
-        return self.lr * mh / (np.sqrt(vh) + self.eps)
 
 
 def es_gradient(fitness: np.ndarray, eps: np.ndarray, sigma: float) -> np.ndarray:

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from .. import __version__
+from .._version import __version__
 from ..config import sizes
 from ..config.schema import Experiment
 from ..errors import UsageError

@@ -1,5 +1,5 @@
 """The adaptive attacker, a second searcher beside the parametric one: a policy that maps what each
-Byzantine robot observes (the RL interface's observation, ``rl.observe.OBSERVATION``) to its action (the
+Byzantine robot observes (the RL interface's observation, ``agents.observe.OBSERVATION``) to its action (the
 attacker's parameters named by ``actions``, by default the lie's rotation and whether to collude), chosen
 anew every ``interval`` steps, trained by evolution strategies through the RL interface's compiled runs
 (docs/rl.md, "The adaptive attacker").
@@ -32,9 +32,9 @@ import pandas as pd
 
 from ..behaviours.attacks import POLICY
 from ..errors import ArgumentError, UsageError
-from ..rl.observe import OBSERVATION
-from ..rl.runs import ACTIONS
-from ..rl.train import Adam
+from ..agents.observe import OBSERVATION
+from ..agents.optim import Adam
+from ..agents.runs import ACTIONS
 from ..seeds import run_seed
 from .adaptive_play import BATCH, Player, check_memory
 from .objective import OBJECTIVES

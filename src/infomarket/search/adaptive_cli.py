@@ -7,8 +7,8 @@ import argparse
 import json
 import math
 import time
-from pathlib import Path
 
+from ..analysis.study import out_dir
 from ..cliargs import UsageError, at_least, seed_value, workers_count
 
 #: The policy's and the summaries' file names in ``--out``.
@@ -108,18 +108,14 @@ def cmd_adaptive_attack(args) -> int:
     from ..errors import report
     from ..runner.progress import progress
     from . import study as study_mod
-    from ..rl.observe import OBSERVATION
-    from ..rl.runs import ACTIONS
+    from ..agents.observe import OBSERVATION
+    from ..agents.runs import ACTIONS
     from .adaptive import resumed_generations, train
     from .adaptive_play import BATCH, check_memory
 
-    if not args.out.strip():  # Path("") is the current folder: a blank variable must not write there
-        raise UsageError(f"--out {args.out!r}: give a folder for the checkpoint, the policy and the summary")
+    out = out_dir(args.out, holds="the checkpoint, the policy and the summary")
     if not args.defence.strip():
         raise UsageError(f"--defence {args.defence!r}: name one defence of the study, e.g. staking")
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise UsageError(f"--out {out}: exists and is not a directory")
     exp = load_experiment(args.experiment)
     (cell,) = study_mod.cells(study_mod.load(exp), [args.defence.strip()], [args.byzantines])
     steps = args.steps if args.steps is not None else exp.steps

@@ -1,9 +1,9 @@
 """Playing policies of the adaptive attacker: many (policy, run seed) episodes through the RL interface's
-compiled runs (``rl.runs.Runs``, the engine under ``AttackVectorEnv``), in batches, inline or on a local
+compiled runs (``agents.runs.Runs``, the engine under ``AttackVectorEnv``), in batches, inline or on a local
 process pool.
 
 One episode is one run of the configuration with run seed s (the seed ``simulate`` takes): every
-``interval`` steps the agents observe (``rl.observe.OBSERVATION``), the policy sets their action
+``interval`` steps the agents observe (``agents.observe.OBSERVATION``), the policy sets their action
 parameters, and the engine runs ``interval`` steps, exactly as ``AttackVectorEnv.step`` does.  The runs are
 reset with the given run seeds directly: the vector env's ``reset`` draws each episode's run seed from its
 own seed, and the confirmation needs runs on the driver's seeds.  Each run depends only on its seed and
@@ -17,7 +17,7 @@ import pandas as pd
 from .. import interrupts
 from ..config import sizes
 from ..errors import UsageError
-from ..rl.runs import Runs
+from ..agents.runs import Runs
 from ..runner.execute import local_executor
 from .objective import per_run
 

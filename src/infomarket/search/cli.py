@@ -6,6 +6,7 @@ import functools
 import time
 from pathlib import Path
 
+from ..analysis.study import out_dir, questions_path, refuse_declared_seed
 from ..cliargs import UsageError, at_least, dask_client, seed_value, workers_count
 from .baselines import rotation_grid
 
@@ -66,17 +67,6 @@ def _reductions(st, declared, exp, chosen, all_cells, args) -> list[str]:
     return out
 
 
-def refuse_declared_seed(seed: int, declared: int, reductions: list[str]) -> None:
-    """A study's declared seed keys its confirmation seeds, which no run may touch before the study's own
-    (questions.toml [seed_sets]): any run that is not the whole declared study (a pilot, a reduced search,
-    some of its cells) must take another ``--seed``.  The whole study may still be made in several
-    invocations: it resumes from its store, every invocation the whole study."""
-    if reductions and seed == declared:
-        raise UsageError(f"--seed {seed} is the study's declared seed, and this run is not the whole declared "
-                         f"study ({'; '.join(reductions)}): its confirmation runs would be the study's own, seen "
-                         f"before the study; give another --seed (only the whole declared study may use it)")
-
-
 def _list_baselines(st) -> int:
     grid = rotation_grid(st.settings.grid_step)
     for name, params in st.baselines.items():
@@ -101,9 +91,10 @@ def cmd_attack_search(args) -> int:
     from . import adaptive, provenance, report
 
     exp = load_experiment(args.experiment)
-    path = Path(args.questions) if args.questions else study_mod.QUESTIONS
+    path = questions_path(args.questions, study_mod.QUESTIONS)
     decl = study_mod.Declaration.read(path, path.name)
-    data = decl.data if args.questions else study_mod.load_declarations()  # the package's, read as the study reads it
+    # the package's file is read as the study reads it
+    data = decl.data if args.questions is not None else study_mod.load_declarations()
     st = study_mod.load(exp, data, path=path, budget=args.budget, popsize=args.popsize, restarts=args.restarts,
                         runs=args.runs,
                         finalists=args.finalists, race=_race(args.race) if args.race is not None else None,
@@ -117,10 +108,7 @@ def cmd_attack_search(args) -> int:
         return _list_baselines(st)
     if args.validate:
         return _validate(st, args)
-    if args.out is None:
-        raise UsageError("attack-search needs --out FOLDER (the store and the report go there)")
-    if not args.out.strip():  # Path("") is the current folder: a blank variable must not write there
-        raise UsageError(f"--out {args.out!r}: give a folder for the store and the report")
+    out = out_dir(args.out, "attack-search")
     defences = _names(args.defence) if args.defence is not None else None
     chosen = cells(st, defences, _ints(args.byzantines) if args.byzantines is not None else None)
     if args.steps is not None and args.transitory is not None and args.transitory >= args.steps:
@@ -133,9 +121,6 @@ def cmd_attack_search(args) -> int:
     refuse_declared_seed(st.settings.seed, declared.settings.seed,
                          ([args.reduced] if args.reduced else []) + smaller)
     reduced = "; ".join(([args.reduced] if args.reduced else []) + smaller)
-    out = Path(args.out)
-    if out.exists() and not out.is_dir():
-        raise UsageError(f"--out {out}: exists and is not a directory")
     store = Store(out / "store", cache=True)  # read after every generation: each part read once
     store.refuse_foreign()
     total = planned_runs(st) * len(chosen)

@@ -25,6 +25,8 @@ import numpy as np
 from ..analysis import paired_runs as pr
 from ..analysis import stats
 from ..analysis.declared import size_note
+from ..analysis.formats import interval_text, json_ready
+from ..analysis.study import Report, drawn
 from ..errors import ArgumentError
 from ..runner.progress import busy_markdown
 from . import decision
@@ -290,45 +292,16 @@ def write(out: Path, analysis: dict, *, reduced: str = "", wall_seconds: float |
     and the first run's time, printed as they are; ``header``: ``commit``, ``tree_clean``,
     ``questions_commit`` and ``validation`` (the planted suite's recovery rate per searcher), the first
     keys of ``report.json`` and the first lines of ``report.md``."""
-    out = Path(out)
-    paths = [out / "report.json", out / "report.md"]
     top = {"commit": None, "tree_clean": None, "questions_commit": None, "validation": {}, **(header or {})}
     meta = {**top, "reduced": reduced, "wall_seconds": wall_seconds, "steps": steps, "transitory": transitory,
             "provenance": provenance or {}, "busy": busy or {}}
-    paths[0].write_text(json.dumps(json_ready({**meta, **analysis}), indent=2) + "\n")
-    paths[1].write_text(markdown(analysis, reduced=reduced, wall_seconds=wall_seconds, steps=steps,
-                                 transitory=transitory, provenance=provenance, header=top, records=records,
-                                 busy=busy))
+    parts: list = [("report.json", json.dumps(json_ready({**meta, **analysis}), indent=2) + "\n"),
+                   ("report.md", markdown(analysis, reduced=reduced, wall_seconds=wall_seconds, steps=steps,
+                                          transitory=transitory, provenance=provenance, header=top, records=records,
+                                          busy=busy))]
     if analysis["cells"]:
-        import matplotlib.pyplot as plt  # only when a figure is drawn: matplotlib is slow to import
-
-        fig = figure(analysis)
-        fig.savefig(out / "loss.png", dpi=120)
-        plt.close(fig)
-        paths.append(out / "loss.png")
-    return paths
-
-
-def json_ready(v):
-    """JSON-ready: numpy scalars as Python numbers, NaN and infinities as null."""
-    if isinstance(v, dict):
-        return {str(k): json_ready(x) for k, x in v.items()}
-    if isinstance(v, (list, tuple)):
-        return [json_ready(x) for x in v]
-    if isinstance(v, np.ndarray):
-        return json_ready(v.tolist())
-    if isinstance(v, (np.integer, np.bool_)):
-        return v.item()
-    if isinstance(v, (float, np.floating)):
-        return float(v) if math.isfinite(v) else None
-    return v
-
-
-def interval_text(lo: float, hi: float, fmt: str) -> str:
-    """An interval as a report prints it: ``[lo, hi]`` in ``fmt``, or why it has no bounds."""
-    if math.isnan(lo) or math.isnan(hi):
-        return "undefined"
-    return "unbounded" if not (math.isfinite(lo) and math.isfinite(hi)) else f"[{lo:{fmt}}, {hi:{fmt}}]"
+        parts.append(("loss.png", drawn(lambda: figure(analysis), dpi=120)))
+    return Report(parts).write(out)
 
 
 def _role_table(cells: list[dict]) -> list[str]:

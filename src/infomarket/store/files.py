@@ -15,13 +15,15 @@ from pathlib import Path
 import pandas as pd
 
 
-def write_atomic(path: str | Path, write: Callable[[Path], object]) -> Path:
+def write_atomic(path: str | Path, write: Callable[[Path], object], keep_suffix: bool = False) -> Path:
     """Call ``write(tmp)`` on a fresh temporary file next to ``path``, then rename it to ``path``.
 
     The temporary file is created (empty) with the umask's permissions before ``write`` replaces its
-    contents, so the result has them too; on any error the temporary file is removed."""
+    contents, so the result has them too; on any error the temporary file is removed.  ``keep_suffix``:
+    the temporary name ends in ``path``'s suffix too, for a writer that picks its format by it (a figure's
+    ``savefig``)."""
     path = Path(path)
-    tmp = path.parent / f".{path.name}.{secrets.token_hex(6)}.tmp"
+    tmp = path.parent / f".{path.name}.{secrets.token_hex(6)}.tmp{path.suffix if keep_suffix else ''}"
     os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
     try:
         write(tmp)
@@ -37,10 +39,10 @@ def write_parquet_atomic(df: pd.DataFrame, path: str | Path) -> Path:
     return write_atomic(path, lambda tmp: df.to_parquet(tmp, index=False))
 
 
-def write_text_atomic(text: str, path: str | Path) -> Path:
+def write_text_atomic(text: str, path: str | Path, encoding: str | None = None) -> Path:
     """Write ``text`` to ``path`` atomically (a temporary file, then a rename): a reader sees the old or the new
-    file, never part of one."""
-    return write_atomic(path, lambda tmp: tmp.write_text(text))
+    file, never part of one.  ``encoding``: as ``Path.write_text``'s (None: the locale's)."""
+    return write_atomic(path, lambda tmp: tmp.write_text(text, encoding=encoding))
 
 
 def sha256_file(path: str | Path) -> str:

@@ -16,7 +16,8 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from .. import __version__, interrupts
+from .. import interrupts
+from .._version import __version__
 from .errors import Inspection, Problem, RecordAltered, SqlError, StoreDamaged, StoreError  # noqa: F401 - re-exported: the store's errors, where callers import them
 from . import integrity
 from .tables import DATA_TABLES, OPTIONAL_TABLES, TABLES

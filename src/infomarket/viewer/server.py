@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 from aiohttp import WSCloseCode, WSMsgType, web
 
-from .. import __version__
+from .._version import __version__
 from ..config.schema import Experiment
 from ..errors import InfomarketError, InternalError
 from . import DEFAULT_PORT, STATIC
