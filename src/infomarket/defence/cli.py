@@ -96,7 +96,7 @@ def cmd_defence_search(args) -> int:
     smaller = _reductions(st, declared, args)
     parts = ("families ", "Byzantine counts ")  # a part of the study, with its declared settings
     refuse_declared_seed(st.settings.seed, declared.settings.seed,
-                         ([args.reduced] if args.reduced else []) + [r for r in smaller if not r.startswith(parts)])
+                         (["--reduced"] if args.reduced else []) + [r for r in smaller if not r.startswith(parts)])
     reduced = "; ".join(([args.reduced] if args.reduced else []) + smaller)
     out = Path(args.out)
     if out.exists() and not out.is_dir():
