@@ -9,6 +9,8 @@ import signal
 import subprocess
 import time
 
+import pytest
+
 from infomarket.cli import main
 from infomarket.store import Store
 
@@ -114,6 +116,29 @@ def test_ctrl_c_keeps_the_finished_runs_of_the_part_in_progress(tmp_path, capsys
     assert main(argv) == 0
     assert main(["sweep", "long.toml", "--out", "whole", "--workers", "1", "--quiet"]) == 0
     _same_runs(Store(tmp_path / "s"), Store(tmp_path / "whole"))
+
+
+@pytest.mark.parametrize("when", ["before", "after"])
+def test_a_stop_during_a_commit_leaves_the_part_committed_once(when, tmp_path, capsys, monkeypatch):
+    """Ctrl-C while the first part (20 runs) is being written, before or after its commit record: its runs
+    are committed (once: no "already committed" error), and the sweep stops."""
+    (tmp_path / "long.toml").write_text(LONG)
+    real, calls = Store.write_part, []
+
+    def write_part(self, *args, **kw):
+        calls.append(1)
+        if len(calls) == 1 and when == "before":
+            raise KeyboardInterrupt
+        real(self, *args, **kw)
+        if len(calls) == 1:
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(Store, "write_part", write_part)
+    monkeypatch.chdir(tmp_path)
+    assert main(["sweep", "long.toml", "--out", "s", "--workers", "1", "--quiet"]) == 130
+    err = capsys.readouterr().err
+    assert err.startswith("infomarket: error: interrupted: 20 of 80 runs committed in s;"), err
+    assert sorted(Store(tmp_path / "s").runs().run) == list(range(20))
 
 
 def test_ctrl_c_of_a_pool_sweep_commits_the_runs_its_workers_had_finished(tmp_path, procs):

@@ -40,6 +40,7 @@ from ..engine.simulation import Simulation
 from ..engine.specialise import kernel_id
 from ..checks import explain, explain_compile_failure
 from ..errors import InfomarketError, RuleRunError
+from .partial import Keep
 from .plan import Condition
 
 MAX_ERROR_CHARS = 4000
@@ -204,6 +205,20 @@ class Task:
     def size(self) -> int:
         """The number of runs in the task, over all its members."""
         return sum(len(r) for _, r in self.members)
+
+    def first(self, count: int) -> Task | None:
+        """The task of this one's first ``count`` runs (in its members' order), or None when ``count`` is 0:
+        what a stop left finished of it (``partial``)."""
+        members, left = [], count
+        for c, runs in self.members:
+            if left <= 0:
+                break
+            members.append((c, runs[:left]))
+            left -= len(runs)
+        if not members:
+            return None
+        (c, runs), *more = members
+        return Task(c, runs, tuple(more))
 
     @property
     def part_id(self) -> str:
@@ -401,36 +416,35 @@ def execute(tasks: list[Task], finished: Callable[[Task, list[RunOutput]], None]
     first task goes to another process.  On any exception, Ctrl-C included, tasks not yet started are
     cancelled and the exception propagates; tasks already finished have been handed to ``finished``.
     ``keep_partial``: on a stop, the finished runs of the tasks in progress are handed to ``finished`` too,
-    as tasks of those runs (``partial``; inline or on a local pool: a Dask worker's disk is not this one's).
+    as tasks of those runs (``partial``; inline or on a local pool: a Dask worker's disk is not this one's),
+    and a task whose ``finished`` the stop cut short is handed again (``finished`` must allow it).
     Returns the seconds spent warming up."""
-    from .partial import Keep  # here: partial builds on this module's Task
-
     if not tasks:
         return 0.0
     if executor is None or isinstance(executor, InlineExecutor):  # no other process: nothing to warm
         for t in tasks:
-            keep = Keep(None, t.size) if keep_partial else None
+            keep, out = (Keep(None, t.size) if keep_partial else None), None
             try:
                 out = run_calls(_calls(t, record_events), keep)
+                finished(t, out)
             except KeyboardInterrupt:
-                if keep is not None:
-                    _hand_partial(t, keep.kept(), finished)
+                if keep is not None:  # the runs finished, or the whole task if the stop cut its commit short
+                    _hand_partial(t, keep.kept() if out is None else out, finished)
                 raise
-            finished(t, out)
             interrupts.check()
         return 0.0
     warm_seconds = sum(warm_up(c.config for t in tasks for c, _ in t.members).values())
     folder = (Path(tempfile.mkdtemp(prefix="infomarket-runs-")) if keep_partial and
               isinstance(executor, ProcessPoolExecutor) else None)
     futures: dict[Future, tuple[Task, Keep | None]] = {}
-    handed: set[Future] = set()
+    handed: set[Future] = set()  # ``finished`` returned for these
     try:
         for k, t in enumerate(tasks):
             keep = Keep(folder / str(k), t.size) if folder is not None else None
             futures[executor.submit(run_calls, _calls(t, record_events), keep)] = (t, keep)
         for fut in as_completed(futures):  # the wait is interrupted by a signal at once
-            handed.add(fut)  # once: a stop inside ``finished`` leaves its part committed or not, never twice
             finished(futures[fut][0], fut.result())
+            handed.add(fut)
             interrupts.check()
     except BaseException as exc:  # noqa: BLE001 - the pending runs are cancelled, then it is raised again as a stop
         for f in futures:
@@ -446,7 +460,8 @@ def execute(tasks: list[Task], finished: Callable[[Task, list[RunOutput]], None]
 
 def _keep_finished(futures: dict, handed: set, finished: Callable[[Task, list[RunOutput]], None]) -> None:
     """After a stop: every task done but not yet handed over, and the finished runs of the others, to
-    ``finished``."""
+    ``finished``.  A task whose ``finished`` the stop cut short is handed over again: ``finished`` must then
+    leave a part it had committed as it is (the sweep's does)."""
     for fut, (task, keep) in futures.items():
         if fut in handed:
             continue
@@ -457,9 +472,7 @@ def _keep_finished(futures: dict, handed: set, finished: Callable[[Task, list[Ru
 
 
 def _hand_partial(task: Task, outputs: list[RunOutput], finished: Callable[[Task, list[RunOutput]], None]) -> None:
-    from .partial import prefix  # here: partial builds on this module's Task
-
-    part = prefix(task, outputs)
+    part = task.first(len(outputs))
     if part is not None:
         finished(part, outputs)
 

@@ -6,8 +6,8 @@ progress (about 40 runs a task on a long sweep).  ``Keep`` takes each group as i
 the task runs in this process, else a file per group in a folder of this machine (a local pool's workers
 are forks of this process), each written whole and then renamed, so the parent, stopped, reads only whole
 groups even while a worker is still writing.  The parent then commits those runs as a part of their own
-(``prefix``): its id names its own runs, so a resumed sweep's parts, made of the runs still missing, never
-collide with it, and every run keeps the seed it would have had.
+(``Task.first``): its id names its own runs, so a resumed sweep's parts, made of the runs still missing,
+never collide with it, and every run keeps the seed it would have had.
 """
 from __future__ import annotations
 
@@ -15,22 +15,21 @@ import os
 import pickle
 from pathlib import Path
 
-from .execute import RunOutput, Task
-
-__all__ = ["Keep", "prefix"]
+__all__ = ["Keep"]
 
 
 class Keep:
-    """Where a task's finished groups of runs go (``run_calls``' ``keep``): a list here (``folder`` None:
-    the task runs in this process) or one file per group in ``folder`` (a pool worker's copy writes, the
-    parent's reads).  The task's last group is not kept: the task's own result holds it."""
+    """Where a task's finished groups of runs (lists of ``execute.RunOutput``) go (``run_calls``' ``keep``):
+    a list here (``folder`` None: the task runs in this process) or one file per group in ``folder`` (a pool
+    worker's copy writes, the parent's reads).  The task's last group is not kept: the task's own result
+    holds it."""
 
     def __init__(self, folder: Path | None, total: int):
         self.folder, self.total = folder, total
-        self.groups: list[list[RunOutput]] = []
+        self.groups: list[list] = []
         self.seen = 0
 
-    def __call__(self, outputs: list[RunOutput]) -> None:
+    def __call__(self, outputs: list) -> None:
         """Keep ``outputs``, the next group of the task's runs, in order."""
         self.seen += len(outputs)
         if self.seen >= self.total:
@@ -44,25 +43,10 @@ class Keep:
         tmp.write_bytes(pickle.dumps(outputs, protocol=pickle.HIGHEST_PROTOCOL))
         os.replace(tmp, path)
 
-    def kept(self) -> list[RunOutput]:
+    def kept(self) -> list:
         """The outputs of the groups kept so far, in the task's order."""
         if self.folder is None:
             return [o for g in self.groups for o in g]
         if not self.folder.is_dir():
             return []
         return [o for path in sorted(self.folder.glob("*.pkl")) for o in pickle.loads(path.read_bytes())]
-
-
-def prefix(task: Task, outputs: list[RunOutput]) -> Task | None:
-    """The task made of the runs that ``outputs`` hold (the first ``len(outputs)`` runs of ``task``, in
-    its members' order), or None when there are none."""
-    members, left = [], len(outputs)
-    for c, runs in task.members:
-        if left <= 0:
-            break
-        members.append((c, runs[:left]))
-        left -= len(runs)
-    if not members:
-        return None
-    (c, runs), *more = members
-    return Task(c, runs, tuple(more))

@@ -249,6 +249,8 @@ def _run(conds, store, workers, executor, on_done, on_plan, record_events, on_pa
 
     def finished(task: Task, outputs: list[RunOutput]) -> None:
         nonlocal env_steps, compile_seconds, run_seconds
+        if store.part_path("runs", task.part_id).exists():  # handed again after a stop cut its commit short
+            return
         tables = _frames(task, outputs)
         keys = dict.fromkeys(k for c, _ in task.members for k in c.keys)
         store.write_part(task.part_id, **tables, keys=keys)
