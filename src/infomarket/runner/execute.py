@@ -181,7 +181,7 @@ def _alone(cfg: Experiment, items: list[tuple[int, int]], record_events: bool) -
 def run_calls(calls: list[tuple], keep: Callable[[list[RunOutput]], None] | None = None) -> list[RunOutput]:
     """``run_chunk`` for each (configuration, items, record_events) of one task, outputs in order; ``keep``
     gets each finished group of runs (``partial.Keep``)."""
-    return [o for call in calls for o in run_chunk(*call, keep=keep)]
+    return [o for cfg, items, record_events in calls for o in run_chunk(cfg, items, record_events, keep)]
 
 
 # ------------------------------------------------------------------------------------------ tasks
