@@ -306,3 +306,21 @@ def test_a_message_names_its_path_once(tmp_path, capsys):
     assert main(["run", "fig2B", "--runs", "1", "--steps", "10", "--out", str(tmp_path / "s"), "--quiet"]) == 0
     line = refused(capsys, ["sensitivity", str(tmp_path / "s"), "--out", str(tmp_path / "r")], "sampled design")
     assert line.count(str(tmp_path / "s")) == 1, line
+
+
+
+def test_the_declared_seed_refusal_is_one_short_line_naming_the_seed_and_what_differs():
+    """A reduced run with the study's declared seed is refused in one line of at most 160 characters (it ran to
+    about 300): the seed, what differs by name, as many as fit and how many more.  (The search's own test
+    checks the line the command prints.)"""
+    from infomarket.analysis.study import seed_refusal
+
+    reductions = ["2 of 8 cells", "--steps 1500 (declared 15000)", "--budget 4 (declared 96)", "--reduced"]
+    assert seed_refusal(61001, reductions) == ("--seed 61001 is the declared study's own; this run differs in "
+                                               "2 of 8 cells, --steps, --budget, --reduced: give another --seed")
+    many = [f"--option-{i} {i} (declared {i + 1})" for i in range(20)]
+    line = seed_refusal(2**63 - 1, ["1 of 8 cells", *many])
+    assert line == (f"--seed {2**63 - 1} is the declared study's own; this run differs in 1 of 8 cells, "
+                    "--option-0, --option-1, --option-2 and 17 more: give another --seed")
+    assert len(line) == 76 + 12 + 3 * 12 + 12 + 21 == 157  # head, the cells, three options, how many more, tail
+    assert len(seed_refusal(7, ["x" * 1000])) <= 160

@@ -114,6 +114,30 @@ def test_rl_train_checks_its_out_before_training(tmp_path, capsys, monkeypatch):
                      "--out", str(tmp_path / "r.json")], "--out", "Read-only")
 
 
+@pytest.mark.parametrize("option, name", [("--out", "r.html"), ("--movie", "r.gif")])
+@pytest.mark.parametrize("where, words", [("read-only", ["Read-only"]), ("under a file", ["not a folder"]),
+                                          ("a folder", ["is a directory"])])
+def test_replay_checks_its_files_before_recording(option, name, where, words, tmp_path, capsys, monkeypatch):
+    """Each file replay writes is checked before the run is recorded, and named for what is wrong with it."""
+    import tempfile
+
+    from infomarket.viewer import recording
+
+    target = tmp_path / name
+    if where == "read-only":
+        def read_only(*args, **kwargs):
+            raise OSError(errno.EROFS, os.strerror(errno.EROFS))
+
+        monkeypatch.setattr(tempfile, "TemporaryFile", read_only)
+    elif where == "under a file":
+        (tmp_path / "file").write_text("x")
+        target = tmp_path / "file" / name
+    else:
+        target.mkdir()
+    monkeypatch.setattr(recording, "record", never)
+    refused(capsys, ["replay", "fig2B", "--steps", "20", option, str(target)], option, str(target), *words)
+
+
 # ------------------------------------------------------------------ the Python API: arguments named
 @pytest.mark.parametrize("steps", [-5, "x", 0, 2.5, True, 10**30, 2**63, [10]])
 def test_simulate_names_steps(steps, fig2b):

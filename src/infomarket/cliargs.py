@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import errno
 import os
 import re
 import sys
@@ -10,8 +11,8 @@ from pathlib import Path
 
 from .errors import UsageError, printable, report
 
-__all__ = ["Parser", "UsageError", "at_least", "fraction", "scheduler_address", "seed_value", "workers_count",
-           "writable_dir", "writable_file"]
+__all__ = ["Parser", "UsageError", "at_least", "creatable_dir", "fraction", "scheduler_address", "seed_value",
+           "workers_count", "writable_dir", "writable_file"]
 
 
 class Parser(argparse.ArgumentParser):
@@ -39,6 +40,30 @@ def writable_dir(path: str | Path, option: str = "--out") -> Path:
     return path
 
 
+def creatable_dir(path: str | Path, option: str = "--out") -> Path:
+    """Check that folder ``path`` could be created (or, existing, written to) and create nothing: for a
+    command that must still refuse its input after this check, and leaves no empty folder when it does.
+    The nearest existing folder above ``path`` must take new files, and each missing name must fit."""
+    path = Path(path)
+    try:
+        if path.exists() and not path.is_dir():
+            raise UsageError(f"{option} {path}: exists and is not a directory")
+        probe, missing = path, []
+        while not probe.exists() and probe != probe.parent:
+            missing.append(probe.name)
+            probe = probe.parent
+        if not probe.is_dir():
+            raise UsageError(f"{option} {path}: {probe} is not a folder; choose another path")
+        longest = os.pathconf(probe, "PC_NAME_MAX") if hasattr(os, "pathconf") else 255
+        if any(len(os.fsencode(name)) > longest for name in missing):
+            raise OSError(errno.ENAMETOOLONG, os.strerror(errno.ENAMETOOLONG))
+        with tempfile.TemporaryFile(dir=probe):
+            pass
+    except OSError as exc:  # a read-only or full folder, a name too long
+        raise UsageError(f"{option} {path}: cannot write there ({exc.strerror or exc})") from None
+    return path
+
+
 def writable_file(path: str | Path, option: str = "--out") -> Path:
     """Check that file ``path`` can be written (its folder exists and takes new files; an existing file is
     writable), before any work; creates nothing."""
@@ -46,6 +71,8 @@ def writable_file(path: str | Path, option: str = "--out") -> Path:
     if path.is_dir():
         raise UsageError(f"{option} {path}: is a directory; give a file name")
     folder = path.parent
+    if folder.exists() and not folder.is_dir():
+        raise UsageError(f"{option} {path}: {folder} is not a folder; give a file name in an existing folder")
     if not folder.is_dir():
         raise UsageError(f"{option} {path}: the folder {folder} does not exist; give a file name in an existing folder")
     try:

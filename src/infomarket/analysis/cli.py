@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import argparse
 
-from ..cliargs import writable_dir
+from ..cliargs import creatable_dir
 
 
 def add_subcommand(subparsers) -> None:
@@ -27,17 +27,19 @@ def cmd_figures(args: argparse.Namespace) -> int:
     """Exit 0 when the report is written, whatever the verdicts: a failed row is a finding, not an error."""
     # the analysis and matplotlib load when the command runs, not when the CLI starts
     from ..store import Store
-    from .frames import Frames
+    from .frames import Frames, store_meta
     from .report import build_report
     from .study import out_dir
 
     out = out_dir(args.out)
-    # raises StoreError for a missing or foreign folder, StoreDamaged (naming the repair) for a damaged one
     store = Store(args.store)
-    frames = Frames.of(store)
+    store_meta(store)  # a missing or foreign folder is named first
+    # before the tables are read (a big store takes a while), and creating nothing: a damaged store, refused
+    # next, leaves no empty --out behind
+    creatable_dir(out)
+    frames = Frames.of(store)  # StoreDamaged, naming the repair, for a damaged part
     echo = (lambda *a, **k: None) if getattr(args, "quiet", False) else print
     if frames.robots.empty and frames.history.empty:
         echo(f"{args.store}: the store holds no completed runs; writing an empty report")
-    writable_dir(out)
     build_report(frames, out, vector=args.vector, echo=echo, label=str(args.store), store=store)
     return 0

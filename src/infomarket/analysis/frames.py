@@ -64,15 +64,25 @@ class Frames:
         Raises:
             StoreError: the folder is missing, is not a store, or its ``store.json`` is unreadable.
         """
-        if not store.root.exists():
-            raise StoreError(f"{store.root}: no such folder")
-        if not store.exists():
-            raise StoreError(f"{store.root}: not an infomarket results store (no store.json)")
-        try:
-            meta = json.loads(store.meta_path.read_text())
-        except (OSError, ValueError) as exc:
-            raise StoreError(f"{store.meta_path}: unreadable ({exc})") from None
+        meta = store_meta(store)
         return cls(robots=store.robots(), history=store.history(), runs=store.runs(), meta=meta)
+
+
+def store_meta(store: Store) -> dict:
+    """The store's ``store.json``, read before its tables: the quick check that the folder is a readable
+    store, so a command names a wrong path before it checks its other arguments or reads the tables.
+
+    Raises:
+        StoreError: the folder is missing, is not a store, or its ``store.json`` is unreadable.
+    """
+    if not store.root.exists():
+        raise StoreError(f"{store.root}: no such folder")
+    if not store.exists():
+        raise StoreError(f"{store.root}: not an infomarket results store (no store.json)")
+    try:
+        return json.loads(store.meta_path.read_text())
+    except (OSError, ValueError) as exc:
+        raise StoreError(f"{store.meta_path}: unreadable ({exc})") from None
 
 
 def experiment(table: pd.DataFrame, name: str) -> pd.DataFrame:

@@ -6,7 +6,11 @@ same ``Report`` so they never disagree.
 """
 from __future__ import annotations
 
+import contextlib
 import html
+import os
+import shutil
+import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -67,8 +71,34 @@ def build_report(source, out: str | Path, *, vector: str = "svg", label: str | N
     ``source`` is anything ``Frames.of`` reads; ``label`` names it in the report (default: its path).
     ``store`` (or ``source`` when it is a store): its sampled designs get a global-sensitivity section."""
     out = Path(out)
+    created = not out.exists()
     out.mkdir(parents=True, exist_ok=True)
-    label = label or _label(source)
+    # drawn into a staging folder inside ``out`` and moved in once every file is written: a full disk or a
+    # stop half-way leaves ``out`` as it was (an older report whole), never a part of a new set beside it
+    staging = Path(tempfile.mkdtemp(prefix=".report-", suffix=".part", dir=out))
+    try:
+        report = _draw(source, staging, vector, label or _label(source), echo, store)
+        for path in sorted(staging.iterdir()):
+            os.replace(path, out / path.name)
+    except BaseException:
+        shutil.rmtree(staging, ignore_errors=True)
+        if created:
+            with contextlib.suppress(OSError):  # only if still empty
+                out.rmdir()
+        raise
+    staging.rmdir()
+    report.files = [out / p.name for p in report.files]
+    for r in report.figures:
+        r.files = [out / p.name for p in r.files]
+    if report.future is not None:
+        report.future.figures = [(n, c, [out / p.name for p in files], note)
+                                 for n, c, files, note in report.future.figures]
+    echo(f"wrote {', '.join(str(p) for p in report.files)}")
+    return report
+
+
+def _draw(source, out: Path, vector: str, label: str, echo: Callable[[str], None], store: Store | None) -> Report:
+    """``build_report``'s work, every file written into ``out`` (its staging folder)."""
     frames = Frames.of(source)
     incomplete = gaps(frames.runs)
     for gap in incomplete.values():
@@ -100,7 +130,6 @@ def build_report(source, out: str | Path, *, vector: str = "svg", label: str | N
     echo(f"paper vs this store: {_counts_text(report)}")
     for name, text in (("report.md", to_markdown(report)), ("report.html", to_html(report))):
         report.files.append(write_text_atomic(text, out / name, "utf-8"))
-    echo(f"wrote {', '.join(str(p) for p in report.files)}")
     return report
 
 

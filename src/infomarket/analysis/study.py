@@ -307,9 +307,34 @@ def refuse_declared_seed(seed: int, declared: int, reductions: list[str]) -> Non
     cells: ``reductions`` says how) must take another seed.  The whole study may still be made in several
     invocations: it resumes from its store, every invocation the whole study."""
     if reductions and seed == declared:
-        raise UsageError(f"--seed {seed} is the study's declared seed, and this run is not the whole declared "
-                         f"study ({'; '.join(reductions)}): its confirmation runs would be the study's own, seen "
-                         f"before the study; give another --seed (only the whole declared study may use it)")
+        raise UsageError(seed_refusal(seed, reductions))
+
+
+def seed_refusal(seed: int, reductions: list[str], most: int = 160) -> str:
+    """The refusal in one line of at most ``most`` characters: the seed, then what differs from the declared
+    study by name (an option, without its values; "2 of 8 cells"), as many as fit and how many more.  Why
+    the seed is kept is the docstring's and the docs' to say, not the error line's."""
+    names = list(dict.fromkeys(_difference(r) for r in reductions))
+    head = f"--seed {seed} is the declared study's own; this run differs in "
+    tail = ": give another --seed"
+    shown = len(names)
+    while shown > 1 and len(_listed(head, names, shown, tail)) > most:
+        shown -= 1
+    line = _listed(head, names, shown, tail)
+    return line if len(line) <= most else line[:most - len(tail) - 1] + "…" + tail
+
+
+def _difference(reduction: str) -> str:
+    """A difference by its name: ``--steps 400 (declared 15000)`` -> ``--steps``; other kinds cut to 24
+    characters."""
+    if reduction.startswith("--"):
+        return reduction.split()[0]
+    return reduction if len(reduction) <= 24 else reduction[:23] + "…"
+
+
+def _listed(head: str, names: list[str], shown: int, tail: str) -> str:
+    more = len(names) - shown
+    return head + ", ".join(names[:shown]) + (f" and {more} more" if more else "") + tail
 
 
 def questions_path(value: str | Path | None, default: Path) -> Path:

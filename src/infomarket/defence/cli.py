@@ -92,7 +92,7 @@ def cmd_defence_search(args) -> int:
     smaller = _reductions(st, declared, args)
     parts = ("families ", "Byzantine counts ")  # a part of the study, with its declared settings
     refuse_declared_seed(st.settings.seed, declared.settings.seed,
-                         ([args.reduced] if args.reduced else []) + [r for r in smaller if not r.startswith(parts)])
+                         (["--reduced"] if args.reduced else []) + [r for r in smaller if not r.startswith(parts)])
     reduced = "; ".join(([args.reduced] if args.reduced else []) + smaller)
     client = dask_client(args.dask) if args.dask else None
     store = Store(out / "store", cache=True)

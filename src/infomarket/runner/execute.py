@@ -18,13 +18,16 @@ from __future__ import annotations
 import math
 import multiprocessing
 import os
+import shutil
 import sys
+import tempfile
 import time
 import traceback
 from collections.abc import Callable, Iterable
 from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
 from contextlib import contextmanager
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -37,6 +40,7 @@ from ..engine.simulation import Simulation
 from ..engine.specialise import kernel_id
 from ..checks import explain, explain_compile_failure
 from ..errors import InfomarketError, RuleRunError
+from .partial import Keep
 from .plan import Condition
 
 MAX_ERROR_CHARS = 4000
@@ -136,10 +140,12 @@ def _failed(run: int, seed: int, exc: BaseException) -> RunOutput:
     return RunOutput(run, seed, empty, empty, empty, empty, error=text, rule_error=isinstance(exc, RuleRunError))
 
 
-def run_chunk(cfg: Experiment, items: list[tuple[int, int]], record_events: bool = False) -> list[RunOutput]:
+def run_chunk(cfg: Experiment, items: list[tuple[int, int]], record_events: bool = False,
+              keep: Callable[[list[RunOutput]], None] | None = None) -> list[RunOutput]:
     """Run ``items`` (run, seed) of ``cfg`` in this process, up to ``TOGETHER`` at a time in one compiled
     call (``run_together``); a run that raises becomes a RunOutput with its error text and the others
-    still run (its group is run again one run at a time).  Ctrl-C (KeyboardInterrupt) is not caught."""
+    still run (its group is run again one run at a time).  Ctrl-C (KeyboardInterrupt) is not caught.
+    ``keep(outputs)`` gets each group's outputs as it finishes (``partial.Keep``)."""
     try:
         for entry in cfg.plugins:  # rules registered by plugins must exist in this worker too
             plugins.load(entry)
@@ -151,11 +157,14 @@ def run_chunk(cfg: Experiment, items: list[tuple[int, int]], record_events: bool
         group = items[k:k + size]
         if len(group) > 1:
             try:
-                out += run_together(cfg, group, record_events)
-                continue
+                done = run_together(cfg, group, record_events)
             except Exception:  # noqa: BLE001 - run alone, so each run's error is its own and the others go on
-                pass
-        out += _alone(cfg, group, record_events)
+                done = _alone(cfg, group, record_events)
+        else:
+            done = _alone(cfg, group, record_events)
+        out += done
+        if keep is not None:
+            keep(done)
     return out
 
 
@@ -169,9 +178,10 @@ def _alone(cfg: Experiment, items: list[tuple[int, int]], record_events: bool) -
     return out
 
 
-def run_calls(calls: list[tuple]) -> list[RunOutput]:
-    """``run_chunk`` for each (configuration, items, record_events) of one task, outputs in order."""
-    return [o for call in calls for o in run_chunk(*call)]
+def run_calls(calls: list[tuple], keep: Callable[[list[RunOutput]], None] | None = None) -> list[RunOutput]:
+    """``run_chunk`` for each (configuration, items, record_events) of one task, outputs in order; ``keep``
+    gets each finished group of runs (``partial.Keep``)."""
+    return [o for cfg, items, record_events in calls for o in run_chunk(cfg, items, record_events, keep)]
 
 
 # ------------------------------------------------------------------------------------------ tasks
@@ -195,6 +205,20 @@ class Task:
     def size(self) -> int:
         """The number of runs in the task, over all its members."""
         return sum(len(r) for _, r in self.members)
+
+    def first(self, count: int) -> Task | None:
+        """The task of this one's first ``count`` runs (in its members' order), or None when ``count`` is 0:
+        what a stop left finished of it (``partial``)."""
+        members, left = [], count
+        for c, runs in self.members:
+            if left <= 0:
+                break
+            members.append((c, runs[:left]))
+            left -= len(runs)
+        if not members:
+            return None
+        (c, runs), *more = members
+        return Task(c, runs, tuple(more))
 
     @property
     def part_id(self) -> str:
@@ -386,32 +410,71 @@ def warm_up(configs: Iterable[Experiment]) -> dict[str, float]:
 
 # ---------------------------------------------------------------------------------------- execute
 def execute(tasks: list[Task], finished: Callable[[Task, list[RunOutput]], None], *,
-            executor: Executor | None = None, record_events: bool = False) -> float:
+            executor: Executor | None = None, record_events: bool = False, keep_partial: bool = False) -> float:
     """Run every task on ``executor`` (None: inline, in this process), calling ``finished(task, outputs)``
     here as each completes (in completion order).  Kernels are warmed up once per kernel id before the
     first task goes to another process.  On any exception, Ctrl-C included, tasks not yet started are
     cancelled and the exception propagates; tasks already finished have been handed to ``finished``.
+    ``keep_partial``: on a stop, the finished runs of the tasks in progress are handed to ``finished`` too,
+    as tasks of those runs (``partial``; inline or on a local pool: a Dask worker's disk is not this one's),
+    and a task whose ``finished`` the stop cut short is handed again (``finished`` must allow it).
     Returns the seconds spent warming up."""
     if not tasks:
         return 0.0
     if executor is None or isinstance(executor, InlineExecutor):  # no other process: nothing to warm
         for t in tasks:
-            finished(t, run_calls(_calls(t, record_events)))
+            keep, out = (Keep(None, t.size) if keep_partial else None), None
+            try:
+                out = run_calls(_calls(t, record_events), keep)
+                finished(t, out)
+            except KeyboardInterrupt:
+                if keep is not None:  # the runs finished, or the whole task if the stop cut its commit short
+                    _hand_partial(t, keep.kept() if out is None else out, finished)
+                raise
             interrupts.check()
         return 0.0
     warm_seconds = sum(warm_up(c.config for t in tasks for c, _ in t.members).values())
-    futures: dict[Future, Task] = {}
+    folder = (Path(tempfile.mkdtemp(prefix="infomarket-runs-")) if keep_partial and
+              isinstance(executor, ProcessPoolExecutor) else None)
+    futures: dict[Future, tuple[Task, Keep | None]] = {}
+    handed: set[Future] = set()  # ``finished`` returned for these
     try:
-        for t in tasks:
-            futures[executor.submit(run_calls, _calls(t, record_events))] = t
+        for k, t in enumerate(tasks):
+            keep = Keep(folder / str(k), t.size) if folder is not None else None
+            futures[executor.submit(run_calls, _calls(t, record_events), keep)] = (t, keep)
         for fut in as_completed(futures):  # the wait is interrupted by a signal at once
-            finished(futures[fut], fut.result())
+            finished(futures[fut][0], fut.result())
+            handed.add(fut)
             interrupts.check()
     except BaseException as exc:  # noqa: BLE001 - the pending runs are cancelled, then it is raised again as a stop
         for f in futures:
             f.cancel()
+        if folder is not None and (isinstance(exc, KeyboardInterrupt) or interrupts.requested()):
+            _keep_finished(futures, handed, finished)
         interrupts.raise_stopped(exc)
+    finally:
+        if folder is not None:
+            shutil.rmtree(folder, ignore_errors=True)
     return warm_seconds
+
+
+def _keep_finished(futures: dict, handed: set, finished: Callable[[Task, list[RunOutput]], None]) -> None:
+    """After a stop: every task done but not yet handed over, and the finished runs of the others, to
+    ``finished``.  A task whose ``finished`` the stop cut short is handed over again: ``finished`` must then
+    leave a part it had committed as it is (the sweep's does)."""
+    for fut, (task, keep) in futures.items():
+        if fut in handed:
+            continue
+        if fut.done() and not fut.cancelled() and fut.exception() is None:
+            finished(task, fut.result())
+        elif keep is not None:
+            _hand_partial(task, keep.kept(), finished)
+
+
+def _hand_partial(task: Task, outputs: list[RunOutput], finished: Callable[[Task, list[RunOutput]], None]) -> None:
+    part = task.first(len(outputs))
+    if part is not None:
+        finished(part, outputs)
 
 
 def _calls(task: Task, record_events: bool) -> list[tuple]:

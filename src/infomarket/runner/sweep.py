@@ -249,6 +249,8 @@ def _run(conds, store, workers, executor, on_done, on_plan, record_events, on_pa
 
     def finished(task: Task, outputs: list[RunOutput]) -> None:
         nonlocal env_steps, compile_seconds, run_seconds
+        if store.part_path("runs", task.part_id).exists():  # handed again after a stop cut its commit short
+            return
         tables = _frames(task, outputs)
         keys = dict.fromkeys(k for c, _ in task.members for k in c.keys)
         store.write_part(task.part_id, **tables, keys=keys)
@@ -263,11 +265,12 @@ def _run(conds, store, workers, executor, on_done, on_plan, record_events, on_pa
         if on_done:
             on_done(task.size)
 
+    # keep_partial: a stop commits the finished runs of the parts in progress too (runner.partial)
     if executor is not None:
-        warm = execute(tasks, finished, executor=executor, record_events=record_events)
+        warm = execute(tasks, finished, executor=executor, record_events=record_events, keep_partial=True)
     else:
         with local_executor(max(1, min(workers, len(tasks)))) as pool:  # never more processes than tasks
-            warm = execute(tasks, finished, executor=pool, record_events=record_events)
+            warm = execute(tasks, finished, executor=pool, record_events=record_events, keep_partial=True)
     first = (failed[0].error or "").strip().splitlines()[-1] if failed else ""
     rule_errors = [o for o in failed if o.rule_error]
     if rule_errors:  # the clearest message: a rule's, named with its file, line and step

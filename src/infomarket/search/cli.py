@@ -118,8 +118,7 @@ def cmd_attack_search(args) -> int:
     first = chosen[0].with_attack({}, steps=args.steps, transitory=args.transitory)
     declared = study_mod.load(exp, data, path=path)
     smaller = _reductions(st, declared, exp, chosen, cells(st), args)
-    refuse_declared_seed(st.settings.seed, declared.settings.seed,
-                         ([args.reduced] if args.reduced else []) + smaller)
+    refuse_declared_seed(st.settings.seed, declared.settings.seed, (["--reduced"] if args.reduced else []) + smaller)
     reduced = "; ".join(([args.reduced] if args.reduced else []) + smaller)
     store = Store(out / "store", cache=True)  # read after every generation: each part read once
     store.refuse_foreign()

@@ -80,6 +80,8 @@ def check_movie_path(path: str | Path) -> Path:
     if path.suffix.lower() == ".mp4" and ffmpeg_path() is None:
         raise ConfigError(f"--movie {path}: writing .mp4 needs ffmpeg, and none was found "
                           "(pip install imageio-ffmpeg, or install ffmpeg); a .gif needs nothing more")
+    if path.parent.exists() and not path.parent.is_dir():
+        raise ConfigError(f"--movie {path}: {path.parent} is not a folder; give a file name in an existing folder")
     if not path.parent.is_dir():
         raise ConfigError(f"--movie {path}: folder {path.parent} does not exist")
     return path
