@@ -67,18 +67,6 @@ def next_younger(w, me, nbrs, site, after):
     return s
 
 
-@njit(cache=True)
-def younger_offers(w, me, nbrs, site):
-    """The offers a buy rule walks for ``site``: ``for s in younger_offers(w, me, nbrs, site):`` yields
-    each candidate in (offered age, id) order while its offer is younger than the robot's current entry
-    (``next_younger``).  The entry is read again before each candidate, so a purchase the rule has just
-    combined in raises the bar for the next; ``break`` ends the walk (one purchase per site)."""
-    s = next_younger(w, me, nbrs, site, -1)
-    while s >= 0:
-        yield s
-        s = next_younger(w, me, nbrs, site, s)
-
-
 @njit(forceinline=True, cache=True)
 def buy(w, me, seller, site):
     """Buy the seller's offer for ``site``: (ok, x, y, age), the vector in the buyer's frame.

@@ -2,7 +2,7 @@
 filtered by reputation, and two attacks aimed at reputation-based defences.  (Registered by
 ``infomarket.builtins``; docs/research.md explains them and what the ``future`` sweep found.)"""
 from ..engine.geometry import rotate
-from .api import buy, combine, confirm_or_wait, current, diff, own_entry, pending_clear, pending_has, younger_offers
+from .api import buy, combine, confirm_or_wait, current, diff, next_younger, own_entry, pending_clear, pending_has
 from .market import sales_settled, seller_reputation, wealth_share
 
 
@@ -14,7 +14,11 @@ def reputation_sceptic_buy(w, me, nbrs, threshold=0.25, trust_reputation=0.85, t
     ``trust_reputation``, or a wealth share of at least ``trust_share``, is believed without a second
     confirmation; anyone else is treated exactly as the sceptical robot treats every seller."""
     for site in range(2):
-        for s in younger_offers(w, me, nbrs, site):
+        s = -1
+        while True:
+            s = next_younger(w, me, nbrs, site, s)
+            if s < 0:
+                break
             valid, ox, oy, oage = current(w, me, site)
             if pending_has(w, me, site, s):
                 continue

@@ -2,7 +2,7 @@
 (Registered as ``sceptical`` by ``infomarket.builtins``.)"""
 from ..jit import njit
 
-from .api import buy, combine, confirm_or_wait, current, diff, pending_clear, pending_has, younger_offers
+from .api import buy, combine, confirm_or_wait, current, diff, next_younger, pending_clear, pending_has
 
 
 def sceptical_buy(w, me, nbrs, threshold=0.25):
@@ -17,7 +17,11 @@ def sceptical_buy(w, me, nbrs, threshold=0.25):
 def sceptical_site(w, me, nbrs, site, threshold, ignore_kind):
     """The sceptical rule for one site, never buying from sellers of behaviour kind ``ignore_kind`` (-1:
     none; colluders pass their own, ``behaviours.attacks``)."""
-    for s in younger_offers(w, me, nbrs, site):
+    s = -1
+    while True:
+        s = next_younger(w, me, nbrs, site, s)
+        if s < 0:
+            break
         valid, ox, oy, oage = current(w, me, site)
         if w.kind[s] == ignore_kind or pending_has(w, me, site, s):
             continue

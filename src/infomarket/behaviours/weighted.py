@@ -1,7 +1,7 @@
 """A defence by continuous trust: honest robots that average bought information in with a weight that
 grows with the seller's reputation, instead of the sceptic's yes/no confirmation.
 (Registered as ``reputation_weighted`` by ``infomarket.builtins``.)"""
-from .api import buy, current, install, younger_offers
+from .api import buy, current, install, next_younger
 from .market import seller_reputation
 
 
@@ -12,7 +12,11 @@ def reputation_weighted_buy(w, me, nbrs, power=2.0):
     one with a clean record counts as the paper's weighting says.  An invalid entry takes the purchase;
     ``power`` = 0 is the naive robot."""
     for site in range(2):
-        for s in younger_offers(w, me, nbrs, site):
+        s = -1
+        while True:
+            s = next_younger(w, me, nbrs, site, s)
+            if s < 0:
+                break
             valid, ox, oy, oage = current(w, me, site)
             ok, x, y, age = buy(w, me, s, site)
             if not ok:
