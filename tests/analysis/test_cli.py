@@ -80,7 +80,7 @@ def _full_disk_at(name: str, monkeypatch):
     savefig = Figure.savefig
 
     def full_disk(self, fname, *args, **kwargs):
-        if Path(fname).name.startswith(name):
+        if Path(fname).name.lstrip(".").startswith(name):  # the atomic writer's temporary name too
             raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(fname))
         return savefig(self, fname, *args, **kwargs)
 
