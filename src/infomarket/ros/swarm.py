@@ -27,7 +27,7 @@ from ..evm.units import to_units
 from . import launch
 from .faults import Faults
 from .hostile import Hostile
-from .world import Trader, World
+from .world import RETRY, Trader, World
 
 
 def prepare(experiment: str, robots: int, steps: int, scheme: str, faults: Faults):
@@ -50,19 +50,34 @@ def prepare(experiment: str, robots: int, steps: int, scheme: str, faults: Fault
 class Swarm:
     """The run's processes and state; ``run()`` returns the report, ``close()`` ends every process."""
 
-    def __init__(self, config, params, seed: int, out: Path, rpc: str | None, faults: Faults):
+    def __init__(self, config, params, seed: int, out: Path, rpc: str | None, faults: Faults, *,
+                 per_process: int = 1, controlled: list[int] = (), controller_timeout: float | None = None,
+                 retry: float = RETRY):
         self.config, self.params, self.seed, self.out, self.rpc, self.faults = config, params, seed, out, rpc, faults
         self.n = config.swarm.robots
+        #: the robots each agent process hosts (one each by default)
+        self.groups = [list(range(i, min(i + per_process, self.n))) for i in range(0, self.n, per_process)]
+        self.controlled, self.controller_timeout = set(controlled), controller_timeout
+        for robots in self.groups:
+            if 0 < len(self.controlled.intersection(robots)) < len(robots):
+                raise ConfigError(f"robots {robots} share an agent process: --controlled names all of them or none")
+        self.retry = retry
         self.node = None
-        self.agents: list = []
+        self.agents: list = []  # one process per group
         self.world = None
         self.restarted = 0
         self.welcomed: dict[int, str] = {}
 
-    def _agent(self, robot: int):
-        folder = self.out / "agents" / f"robot_{robot}"
-        argv = launch.agent_argv(robot, folder, self.rpc, self.market.address, self.faults.drop, self.seed)
-        return launch.start(argv, self.out / "agents" / f"robot_{robot}.log")
+    def _agent(self, group: int):
+        """Start the process of group ``group`` (a robot's agent, or several robots' in one process)."""
+        robots = self.groups[group]
+        controlled = [r in self.controlled for r in robots]
+        argv = launch.agent_argv(robots, self.out / "agents", self.rpc, self.market.address, self.faults.drop,
+                                 self.seed, all(controlled), self.controller_timeout)
+        return launch.start(argv, self.out / "agents" / launch.log_name(robots))
+
+    def _group_of(self, robot: int) -> int:
+        return next(g for g, robots in enumerate(self.groups) if robot in robots)
 
     def _check(self) -> None:
         """Welcome every agent that says hello (again, after a restart); fail if one died by itself."""
@@ -72,10 +87,10 @@ class Swarm:
                 raise SimulationError(f"robot {robot}'s agent came back with another key ({hello['address']})")
             self.welcomed.setdefault(robot, hello["address"])
             self.world.send_task(robot, {"kind": "welcome"})
-        for robot, proc in enumerate(self.agents):
+        for robots, proc in zip(self.groups, self.agents):
             if proc.poll() is not None:
-                raise SimulationError(f"robot {robot}'s agent exited with status {proc.returncode}; see "
-                                   f"{self.out / 'agents' / f'robot_{robot}.log'}")
+                raise SimulationError(f"the agent process of robots {robots} exited with status "
+                                      f"{proc.returncode}; see {self.out / 'agents' / launch.log_name(robots)}")
 
     def run(self, say=print) -> dict:
         t0 = time.perf_counter()
@@ -85,13 +100,13 @@ class Swarm:
             say(f"chain node: Hardhat at {self.rpc} (up after {time.perf_counter() - t0:.1f} s)")
         chain = connect(self.rpc)
         self.market = market = ChainMarket.deploy(self.params, backend=chain, seed=self.seed)
-        say(f"market contract at {market.address}; starting {self.n} agent processes")
+        say(f"market contract at {market.address}; starting {len(self.groups)} agent processes for {self.n} robots")
         # A swarm of its own: another swarm on this machine (a parallel test, another user) must not
         # hear these topics. The agents inherit both variables.
         os.environ.setdefault("ROS_DOMAIN_ID", str(1 + os.getpid() % 100))
         os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
         self.world = world = World(self.n)
-        self.agents = [self._agent(i) for i in range(self.n)]
+        self.agents = [self._agent(g) for g in range(len(self.groups))]
         while len(self.welcomed) < self.n:
             world.spin()
             self._check()
@@ -101,7 +116,7 @@ class Swarm:
             market.grant_wealth(a, to_units(self.config.payment.initial_wealth))
         if self.faults.hostile:
             world.hostile = Hostile(world, market.domain, addresses)
-        trader = Trader(world, market, addresses, self.params, on_wait=self._check)
+        trader = Trader(world, market, addresses, self.params, on_wait=self._check, retry=self.retry)
         sim = Simulation(self.config, self.seed, record_events=True)
         say(f"agents registered ({', '.join(str(p.pid) for p in self.agents)}) after {time.perf_counter() - t0:.1f} s; "
             f"running {self.config.steps} steps")
@@ -136,8 +151,9 @@ class Swarm:
         robot = self.faults.kill[0]
 
         def kill(where: str) -> None:
-            launch.kill(self.agents[robot])
-            self.agents[robot] = self._agent(robot)
+            group = self._group_of(robot)
+            launch.kill(self.agents[group])
+            self.agents[group] = self._agent(group)
             self.restarted += 1
             say(f"step {step}: robot {robot}'s agent killed (SIGKILL) {where} and started again")
 
@@ -167,7 +183,8 @@ class Swarm:
             "robots": self.n, "steps": self.config.steps, "seed": self.seed, "rpc": self.rpc,
             "ros_domain_id": os.environ["ROS_DOMAIN_ID"],
             "market": market.address, "processes": len({p.pid for p in self.agents}),
-            "restarted_agents": self.restarted,
+            "restarted_agents": self.restarted, "robots_per_process": max(map(len, self.groups)),
+            "controlled": sorted(self.controlled), "declined": tally.declined,
             "light_contracts": sales, "refusals_confirmed": tally.refusals_confirmed,
             "deposits": len(tally.deposit_gas),
             "messages": {**tally.messages, "protocol": protocol,
