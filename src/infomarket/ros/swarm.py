@@ -172,6 +172,10 @@ class Swarm:
         market, tally = self.market, self.world.tally
         wealth = result.robots.sort_values("robot")["wealth"].to_numpy()
         rows = [BalanceRow(i, market.balance_of(a), float(wealth[i]), trader.bound[i]) for i, a in enumerate(addresses)]
+        # A sale's payout waits for the buyer's deposit: until then the chain must hold it as an open record
+        # of the buyer's round trip, naming its seller (a run without a deposit is checked by these too).
+        open_chain = [[c[0] for c in market.contributors(a)] for a in addresses]
+        open_engine = [[addresses[s] for s in sellers] for sellers in trader.open_sellers]
         sales = trader.sales
         gas_total = sum(tally.reveal_gas) + sum(tally.deposit_gas)
         protocol = sum(tally.messages[k] for k in ("offer", "acceptance", "deposit", "task", "done"))
@@ -195,13 +199,16 @@ class Swarm:
             "refused_messages": len(tally.refused_messages),
             "refused_examples": [r.get("what", "") + ": " + r.get("reason", "") for r in tally.refused_messages[:10]],
             "disagreements": tally.disagreements,
-            "on_chain_matches_engine": all(r.ok for r in rows) and not tally.disagreements,
+            "on_chain_matches_engine": all(r.ok for r in rows) and open_chain == open_engine and not tally.disagreements,
             "faults": {"kill": list(self.faults.kill) if self.faults.kill else None, "drop": self.faults.drop,
                        "hostile": self.faults.hostile},
             "wall_seconds": round(wall, 2), "seconds": {k: round(v, 2) for k, v in self.seconds.items()},
             "balances": [{"robot": r.robot, "address": addresses[r.robot], "on_chain": r.chain_units / 1e9,
                           "engine": r.expected, "diff_units": round(r.diff_units, 3), "bound_units": r.bound_units,
-                          "ok": r.ok} for r in rows],
+                          "ok": r.ok, "open_purchases": {"on_chain": len(open_chain[r.robot]),
+                                                         "engine": len(open_engine[r.robot]),
+                                                         "same_sellers": open_chain[r.robot] == open_engine[r.robot]}}
+                         for r in rows],
         }
 
     def close(self) -> None:
