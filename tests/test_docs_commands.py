@@ -56,6 +56,8 @@ NOT_RUN = {
         "as above; tests/ros/test_swarm.py kills an agent in the middle of a sale",
     "infomarket ros swarm fig4C --robots 6 --steps 2000 --seed 3 --out runs/drop --fault drop:0.05":
         "as above; tests/ros/test_swarm.py drops a fifth of the agents' messages",
+    "infomarket ros swarm fig4C --robots 3 --steps 750 --seed 18 --out runs/declined --controlled all "
+    "--agents-per-process 3": "needs the example controller running; tests/ros/test_controller.py runs it",
     "infomarket store verify STORE": "a placeholder store; verify is tested in tests/store/test_integrity.py",
     "infomarket store repair STORE": "a placeholder store; repair is tested in tests/store/test_integrity.py",
     "infomarket sweep EXP --out STORE": "a placeholder experiment; sweeps are tested in tests/runner",
