@@ -81,3 +81,14 @@ def check_ledger(report: dict, engine: dict) -> None:
         assert row["engine"] == pytest.approx(wealth, abs=1e-12)
         assert abs(row["on_chain"] * 1e9 - wealth * 1e9) <= bound + 0.5, row
         assert row["open_purchases"] == {"on_chain": n_open, "engine": n_open, "same_sellers": True}, row
+
+
+def start_controller(procs, domain: int, log: Path, robots: str, *rule: str):
+    """examples/ros_controller.py for ``robots`` in ROS domain ``domain``, logging to ``log``."""
+    return procs.start([sys.executable, EXAMPLE_CONTROLLER, "--robots", robots, "--log", log, *rule],
+                       env=ros_env(domain))
+
+
+def answers(log: Path) -> list[dict]:
+    """The controller's log: each question it was asked, with its answer."""
+    return [json.loads(line) for line in log.read_text().splitlines()] if log.exists() else []

@@ -11,7 +11,8 @@ import pytest
 from eth_account import Account
 
 from ..procs import HANG
-from .common import ROBOTS, check_ledger, engine_ledger, needs_ros, swarm
+from .common import (ROBOTS, answers, check_ledger, engine_ledger, needs_ros, own_domain, start_controller,
+                     swarm)
 
 pytestmark = needs_ros
 STEPS = 1000
@@ -23,14 +24,28 @@ def engine():
 
 
 def test_agents_in_lock_step_reach_the_engines_ledger(procs, tmp_path, rpc, engine):
-    report = swarm(procs, tmp_path, rpc, STEPS)
+    """Robots 0 and 1 share one agent process and ask a controller (examples/ros_controller.py, a plain
+    rclpy process) before buying or selling; robot 2, the seller, has a process of its own and does what
+    its tasks say. The controller agrees with the behaviour, so the ledger is the engine's; each sale
+    was put to the buyer's controller (the faults test below runs one process per robot, no controller)."""
+    log, domain = tmp_path / "answers.jsonl", own_domain()
+    start_controller(procs, domain, log, "0-1")
+    report = swarm(procs, tmp_path / "run", rpc, STEPS, "--agents-per-process", "2", "--controlled", "0,1",
+                   domain=domain)
     check_ledger(report, engine)
-    assert report["processes"] == ROBOTS and report["restarted_agents"] == 0
+    assert report["processes"] == 2 and report["robots_per_process"] == 2 and report["restarted_agents"] == 0
+    assert report["controlled"] == [0, 1] and report["declined"] == 0
+    agents = tmp_path / "run" / "agents"
+    assert sorted(p.name for p in agents.glob("*.log")) == ["robot_2.log", "robots_0-1.log"]
     assert report["messages"]["offer"] >= engine["sales"] and report["messages"]["acceptance"] >= engine["sales"]
     assert report["gas"]["reveal_mean"] > 0 and report["gas"]["deposit_mean"] > 0
-    keys = [tmp_path / "agents" / f"robot_{i}" / "key" for i in range(ROBOTS)]
+    keys = [agents / f"robot_{i}" / "key" for i in range(ROBOTS)]
     assert all(k.stat().st_mode & 0o777 == 0o600 for k in keys)
-    assert len({k.read_text() for k in keys}) == ROBOTS  # each robot its own key
+    assert len({k.read_text() for k in keys}) == ROBOTS  # each robot its own key, two of them in one process
+    got = answers(log)
+    # each sale put to its buyer's controller, naming the seller; the seller (robot 2) asked nobody
+    assert {(a["step"], a["seller"], a["robot"]) for a in got if a["question"] == "buy"} == set(engine["sale_list"])
+    assert all(a["yes"] for a in got) and not any(a["question"] == "sell" for a in got)
 
 
 def test_killed_agent_dropped_messages_and_hostile_ones_lose_nothing(procs, tmp_path, rpc, engine):
