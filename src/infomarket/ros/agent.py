@@ -9,6 +9,10 @@ for a deposit the robot signs ``Deposit(robot, trip)`` for the nest. Every step 
 message seen again (a retry after a drop or a restart) is answered from the state on disk, and the
 contract refuses a second reveal of the same light contract, so nothing is paid twice.
 
+With a controller (``controller=True``), the robot's own code has the last word: the agent asks it
+before it signs an offer and before it accepts one it heard (``decide.py``); a no ends the sale there,
+reported as declined.
+
 Anything malformed, forged (a signature by another key, a seller or buyer other than expected) or
 replayed (a message for a sale that is over) is refused, logged and reported on ``/market/done`` as a
 ``refused`` notice; the agent keeps running.
