@@ -51,6 +51,8 @@ NOT_RUN = {
         "as above; tests/ros/test_swarm.py kills an agent in the middle of a sale",
     "infomarket ros swarm fig4C --robots 6 --steps 2000 --seed 3 --out runs/drop --fault drop:0.05":
         "as above; tests/ros/test_swarm.py drops a fifth of the agents' messages",
+    "infomarket ros swarm fig4C --robots 3 --steps 750 --seed 18 --out runs/declined --controlled all "
+    "--agents-per-process 3": "needs the example controller running; tests/ros/test_controller.py runs it",
     "infomarket bench --scaling": "96 timed runs; tests/bench runs the same code with 2 runs of 200 steps",
     "infomarket sweep future --out results/future --workers 1":
         "4 736 runs of 30 000 steps; tests/test_commands.py plans it and its --scale",

@@ -1,101 +1,70 @@
-"""``infomarket ros swarm`` end to end: real agent processes over ROS 2, a real Hardhat node.
-
-The expected ledger comes from ``simulate`` run here (the engine alone, no agent, no chain), and the
-rounding bound from its events (a unit per share paid at each deposit, either side), so the swarm's own
-comparison is checked against an independent one. The runs are small (3 robots, 1000 steps, seed 18:
-15 sales of robot 2 to robot 1 in steps 548-562, then robot 2's deposit at step 917) and share one
-node. Skipped when the ROS 2 wheels are missing.
+"""``infomarket ros swarm`` end to end: real agent processes over ROS 2, a real Hardhat node, one agent
+process per robot, each agent doing what the engine's behaviours decided (tests/ros/common.py says
+what the runs hold). Skipped when the ROS 2 wheels are missing.
 """
 from __future__ import annotations
 
-import json
 import signal
 import subprocess
-import sys
+import time
 from pathlib import Path
 
 import pytest
 from eth_account import Account
 
-from infomarket.ros import env
-
-from ..evm.node import running_node
 from ..procs import HANG
+from .common import (ROBOTS, answers, check_ledger, engine_ledger, needs_ros, own_domain, start_controller,
+                     swarm)
 
-REASON = env.missing()
-pytestmark = pytest.mark.skipif(REASON is not None, reason=f"the ROS 2 wheels cannot be loaded: {REASON}")
-ROBOTS, STEPS, SEED = 3, 1000, 18
-RUN = ("fig4C", "--robots", str(ROBOTS), "--steps", str(STEPS), "--seed", str(SEED))
-
-
-@pytest.fixture(scope="module")
-def rpc():
-    with running_node() as url:
-        yield url
+pytestmark = needs_ros
+STEPS = 1000
 
 
 @pytest.fixture(scope="module")
 def engine():
-    """The engine's own run of the same swarm: final wealth, sales, deposits, the rounding bound."""
-    from infomarket import load_experiment, simulate
-    from infomarket.evm.cli import demo_config
-
-    result = simulate(demo_config(load_experiment("fig4C"), ROBOTS, STEPS, "staking"), seed=SEED, record_events=True)
-    bound, open_sellers = [0] * ROBOTS, [[] for _ in range(ROBOTS)]
-    for ev in result.events.itertuples():
-        if ev.kind == "purchase":
-            open_sellers[ev.buyer].append(ev.seller)
-        elif ev.kind == "deposit":
-            bound[ev.buyer] += len(open_sellers[ev.buyer])
-            for s in open_sellers[ev.buyer]:
-                bound[s] += 1
-            open_sellers[ev.buyer] = []
-    kinds = result.events["kind"].value_counts()
-    return {"wealth": result.robots.sort_values("robot")["wealth"].tolist(), "bound": bound,
-            "sales": int(kinds.get("purchase", 0)), "deposits": int(kinds.get("deposit", 0))}
-
-
-def swarm(procs, out: Path, rpc: str, *extra: str):
-    done = procs.run([sys.executable, "-m", "infomarket.cli", "ros", "swarm", *RUN, "--out", out, "--rpc", rpc, *extra])
-    assert done.returncode == 0, done.stderr[-3000:] + done.stdout[-2000:]
-    report = json.loads((out / "report.json").read_text())
-    report["stdout"] = done.stdout
-    return report
-
-
-def check_ledger(report: dict, engine: dict) -> None:
-    assert engine["sales"] > 0 and engine["deposits"] > 0  # the comparison proves something
-    assert report["on_chain_matches_engine"] is True
-    assert report["light_contracts"] == engine["sales"] and report["deposits"] == engine["deposits"]
-    for row, wealth, bound in zip(report["balances"], engine["wealth"], engine["bound"]):
-        assert row["engine"] == pytest.approx(wealth, abs=1e-12)
-        assert abs(row["on_chain"] * 1e9 - wealth * 1e9) <= bound + 0.5, row
+    return engine_ledger(STEPS)
 
 
 def test_agents_in_lock_step_reach_the_engines_ledger(procs, tmp_path, rpc, engine):
-    report = swarm(procs, tmp_path, rpc)
+    """Robots 0 and 1 share one agent process and ask a controller (examples/ros_controller.py, a plain
+    rclpy process) before buying or selling; robot 2, the seller, has a process of its own and does what
+    its tasks say. The controller agrees with the behaviour, so the ledger is the engine's; each sale
+    was put to the buyer's controller (the faults test below runs one process per robot, no controller)."""
+    log, domain = tmp_path / "answers.jsonl", own_domain()
+    start_controller(procs, domain, log, "0-1")
+    report = swarm(procs, tmp_path / "run", rpc, STEPS, "--agents-per-process", "2", "--controlled", "0,1",
+                   domain=domain)
     check_ledger(report, engine)
-    assert report["processes"] == ROBOTS and report["restarted_agents"] == 0
+    assert report["processes"] == 2 and report["robots_per_process"] == 2 and report["restarted_agents"] == 0
+    assert report["controlled"] == [0, 1] and report["declined"] == 0
+    agents = tmp_path / "run" / "agents"
+    assert sorted(p.name for p in agents.glob("*.log")) == ["robot_2.log", "robots_0-1.log"]
     assert report["messages"]["offer"] >= engine["sales"] and report["messages"]["acceptance"] >= engine["sales"]
     assert report["gas"]["reveal_mean"] > 0 and report["gas"]["deposit_mean"] > 0
-    keys = [tmp_path / "agents" / f"robot_{i}" / "key" for i in range(ROBOTS)]
+    keys = [agents / f"robot_{i}" / "key" for i in range(ROBOTS)]
     assert all(k.stat().st_mode & 0o777 == 0o600 for k in keys)
-    assert len({k.read_text() for k in keys}) == ROBOTS  # each robot its own key
+    assert len({k.read_text() for k in keys}) == ROBOTS  # each robot its own key, two of them in one process
+    got = answers(log)
+    # each sale put to its buyer's controller, naming the seller; the seller (robot 2) asked nobody
+    assert {(a["step"], a["seller"], a["robot"]) for a in got if a["question"] == "buy"} == set(engine["sale_list"])
+    assert all(a["yes"] for a in got) and not any(a["question"] == "sell" for a in got)
 
 
 def test_killed_agent_dropped_messages_and_hostile_ones_lose_nothing(procs, tmp_path, rpc, engine):
-    """SIGKILL robot 2 (the seller) in the middle of a sale, lose a fifth of every agent's messages, and send
-    malformed, forged and replayed messages before every sale: the ledger is still the engine's, each sale
-    revealed once, the restarted agent kept its key, and every hostile message was refused and logged."""
+    """SIGKILL robot 2 (the seller, in a process of its own) in the middle of a sale, lose a fifth of every
+    agent's messages, and send malformed, forged and replayed messages before every sale: the ledger is
+    still the engine's, each sale revealed once, the restarted agent kept its key, and every hostile
+    message was refused and logged. (Robots 0 and 1 share a process: one agent start-up less.)"""
     key = tmp_path / "agents" / "robot_2" / "key"
-    report = swarm(procs, tmp_path, rpc, "--fault", "kill:2@555", "--fault", "drop:0.2", "--fault", "hostile")
+    report = swarm(procs, tmp_path, rpc, STEPS, "--fault", "kill:2@555", "--fault", "drop:0.2", "--fault", "hostile",
+                   "--retry-after", "0.3", "--agents-per-process", "2")
     check_ledger(report, engine)
-    assert report["restarted_agents"] == 1 and report["processes"] == ROBOTS
+    assert report["restarted_agents"] == 1 and report["processes"] == 2
     assert "robot 2's agent killed (SIGKILL) in the middle of a sale" in report["stdout"]
     assert report["balances"][2]["address"] == Account.from_key(bytes.fromhex(key.read_text())).address
     assert report["messages"]["retries"] > 0  # the drops were made up for by sending again
     assert report["refused_messages"] > 0  # notices on /market/done (themselves subject to the drops)
-    logs = "".join((tmp_path / "agents" / f"robot_{i}.log").read_text() for i in range(ROBOTS))
+    logs = "".join(p.read_text() for p in (tmp_path / "agents").glob("*.log"))
     refused = [line for line in logs.splitlines() if ": refused " in line]
     assert len(refused) >= engine["sales"]  # three hostile messages are sent before each sale
     assert any("refused offer: malformed" in line for line in refused)
@@ -104,15 +73,24 @@ def test_killed_agent_dropped_messages_and_hostile_ones_lose_nothing(procs, tmp_
     assert key.stat().st_mode & 0o777 == 0o600
 
 
+def _command(pid: int) -> str:
+    try:
+        return (Path("/proc") / str(pid) / "cmdline").read_bytes().replace(b"\0", b" ").decode()
+    except OSError:  # gone meanwhile
+        return ""
+
+
 def test_ctrl_c_ends_every_process_of_the_swarm(procs, tmp_path):
-    """Ctrl-C once the agents run: the swarm ends, and no agent or chain node of its session is left (the
-    swarm starts its own node here)."""
+    """Ctrl-C once the chain node and the agents (a process per robot by default) have started: the swarm
+    ends, and no agent or chain node of its session is left (the swarm starts its own node here)."""
     proc = procs.cli("ros", "swarm", "fig4C", "--robots", "2", "--steps", "100000", "--out", tmp_path,
-                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-    for line in proc.stdout:
-        if "running" in line:
+                     stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    while True:
+        commands = [_command(p) for p in procs.leftovers(proc)]
+        if sum(" ros agent " in c for c in commands) == 2 and any("hardhat" in c for c in commands):
             break
-    assert procs.leftovers(proc)  # the agents and the node are running
+        assert proc.poll() is None, "the swarm ended before its agents started"
+        time.sleep(0.1)
     proc.send_signal(signal.SIGINT)
     proc.wait(timeout=HANG)
     assert proc.returncode != 0

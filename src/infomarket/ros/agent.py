@@ -9,6 +9,10 @@ for a deposit the robot signs ``Deposit(robot, trip)`` for the nest. Every step 
 message seen again (a retry after a drop or a restart) is answered from the state on disk, and the
 contract refuses a second reveal of the same light contract, so nothing is paid twice.
 
+With a controller (``controller=True``), the robot's own code has the last word: the agent asks it
+before it signs an offer and before it accepts one it heard (``decide.py``); a no ends the sale there,
+reported as declined.
+
 Anything malformed, forged (a signature by another key, a seller or buyer other than expected) or
 replayed (a message for a sale that is over) is refused, logged and reported on ``/market/done`` as a
 ``refused`` notice; the agent keeps running.
@@ -38,6 +42,7 @@ from ..evm.protocol import (
     sign_offer,
 )
 from . import wire
+from .decide import Decisions
 from .state import AgentState, load_or_create_key
 
 #: Blocks an offer stays valid (the contract's ``maxValidity`` is 256).
@@ -52,7 +57,7 @@ class MarketAgent:
     """The node and the protocol; ``spin()`` runs it until the process is stopped."""
 
     def __init__(self, robot: int, folder: Path, rpc: str, market_address: str, *, drop: float = 0.0,
-                 seed: int = 0):
+                 seed: int = 0, controller: bool = False, controller_timeout: float | None = None):
         import rclpy
         from nav_msgs.msg import Odometry
         from rclpy.signals import SignalHandlerOptions
@@ -73,7 +78,8 @@ class MarketAgent:
         self.pose = None
         self.sensed: list[float] = []
         self._String, self._Bytes = String, UInt8MultiArray
-        rclpy.init(args=None, signal_handler_options=SignalHandlerOptions.NO)
+        if not rclpy.ok():  # once per process: several agents may share one (``host``)
+            rclpy.init(args=None, signal_handler_options=SignalHandlerOptions.NO)
         self.rclpy = rclpy
         self.node = node = rclpy.create_node(f"market_agent_{robot}")
         q = wire.qos()
@@ -88,6 +94,13 @@ class MarketAgent:
         self.deposits = node.create_publisher(UInt8MultiArray, wire.DEPOSIT, q)
         self._peers: dict[str, object] = {}
         node.create_timer(HELLO_EVERY, self._say_hello)
+        self.decisions = None
+        self._waiting: dict[tuple[int, str], object] = {}  # what to resume once a question is answered
+        if controller:
+            asks = node.create_publisher(String, wire.ask(robot), q)
+            self.decisions = Decisions(lambda text: asks.publish(String(data=text)), controller_timeout)
+            node.create_subscription(String, wire.decision(robot), self._on_decision, q)
+            node.create_timer(0.2, self._on_timeout)
         self._recover()
 
     # -- sending --------------------------------------------------------------------------------------
@@ -149,12 +162,16 @@ class MarketAgent:
             return self._deposit(t)
         return self.refuse("task", f"unknown kind {kind!r}")
 
-    def _sell(self, t: dict) -> None:
+    def _sell(self, t: dict, decided: bool = False) -> None:
         rec = self.state.get(t["id"])
         if rec is not None and "result" in rec:
             return self._report(kind="done", id=t["id"], **rec["result"])
         if rec is not None and rec.get("lc"):
             return self._reveal(t["id"], rec)
+        if rec is None and self.decisions is not None and not decided:
+            self._waiting[(int(t["id"]), "sell")] = t
+            return self.decisions.ask(t["id"], "sell", {k: t[k] for k in (
+                "step", "buyer", "buyer_address", "site", "age", "x", "y")})
         if rec is None:
             info = PathInfo.from_floats(float(t["x"]), float(t["y"]))
             offer = Offer(self.account.address, int(t["site"]), int(t["age"]),
@@ -169,7 +186,7 @@ class MarketAgent:
     def _on_offer(self, msg) -> None:
         self._accept(bytes(msg.data))
 
-    def _accept(self, data: bytes) -> None:
+    def _accept(self, data: bytes, decided: bool = False) -> None:
         try:
             task_id, offer, sig = wire.decode_offer(data)
         except wire.WireError as exc:
@@ -186,6 +203,14 @@ class MarketAgent:
         if offer.seller != checksum(t["seller_address"]) or (offer.site, offer.age) != (t["site"], t["age"]):
             return self.refuse("offer", f"task {task_id}: not the offer this robot's behaviour chose "
                                         f"(seller {offer.seller}, site {offer.site}, age {offer.age})")
+        if "result" in rec:  # declined by its controller: the same answer to a repeat
+            return self._report(kind="done", id=task_id, **rec["result"])
+        if "lc" not in rec and self.decisions is not None and not decided:
+            self._waiting[(task_id, "buy")] = data
+            return self.decisions.ask(task_id, "buy", {
+                "step": t["step"], "seller": t["seller"], "seller_address": offer.seller, "site": offer.site,
+                "age": offer.age, "max_block": offer.max_block, "path_hash": "0x" + offer.path_hash.hex(),
+                "seller_x": t["seller_x"], "seller_y": t["seller_y"]})
         if "lc" in rec:
             lc = wire.lc_from_json(rec["lc"])
             if (lc.offer, lc.offer_signature) != (offer, sig):
@@ -254,6 +279,36 @@ class MarketAgent:
             print(f"robot {self.robot}: recovering the light contract of task {task_id}", file=sys.stderr, flush=True)
             self._reveal(task_id, rec)
 
+    # -- the robot's controller ------------------------------------------------------------------------
+    def _on_decision(self, msg) -> None:
+        try:
+            settled = self.decisions.answer(msg.data)
+        except wire.WireError as exc:
+            return self.refuse("decision", str(exc))
+        if settled is not None:
+            self._resume(*settled)
+        return None
+
+    def _on_timeout(self) -> None:
+        for task_id, question in self.decisions.expired():
+            print(f"robot {self.robot}: no answer from the controller to {question!r} in task {task_id}: "
+                  "the behaviour's decision (yes)", file=sys.stderr, flush=True)
+            self._resume(task_id, question, True)
+
+    def _resume(self, task_id: int, question: str, yes: bool) -> None:
+        """Carry on with a sale once the controller (or the timeout) has answered."""
+        what = self._waiting.pop((task_id, question), None)
+        if what is None:
+            return None
+        if yes:
+            return self._sell(what, decided=True) if question == "sell" else self._accept(what, decided=True)
+        result = {"refused": True, "gas": 0, "declined": "seller" if question == "sell" else "buyer"}
+        rec = self.state.get(task_id) or {"kind": question, "task": what}
+        self.state.put(task_id, {**rec, "result": result})
+        print(f"robot {self.robot}: its controller declined to {question} in task {task_id}", file=sys.stderr,
+              flush=True)
+        return self._report(kind="done", id=task_id, **result)
+
     # -- deposit ---------------------------------------------------------------------------------------
     def _deposit(self, t: dict) -> None:
         rec = self.state.get(t["id"])
@@ -267,9 +322,21 @@ class MarketAgent:
         self._send(self.deposits, self._bytes(data))
 
     def spin(self) -> None:
-        try:
-            while True:
-                self.rclpy.spin_once(self.node, timeout_sec=0.1)
-        finally:
-            self.node.destroy_node()
-            self.rclpy.try_shutdown()
+        spin([self])
+
+
+def spin(agents: list[MarketAgent]) -> None:
+    """Run ``agents`` (one robot's, or many robots' hosted in this one process) until the process is
+    stopped: one executor serves every agent's node, in this one thread."""
+    from rclpy.executors import SingleThreadedExecutor
+
+    executor = SingleThreadedExecutor()
+    for a in agents:
+        executor.add_node(a.node)
+    try:
+        while True:
+            executor.spin_once(timeout_sec=0.1)
+    finally:
+        for a in agents:
+            a.node.destroy_node()
+        agents[0].rclpy.try_shutdown()

@@ -30,6 +30,48 @@ def _drop(text: str) -> float:
     return p
 
 
+def _robot_list(text: str) -> list[int]:
+    """``0,3,5``, ``0-4`` or a mix (``0-2,7``): robot numbers, each once, in order."""
+    robots: list[int] = []
+    try:
+        for part in text.split(","):
+            lo, _, hi = part.partition("-")
+            robots += range(int(lo), int(hi or lo) + 1)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected robot numbers such as 0,2 or 0-4, got {text!r}") from None
+    if not robots or min(robots) < 0 or len(set(robots)) != len(robots):
+        raise argparse.ArgumentTypeError(f"expected distinct robot numbers >= 0, got {text!r}")
+    return robots
+
+
+def _controlled(text: str) -> list[int] | str:
+    return "all" if text == "all" else _robot_list(text)
+
+
+def _seconds(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected seconds, got {text!r}") from None
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
+    return value
+
+
+def _agent_options(p) -> None:
+    """What an agent process takes, whether it hosts one robot's agent or many."""
+    p.add_argument("--rpc", type=_rpc_url, required=True, metavar="URL", help="the chain's JSON-RPC node")
+    p.add_argument("--market", required=True, metavar="ADDRESS", help="the market contract's address")
+    p.add_argument("--drop", type=_drop, default=0.0, metavar="P", help="lose this share of the messages it "
+                   "sends (a fault to test the protocol's retries; default 0)")
+    p.add_argument("--seed", type=seed_value, default=0, help="seed of the drops")
+    p.add_argument("--controller", action="store_true", help="ask the robot's controller before selling or "
+                   "buying (topics /robot_N/market/ask and /robot_N/market/decision, docs/ros.md); default: do "
+                   "what the tasks say (the registered behaviour's decisions)")
+    p.add_argument("--controller-timeout", type=_seconds, metavar="S", help="with --controller: after S seconds "
+                   "without an answer take the behaviour's decision (default: wait for the answer)")
+
+
 def _fault(text: str):
     # at parse time: a light module (no engine, no ROS 2)
     from .faults import parse_fault
@@ -48,12 +90,17 @@ def add_subcommand(subparsers) -> None:
     a = commands.add_parser("agent", help="one robot's market agent (a ROS 2 node with its own key)")
     a.add_argument("--robot", type=at_least(0), required=True, help="the robot's number (its topics: /robot_N/...)")
     a.add_argument("--state", type=Path, required=True, help="folder of its key (created, mode 0600) and state")
-    a.add_argument("--rpc", type=_rpc_url, required=True, metavar="URL", help="the chain's JSON-RPC node")
-    a.add_argument("--market", required=True, metavar="ADDRESS", help="the market contract's address")
-    a.add_argument("--drop", type=_drop, default=0.0, metavar="P", help="lose this share of the messages it "
-                   "sends (a fault to test the protocol's retries; default 0)")
-    a.add_argument("--seed", type=seed_value, default=0, help="seed of the drops")
+    _agent_options(a)
     a.set_defaults(func=run_agent)
+    h = commands.add_parser("host", help="many robots' market agents in one process (for large swarms)",
+                            description="The agents of --robots, each its own ROS 2 node with its own key, "
+                                        "hosted in this one OS process.")
+    h.add_argument("--robots", type=_robot_list, required=True, metavar="LIST",
+                   help="the robots hosted, e.g. 0-9 or 0,2,4")
+    h.add_argument("--state", type=Path, required=True, metavar="DIR",
+                   help="folder holding each robot's key and state in DIR/robot_N")
+    _agent_options(h)
+    h.set_defaults(func=run_host)
     s = commands.add_parser("swarm", help="the engine as the world, one agent process per robot, a chain node",
                             description="Run EXPERIMENT scaled to --robots with one market agent process per "
                                         "robot in lock step with the engine, and check that every balance on "
@@ -68,6 +115,15 @@ def add_subcommand(subparsers) -> None:
                    help="JSON-RPC node to use (an unlocked funded account pays gas); default: start a Hardhat node")
     s.add_argument("--fault", type=_fault, action="append", default=[], metavar="FAULT",
                    help="kill:ROBOT@STEP, drop:P or hostile (may be repeated)")
+    s.add_argument("--agents-per-process", type=at_least(1), default=1, metavar="K",
+                   help="host up to K robots' agents in each OS process (default 1: a process per robot)")
+    s.add_argument("--controlled", type=_controlled, default=[], metavar="LIST",
+                   help="robots whose agents ask their controller (all, or e.g. 0,2); start the controllers "
+                        "yourself, in the swarm's ROS domain (docs/ros.md)")
+    s.add_argument("--controller-timeout", type=_seconds, metavar="S",
+                   help="controlled agents take the behaviour's decision after S seconds without an answer")
+    s.add_argument("--retry-after", type=_seconds, default=1.0, metavar="S",
+                   help="send a task again after S seconds without an answer (default 1)")
     s.set_defaults(func=run_swarm)
 
 
@@ -78,18 +134,29 @@ def _ready() -> str | None:
 
 
 def run_agent(args) -> int:
+    return _serve([args.robot], lambda robot: args.state, args)
+
+
+def run_host(args) -> int:
+    return _serve(args.robots, lambda robot: args.state / f"robot_{robot}", args)
+
+
+def _serve(robots: list[int], folder, args) -> int:
     reason = _ready()
     if reason:
         return report_error(reason, 2)
     # after ensure(): it loads ROS 2 and the chain client
-    from .agent import MarketAgent
+    from ..errors import UsageError
+    from .agent import MarketAgent, spin
 
     try:
-        agent = MarketAgent(args.robot, args.state, args.rpc, args.market, drop=args.drop, seed=args.seed)
-    except (OSError, ValueError) as exc:
+        agents = [MarketAgent(r, folder(r), args.rpc, args.market, drop=args.drop, seed=args.seed,
+                              controller=args.controller, controller_timeout=args.controller_timeout)
+                  for r in robots]
+    except (OSError, ValueError, UsageError) as exc:
         return report_error(exc, 2)
     try:
-        agent.spin()
+        spin(agents)
     except KeyboardInterrupt:
         return 0
     return 0
@@ -114,7 +181,14 @@ def run_swarm(args) -> int:
         config, params = prepare(args.experiment, args.robots, args.steps, args.scheme, faults)
     except (ConfigError, ChainError, ValueError) as exc:
         return report_error(exc, 2)
-    swarm = Swarm(config, params, args.seed, args.out, args.rpc, faults)
+    controlled = list(range(args.robots)) if args.controlled == "all" else args.controlled
+    if any(r >= args.robots for r in controlled):
+        return report_error(f"--controlled: robots are 0..{args.robots - 1}", 2)
+    try:
+        swarm = Swarm(config, params, args.seed, args.out, args.rpc, faults, per_process=args.agents_per_process,
+                      controlled=controlled, controller_timeout=args.controller_timeout, retry=args.retry_after)
+    except ConfigError as exc:
+        return report_error(exc, 2)
     try:
         report = swarm.run()
     except UsageError as exc:  # no chain node to start: the user's to set up

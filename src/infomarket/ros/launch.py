@@ -46,9 +46,22 @@ def stop(proc: subprocess.Popen | None) -> None:
         proc.wait(timeout=5)
 
 
-def agent_argv(robot: int, folder: Path, rpc: str, market: str, drop: float, seed: int) -> list[str]:
-    return [sys.executable, "-m", "infomarket.cli", "ros", "agent", "--robot", str(robot), "--state", str(folder),
-            "--rpc", rpc, "--market", market, "--drop", repr(drop), "--seed", str(seed)]
+def agent_argv(robots: list[int], folder: Path, rpc: str, market: str, drop: float, seed: int,
+               controller: bool = False, timeout: float | None = None) -> list[str]:
+    """The command of one agent process: ``ros agent`` for one robot (its state in ``folder/robot_N``),
+    ``ros host`` for several."""
+    if len(robots) == 1:
+        who = ["agent", "--robot", str(robots[0]), "--state", str(folder / f"robot_{robots[0]}")]
+    else:
+        who = ["host", "--robots", ",".join(map(str, robots)), "--state", str(folder)]
+    return [sys.executable, "-m", "infomarket.cli", "ros", *who, "--rpc", rpc, "--market", market,
+            "--drop", repr(drop), "--seed", str(seed), *(["--controller"] if controller else []),
+            *(["--controller-timeout", repr(timeout)] if controller and timeout else [])]
+
+
+def log_name(robots: list[int]) -> str:
+    """An agent process's log: ``robot_N.log``, or ``robots_A-B.log`` for several robots in one process."""
+    return f"robot_{robots[0]}.log" if len(robots) == 1 else f"robots_{robots[0]}-{robots[-1]}.log"
 
 
 def _free_port() -> int:

@@ -27,7 +27,14 @@ from ..evm.units import to_units
 from . import launch
 from .faults import Faults
 from .hostile import Hostile
-from .world import Trader, World
+from .world import RETRY, Trader, World
+
+
+#: Steps between two looks at the world's incoming messages when no trade waits for them (a trade spins
+#: until it is done). A look costs about as much as publishing a step (rclpy rebuilds its wait set of
+#: every topic); messages wait meanwhile in their queues (100 deep), and between trades only stragglers
+#: arrive (a duplicate offer or outcome, to be counted).
+DRAIN_EVERY = 10
 
 
 def prepare(experiment: str, robots: int, steps: int, scheme: str, faults: Faults):
@@ -50,19 +57,34 @@ def prepare(experiment: str, robots: int, steps: int, scheme: str, faults: Fault
 class Swarm:
     """The run's processes and state; ``run()`` returns the report, ``close()`` ends every process."""
 
-    def __init__(self, config, params, seed: int, out: Path, rpc: str | None, faults: Faults):
+    def __init__(self, config, params, seed: int, out: Path, rpc: str | None, faults: Faults, *,
+                 per_process: int = 1, controlled: list[int] = (), controller_timeout: float | None = None,
+                 retry: float = RETRY):
         self.config, self.params, self.seed, self.out, self.rpc, self.faults = config, params, seed, out, rpc, faults
         self.n = config.swarm.robots
+        #: the robots each agent process hosts (one each by default)
+        self.groups = [list(range(i, min(i + per_process, self.n))) for i in range(0, self.n, per_process)]
+        self.controlled, self.controller_timeout = set(controlled), controller_timeout
+        for robots in self.groups:
+            if 0 < len(self.controlled.intersection(robots)) < len(robots):
+                raise ConfigError(f"robots {robots} share an agent process: --controlled names all of them or none")
+        self.retry = retry
         self.node = None
-        self.agents: list = []
+        self.agents: list = []  # one process per group
         self.world = None
         self.restarted = 0
         self.welcomed: dict[int, str] = {}
 
-    def _agent(self, robot: int):
-        folder = self.out / "agents" / f"robot_{robot}"
-        argv = launch.agent_argv(robot, folder, self.rpc, self.market.address, self.faults.drop, self.seed)
-        return launch.start(argv, self.out / "agents" / f"robot_{robot}.log")
+    def _agent(self, group: int):
+        """Start the process of group ``group`` (a robot's agent, or several robots' in one process)."""
+        robots = self.groups[group]
+        controlled = [r in self.controlled for r in robots]
+        argv = launch.agent_argv(robots, self.out / "agents", self.rpc, self.market.address, self.faults.drop,
+                                 self.seed, all(controlled), self.controller_timeout)
+        return launch.start(argv, self.out / "agents" / launch.log_name(robots))
+
+    def _group_of(self, robot: int) -> int:
+        return next(g for g, robots in enumerate(self.groups) if robot in robots)
 
     def _check(self) -> None:
         """Welcome every agent that says hello (again, after a restart); fail if one died by itself."""
@@ -72,10 +94,10 @@ class Swarm:
                 raise SimulationError(f"robot {robot}'s agent came back with another key ({hello['address']})")
             self.welcomed.setdefault(robot, hello["address"])
             self.world.send_task(robot, {"kind": "welcome"})
-        for robot, proc in enumerate(self.agents):
+        for robots, proc in zip(self.groups, self.agents):
             if proc.poll() is not None:
-                raise SimulationError(f"robot {robot}'s agent exited with status {proc.returncode}; see "
-                                   f"{self.out / 'agents' / f'robot_{robot}.log'}")
+                raise SimulationError(f"the agent process of robots {robots} exited with status "
+                                      f"{proc.returncode}; see {self.out / 'agents' / launch.log_name(robots)}")
 
     def run(self, say=print) -> dict:
         t0 = time.perf_counter()
@@ -85,13 +107,13 @@ class Swarm:
             say(f"chain node: Hardhat at {self.rpc} (up after {time.perf_counter() - t0:.1f} s)")
         chain = connect(self.rpc)
         self.market = market = ChainMarket.deploy(self.params, backend=chain, seed=self.seed)
-        say(f"market contract at {market.address}; starting {self.n} agent processes")
+        say(f"market contract at {market.address}; starting {len(self.groups)} agent processes for {self.n} robots")
         # A swarm of its own: another swarm on this machine (a parallel test, another user) must not
         # hear these topics. The agents inherit both variables.
         os.environ.setdefault("ROS_DOMAIN_ID", str(1 + os.getpid() % 100))
         os.environ.setdefault("ROS_AUTOMATIC_DISCOVERY_RANGE", "LOCALHOST")
         self.world = world = World(self.n)
-        self.agents = [self._agent(i) for i in range(self.n)]
+        self.agents = [self._agent(g) for g in range(len(self.groups))]
         while len(self.welcomed) < self.n:
             world.spin()
             self._check()
@@ -101,7 +123,7 @@ class Swarm:
             market.grant_wealth(a, to_units(self.config.payment.initial_wealth))
         if self.faults.hostile:
             world.hostile = Hostile(world, market.domain, addresses)
-        trader = Trader(world, market, addresses, self.params, on_wait=self._check)
+        trader = Trader(world, market, addresses, self.params, on_wait=self._check, retry=self.retry)
         sim = Simulation(self.config, self.seed, record_events=True)
         say(f"agents registered ({', '.join(str(p.pid) for p in self.agents)}) after {time.perf_counter() - t0:.1f} s; "
             f"running {self.config.steps} steps")
@@ -113,7 +135,8 @@ class Swarm:
             sim.step(1)
             w = sim.world
             world.publish_step(step, w.pos, headings(w), comm)
-            world.spin(0)
+            if step % DRAIN_EVERY == 0:
+                world.spin(0)
             t2 = time.perf_counter()
             self.seconds["world"] += t2 - t1
             if self.faults.kill and step == self.faults.kill[1]:
@@ -136,8 +159,9 @@ class Swarm:
         robot = self.faults.kill[0]
 
         def kill(where: str) -> None:
-            launch.kill(self.agents[robot])
-            self.agents[robot] = self._agent(robot)
+            group = self._group_of(robot)
+            launch.kill(self.agents[group])
+            self.agents[group] = self._agent(group)
             self.restarted += 1
             say(f"step {step}: robot {robot}'s agent killed (SIGKILL) {where} and started again")
 
@@ -156,6 +180,10 @@ class Swarm:
         market, tally = self.market, self.world.tally
         wealth = result.robots.sort_values("robot")["wealth"].to_numpy()
         rows = [BalanceRow(i, market.balance_of(a), float(wealth[i]), trader.bound[i]) for i, a in enumerate(addresses)]
+        # A sale's payout waits for the buyer's deposit: until then the chain must hold it as an open record
+        # of the buyer's round trip, naming its seller (a run without a deposit is checked by these too).
+        open_chain = [[c[0] for c in market.contributors(a)] for a in addresses]
+        open_engine = [[addresses[s] for s in sellers] for sellers in trader.open_sellers]
         sales = trader.sales
         gas_total = sum(tally.reveal_gas) + sum(tally.deposit_gas)
         protocol = sum(tally.messages[k] for k in ("offer", "acceptance", "deposit", "task", "done"))
@@ -167,7 +195,8 @@ class Swarm:
             "robots": self.n, "steps": self.config.steps, "seed": self.seed, "rpc": self.rpc,
             "ros_domain_id": os.environ["ROS_DOMAIN_ID"],
             "market": market.address, "processes": len({p.pid for p in self.agents}),
-            "restarted_agents": self.restarted,
+            "restarted_agents": self.restarted, "robots_per_process": max(map(len, self.groups)),
+            "controlled": sorted(self.controlled), "declined": tally.declined,
             "light_contracts": sales, "refusals_confirmed": tally.refusals_confirmed,
             "deposits": len(tally.deposit_gas),
             "messages": {**tally.messages, "protocol": protocol,
@@ -178,13 +207,17 @@ class Swarm:
             "refused_messages": len(tally.refused_messages),
             "refused_examples": [r.get("what", "") + ": " + r.get("reason", "") for r in tally.refused_messages[:10]],
             "disagreements": tally.disagreements,
-            "on_chain_matches_engine": all(r.ok for r in rows) and not tally.disagreements,
+            "on_chain_matches_engine": (all(r.ok for r in rows) and open_chain == open_engine
+                                        and not tally.disagreements),
             "faults": {"kill": list(self.faults.kill) if self.faults.kill else None, "drop": self.faults.drop,
                        "hostile": self.faults.hostile},
             "wall_seconds": round(wall, 2), "seconds": {k: round(v, 2) for k, v in self.seconds.items()},
             "balances": [{"robot": r.robot, "address": addresses[r.robot], "on_chain": r.chain_units / 1e9,
                           "engine": r.expected, "diff_units": round(r.diff_units, 3), "bound_units": r.bound_units,
-                          "ok": r.ok} for r in rows],
+                          "ok": r.ok, "open_purchases": {"on_chain": len(open_chain[r.robot]),
+                                                         "engine": len(open_engine[r.robot]),
+                                                         "same_sellers": open_chain[r.robot] == open_engine[r.robot]}}
+                         for r in rows],
         }
 
     def close(self) -> None:

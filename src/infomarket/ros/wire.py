@@ -47,6 +47,16 @@ def acceptances(robot: int) -> str:
     return f"/robot_{robot}/market/acceptance"
 
 
+def ask(robot: int) -> str:
+    """std_msgs/String (JSON): the agent's questions to its robot's controller (``decide.py``)."""
+    return f"/robot_{robot}/market/ask"
+
+
+def decision(robot: int) -> str:
+    """std_msgs/String (JSON): the controller's answers, ``{"id", "question", "yes"}``."""
+    return f"/robot_{robot}/market/decision"
+
+
 def qos():
     """Reliable, keep the last 100, volatile: lost messages (drops, a restarted agent) are resent by
     the protocol's own retries, never replayed by the middleware."""

@@ -44,6 +44,7 @@ class Tally:
     sale_seconds: list = field(default_factory=list)
     refused_messages: list = field(default_factory=list)
     refusals_confirmed: int = 0
+    declined: int = 0  # sales a robot's controller declined
     retries: int = 0
     disagreements: list = field(default_factory=list)
 
@@ -156,21 +157,22 @@ class World:
 class Trader:
     """Carries out the engine's ledger events through the agents and the contract."""
 
-    def __init__(self, world: World, market, addresses: list[str], params, on_wait=None):
+    def __init__(self, world: World, market, addresses: list[str], params, on_wait=None, retry: float = RETRY):
         self.world, self.market, self.addresses, self.params = world, market, addresses, params
+        self.retry = retry
         self.on_wait = on_wait or (lambda: None)
         self.open_sellers: list[list[int]] = [[] for _ in addresses]
         self.bound = [0] * len(addresses)
         self.sales = 0
 
     def _until(self, done, resend) -> None:
-        """Spin until ``done()``; ``resend()`` every ``RETRY`` seconds meanwhile."""
+        """Spin until ``done()``; ``resend()`` every ``retry`` seconds meanwhile."""
         resend()
         last = time.monotonic()
         while not done():
             self.world.spin()
             self.on_wait()
-            if time.monotonic() - last > RETRY:
+            if time.monotonic() - last > self.retry:
                 self.world.tally.retries += 1
                 resend()
                 last = time.monotonic()
@@ -197,6 +199,12 @@ class Trader:
         t0 = time.perf_counter()
         self._until(lambda: task_id in self.world.outcomes, resend)
         out = self.world.outcomes[task_id]
+        if out.get("declined"):  # the robot's controller overruled the behaviour: the ledgers part here
+            self.world.tally.declined += 1
+            self.world.tally.disagreements.append(
+                f"step {ev['step']}: the {out['declined']}'s controller declined the sale of robot {seller} to "
+                f"robot {buyer} (the engine {'refused' if ev['kind'] == 'refused' else 'made'} it)")
+            return
         expected_refusal = ev["kind"] == "refused"
         if bool(out.get("refused")) != expected_refusal or out.get("error"):
             self.world.tally.disagreements.append(
