@@ -340,6 +340,13 @@ class ChainMarket:
         """Return the stakes of ``buyer``'s expired records to their sellers (anyone may)."""
         return self.transact(sender or self.market, "refundExpired", buyer, max_records)
 
+    def expire(self, buyer: str, batch: int = SETTLE_BATCH, sender: LocalAccount | None = None) -> list[TxResult]:
+        """``refundExpired`` and as many ``settle`` calls as the expired round trip needs (anyone may)."""
+        results = [self.refund_expired(buyer, batch, sender=sender)]
+        while self.pending_settlement(buyer)[0]:
+            results.append(self.settle(buyer, batch, sender=sender))
+        return results
+
     def reveal(self, sender: LocalAccount, lc: LightContract, info: PathInfo) -> TxResult:
         """Submit a light contract and its path information (normally ``sender`` is the seller)."""
         return self.transact(sender, "revealInformation", lc.as_abi(), info.as_abi())
