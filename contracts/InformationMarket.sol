@@ -38,7 +38,8 @@ pragma solidity 0.8.28;
 /// `registrarQuota` times in any `registrarPeriod` consecutive blocks. Registering locks `registrationBond` of
 /// the robot's grant as its bond: it comes back to the robot `bondDelay` blocks after the robot leaves
 /// the market (`exit`, then `withdrawBond`), and is forfeited (burned) when `registrarThreshold`
-/// registrars revoke the robot (`revokeRegistration`), before or during that delay. A depositor
+/// registrars revoke the robot (`revokeRegistration`), before or during that delay; `registrarThreshold`
+/// + 1 registrars may reverse a revocation within `bondDelay` blocks (`reinstate`), minting the bond back. A depositor
 /// submits a deposit only with its evidence: the robot's signature over its round trip and a nest's
 /// acknowledgement of it. A
 /// pauser stops registrations, reveals and deposits; settlements and expiries go on while paused, so no
@@ -293,6 +294,18 @@ contract InformationMarket {
     /// @param amount The bond, 1e-9 units.
     event BondForfeited(address indexed robot, uint256 amount);
 
+    /// @notice `registrar` approved reversing `robot`'s revocation.
+    /// @param registrar The approving registrar.
+    /// @param robot The robot.
+    /// @param approvals Distinct registrars that approved reinstating it so far.
+    event ReinstatementApproved(address indexed registrar, address indexed robot, uint256 approvals);
+
+    /// @notice `robot`'s revocation was reversed: it is registered again (or exiting again, when it was),
+    /// with its bond restored.
+    /// @param robot The robot.
+    /// @param bond The bond restored (minted again), 1e-9 units.
+    event RegistrationReinstated(address indexed robot, uint256 bond);
+
     /// @notice `account` received `role` from `sender`.
     /// @param role The role.
     /// @param account The account.
@@ -451,6 +464,12 @@ contract InformationMarket {
     /// @param robot The robot.
     error InfoMarketNotExiting(address robot);
 
+    /// @notice `robot` has no revocation that can still be reversed (not revoked, or its appeal window
+    /// ended at block `until`).
+    /// @param robot The robot.
+    /// @param until Last block of the appeal window (0 when not revoked).
+    error InfoMarketNotRevoked(address robot, uint64 until);
+
     /// @notice `robot`'s bond is locked until block `unlockBlock`.
     /// @param robot The robot.
     /// @param unlockBlock First block of `withdrawBond`.
@@ -511,9 +530,11 @@ contract InformationMarket {
     uint8 private constant _WEIGH = 1;
     uint8 private constant _PAY = 2;
     /// @dev An identity's life after registration: active (`_registered`), exiting (bond locked until
-    /// `_exits[robot].at`), closed (bond returned or forfeited; the robot may not register again).
+    /// `_exits[robot].at`), closed (bond returned; the robot may not register again), revoked (bond
+    /// burned; reinstated by more registrars than revoked it before `_exits[robot].at`, else for good).
     uint8 private constant _EXITING = 1;
     uint8 private constant _CLOSED = 2;
+    uint8 private constant _REVOKED = 3;
     /// @dev An approval withdrawn by its registrar.
     uint256 private constant _CANCELLED = type(uint256).max;
 
@@ -600,10 +621,14 @@ contract InformationMarket {
     mapping(address registrar => uint256) private _quotaUsed;
     mapping(address registrar => mapping(uint256 slot => uint64)) private _quotaBlocks;
     bool private _paused;
-    /// @dev Exits: the block from which the bond may be withdrawn, and the identity's state.
+    /// @dev Exits: the block from which the bond may be withdrawn (exiting) or until which a revocation
+    /// may be reversed (revoked), the identity's state, how many times it was reinstated (revocation
+    /// and reinstatement approvals are counted per reinstatement) and whether it was exiting when revoked.
     struct Exit {
         uint64 at;
         uint8 state;
+        uint64 reinstated;
+        bool exiting;
     }
     mapping(address robot => Exit) private _exits;
 
@@ -769,7 +794,7 @@ contract InformationMarket {
         if (!_registered[msg.sender]) revert InfoMarketUnregistered(msg.sender);
         _registered[msg.sender] = false;
         uint64 at = uint64(block.number) + _bondDelay;
-        _exits[msg.sender] = Exit(at, _EXITING);
+        _exits[msg.sender] = Exit(at, _EXITING, _exits[msg.sender].reinstated, false);
         emit ExitRequested(msg.sender, at);
     }
 
@@ -789,7 +814,8 @@ contract InformationMarket {
 
     /// @notice Approves revoking `robot` (registered, or exited within its bond delay); the
     /// `registrarThreshold`-th distinct registrar to approve revokes it: it may no longer buy, sell or
-    /// deposit, nor register again, and its bond is burned. Works while paused.
+    /// deposit, nor register again, and its bond is burned, unless more registrars reverse it within
+    /// `bondDelay` blocks (`reinstate`). Works while paused.
     /// @dev Requirements: the caller is a registrar within its quota (as for `grantWealth`) whose approval of
     /// revoking `robot` does not stand already (only standing approvals count); `robot`
     /// holds a bond. Emits {RevocationApproved}, and {BondForfeited} when it revokes.
@@ -799,14 +825,49 @@ contract InformationMarket {
         _requireRole(REGISTRAR_ROLE);
         Exit storage e = _exits[robot];
         if (!_registered[robot] && e.state != _EXITING) revert InfoMarketUnregistered(robot);
-        uint256 count = _approve(keccak256(abi.encode("revoke", robot)), robot);
+        uint256 count = _approve(keccak256(abi.encode("revoke", robot, e.reinstated)), robot);
         emit RevocationApproved(msg.sender, robot, count);
         revoked = count >= _registrarThreshold;
         if (!revoked) return false;
         _registered[robot] = false;
-        e.state = _CLOSED;
+        e.exiting = e.state == _EXITING;
+        e.state = _REVOKED;
+        e.at = uint64(block.number) + _bondDelay;
         _totalSupply -= _registrationBond;
         emit BondForfeited(robot, _registrationBond);
+    }
+
+    /// @notice Approves reversing `robot`'s revocation, within `bondDelay` blocks of it; the
+    /// (`registrarThreshold` + 1)-th distinct registrar to approve reinstates it: registered again (or
+    /// exiting again, its bond withdrawable `bondDelay` blocks later, when it was exiting), its bond
+    /// minted back. More registrars must agree to reverse a revocation than to make one, so the keys
+    /// that revoked cannot undo an honest majority's revocation, and a revocation by compromised keys is
+    /// reversed by the others once the admin has replaced those keys. Works while paused.
+    /// @dev Requirements: the caller is a registrar within its quota (reinstatements count against it as
+    /// revocations do) whose approval does not stand already; `robot` was revoked less than `bondDelay`
+    /// blocks ago. Approvals of revoking and of reinstating a robot count anew after each reinstatement.
+    /// Emits {ReinstatementApproved}, and {RegistrationReinstated} when it reinstates.
+    /// @param robot The robot.
+    /// @return reinstated Whether this approval reinstated it.
+    function reinstate(address robot) external returns (bool reinstated) {
+        _requireRole(REGISTRAR_ROLE);
+        Exit storage e = _exits[robot];
+        if (e.state != _REVOKED || block.number >= e.at) revert InfoMarketNotRevoked(robot, e.at);
+        uint256 count = _approve(keccak256(abi.encode("reinstate", robot, e.reinstated)), robot);
+        emit ReinstatementApproved(msg.sender, robot, count);
+        reinstated = count > _registrarThreshold;
+        if (!reinstated) return false;
+        e.reinstated += 1;
+        if (e.exiting) {
+            e.state = _EXITING;
+            e.at = uint64(block.number) + _bondDelay;
+        } else {
+            e.state = 0;
+            e.at = 0;
+            _registered[robot] = true;
+        }
+        _totalSupply += _registrationBond;
+        emit RegistrationReinstated(robot, _registrationBond);
     }
 
     /// @notice Withdraws the caller's standing approval of registering `robot` with `amount`.
@@ -821,7 +882,7 @@ contract InformationMarket {
     /// @dev Requirements: the approval stands. Emits {ApprovalCancelled}.
     /// @param robot The robot.
     function cancelRevocation(address robot) external {
-        _cancel(keccak256(abi.encode("revoke", robot)), robot);
+        _cancel(keccak256(abi.encode("revoke", robot, _exits[robot].reinstated)), robot);
     }
 
     function _cancel(bytes32 request, address robot) private {

@@ -129,8 +129,8 @@ def replay_events(events: Iterable, robots: int, *, scheme: str = "delayed", ini
     ``stake_expiry`` = T > 0 applies the stake-expiry rule (docs/chain.md): at the start of each step
     s (before its first event), a buyer whose first open transaction was opened at a step t with
     t + T <= s has its whole round trip settled by the scheme's weights as a deposit would settle it,
-    the share paid from its own balance as far as it goes (``ledger.kernels.settle_expired``).  ``reputation_decay`` < 1 keeps the decayed
-    reputation record (``payment.reputation_decay``)."""
+    the share paid from its own balance as far as it goes (``ledger.kernels.settle_expired``).
+    ``reputation_decay`` < 1 keeps the decayed reputation record (``payment.reputation_decay``)."""
     ledger = Ledger(robots, scheme=scheme, initial_wealth=initial_wealth, reward=reward,
                     information_share=information_share, stake=stake, params=params, stake_expiry=stake_expiry,
                     reputation_decay=reputation_decay)

@@ -81,3 +81,26 @@ def test_an_expired_round_trip_left_past_the_deadline_is_still_weighed(make_mark
     amount = 620_000_000 - 20_000
     expected = [TOKEN - 40_000_000 + amount * w // 5 - 10_000 for w in (2, 2, 1)]
     assert [market.balance_of(r.address) for r in robots[1:4]] == expected
+
+
+def test_a_buyer_that_cannot_pay_the_whole_share_pays_its_balance(make_market, robots):
+    """The share of an expired round trip comes from the buyer's balance as far as it goes: with 0.2
+    token, its one seller gets 0.2 and its stake back. With nothing and no stakes, the escrow is empty:
+    a registered robot that settles it, batch by batch, earns no bounty (there is none to take), and the
+    settlement still ends."""
+    market = make_market("outlier_distinct", stake=0.04, stake_expiry=EXPIRY, wealth=[0.2] + [1.0] * 7)
+    buyer, seller = robots[0], robots[1]
+    sell(market, seller, buyer, 10.0)
+    _wait(market)
+    (closed,) = market.expire(buyer.address)[0].of("RoundTripExpired")
+    assert (closed["share"], closed["pot"]) == (200_000_000, 40_000_000)
+    assert (market.balance_of(buyer.address), market.balance_of(seller.address)) == (0, TOKEN + 200_000_000)
+
+    market = make_market("outlier", stake=0.0, stake_expiry=EXPIRY, settle_batch=1, wealth=[0.0] + [1.0] * 7)
+    for age, seller in enumerate(robots[1:3]):
+        sell(market, seller, buyer, 10.0, age=age)
+    _wait(market)
+    keeper = robots[6]  # registered: it earns the bounty where there is one
+    results = market.expire(buyer.address, batch=1, sender=keeper)
+    assert [e["amount"] for r in results for e in r.of("RewardShared")] == [0, 0]
+    assert not market.pending_settlement(buyer.address)[0] and market.balance_of(keeper.address) == TOKEN
