@@ -43,7 +43,8 @@ pragma solidity 0.8.28;
 /// submits a deposit only with its evidence: the robot's signature over its round trip and a nest's
 /// acknowledgement of it. A
 /// pauser stops registrations, reveals and deposits; settlements and expiries go on while paused, so no
-/// stake is ever held by a pause. Only registered robots may buy, sell or be paid a reward. A light
+/// stake is ever held by a pause. Only registered robots may buy, sell or be paid a reward (a record
+/// revealed before its seller was revoked is still weighed and paid). A light
 /// contract names the buyer's round trip it belongs to, so a reveal after the buyer's deposit is
 /// refused rather than paid from the next item.
 ///

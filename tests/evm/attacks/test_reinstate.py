@@ -66,10 +66,10 @@ def test_a_revocation_stands_after_its_appeal_window_and_only_registrars_reinsta
     market.exit(leaving)
     market.revoke(leaving.address, [first, second])
     for registrar in (first, second, third):
-        market.transact(registrar, "reinstate", leaving.address)
+        done = market.transact(registrar, "reinstate", leaving.address)
     assert not market.view("isRegistered", leaving.address) and market.bond_of(leaving.address) == BOND
     refused(lambda: market.withdraw_bond(leaving.address), "InfoMarketBondLocked", robot=leaving.address,
-            unlockBlock=market.backend.block_number + 50)
-    market.backend.advance_to(market.backend.block_number + 50)
+            unlockBlock=done.block_number + 50)
+    market.backend.advance_to(done.block_number + 50)
     market.withdraw_bond(leaving.address)
     assert market.balance_of(leaving.address) == 10**9 + BOND
