@@ -16,10 +16,11 @@ pragma solidity 0.8.28;
 /// The contract trusts no seller's word about its information: the direction each record is weighed
 /// by is that of the vector the seller committed to, minus the seller's position the buyer signed
 /// (docs/model.md §4), and "within theta" is decided on those integer vectors with dot products
-/// against a fixed cos(theta), exactly. A stake never stays locked for ever: records older than
-/// `stakeExpiry` blocks (never 0) give their stake back to their seller (anyone may trigger it) and are
-/// paid, at the buyer's next deposit, an equal part of the share (share / records of the round trip),
-/// so a buyer gains nothing by waiting for its records to expire; a deposit not weighed within
+/// against a fixed cos(theta), exactly. A stake never stays locked for ever: once the first record of a
+/// round trip is `stakeExpiry` blocks old (never 0), anyone may settle the whole round trip
+/// (`refundExpired`) as a prompt deposit would, every record weighed, the share paid out of the buyer's
+/// balance as far as it goes (it gets the whole reward at its next deposit), so neither the buyer nor a
+/// seller of many records gains anything by letting records expire; a deposit not weighed within
 /// `settlementDeadline` blocks is still weighed, never paid by a cruder rule (so nobody gains by
 /// leaving it unfinished), and from then on any caller earns the bounty for finishing it. Every call
 /// does a bounded amount of work: a round trip holds at most
@@ -37,11 +38,13 @@ pragma solidity 0.8.28;
 /// `registrarQuota` times in any `registrarPeriod` consecutive blocks. Registering locks `registrationBond` of
 /// the robot's grant as its bond: it comes back to the robot `bondDelay` blocks after the robot leaves
 /// the market (`exit`, then `withdrawBond`), and is forfeited (burned) when `registrarThreshold`
-/// registrars revoke the robot (`revokeRegistration`), before or during that delay. A depositor
+/// registrars revoke the robot (`revokeRegistration`), before or during that delay; `registrarThreshold`
+/// + 1 registrars may reverse a revocation within `bondDelay` blocks (`reinstate`), minting the bond back. A depositor
 /// submits a deposit only with its evidence: the robot's signature over its round trip and a nest's
 /// acknowledgement of it. A
-/// pauser stops registrations, reveals and deposits; settlements and refunds go on while paused, so no
-/// stake is ever held by a pause. Only registered robots may buy, sell or be paid a reward. A light
+/// pauser stops registrations, reveals and deposits; settlements and expiries go on while paused, so no
+/// stake is ever held by a pause. Only registered robots may buy, sell or be paid a reward (a record
+/// revealed before its seller was revoked is still weighed and paid). A light
 /// contract names the buyer's round trip it belongs to, so a reveal after the buyer's deposit is
 /// refused rather than paid from the next item.
 ///
@@ -139,7 +142,7 @@ contract InformationMarket {
     }
 
     /// @dev A buyer's records are `_records[buyer][i]`; its open round trip is [start, count) and began
-    /// at index `first` (refunds move `start`, never `first`). `trip` numbers its round trips.
+    /// at index `first` (the two are equal: a round trip is closed whole). `trip` numbers its round trips.
     struct Round {
         uint64 start;
         uint64 count;
@@ -161,8 +164,8 @@ contract InformationMarket {
     /// @dev A deposited round trip being settled, records [next, end) still to process in `phase`
     /// (in the weighing phase `next` is the next record to weigh).
     /// `escrow` holds the reward share and the stakes not yet paid out; `amount` is what the records
-    /// share (fixed when paying starts); `first` is the round trip's first record, `live` its first
-    /// live one: the expired records [first, live) are each paid `perExpired`, the live ones the rest.
+    /// share (fixed when paying starts); `first` is the round trip's first record and `live` the first
+    /// one weighed (the same record: every record of a round trip is weighed and paid by weight).
     /// `counted`: under OutlierCapped, how many of the live records weighed so far count (are not void).
     struct Settlement {
         uint64 next;
@@ -175,7 +178,6 @@ contract InformationMarket {
         uint256 escrow;
         uint256 amount;
         uint256 totalWeight;
-        uint256 perExpired;
     }
 
     // ------------------------------------------------------------------------------------------------
@@ -220,20 +222,21 @@ contract InformationMarket {
         bytes32 pathHash
     );
 
-    /// @notice A record expired (its buyer did not deposit within `stakeExpiry` blocks): its stake went
-    /// back to its seller and it takes no part in the weighing; the buyer's next deposit pays it an
-    /// equal part of the share ({RewardShared} with weight 0).
+    /// @notice `buyer`'s open round trip expired (its first record is `stakeExpiry` blocks old, or the
+    /// buyer is no longer registered) and was closed for settlement as a deposit closes it: its records
+    /// are weighed and paid ({RewardShared}) from its stakes and `share`, which the buyer paid from its
+    /// balance (the reward's share, or the whole balance when that is less).
     /// @param buyer The buyer.
-    /// @param seller The seller, refunded.
-    /// @param index The record.
-    /// @param amount Stake returned, 1e-9 units (0 without staking).
-    event RecordExpired(address indexed buyer, address indexed seller, uint256 index, uint256 amount);
+    /// @param share Paid by the buyer into the settlement, 1e-9 units.
+    /// @param pot Stakes of the round trip.
+    /// @param transactions Number of records in the round trip.
+    event RoundTripExpired(address indexed buyer, uint256 share, uint256 pot, uint256 transactions);
 
     /// @notice The market paid `robot` the reward for one item and closed its round trip for settlement.
     /// @param robot Depositing robot.
     /// @param reward Reward minted to it, 1e-9 units.
-    /// @param pot Stakes of the round trip (refunds of expired records come out of it).
-    /// @param transactions Number of records in the round trip, expired ones included (each is paid).
+    /// @param pot Stakes of the round trip.
+    /// @param transactions Number of records in the round trip (each is weighed and paid).
     event ItemBought(address indexed robot, uint256 reward, uint256 pot, uint256 transactions);
 
     /// @notice One record's seller received its share of a deposit.
@@ -243,8 +246,7 @@ contract InformationMarket {
     /// @param weight The record's weight (1 under delayed payment, similar-transaction count under
     /// outlier, distinct-seller count * 1e27 / the seller's records for the site under outlier-distinct;
     /// under outlier-capped stake * C for a void record and (share + counted records * stake) * its count
-    /// for a counted one, C the counts' sum; 0 for an expired record, paid the share over the round
-    /// trip's records).
+    /// for a counted one, C the counts' sum).
     /// @param amount Share paid, 1e-9 units.
     event RewardShared(address indexed robot, address indexed seller, uint256 index, uint256 weight, uint256 amount);
 
@@ -292,6 +294,18 @@ contract InformationMarket {
     /// @param robot The robot.
     /// @param amount The bond, 1e-9 units.
     event BondForfeited(address indexed robot, uint256 amount);
+
+    /// @notice `registrar` approved reversing `robot`'s revocation.
+    /// @param registrar The approving registrar.
+    /// @param robot The robot.
+    /// @param approvals Distinct registrars that approved reinstating it so far.
+    event ReinstatementApproved(address indexed registrar, address indexed robot, uint256 approvals);
+
+    /// @notice `robot`'s revocation was reversed: it is registered again (or exiting again, when it was),
+    /// with its bond restored.
+    /// @param robot The robot.
+    /// @param bond The bond restored (minted again), 1e-9 units.
+    event RegistrationReinstated(address indexed robot, uint256 bond);
 
     /// @notice `account` received `role` from `sender`.
     /// @param role The role.
@@ -451,6 +465,12 @@ contract InformationMarket {
     /// @param robot The robot.
     error InfoMarketNotExiting(address robot);
 
+    /// @notice `robot` has no revocation that can still be reversed (not revoked, or its appeal window
+    /// ended at block `until`).
+    /// @param robot The robot.
+    /// @param until Last block of the appeal window (0 when not revoked).
+    error InfoMarketNotRevoked(address robot, uint64 until);
+
     /// @notice `robot`'s bond is locked until block `unlockBlock`.
     /// @param robot The robot.
     /// @param unlockBlock First block of `withdrawBond`.
@@ -493,7 +513,7 @@ contract InformationMarket {
     /// bounds the declared gas per transaction is measured at (docs/gas.md).
     uint256 private constant _MAX_TRIP_RECORDS = 512;
     uint256 private constant _MAX_SETTLE_BATCH = 48;
-    /// @dev Most units of work one settlement can take: a refund, a weighing (at most
+    /// @dev Most units of work one settlement can take, with one to spare: a weighing (at most
     /// ceil(512 / 40) = 13 units) and a payment per record. The bounty of them all fits in the share.
     uint256 private constant _MAX_SETTLEMENT_UNITS = _MAX_TRIP_RECORDS * 15;
     /// @dev Scale of an OutlierDistinct weight (distinct sellers / seller's records, as a fixed point).
@@ -506,13 +526,16 @@ contract InformationMarket {
     uint256 private constant _MAX_CAPPED_AMOUNT = 2 ** 96;
     /// @dev Longest bond delay, blocks: block numbers plus it never overflow 64 bits.
     uint64 private constant _MAX_DELAY = 2 ** 40;
-    uint8 private constant _EXPIRE = 0;
+    /// @dev Settlement phases: closed (nothing done yet), weighing, paying.
+    uint8 private constant _CLOSED_TRIP = 0;
     uint8 private constant _WEIGH = 1;
     uint8 private constant _PAY = 2;
     /// @dev An identity's life after registration: active (`_registered`), exiting (bond locked until
-    /// `_exits[robot].at`), closed (bond returned or forfeited; the robot may not register again).
+    /// `_exits[robot].at`), closed (bond returned; the robot may not register again), revoked (bond
+    /// burned; reinstated by more registrars than revoked it before `_exits[robot].at`, else for good).
     uint8 private constant _EXITING = 1;
     uint8 private constant _CLOSED = 2;
+    uint8 private constant _REVOKED = 3;
     /// @dev An approval withdrawn by its registrar.
     uint256 private constant _CANCELLED = type(uint256).max;
 
@@ -599,10 +622,14 @@ contract InformationMarket {
     mapping(address registrar => uint256) private _quotaUsed;
     mapping(address registrar => mapping(uint256 slot => uint64)) private _quotaBlocks;
     bool private _paused;
-    /// @dev Exits: the block from which the bond may be withdrawn, and the identity's state.
+    /// @dev Exits: the block from which the bond may be withdrawn (exiting) or until which a revocation
+    /// may be reversed (revoked), the identity's state, how many times it was reinstated (revocation
+    /// and reinstatement approvals are counted per reinstatement) and whether it was exiting when revoked.
     struct Exit {
         uint64 at;
         uint8 state;
+        uint64 reinstated;
+        bool exiting;
     }
     mapping(address robot => Exit) private _exits;
 
@@ -614,7 +641,7 @@ contract InformationMarket {
     /// @param stake_ Stake per sale, 1e-9 units (0 = no staking); must be 0 under delayed payment.
     /// @param cosTheta_ cos(theta) of the similarity window, in units of 1e-9 (in [-1e9, 1e9]); two
     /// records are similar when the angle between their vectors is strictly less than theta.
-    /// @param stakeExpiry_ Blocks after which an undeposited record expires (>= 1: stakes always expire).
+    /// @param stakeExpiry_ Blocks after which a round trip's first record expires the round trip (>= 1).
     /// @param maxRecordsPerSeller_ Most records one seller may sell one buyer in one round trip (>= 1).
     /// @param maxRecordsPerTrip_ Most live records a buyer's open round trip may hold (1 to 512).
     /// @param maxValidity_ Furthest a light contract's last block may lie ahead of its reveal (>= 1).
@@ -768,7 +795,7 @@ contract InformationMarket {
         if (!_registered[msg.sender]) revert InfoMarketUnregistered(msg.sender);
         _registered[msg.sender] = false;
         uint64 at = uint64(block.number) + _bondDelay;
-        _exits[msg.sender] = Exit(at, _EXITING);
+        _exits[msg.sender] = Exit(at, _EXITING, _exits[msg.sender].reinstated, false);
         emit ExitRequested(msg.sender, at);
     }
 
@@ -788,7 +815,8 @@ contract InformationMarket {
 
     /// @notice Approves revoking `robot` (registered, or exited within its bond delay); the
     /// `registrarThreshold`-th distinct registrar to approve revokes it: it may no longer buy, sell or
-    /// deposit, nor register again, and its bond is burned. Works while paused.
+    /// deposit, nor register again, and its bond is burned, unless more registrars reverse it within
+    /// `bondDelay` blocks (`reinstate`). Works while paused.
     /// @dev Requirements: the caller is a registrar within its quota (as for `grantWealth`) whose approval of
     /// revoking `robot` does not stand already (only standing approvals count); `robot`
     /// holds a bond. Emits {RevocationApproved}, and {BondForfeited} when it revokes.
@@ -798,14 +826,49 @@ contract InformationMarket {
         _requireRole(REGISTRAR_ROLE);
         Exit storage e = _exits[robot];
         if (!_registered[robot] && e.state != _EXITING) revert InfoMarketUnregistered(robot);
-        uint256 count = _approve(keccak256(abi.encode("revoke", robot)), robot);
+        uint256 count = _approve(keccak256(abi.encode("revoke", robot, e.reinstated)), robot);
         emit RevocationApproved(msg.sender, robot, count);
         revoked = count >= _registrarThreshold;
         if (!revoked) return false;
         _registered[robot] = false;
-        e.state = _CLOSED;
+        e.exiting = e.state == _EXITING;
+        e.state = _REVOKED;
+        e.at = uint64(block.number) + _bondDelay;
         _totalSupply -= _registrationBond;
         emit BondForfeited(robot, _registrationBond);
+    }
+
+    /// @notice Approves reversing `robot`'s revocation, within `bondDelay` blocks of it; the
+    /// (`registrarThreshold` + 1)-th distinct registrar to approve reinstates it: registered again (or
+    /// exiting again, its bond withdrawable `bondDelay` blocks later, when it was exiting), its bond
+    /// minted back. More registrars must agree to reverse a revocation than to make one, so the keys
+    /// that revoked cannot undo an honest majority's revocation, and a revocation by compromised keys is
+    /// reversed by the others once the admin has replaced those keys. Works while paused.
+    /// @dev Requirements: the caller is a registrar within its quota (reinstatements count against it as
+    /// revocations do) whose approval does not stand already; `robot` was revoked less than `bondDelay`
+    /// blocks ago. Approvals of revoking and of reinstating a robot count anew after each reinstatement.
+    /// Emits {ReinstatementApproved}, and {RegistrationReinstated} when it reinstates.
+    /// @param robot The robot.
+    /// @return reinstated Whether this approval reinstated it.
+    function reinstate(address robot) external returns (bool reinstated) {
+        _requireRole(REGISTRAR_ROLE);
+        Exit storage e = _exits[robot];
+        if (e.state != _REVOKED || block.number >= e.at) revert InfoMarketNotRevoked(robot, e.at);
+        uint256 count = _approve(keccak256(abi.encode("reinstate", robot, e.reinstated)), robot);
+        emit ReinstatementApproved(msg.sender, robot, count);
+        reinstated = count > _registrarThreshold;
+        if (!reinstated) return false;
+        e.reinstated += 1;
+        if (e.exiting) {
+            e.state = _EXITING;
+            e.at = uint64(block.number) + _bondDelay;
+        } else {
+            e.state = 0;
+            e.at = 0;
+            _registered[robot] = true;
+        }
+        _totalSupply += _registrationBond;
+        emit RegistrationReinstated(robot, _registrationBond);
     }
 
     /// @notice Withdraws the caller's standing approval of registering `robot` with `amount`.
@@ -820,7 +883,7 @@ contract InformationMarket {
     /// @dev Requirements: the approval stands. Emits {ApprovalCancelled}.
     /// @param robot The robot.
     function cancelRevocation(address robot) external {
-        _cancel(keccak256(abi.encode("revoke", robot)), robot);
+        _cancel(keccak256(abi.encode("revoke", robot, _exits[robot].reinstated)), robot);
     }
 
     function _cancel(bytes32 request, address robot) private {
@@ -833,8 +896,8 @@ contract InformationMarket {
 
     /// @notice Buys the item `robot` deposited: pays it the reward, closes its round trip and settles
     /// up to `settleBatch` records of it; `settle` finishes the rest.
-    /// @dev The reward share and the pot go into the settlement's escrow. Settling refunds the records
-    /// that expired before this block, weighs the live ones and pays each floor(amount * w / sum w);
+    /// @dev The reward share and the pot go into the settlement's escrow. Settling weighs every record
+    /// of the round trip (expired or not: a deposit is a prompt one) and pays each floor(amount * w / sum w);
     /// the remainder goes back to `robot`, so the supply changes by exactly the reward.
     /// Requirements: the caller is a depositor; not paused; the robot is registered; its previous round
     /// trip is fully settled; the evidence holds the robot's signature over `Deposit(robot, trip)` for
@@ -855,37 +918,22 @@ contract InformationMarket {
         if (signer == address(0) || signer != robot) revert InfoMarketInvalidDepositSignature(robot, signer);
         signer = _recover(digest, evidence.nestV, evidence.nestR, evidence.nestS);
         if (signer == address(0) || !_roles[NEST_ROLE][signer]) revert InfoMarketUnacknowledgedDeposit(robot, signer);
-        uint256 pot = _pots[robot];
         uint256 share = (_reward * _informationShare) / _WAD;
         // The robot receives the reward and escrows the share: never negative since share <= reward.
         _balances[robot] += _reward - share;
         _totalSupply += _reward;
-        _pots[robot] = 0;
-        uint64 start = round.start;
-        uint64 first = round.first;
-        uint64 end = round.count;
-        round.start = end;
-        round.first = end;
-        round.trip += 1;
-        emit ItemBought(robot, _reward, pot, end - first);
-        s.next = start;
-        s.end = end;
-        s.closedAt = uint64(block.number);
-        s.live = start;
-        s.phase = _EXPIRE;
-        s.first = first;
-        s.escrow = share + pot;
-        done = _settle(robot, _settleBatch);
+        emit ItemBought(robot, _reward, _pots[robot], round.count - round.first);
+        done = _close(robot, share, _settleBatch);
     }
 
     /// @notice Continues the settlement of `robot`'s deposited round trip for at most `maxRecords`
     /// records of work; anyone may call it (it moves money only by the market's rules), and a
     /// registered caller (any caller from `settlementDeadline` blocks after the deposit) earns `settleBounty`
     /// per unit of work, from the share.
-    /// @dev Requirements: a settlement is pending. Emits {RecordExpired}, {RewardShared},
+    /// @dev Requirements: a settlement is pending. Emits {RewardShared},
     /// {SettlementBountyPaid} and, at the end, {SettlementCompleted}.
     /// @param robot The depositing robot.
-    /// @param maxRecords Work bound, capped at `settleBatch`: each record refunded or paid counts one,
+    /// @param maxRecords Work bound, capped at `settleBatch`: each record paid counts one,
     /// each record weighed ceil(m / 64) for m live records (at least one record is weighed when the
     /// bound is `settleBatch`, so the default batch always makes progress).
     /// @return done Whether the round trip is now fully settled.
@@ -894,26 +942,34 @@ contract InformationMarket {
         return _settle(robot, maxRecords < _settleBatch ? maxRecords : _settleBatch);
     }
 
-    /// @notice Returns to their sellers the stakes of `buyer`'s open records that expired (opened
-    /// `stakeExpiry` blocks ago or more, or any record once the buyer is no longer registered: revoked or
-    /// exited, it can never deposit), oldest first, at most `maxRecords`; anyone may call it.
-    /// @dev Records are appended in block order, so the expired ones are a prefix of the open round
-    /// trip. Emits {RecordExpired} per record.
-    /// @param buyer The buyer whose pot holds the stakes.
-    /// @param maxRecords Most records to refund in this call (capped at `settleBatch`).
-    /// @return refunded How many records expired.
+    /// @notice Settles `buyer`'s open round trip once it can no longer be deposited in time: its first
+    /// record opened `stakeExpiry` blocks ago or more, or the buyer is no longer registered (revoked or
+    /// exited, it can never deposit). The round trip is closed as a deposit closes it, and every record
+    /// is weighed and paid as a prompt deposit would pay it, from its stakes and the reward's share,
+    /// which the buyer pays from its balance as far as that goes; the buyer's next deposit starts a new
+    /// round trip and keeps the whole reward when that one is empty. So a seller is never better off
+    /// because its records expired, and a buyer that waits for expiry still pays the share. Anyone may
+    /// call it; a registered caller earns the bounty, as for `settle`, which finishes the rest.
+    /// @dev Requirements: no settlement of `buyer` is pending (`settle` it first). Does nothing (returns
+    /// 0) when the round trip is empty or has not expired. Emits {RoundTripExpired}, then what {settle} emits.
+    /// @param buyer The buyer.
+    /// @param maxRecords Work bound of this call, as for `settle` (capped at `settleBatch`).
+    /// @return refunded How many records the closed round trip holds.
     function refundExpired(address buyer, uint256 maxRecords) external returns (uint256 refunded) {
-        if (maxRecords > _settleBatch) maxRecords = _settleBatch;
         Round storage round = _rounds[buyer];
-        uint64 i = round.start;
+        uint64 first = round.first;
         uint64 end = round.count;
-        bool gone = !_registered[buyer]; // revoked or exited: it can never deposit, its records expire now
-        while (i < end && refunded < maxRecords && (gone || _expired(_records[buyer][i].openedAt, block.number))) {
-            _pots[buyer] -= _refund(buyer, i);
-            ++i;
-            ++refunded;
-        }
-        round.start = i;
+        if (end == first) return 0;
+        if (_registered[buyer] && !_expired(_records[buyer][first].openedAt, block.number)) return 0;
+        Settlement storage s = _settlements[buyer];
+        if (s.end != 0) revert InfoMarketSettlementPending(buyer, s.end - s.next);
+        uint256 share = (_reward * _informationShare) / _WAD;
+        uint256 balance = _balances[buyer];
+        if (share > balance) share = balance;
+        _balances[buyer] = balance - share;
+        emit RoundTripExpired(buyer, share, _pots[buyer], end - first);
+        _close(buyer, share, maxRecords < _settleBatch ? maxRecords : _settleBatch);
+        refunded = end - first;
     }
 
     // ------------------------------------------------------------------------------------------------
@@ -945,7 +1001,7 @@ contract InformationMarket {
     }
 
     /// @notice Stops (`paused_` true) or resumes registrations, reveals and deposits. Settlements and
-    /// stake refunds never stop.
+    /// expiries (`refundExpired`) never stop.
     /// @dev Requirements: the caller is a pauser. Emits {PauseSet} when the state changes.
     /// @param paused_ The new state.
     function setPaused(bool paused_) external {
@@ -1040,7 +1096,7 @@ contract InformationMarket {
     /// @notice Whether `robot` has a deposited round trip still to settle, and where it stands.
     /// @param robot The account.
     /// @return pending True until the settlement completes.
-    /// @return phase 0 refunding expired records, 1 weighing, 2 paying.
+    /// @return phase 0 closed (nothing done yet), 1 weighing, 2 paying.
     /// @return remaining Records left in the current phase.
     function pendingSettlement(address robot) external view returns (bool pending, uint8 phase, uint256 remaining) {
         Settlement storage s = _settlements[robot];
@@ -1060,7 +1116,7 @@ contract InformationMarket {
         return 9;
     }
 
-    /// @notice The records of `buyer`'s open round trip (unexpired, not yet deposited), in reveal order.
+    /// @notice The records of `buyer`'s open round trip (not yet deposited nor expired), in reveal order.
     /// @param buyer The account.
     /// @return list Its contributors' records.
     function contributors(address buyer) external view returns (Information[] memory list) {
@@ -1391,21 +1447,34 @@ contract InformationMarket {
         return uint256(openedAt) + _stakeExpiry <= now_;
     }
 
-    /// @dev Gives record `index` of `buyer` its stake back; returns the stake (the caller debits it).
-    function _refund(address buyer, uint256 index) private returns (uint256 amount) {
-        address seller = _records[buyer][index].seller;
-        amount = _stake;
-        if (amount > 0) _balances[seller] += amount;
-        emit RecordExpired(buyer, seller, index, amount);
+    /// @dev Closes `robot`'s open round trip (by a deposit or by its expiry) into a settlement whose
+    /// escrow holds `share` and the round trip's stakes, and runs it for `budget` units of work.
+    function _close(address robot, uint256 share, uint256 budget) private returns (bool) {
+        Settlement storage s = _settlements[robot];
+        Round storage round = _rounds[robot];
+        uint256 pot = _pots[robot];
+        _pots[robot] = 0;
+        uint64 first = round.first;
+        uint64 end = round.count;
+        round.start = end;
+        round.first = end;
+        round.trip += 1;
+        s.next = first;
+        s.end = end;
+        s.closedAt = uint64(block.number);
+        s.live = first;
+        s.phase = _CLOSED_TRIP;
+        s.first = first;
+        s.escrow = share + pot;
+        return _settle(robot, budget);
     }
 
     /// @dev Runs the pending settlement of `robot` for at most `budget` units of work, phase by phase:
-    /// refund the expired prefix, weigh the live records, pay every record of the round trip (an
-    /// expired one the share over the number of records, the live ones the rest by weight); then return
-    /// the rest. However late it is finished, the live records are weighed as a prompt settlement
-    /// weighs them: a seller gains nothing by a settlement left pending.
+    /// weigh the records, pay every record of the round trip by weight; then return the rest. However
+    /// late it is finished, the records are weighed as a prompt settlement weighs them: a seller gains
+    /// nothing by a settlement left pending.
     /// A registered caller, and from `settlementDeadline` blocks after the deposit any caller, earns
-    /// `settleBounty` per unit: for refunding and weighing from the escrow before the paid amount is
+    /// `settleBounty` per unit: for weighing from the escrow before the paid amount is
     /// fixed, for paying from each record's share.
     function _settle(address robot, uint256 budget) private returns (bool) {
         Settlement storage s = _settlements[robot];
@@ -1418,17 +1487,7 @@ contract InformationMarket {
         uint64 end = s.end;
         uint256 escrow = s.escrow;
         uint8 phase = s.phase;
-        if (phase == _EXPIRE) {
-            uint64 closedAt = s.closedAt;
-            while (next < end && budget > 0 && _expired(_records[robot][next].openedAt, closedAt)) {
-                escrow -= _refund(robot, next);
-                ++next;
-                --budget;
-            }
-            if (next < end && budget == 0) return _pause(robot, next, escrow, rate * units);
-            s.live = next;
-            phase = _scheme == Scheme.Delayed ? _PAY : _WEIGH;
-        }
+        if (phase == _CLOSED_TRIP) phase = _scheme == Scheme.Delayed ? _PAY : _WEIGH;
         if (phase == _WEIGH) {
             // Weighing one record compares it with every live record: it costs ceil(m / pairs per unit)
             // units of the budget, so a batch's gas stays bounded (m <= 512, docs/gas.md).
@@ -1457,34 +1516,28 @@ contract InformationMarket {
         uint64 live = s.live;
         if (phase != s.phase) {
             // Paying starts, from the round trip's first record: the work so far is paid from the
-            // escrow, then what the records share is fixed. Each expired record is paid an equal part
-            // of the share, stake excluded (it went back to its seller), so a robot that waits for its
-            // records to expire before depositing pays the share all the same.
+            // escrow (never more than it holds: an expired round trip's share may be short), then what
+            // the records share is fixed.
             bounty = rate * (units - budget);
+            if (bounty > escrow) bounty = escrow;
             escrow -= bounty;
             s.amount = escrow;
             if (_scheme == Scheme.Delayed) s.totalWeight = end - live;
-            if (live > first) s.perExpired = (escrow - (end - live) * _stake) / (end - first);
             s.phase = phase;
             next = first;
         }
         uint256 amount = s.amount;
         uint256 total = s.totalWeight;
-        uint256 perExpired = live > first ? s.perExpired : 0;
-        uint256 liveAmount = amount - (live - first) * perExpired;
         bool equal = _scheme == Scheme.Delayed;
         bool capped = !equal && _scheme == Scheme.OutlierCapped;
         while (next < end && budget > 0) {
             Information storage record = _records[robot][next];
-            uint256 weight;
-            uint256 share = perExpired;
-            if (next >= live) {
-                weight = equal ? 1 : record.weight;
-                if (capped) {
-                    (weight, share) = _cappedShare(s, weight, liveAmount, end - live);
-                } else {
-                    share = (liveAmount * weight) / total;
-                }
+            uint256 weight = equal ? 1 : record.weight;
+            uint256 share;
+            if (capped) {
+                (weight, share) = _cappedShare(s, weight, amount, end - live);
+            } else {
+                share = (amount * weight) / total;
             }
             uint256 cut = rate < share ? rate : share;
             _balances[record.seller] += share - cut;
@@ -1522,6 +1575,7 @@ contract InformationMarket {
     /// @dev Stops a settlement call before paying: records where it stands and pays the bounty.
     function _pause(address robot, uint64 next, uint256 escrow, uint256 bounty) private returns (bool) {
         Settlement storage s = _settlements[robot];
+        if (bounty > escrow) bounty = escrow; // an expired round trip's share may be short
         s.next = next;
         s.escrow = escrow - bounty;
         _payBounty(robot, bounty);
@@ -1544,8 +1598,7 @@ contract InformationMarket {
         delete _settlements[robot];
         // When nothing was revealed to the robot since its deposit, its next round trip can start
         // again at index 0 and rewrite warm slots (about 5k gas each) instead of fresh ones (22k). Not
-        // when its open round trip holds records, even all refunded: their sellers' links (`_sold`)
-        // point at their indices.
+        // when its open round trip holds records: their sellers' links (`_sold`) point at their indices.
         Round storage round = _rounds[robot];
         if (round.count == round.first) {
             round.start = 0;

@@ -5,17 +5,17 @@ check the contract against the rules themselves (within the rounding bound), not
 the contract's own integer arithmetic. Directions are compared in degrees, as the simulation does; the
 contract compares vectors, so tests build each vector from its direction (``vector_for``) far enough
 from Theta that the micro-unit rounding cannot matter. With ``expiry`` = T > 0 it also applies the
-stake-expiry rule: at ``advance(step)``, transactions opened at a step t with t + T <= step leave
-the weighing and their stakes are returned; the buyer's next deposit pays each of them share / n (n:
-every transaction of the round trip, expired or not), and the live ones share the rest, share * live / n
-plus their stakes, by the scheme's weights.
+stake-expiry rule: at ``advance(step)``, a buyer whose first open transaction was opened at a step t
+with t + T <= step has its whole round trip settled as a deposit settles it, by the scheme's weights,
+with no reward: the buyer pays the share, min(share, its balance), and the sellers share that and
+their stakes (buyers in id order).
 
 Under ``capped_outlier`` (cap ``cap``) a seller's live records after its first ``cap`` are void, and the
 weights are the simulated rule's (``payments.consensus``): they add up to what the rule reads as the
 round trip's amount, share + pot, a void record weighing its stake and the counted ones the rest by
-eq. 7 among themselves; the ledger pays the live amount in proportion. So without expiry a void record
-gets exactly its stake back, and with expired records in the round trip its stake times
-(share * live / n + pot) / (share + pot).
+eq. 7 among themselves; the ledger pays the amount in proportion. So at a deposit a void record gets
+exactly its stake back, and at an expiry whose buyer could not pay the whole share its stake times
+(paid share + pot) / (share + pot).
 """
 from __future__ import annotations
 
@@ -56,28 +56,25 @@ class ExactLedger:
     balance: list[Fraction] = field(init=False)
     pot: list[Fraction] = field(init=False)
     open: list[list[tuple[int, int, Fraction, int]]] = field(init=False)
-    #: per buyer, the sellers of its round trip's expired transactions
-    expired: list[list[int]] = field(init=False)
     bound: list[int] = field(init=False)
 
     def __post_init__(self) -> None:
         self.balance = [self.initial] * self.robots
         self.pot = [Fraction(0)] * self.robots
         self.open = [[] for _ in range(self.robots)]
-        self.expired = [[] for _ in range(self.robots)]
         self.bound = [0] * self.robots
 
     def advance(self, step: int) -> None:
-        """Start ``step``: expire what its age allows."""
+        """Start ``step``: settle every round trip whose first transaction's age expires it."""
         if not self.expiry:
             return
         for buyer, txs in enumerate(self.open):
-            keep = [t for t in txs if t[3] + self.expiry > step]
-            for seller, _, _, _ in txs[: len(txs) - len(keep)]:
-                self.balance[seller] += self.stake
-                self.pot[buyer] -= self.stake
-                self.expired[buyer].append(seller)
-            self.open[buyer] = keep
+            if txs and txs[0][3] + self.expiry <= step:
+                short = self.balance[buyer] < self.share * self.reward
+                # a short share is the buyer's whole balance: on chain within the buyer's rounding bound,
+                # which every payment from it may then carry
+                self._settle(buyer, min(self.share * self.reward, self.balance[buyer]),
+                             self.bound[buyer] + 1 if short else 0)
 
     def purchase(self, buyer: int, seller: int, site: int, direction: Fraction, step: int = 0) -> bool:
         """Record a sale; False (nothing recorded) when the seller cannot lock the stake."""
@@ -90,15 +87,15 @@ class ExactLedger:
         return True
 
     def deposit(self, robot: int) -> None:
-        txs, expired = self.open[robot], self.expired[robot]
-        self.balance[robot] += self.reward + self.pot[robot]
-        n = len(txs) + len(expired)
-        for seller in expired:
-            self.balance[seller] += self.share * self.reward / n
-            self.balance[robot] -= self.share * self.reward / n
-            self.bound[seller] += 1
-        self.bound[robot] += len(expired)
-        amount = self.share * self.reward * Fraction(len(txs), n or 1) + self.pot[robot]
+        self.balance[robot] += self.reward
+        self._settle(robot, self.share * self.reward)
+
+    def _settle(self, robot: int, share: Fraction, carried: int = 0) -> None:
+        """The robot's round trip paid: ``share`` and its stakes from the robot to its sellers, by weight
+        (each payment's rounding bound grows by ``carried`` units besides its own)."""
+        txs = self.open[robot]
+        self.balance[robot] += self.pot[robot]
+        amount = share + self.pot[robot]
         pot, self.pot[robot] = self.pot[robot], Fraction(0)
         if txs:
             if self.scheme == "delayed":
@@ -123,8 +120,7 @@ class ExactLedger:
             total = sum(weights)
             for (seller, _, _, _), w in zip(txs, weights):
                 self.balance[seller] += amount * w / total if total else 0
-                self.bound[seller] += 1
+                self.bound[seller] += 1 + carried
             self.balance[robot] -= amount if total else 0
             self.bound[robot] += len(txs)
         self.open[robot] = []
-        self.expired[robot] = []

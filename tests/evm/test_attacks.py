@@ -301,14 +301,17 @@ def test_no_call_does_more_than_one_batch_of_work_whatever_it_asks(make_market, 
     buyer = robots[0]
     for age, seller in enumerate(robots[1:6]):
         _sell(market, seller, buyer, age=age)
-    market.buy_item(buyer.address)  # 2 units of work (records refunded, weighed or paid)
+    market.buy_item(buyer.address)  # 2 units of work (records weighed or paid)
     done = market.settle(buyer.address, 2**200)
-    assert len(done.of("RewardShared")) + len(done.of("RecordExpired")) == 2
+    assert len(done.of("RewardShared")) == 2
     assert market.pending_settlement(buyer.address)[0]
+    assert len(market.settle(buyer.address, 2**200).of("RewardShared")) == 1  # the last record: settled
     for age, seller in enumerate(robots[1:6]):
         _sell(market, seller, buyer, age=10 + age)
     market.backend.advance_to(market.backend.block_number + 5)
-    assert len(market.refund_expired(buyer.address, 2**200).of("RecordExpired")) == 2
+    expired = market.refund_expired(buyer.address, 2**200)  # the round trip closes; 2 of its 5 records paid
+    assert len(expired.of("RoundTripExpired")) == 1 and len(expired.of("RewardShared")) == 2
+    assert market.pending_settlement(buyer.address)[0]
 
 
 def test_a_deposit_not_weighed_by_its_deadline_is_still_weighed_and_anyone_finishing_it_is_paid(make_market, robots):

@@ -14,7 +14,7 @@ Every payment-rule mutant of the contract tried fails those 80 within the first 
 3 is one they miss), which the simulated ledger's 200 and the payment vectors cover.
 ``capped_outlier`` (cap 1 or 2, with and without stake) has random sequences of its own, 100 on the
 simulated ledger and 40 on revm, so that the other schemes' draws do not depend on it; among them,
-sellers over their cap with records expired before their void ones.
+sellers over their cap in round trips settled at their expiry.
 """
 from __future__ import annotations
 
@@ -110,18 +110,20 @@ DISTINCT_CASES = [
 
 
 #: Robot 0 buys from 1 (10 degrees) and 2 (15) at step 1, from 3 (20), 4 (25) and 5 (100) at step 6, and
-#: deposits at step 6 (stake expiry 5: the first two expired at the start of step 6) or at step 20 (all
-#: five expired). Every record of the round trip is paid: an expired one share / 5 = 0.1 (its stake went
-#: back), the live ones 0.5 * 3 / 5 = 0.3 plus their stakes by weight; 20 and 25 degrees agree (2
-#: similar records, or 2 distinct sellers), 100 is alone (1): 2/5, 2/5, 1/5. The buyer gains 0.5 either way.
+#: deposits at step 6 or at step 20 (stake expiry 5). At the start of step 6 the round trip of 1 and 2
+#: expires: it is settled as a deposit settles it, the buyer paying the share 0.5 from its balance: 1 and
+#: 2 agree under every scheme, 0.25 each plus their stakes (1.25). 3, 4 and 5 open a new round trip, paid
+#: 0.5 plus their stakes by weight, at the deposit at step 6, or at its expiry at the start of step 11
+#: (the buyer's balance, 0.5, pays the share again) before the deposit at step 20 finds it empty: 20 and
+#: 25 degrees agree (2 similar records, or 2 distinct sellers), 100 is alone (1): 2/5, 2/5, 1/5. The
+#: buyer paid the share twice for one reward either way: it ends at 1.
 _LATE = [purchase(1, 0, 1, 0, 10.0, 0), purchase(1, 0, 2, 0, 15.0, 1), purchase(6, 0, 3, 0, 20.0, 2),
          purchase(6, 0, 4, 0, 25.0, 3), purchase(6, 0, 5, 0, 100.0, 4)]
 
 
 def _late(scheme, stake, weights):
-    live = [1 - stake + (F(3, 10) + 3 * stake) * w for w in weights]
-    return [(scheme, _LATE + [deposit(6, 0)], [F(3, 2), F(11, 10), F(11, 10), *live]),
-            (scheme, _LATE + [deposit(20, 0)], [F(3, 2)] + [F(11, 10)] * 5)]
+    second = [1 - stake + (F(1, 2) + 3 * stake) * w for w in weights]
+    return [(scheme, _LATE + [deposit(step, 0)], [F(1), F(5, 4), F(5, 4), *second]) for step in (6, 20)]
 
 
 LATE_CASES = [*_late("delayed", 0, [F(1, 3)] * 3), *_late("outlier", 0, [F(2, 5), F(2, 5), F(1, 5)]),
@@ -172,26 +174,25 @@ CAPPED_CASES = [
 ]
 
 
-#: Late deposits under the cap (stake expiry 5, cap 1), by hand.
+#: Expired round trips under the cap (stake expiry 5, cap 1), by hand.
 LATE_CAPPED = [
-    # 1@10 at step 1 (expired at the start of step 6), then 2@20, 2@25 (2's second: void) and 3@100 at step
-    # 6, and the deposit at step 6. The expired record is paid 0.5/4 = 0.125 (its stake went back). The
-    # rule's weights add up to share + pot = 0.5 + 0.12 = 0.62: 0.04 for the void record, the rest 0.58
-    # split 1 : 1 (counts 1 and 1). The ledger pays the live amount, 0.5 x 3/4 + 0.12 = 0.495, by those
-    # weights: the void record 0.495 x 0.04/0.62 = 99/3100 (not its whole stake: the simulated rule scales
-    # it as the live amount is), each counted one 0.495 x 0.29/0.62 = 2871/12400.
+    # 1@10 at step 1 expires its round trip at the start of step 6: settled alone, the buyer paying the share,
+    # 0.5 + 0.04 to seller 1 (1.5), the buyer left with 0.5. Then 2@20, 2@25 (2's second: void) and 3@100
+    # at step 6, deposited at step 6: the rule's weights add up to 0.5 + 0.12 = 0.62, 0.04 for the void
+    # record (its stake back), the rest 0.58 split 1 : 1 (counts 1 and 1): 2 ends at 1 - 0.08 + 0.29 + 0.04,
+    # 3 at 0.96 + 0.29, the buyer at 0.5 + 1 - 0.5 = 1.
     ("capped1+stake", [purchase(1, 0, 1, 0, 10.0, 0), purchase(6, 0, 2, 0, 20.0, 1),
                        purchase(6, 0, 2, 0, 25.0, 2), purchase(6, 0, 3, 0, 100.0, 3), deposit(6, 0)],
-     [F(3, 2), F(9, 8), F(92, 100) + F(2871 + 396, 12400), F(96, 100) + F(2871, 12400)]),
-    # 1@10 and 4@12 at step 1 (both expired at step 6), 2@20 at step 3, 2@25 (void) and 3@100 at step 6,
-    # the deposit at step 6: the void record is the second live one of three, with two records expired
-    # before it. Each expired record 0.5/5 = 0.1 (1 and 4 end at 1.1); weights 0.04 (void) and 0.29, 0.29
-    # of 0.5 + 0.12 = 0.62; the live amount 0.5 x 3/5 + 0.12 = 0.42: the void record 0.42 x 0.04/0.62 =
-    # 21/775, each counted one 0.42 x 0.29/0.62 = 609/3100. Seller 2 ends at 1 - 0.08 + 609/3100 + 21/775,
-    # seller 3 at 0.96 + 609/3100, the buyer at 1 + 1 + 0.12 - 0.2 - 0.42 = 1.5.
-    ("capped1+stake", [purchase(1, 0, 1, 0, 10.0, 0), purchase(1, 0, 4, 0, 12.0, 1), purchase(3, 0, 2, 0, 20.0, 2),
-                       purchase(6, 0, 2, 0, 25.0, 3), purchase(6, 0, 3, 0, 100.0, 4), deposit(6, 0)],
-     [F(3, 2), F(11, 10), F(92, 100) + F(609, 3100) + F(21, 775), F(96, 100) + F(609, 3100), F(11, 10)]),
+     [F(1), F(3, 2), F(5, 4), F(5, 4)]),
+    # A buyer that cannot pay the whole share: 1@10 (step 1) and 2@20 (step 6) each expire a round trip, at
+    # steps 6 and 11, 0.5 + 0.04 to their sellers (1.5 each), the buyer's 1 gone in shares. 3@30, 3@35
+    # (void) and 4@100 at step 11 expire at step 16 with a share of 0 (the buyer's balance): the amount is
+    # the pot, 0.12, paid by the rule's weights of 0.62 (void 0.04, counted 0.29 each): the void record
+    # 0.12 x 0.04/0.62 = 6/775, a counted one 0.12 x 0.29/0.62 = 87/1550. The deposit at step 16 finds the
+    # round trip empty: the buyer keeps the reward, 1.
+    ("capped1+stake", [purchase(1, 0, 1, 0, 10.0, 0), purchase(6, 0, 2, 0, 20.0, 1), purchase(11, 0, 3, 0, 30.0, 2),
+                       purchase(11, 0, 3, 0, 35.0, 3), purchase(11, 0, 4, 0, 100.0, 4), deposit(16, 0)],
+     [F(1), F(3, 2), F(3, 2), F(92, 100) + F(87, 1550) + F(6, 775), F(96, 100) + F(87, 1550)]),
 ]
 
 
@@ -264,7 +265,7 @@ class LedgerConformance:
     @pytest.mark.parametrize(("scheme", "events", "expected"), LATE_CASES,
                              ids=[f"{c[0]}-{c[1][-1]['step']}" for c in LATE_CASES])
     def test_a_late_deposit_pays_every_record_by_hand(self, scheme, events, expected):
-        """Shared hand-computed cases of stake expiry: a deposit after some or all records expired."""
+        """Shared hand-computed cases of stake expiry: round trips settled at their expiry, a deposit after."""
         if self.expiries == (0,):
             pytest.skip("this ledger replays one block per transaction: no stake expiry")
         self.check_by_hand(scheme, events, expected, expiry=5, bound=5)
@@ -275,7 +276,7 @@ class LedgerConformance:
         """``capped_outlier``: a seller over its cap, cap 1, two sellers on both sites, a void outlier."""
         self.check_by_hand(scheme, events, expected)
 
-    @pytest.mark.parametrize(("scheme", "events", "expected"), LATE_CAPPED, ids=["void-after-expired", "void-among"])
+    @pytest.mark.parametrize(("scheme", "events", "expected"), LATE_CAPPED, ids=["void-after-expired", "short-share"])
     def test_a_late_deposit_under_the_cap_by_hand(self, scheme, events, expected):
         if self.expiries == (0,):
             pytest.skip("this ledger replays one block per transaction: no stake expiry")

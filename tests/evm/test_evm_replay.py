@@ -76,14 +76,14 @@ def test_disagreements_are_reported_not_hidden():
     assert report.conserved()
 
 
-def test_replay_with_stake_expiry_refunds_at_the_start_of_the_step_like_the_simulation():
-    """T = 5: robot 0's purchase at step 1 expires at the start of step 6 (before robot 0's deposit in
-    step 6), so robot 1 gets its stake back and 0.5 / 2 (an expired record's equal part); robot 2's
-    purchase at step 2 is weighed: 0.5 / 2 and its stake."""
+def test_replay_with_stake_expiry_settles_at_the_start_of_the_step_like_the_simulation():
+    """T = 5: robot 0's purchase at step 1 expires its round trip at the start of step 6 (before robot 0's
+    deposit in step 6): both records, 10 and 12 degrees (weight 2 each), share the 0.5 robot 0 pays from
+    its balance and their stakes; the deposit then finds an empty round trip and keeps the reward."""
     params = MarketParams.from_floats("outlier", stake=0.04, stake_expiry=5)
     events = [purchase(0, 1, step=1), purchase(0, 2, direction=12.0, step=2), deposit(0, step=6)]
     report = replay_on_chain(events, robots=3, params=params, initial_wealth=1.0)
-    assert report.expired == 1 and not report.disagreements and report.conserved()
+    assert report.expired == 2 and not report.disagreements and report.conserved()
     assert report.balances == [1_500_000_000, 1_250_000_000, 1_250_000_000]
     # one step earlier, both are paid: weight 2 each (10 and 12 degrees), 0.5 + 0.08 shared
     events[-1] = deposit(0, step=5)

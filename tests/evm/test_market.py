@@ -172,26 +172,32 @@ def test_a_pending_settlement_blocks_the_next_deposit_until_settled(make_market,
 
 
 def test_a_robot_that_dies_mid_trip_strands_nobodys_stake(make_market, robots):
-    """Robot 0 buys from three sellers and never deposits again. After stakeExpiry blocks anyone can
-    return the stakes; before, nothing moves."""
+    """Robot 0 buys from three sellers and never deposits again. stakeExpiry blocks after its first
+    record anyone can settle the round trip, as a deposit would: the three agreeing records (10, 20 and
+    30 degrees, eq. 7 counts 3 each) share the dead robot's 0.5 share and their 0.12 of stakes equally,
+    floor(620 000 000 / 3) = 206 666 666 each, and the dead robot keeps the 2 units of dust. Before,
+    nothing moves."""
     market = make_market("outlier", stake=0.04, stake_expiry=10)
     dead = robots[0]
     opened = [sell(market, robots[k], dead, FOOD, 10.0 * k)[0].block_number for k in (1, 2, 3)]
     assert market.locked_stake(dead.address) == 3 * 40_000_000
     market.backend.advance_to(opened[0] + 9)  # one block short for the first record
-    assert market.refund_expired(dead.address, sender=robots[6]).of("RecordExpired") == []
-    market.backend.advance_to(opened[2] + 10)
-    expired = market.refund_expired(dead.address, sender=robots[6]).of("RecordExpired")
-    assert [(e["seller"], e["amount"]) for e in expired] == [(robots[k].address, 40_000_000) for k in (1, 2, 3)]
+    assert market.refund_expired(dead.address).of("RoundTripExpired") == []
+    market.backend.advance_to(opened[0] + 10)
+    results = market.expire(dead.address)  # the market's key: an outside caller, unregistered, no bounty
+    (closed,) = results[0].of("RoundTripExpired")
+    assert (closed["share"], closed["pot"], closed["transactions"]) == (500_000_000, 120_000_000, 3)
     assert market.locked_stake(dead.address) == 0
-    assert [market.balance_of(robots[k].address) for k in (1, 2, 3)] == [TOKEN_UNIT] * 3
+    assert [market.balance_of(robots[k].address) for k in (1, 2, 3)] == [TOKEN_UNIT + 166_666_666] * 3
+    assert market.balance_of(dead.address) == TOKEN_UNIT - 500_000_000 + 2
     assert market.contributors(dead.address) == []
     assert market.total_supply() == sum(market.balance_of(a.address) + market.bond_of(a.address) for a in robots)
 
 
-def test_settlement_refunds_expired_records_whether_or_not_anyone_refunded_them(make_market, robots):
-    """Deposit at block t + T: the record opened at t is expired (its stake back, not weighed, paid
-    0.5 / 2 of the share), the one opened at t + 1 shares the rest, 0.5 / 2, with the pot."""
+def test_a_deposit_on_an_expired_round_trip_nobody_closed_is_a_prompt_deposit(make_market, robots):
+    """Deposit at block t + T: the record opened at t has expired the round trip, but nobody called
+    refundExpired; the deposit weighs both records as it would have promptly (10 and 12 degrees agree:
+    0.5 + 0.08 shared equally), and the buyer pays the share once, from the reward."""
     market = make_market("outlier", stake=0.04, stake_expiry=5)
     buyer = robots[0]
     first = sell(market, robots[1], buyer, FOOD, 10.0)[0].block_number
@@ -199,10 +205,9 @@ def test_settlement_refunds_expired_records_whether_or_not_anyone_refunded_them(
     sell(market, robots[2], buyer, FOOD, 12.0)
     market.backend.advance_to(first + 5)
     results = market.deposit(buyer.address)
-    (expired,) = [e for r in results for e in r.of("RecordExpired")]
-    assert (expired["seller"], expired["amount"]) == (robots[1].address, 40_000_000)
+    assert [e for r in results for e in r.of("RoundTripExpired")] == []
     assert [(e["seller"], e["weight"], e["amount"]) for e in shares_of(results)] == [
-        (robots[1].address, 0, 250_000_000), (robots[2].address, 1, 250_000_000 + 40_000_000)]
+        (robots[1].address, 2, 290_000_000), (robots[2].address, 2, 290_000_000)]
     assert market.balance_of(robots[1].address) == TOKEN_UNIT + 250_000_000
     assert market.balance_of(robots[2].address) == TOKEN_UNIT + 250_000_000
     assert market.balance_of(buyer.address) == TOKEN_UNIT + 500_000_000

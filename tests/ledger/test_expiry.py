@@ -4,7 +4,6 @@ import numpy as np
 import pytest
 
 import infomarket as im
-from infomarket.engine.world import open_transactions
 
 
 def _run(expiry: int, steps: int = 3000):
@@ -47,18 +46,22 @@ def test_expiry_changes_nothing_until_a_stake_would_expire():
     assert not np.array_equal(a.world.balance, c.world.balance)  # with a short bound, stakes came back
 
 
-def test_expired_transactions_stay_in_the_round_trip_in_order_without_their_stakes():
-    """They are paid an equal part of the share at the deposit (tests/evm/test_conformance.py)."""
-    sim, _ = _run(30)
+def test_an_expired_round_trip_is_settled_whole_by_weight_before_the_step():
+    """Once its first transaction is stake_expiry steps old, a buyer's whole round trip is paid as a
+    deposit pays it, with no reward (the amounts are checked by hand and against the exact ledger in
+    tests/evm/test_conformance.py): no open transaction is that old, and settlements without a deposit
+    appear in the payments log, weighed (an outlier among them)."""
+    T = 30
+    sim, _ = _run(T)
     sim.step(1500)
     w = sim.world
-    expired = 0
     for i in range(25):
-        sellers, sites, directions = open_transactions(w, i)
         a, k = int(w.tx_off[i]), int(w.tx_count[i])
-        steps, stakes = w.tx_step[a:a + k], w.tx_stake[a:a + k]
-        old = steps <= int(w.clock[0]) - 30
-        assert (np.diff(steps) >= 0).all() and len(sellers) == k
-        assert (stakes[old] == 0.0).all() and (stakes[~old] > 0.0).all()
-        expired += int(old.sum())
-    assert expired > 0  # the rule was exercised
+        steps = w.tx_step[a:a + k]
+        assert (np.diff(steps) >= 0).all() and (steps > int(w.clock[0]) - T).all()
+    r = sim.result()
+    deposits = set(zip(r.events.step[r.events.kind == "deposit"], r.events.buyer[r.events.kind == "deposit"]))
+    expired = r.payments[[(s, b) not in deposits for s, b in zip(r.payments.step, r.payments.buyer)]]
+    assert len(expired) > 0  # the rule was exercised
+    assert (expired.amount > 0).all() and expired.weight.nunique() > 1  # paid, and by weight, not equally
+    assert r.totals["wealth"] + r.totals["pots"] == pytest.approx(25 + len(deposits), abs=1e-9)  # no reward minted

@@ -41,16 +41,17 @@ def test_under_delayed_payment_no_sale_is_an_outlier():
     assert rec["rep_stake_lost"].sum() == 0
 
 
-def test_expired_sales_are_settled_at_an_equal_part_and_money_follows_the_returned_stake():
+def test_an_expired_sale_is_judged_by_weight_and_paid_from_the_buyers_balance():
     events = [LedgerEvent("purchase", 0, 1, 0, 0.0, step=1), LedgerEvent("purchase", 0, 2, 0, 0.0, step=9),
               LedgerEvent("deposit", 0, step=10)]
     res = replay_events(events, 3, scheme="outlier", stake=0.04, stake_expiry=5)
     rec = res.record
-    # seller 1's sale expired at step 6 (stake back): it is paid 0.5 / 2, not judged; seller 2's live
-    # sale 0.5 / 2 + its stake
+    # seller 1's sale expired the buyer's round trip at step 6: settled then by weight (alone, so not an
+    # outlier), the share 0.5 from the buyer's balance and its stake back: 0.54. Seller 2's sale opened a
+    # new round trip, paid 0.5 + its stake at the deposit; the buyer paid the share twice for one reward.
     assert rec["rep_settled"].tolist() == [0, 1, 1] and rec["rep_reduced"].tolist() == [0, 0, 0]
-    assert rec["rep_earned"] == pytest.approx([0.0, 0.25, 0.29], abs=1e-12)
-    assert res.balances == pytest.approx([1.5, 1.25, 1.25], abs=1e-12)
+    assert rec["rep_earned"] == pytest.approx([0.0, 0.54, 0.54], abs=1e-12)
+    assert res.balances == pytest.approx([1.0, 1.5, 1.5], abs=1e-12)
     assert rec["money"][0] == pytest.approx(res.balances.sum() + res.pots.sum(), abs=1e-12)
     assert rec["money"][0] == pytest.approx(4.0, abs=1e-12)
 

@@ -66,17 +66,18 @@ def test_the_rules_pass_the_public_checker(name):
     checks.check_payment(name)
 
 
-def test_with_expired_records_each_live_record_is_slashed_from_its_own_stake():
-    # Stake expiry 5: seller 1's record (step 1) has expired by the deposit at step 6 (its stake went back;
-    # it is paid 0.5 / 4 = 0.125); sellers 2, 3, 4 at 10, 20, 100 degrees (step 3) are live: consensus 20,
-    # they keep 8/9, 1, 1/9 of their own stakes, 0.04 each (never the expired record's 0). The rule's
-    # weights add up to 0.5 + 3 * 0.04 = 0.62: stakes back 0.08, the rest 0.54 shared 4/9 : 1/2 : 1/18.
-    # The ledger pays the live amount 0.5 * 3/4 + 0.12 = 0.495 by them: factor 0.495 / 0.62.
+def test_an_expired_round_trip_is_slashed_as_a_deposit_would_slash_it():
+    # Stake expiry 5: seller 1's record (step 1) expires the round trip at the start of step 6, before the
+    # deposit: all four records, 1 and 2 at 10 degrees, 3 at 20, 4 at 100 (step 3), are settled as at a
+    # deposit, the buyer paying the share 0.5 from its balance. Sums of angular distances 100, 100, 100,
+    # 260: the consensus is the earliest, 10 degrees; the records keep 1, 1, 8/9 and 0 of their 0.04 stakes.
+    # The rule's weights add up to 0.5 + 4 * 0.04 = 0.66: stakes back 0.08 + 0.32/9, the rest 4.9/9 shared
+    # 1 : 1 : 8/9 : 0 (of 26/9). The deposit then finds an empty round trip: the buyer keeps the reward.
     events = [LedgerEvent("purchase", 0, 1, 0, 10.0, 1)] + [
         LedgerEvent("purchase", 0, s, 0, d, 3) for s, d in ((2, 10.0), (3, 20.0), (4, 100.0))] + [
         LedgerEvent("deposit", 0, step=6)]
     out = replay_events(events, 5, scheme="consensus_slash", stake=0.04, params={"slash_angle": 90.0},
                         stake_expiry=5)
-    f = 0.495 / 0.62
-    weights = [0.04 * 8 / 9 + 0.54 * 4 / 9, 0.04 + 0.27, 0.04 / 9 + 0.03]
-    assert list(out.balances) == pytest.approx([1.5, 1.125, *(0.96 + f * w for w in weights)], abs=1e-12)
+    rest = 4.9 / 9
+    weights = [0.04 + rest * 9 / 26, 0.04 + rest * 9 / 26, 0.04 * 8 / 9 + rest * 8 / 26, 0.0]
+    assert list(out.balances) == pytest.approx([1.5, *(0.96 + w for w in weights)], abs=1e-12)

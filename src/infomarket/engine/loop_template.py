@@ -30,7 +30,7 @@ import numpy as np
 from infomarket.engine.step import record_history, variant
 from infomarket.jit import njit
 from infomarket.ledger.backends import operations
-from infomarket.ledger.kernels import burn_fuel, distribute, expire_stakes, live_count, settlement
+from infomarket.ledger.kernels import burn_fuel, distribute, settle_expired, settlement, trip_expired
 from infomarket.ledger.poa.lists import keep_weights, weighed_before, weights_of
 from infomarket.state.view import unlock
 
@@ -86,11 +86,20 @@ def settle(w, i, rng):
         if weighed_before(w, i):
             distribute(w, i, weights_of(w, i))
             return
-    weights = np.zeros(live_count(w, i))
+    weights = np.zeros(w.tx_count[i])
     weigh(w, i, weights, rng)
     if POA:
         keep_weights(w, i, weights)
     distribute(w, i, weights)
+
+
+@njit(cache=True)
+def expire(w, i, rng):
+    """Robot i's round trip expired (``ledger.kernels.trip_expired``): the scheme weighs it as at a
+    deposit and ``ledger.kernels.settle_expired`` pays it, with no reward (the chain model has no expiry)."""
+    weights = np.zeros(w.tx_count[i])
+    weigh(w, i, weights, rng)
+    settle_expired(w, i, weights)
 
 
 #: This kernel's ledger operations (ledger.backends), around its settlement.
@@ -127,7 +136,8 @@ def step_all(views, rngs, t_end, status, clocks):
             begin_step(w)
             if w.stake_expiry > 0:
                 for i in range(n):
-                    expire_stakes(w, i)
+                    if trip_expired(w, i):
+                        expire(w, i, rng)
             for i in range(n):
                 if nbr_count[i] == 0 and not SELL_DRAWS[kind[i]]:
                     continue  # no neighbour can buy its offer this step, and asking for it draws nothing

@@ -160,7 +160,7 @@ def replay_on_chain(events: Iterable[Mapping] | object, *, robots: int, params: 
     Step ``s`` is replayed in block ``b0 + s`` (``b0``: the first block after the setup), every
     transaction of the step in that block when the backend sets its blocks (revm); a backend that
     mines one block per transaction (py-evm, a node) only needs ``stake_expiry == 0``. Before the
-    first event of each step, the stakes that expire at that step are refunded (``refundExpired``),
+    first event of each step, the round trips that expire at that step are settled (``refundExpired``),
     as the simulation does at the start of its step. A deposit is ``buyItem`` followed by ``settle``
     until the round trip is settled. A purchase the chain refuses, or a refusal the chain would accept,
     is recorded in ``disagreements`` rather than stopping the replay. ``start``: the market to replay
@@ -194,7 +194,7 @@ def replay_on_chain(events: Iterable[Mapping] | object, *, robots: int, params: 
                 raise ChainError("stake expiry needs one block per step: replay on the revm backend")
             chain.advance_to(base + step)
             if expire:
-                _expire(market, accounts, open_steps, step, params.stake_expiry, report)
+                _expire(market, accounts, open_steps, step, params, report)
         if kind == "deposit":
             buyer = int(ev["buyer"])
             results = market.deposit(accounts[buyer].address)
@@ -239,16 +239,24 @@ def replay_on_chain(events: Iterable[Mapping] | object, *, robots: int, params: 
     return report
 
 
-def _expire(market, accounts, open_steps, step: int, expiry: int, report: ReplayReport) -> None:
-    """Refund, on chain, every open record opened at ``step - expiry`` or before (anyone may)."""
+def _expire(market, accounts, open_steps, step: int, params: MarketParams, report: ReplayReport) -> None:
+    """Settle, on chain, every open round trip whose first record was opened at ``step - expiry`` or
+    before (``refundExpired``, then ``settle`` until done; anyone may), buyers in id order as the
+    simulated ledger settles them."""
+    share = params.reward * params.information_share // 10**18
     for buyer, opened in enumerate(open_steps):
-        n = 0
-        while n < len(opened) and opened[n][0] + expiry <= step:
-            n += 1
-        if n:
-            result = market.refund_expired(accounts[buyer].address, n)
-            report.expired += len(result.of("RecordExpired"))
-            del opened[:n]
+        if not opened or opened[0][0] + params.stake_expiry > step:
+            continue
+        results = market.expire(accounts[buyer].address)
+        report.expired += len(opened)
+        report.largest_tx = max(report.largest_tx, *(r.gas_used for r in results))
+        (closed,) = results[0].of("RoundTripExpired")
+        carried = report.rounding_bound[buyer] + 1 if closed["share"] < share else 0
+        sellers = [s for _, s in opened]
+        _count_rounding(report.rounding_bound, buyer, sellers)
+        for s in sellers:  # a short share is the buyer's whole balance, rounded as the buyer's is
+            report.rounding_bound[s] += carried
+        opened.clear()
 
 
 #: Why a scheme the simulator has is not on chain (the contract implements ``market.SCHEMES``).

@@ -337,8 +337,16 @@ class ChainMarket:
         return self.transact(sender or self.market, "setPaused", paused)
 
     def refund_expired(self, buyer: str, max_records: int = 2**32, sender: LocalAccount | None = None) -> TxResult:
-        """Return the stakes of ``buyer``'s expired records to their sellers (anyone may)."""
+        """Close ``buyer``'s expired round trip and settle it as a deposit would, for at most ``max_records``
+        units of work (anyone may; ``expire`` finishes it). Nothing happens when it has not expired."""
         return self.transact(sender or self.market, "refundExpired", buyer, max_records)
+
+    def expire(self, buyer: str, batch: int = SETTLE_BATCH, sender: LocalAccount | None = None) -> list[TxResult]:
+        """``refundExpired`` and as many ``settle`` calls as the expired round trip needs (anyone may)."""
+        results = [self.refund_expired(buyer, batch, sender=sender)]
+        while self.pending_settlement(buyer)[0]:
+            results.append(self.settle(buyer, batch, sender=sender))
+        return results
 
     def reveal(self, sender: LocalAccount, lc: LightContract, info: PathInfo) -> TxResult:
         """Submit a light contract and its path information (normally ``sender`` is the seller)."""

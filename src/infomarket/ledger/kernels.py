@@ -85,50 +85,21 @@ def _open_transaction(w, buyer, seller, site, direction):
 
 
 @njit(forceinline=True, cache=True)
-def expired_count(w, buyer):
-    """How many of the buyer's open transactions have expired (0 without stake expiry): those opened at
-    a step t with t + stake_expiry <= now.  Transactions are in step order, so they are a prefix."""
-    if w.stake_expiry <= 0:
-        return 0
-    k = w.tx_count[buyer]
-    a = w.tx_off[buyer]
-    now = w.clock[0]
-    m = 0
-    while m < k and w.tx_step[a + m] + w.stake_expiry <= now:
-        m += 1
-    return m
-
-
-@njit(forceinline=True, cache=True)
-def live_count(w, buyer):
-    """The buyer's open transactions that have not expired: the ones its deposit weighs."""
-    return w.tx_count[buyer] - expired_count(w, buyer)
-
-
-@njit(cache=True)
-def expire_stakes(w, buyer):
-    """The stake-expiry rule (docs/chain.md): at the start of step s, each open transaction of the
-    buyer opened at a step t with t + stake_expiry <= s gives its stake back to its seller.  It stays
-    in the round trip, out of the weighing: the deposit pays it an equal part of the share
-    (``distribute``), so a buyer gains nothing by waiting for its transactions to expire.  The ones
-    refunded at an earlier step hold no stake any more."""
-    a = w.tx_off[buyer]
-    balance, money, pot, stake = unlock(w.balance), unlock(w.money), unlock(w.pot), unlock(w.tx_stake)
-    for x in range(expired_count(w, buyer)):
-        if stake[a + x] == 0.0:
-            continue
-        balance[w.tx_seller[a + x]] += stake[a + x]
-        money[0] += stake[a + x]
-        pot[buyer] -= stake[a + x]
-        stake[a + x] = 0.0
+def trip_expired(w, buyer):
+    """Whether the buyer's open round trip has expired (never without stake expiry): its first
+    transaction was opened at a step t with t + stake_expiry <= now.  It is then settled whole, as a
+    deposit would settle it (``settle_expired``), at the start of the step."""
+    if w.stake_expiry <= 0 or w.tx_count[buyer] == 0:
+        return False
+    return w.tx_step[w.tx_off[buyer]] + w.stake_expiry <= w.clock[0]
 
 
 @njit(cache=True)
 def settlement(w, buyer):
-    """The buyer's live (unexpired) open transactions as (sellers, sites, directions): views of its pool
-    block, what the scheme weighs."""
-    a = w.tx_off[buyer] + expired_count(w, buyer)
-    b = w.tx_off[buyer] + w.tx_count[buyer]
+    """The buyer's open transactions as (sellers, sites, directions): views of its pool block, what the
+    scheme weighs."""
+    a = w.tx_off[buyer]
+    b = a + w.tx_count[buyer]
     return w.tx_seller[a:b], w.tx_site[a:b], w.tx_dir[a:b]
 
 
@@ -157,28 +128,42 @@ def _record_sale(w, seller, weight, top, pay, stake):
 
 @njit(cache=True)
 def distribute(w, buyer, weights):
-    """Settle a deposit: reward and pot to the buyer, then from the buyer to the sellers of its n open
-    transactions: each expired one (its stake already returned) ``info_share * reward / n``, an equal
-    part of the share, and the live ones ``info_share * reward * live / n + pot`` in proportion to
-    ``weights`` (one per live transaction); clear its transactions.  Without expiry that is the paper's
-    ``info_share * reward + pot`` by weight.  Each live seller's reputation record is updated from its
-    weight (an outlier when below half the best weight of its site in this settlement), so rules can
-    read how the market has judged it; an expired sale counts as settled, not as an outlier."""
-    e = expired_count(w, buyer)
+    """Settle a deposit: reward and pot to the buyer, then ``info_share * reward + pot`` from the buyer
+    to the sellers of its open transactions in proportion to ``weights`` (one per transaction); clear
+    them.  Each seller's reputation record is updated from its weight (an outlier when below half the
+    best weight of its site in this settlement), so rules can read how the market has judged it."""
+    _settle(w, buyer, weights, w.reward, w.info_share * w.reward, True)
+
+
+@njit(cache=True)
+def settle_expired(w, buyer, weights):
+    """The stake-expiry rule (docs/chain.md): an expired round trip (``trip_expired``) is settled as a
+    deposit settles it, every transaction weighed, but with no reward: the buyer pays the information
+    share from its balance, as far as that goes, and its next deposit keeps the whole reward unless it
+    bought again.  So a seller is paid by weight however late (a liar's many records are no better paid
+    for expiring) and a buyer gains nothing by waiting for its transactions to expire."""
+    share = min(w.info_share * w.reward, max(w.balance[buyer], 0.0))
+    _settle(w, buyer, weights, 0.0, share, False)
+
+
+@njit(cache=True)
+def _settle(w, buyer, weights, reward, share, deposit):
+    """Reward and pot to the buyer, then ``share + pot`` from the buyer to its sellers by ``weights``;
+    the deposit's reputation count and event when ``deposit``."""
     n = w.tx_count[buyer]
-    k = n - e
     balance, tx_count = unlock(w.balance), unlock(w.tx_count)
-    balance[buyer] += w.reward
+    balance[buyer] += reward
     pot = w.pot[buyer]
     balance[buyer] += pot
     unlock(w.pot)[buyer] = 0.0
-    unlock(w.money)[0] += w.reward + pot
-    unlock(w.rep_deposits)[buyer] += 1
+    unlock(w.money)[0] += reward + pot
+    if deposit:
+        unlock(w.rep_deposits)[buyer] += 1
     total = 0.0
     top0 = 0.0
     top1 = 0.0
-    a = w.tx_off[buyer] + e
-    for x in range(k):
+    a = w.tx_off[buyer]
+    for x in range(n):
         wx = weights[x]
         if not (wx >= 0.0) or math.isinf(wx):
             unlock(w.flags)[0] |= flags.BAD_WEIGHTS
@@ -189,13 +174,9 @@ def distribute(w, buyer, weights):
             top0 = max(top0, wx)
         else:
             top1 = max(top1, wx)
-    if e == 0:
-        amount = w.info_share * w.reward + pot
-    else:
-        _pay_expired(w, buyer, e, w.info_share * w.reward / n)
-        amount = w.info_share * w.reward * k / n + pot
-    paid = k > 0 and total > 0.0
-    for x in range(k):
+    amount = share + pot
+    paid = n > 0 and total > 0.0
+    for x in range(n):
         seller = w.tx_seller[a + x]
         pay = amount * (weights[x] / total) if paid else 0.0
         if paid:
@@ -203,29 +184,18 @@ def distribute(w, buyer, weights):
         _record_sale(w, seller, weights[x], top0 if w.tx_site[a + x] == 0 else top1, pay, w.tx_stake[a + x])
     if paid:
         balance[buyer] -= amount
+        if not deposit and balance[buyer] < 0.0:  # it paid its whole balance: no float residue below 0
+            unlock(w.money)[0] -= balance[buyer]
+            balance[buyer] = 0.0
         if w.record:
-            for x in range(k):
+            for x in range(n):
                 log_payment(w, buyer, a + x, weights[x] / total, amount * (weights[x] / total))
     elif w.record:
-        for x in range(k):
+        for x in range(n):
             log_payment(w, buyer, a + x, 0.0, 0.0)
     tx_count[buyer] = 0
-    log_event(w, EV_DEPOSIT, buyer, -1, -1, 0.0, 0.0, 0.0, 0, 0.0, 0.0, 0.0)
-
-
-@njit(cache=True)
-def _pay_expired(w, buyer, e, part):
-    """The buyer pays each of its ``e`` expired transactions (the first of its block) ``part``."""
-    balance = unlock(w.balance)
-    a = w.tx_off[buyer]
-    for x in range(e):
-        seller = w.tx_seller[a + x]
-        balance[seller] += part
-        balance[buyer] -= part
-        unlock(w.rep_settled)[seller] += 1
-        unlock(w.rep_earned)[seller] += part
-        if w.record:
-            log_payment(w, buyer, a + x, 0.0, part)
+    if deposit:
+        log_event(w, EV_DEPOSIT, buyer, -1, -1, 0.0, 0.0, 0.0, 0, 0.0, 0.0, 0.0)
 
 
 @njit(forceinline=True, cache=True)

@@ -15,7 +15,7 @@ from ..errors import ConfigError, SimulationError
 from ..registry import get_payment
 from ..state.flags import ErrorFlags
 from ..state.view import make_view
-from .kernels import distribute, expire_stakes, expired_count, open_transaction
+from .kernels import distribute, open_transaction, settle_expired, trip_expired
 from .pool import reserve
 from .state import REPUTATION, grow_book, new_book
 
@@ -72,11 +72,15 @@ class Ledger:
             raise SimulationError(flags.describe())
 
     def begin_step(self, step: int) -> None:
-        """Step ``step`` begins: the clock moves there and, with stake expiry, expired stakes go back."""
+        """Step ``step`` begins: the clock moves there and, with stake expiry, every buyer's expired round
+        trip is settled whole, by the scheme's weights, the buyer paying the share (buyers in id order)."""
         self.book.clock[0] = step
         if self.book.stake_expiry > 0:
             for buyer in range(self.book.balance.shape[0]):
-                expire_stakes(self.view, buyer)
+                if trip_expired(self.view, buyer):
+                    self._grow_log(buyer)
+                    settle_expired(self.view, buyer, self._weights(buyer))
+                    self._check()
 
     def purchase(self, buyer: int, seller: int, site: int, direction_deg: float) -> bool:
         """Open a transaction (locking the seller's stake); False when the seller cannot stake."""
@@ -88,21 +92,30 @@ class Ledger:
         self._check()
         return ok
 
-    def deposit(self, buyer: int) -> None:
-        """The buyer deposits an item: the scheme weighs its open transactions and the round trip is paid."""
+    def _grow_log(self, buyer: int) -> None:
+        """Room in the logs for one settlement of the buyer's open transactions."""
         book = self.book
         if book.record:
-            self.book = book = grow_book(book, book.tx_count, int(book.ev_count[0]) + 1,
-                                         int(book.pay_count[0]) + int(book.tx_count[buyer]))
-            self.view = make_view("book", book)
-        a = int(book.tx_off[buyer]) + int(expired_count(self.view, buyer))  # the scheme weighs the live ones
-        b = int(book.tx_off[buyer]) + int(book.tx_count[buyer])
+            self.book = grow_book(book, book.tx_count, int(book.ev_count[0]) + 1,
+                                  int(book.pay_count[0]) + int(book.tx_count[buyer]))
+            self.view = make_view("book", self.book)
+
+    def _weights(self, buyer: int) -> np.ndarray:
+        """The scheme's weights of the buyer's open transactions."""
+        book = self.book
+        a = int(book.tx_off[buyer])
+        b = a + int(book.tx_count[buyer])
         weights = np.zeros(b - a)
         rule = self.scheme.weights
         extra = ([self.view] if rule.wants_market else []) + ([self.rng] if rule.wants_rng else [])
         rule.func(buyer, book.tx_seller[a:b].copy(), book.tx_site[a:b].copy(), book.tx_dir[a:b].copy(), weights,
                   *extra, *book.pparams[:len(rule.params)])
-        distribute(self.view, buyer, weights)
+        return weights
+
+    def deposit(self, buyer: int) -> None:
+        """The buyer deposits an item: the scheme weighs its open transactions and the round trip is paid."""
+        self._grow_log(buyer)
+        distribute(self.view, buyer, self._weights(buyer))
         self._check()
 
 
@@ -114,10 +127,10 @@ def replay_events(events: Iterable, robots: int, *, scheme: str = "delayed", ini
     (a DataFrame's ``itertuples()`` works; 'refused' events are replayed as purchases).
 
     ``stake_expiry`` = T > 0 applies the stake-expiry rule (docs/chain.md): at the start of each step
-    s (before its first event), every open transaction opened at a step t with t + T <= s expires:
-    its stake goes back to its seller, and the buyer's deposit pays it an equal part of the share
-    (``ledger.kernels.distribute``) instead of weighing it.  ``reputation_decay`` < 1 keeps the decayed
-    reputation record (``payment.reputation_decay``)."""
+    s (before its first event), a buyer whose first open transaction was opened at a step t with
+    t + T <= s has its whole round trip settled by the scheme's weights as a deposit would settle it,
+    the share paid from its own balance as far as it goes (``ledger.kernels.settle_expired``).
+    ``reputation_decay`` < 1 keeps the decayed reputation record (``payment.reputation_decay``)."""
     ledger = Ledger(robots, scheme=scheme, initial_wealth=initial_wealth, reward=reward,
                     information_share=information_share, stake=stake, params=params, stake_expiry=stake_expiry,
                     reputation_decay=reputation_decay)

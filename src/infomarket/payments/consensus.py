@@ -23,8 +23,7 @@ def round_trip_amount(market, buyer):
 
 @njit(forceinline=True, cache=True)
 def stake_of(market, buyer, x):
-    """The stake locked by the buyer's x-th open transaction.  x counts its expired transactions too
-    (first in its block, stake 0): the k live ones a rule weighs are the last k."""
+    """The stake locked by the buyer's x-th open transaction (a rule weighs them all, in order)."""
     return market.tx_stake[market.tx_off[buyer] + x]
 
 
@@ -34,7 +33,7 @@ def payouts(market, buyer, refund, share, weights):
     is left of the round trip's amount in proportion to ``share`` (equally when ``share`` sums to 0):
     they sum to that amount, so the ledger pays each weight as it is."""
     k = weights.shape[0]
-    first = market.tx_count[buyer] - k  # the expired transactions before the live ones weighed
+    first = market.tx_count[buyer] - k  # 0: every open transaction is weighed
     rest = round_trip_amount(market, buyer)
     total = 0.0
     for x in range(k):

@@ -67,7 +67,7 @@ def test_the_quota_holds_in_every_window_not_only_in_each_period(fresh):
     market.approve(registrar, robots[2].address, GRANT)
 
 
-def test_revocations_count_against_the_quota_and_a_revoked_buyers_sellers_are_refunded_at_once(fresh):
+def test_revocations_count_against_the_quota_and_a_revoked_buyers_sellers_are_paid_at_once(fresh):
     market, robots = fresh(accounts=4, registrar_quota=2, registrar_period=100, stake=0.04)
     buyer, seller, *others = robots
     for pair in (robots[:2], robots[2:]):  # two registrations per registrar and window
@@ -83,6 +83,8 @@ def test_revocations_count_against_the_quota_and_a_revoked_buyers_sellers_are_re
             "InfoMarketRegistrarQuotaExceeded", registrar=r0.address, limit=2)
     market.transact(r1, "revokeRegistration", buyer.address)  # revoked
     assert not market.view("isRegistered", buyer.address)
-    market.refund_expired(buyer.address)  # at once, not after the stake expiry
+    market.expire(buyer.address)  # at once, not after the stake expiry: settled as a deposit would be
     assert market.locked_stake(buyer.address) == 0
-    assert market.balance_of(seller.address) == 10**9
+    # the seller's record, alone, gets the share (paid from the revoked buyer's balance) and its stake
+    assert market.balance_of(seller.address) == 10**9 + 500_000_000
+    assert market.balance_of(buyer.address) == 500_000_000

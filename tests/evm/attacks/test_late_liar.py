@@ -64,3 +64,36 @@ def test_a_liar_is_paid_by_weight_however_late_its_buyers_settlement_finishes(ma
     assert bounty == (12 + 13) * 10_000
     # the reward less the share, as ever, and the rounding dust (under a unit a record)
     assert 0 <= market.balance_of(buyer.address) - (WEALTH + TOKEN // 2) < 13
+
+
+EXPIRY = 20  # blocks: more than the 13 reveals take on py-evm (a block each), so none expires before the last
+
+
+def _expiring_round_trip(make_market, robots, scheme):
+    options = {"cap": 1} if scheme == "capped_outlier" else {}
+    market = make_market(scheme, stake=0.04, stake_expiry=EXPIRY, settlement_deadline=10**6, **options)
+    buyer, liar, honest = robots[0], robots[1], robots[2:5]
+    for age in range(10):
+        sell(market, liar, buyer, 100.0, age=age)
+    for age, (seller, direction) in enumerate(zip(honest, (10.0, 15.0, 20.0))):
+        sell(market, seller, buyer, direction, age=100 + age)
+    market.backend.advance_to(market.backend.block_number + EXPIRY)  # every record has expired
+    return market, buyer, liar, honest
+
+
+@pytest.mark.parametrize("scheme", sorted(PROMPT))
+@pytest.mark.parametrize("trigger", ["refundExpired", "deposit"])
+def test_a_liar_is_no_better_off_when_its_buyers_records_expire(make_market, robots, scheme, trigger):
+    """The third audit's M1 past expiry: records that expired were refunded their stakes and paid
+    share / 13 each at the deposit, +384 615 380 to the liar under both schemes. The expiry is reached
+    either by anyone's ``refundExpired`` (then the buyer deposits later) or by the deposit itself."""
+    liar_net, honest_net = PROMPT[scheme]
+    market, buyer, liar, honest = _expiring_round_trip(make_market, robots, scheme)
+    if trigger == "refundExpired":
+        market.expire(buyer.address)  # the market's node, unregistered: no bounty
+    market.deposit(buyer.address)
+    late_liar, late_honest = _nets(market, liar, honest)
+    assert late_liar <= liar_net, late_liar  # never better off late than prompt
+    assert (late_liar, late_honest) == (liar_net, [honest_net] * 3)  # weighed exactly as a prompt deposit
+    # the buyer gains the reward less the share either way, and the rounding dust (under a unit a record)
+    assert 0 <= market.balance_of(buyer.address) - (WEALTH + TOKEN // 2) < 13

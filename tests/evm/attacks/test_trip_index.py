@@ -1,17 +1,19 @@
 """A buyer's record indices are never reset under a round trip that holds records.
 
 The exploit: a settlement left pending for `stakeExpiry` blocks while the buyer's next round trip
-receives a record that then expires and is refunded (anyone may call `refundExpired`). When that
+receives a record that then expires and is refunded (anyone could call `refundExpired`). When that
 settlement finished, the contract saw an empty open round trip and restarted the buyer's indices at
 0, but the refunded seller's per-buyer link (`_sold`) still held its old index: its next reveal
 underflowed (`Panic(0x11)`), or its link pointed at another seller's record, and under
-`outlier_distinct` the two sellers were counted as one voice and paid half a share each.
+`outlier_distinct` the two sellers were counted as one voice and paid half a share each. An expiry
+now closes the whole round trip (a new round trip number, so no link of it counts again), and only
+once the pending settlement is finished.
 """
 from __future__ import annotations
 
 import pytest
 
-from .helpers import sell, settle_all
+from .helpers import refused, sell, settle_all
 
 
 @pytest.mark.parametrize("order", ["linked-to-another", "revealed-first"])
@@ -25,13 +27,15 @@ def test_a_refunded_record_under_a_pending_settlement_keeps_its_sellers_link(mak
     market.buy_item(buyer.address)  # one unit of work: the settlement stays pending
     sell(market, refunded, buyer, 11.0, age=2)  # round trip 1: record 2
     market.backend.advance_to(market.backend.block_number + 10)
-    assert len(market.refund_expired(buyer.address).of("RecordExpired")) == 1  # the open round trip is empty
-    settle_all(market, buyer.address, 1)  # round trip 0 settles: indices may restart only if nothing was sold
+    refused(lambda: market.refund_expired(buyer.address), "InfoMarketSettlementPending", robot=buyer.address,
+            remaining=1)  # round trip 0 first: 1 of its 2 records weighed
+    settle_all(market, buyer.address, 1)  # round trip 0 settles
+    (closed,) = market.expire(buyer.address)[0].of("RoundTripExpired")  # round trip 1: its one record gets 0.5
+    assert closed["transactions"] == 1 and market.balance_of(refunded.address) == 10**9 + 500_000_000
     sellers = [*honest, refunded] if order == "linked-to-another" else [refunded, *honest]
     for age, seller in enumerate(sellers):
         sell(market, seller, buyer, 10.0 + age, age=10 + age)
     shares = [e for r in market.deposit(buyer.address) for e in r.of("RewardShared")]
-    # Five records: the refunded one is paid 0.5 / 5 token (weight 0, an expired record); four distinct
-    # sellers, every pair within theta, share the rest, 0.5 * 4 / 5: four equal voices, 0.1 token each.
-    expected = [(refunded.address, 0, 100_000_000)] + [(s.address, 4 * 10**27, 100_000_000) for s in sellers]
+    # Four distinct sellers, every pair within theta, share 0.5: four equal voices, 0.125 token each.
+    expected = [(s.address, 4 * 10**27, 125_000_000) for s in sellers]
     assert sorted((e["seller"], e["weight"], e["amount"]) for e in shares) == sorted(expected)

@@ -226,7 +226,8 @@ def test_a_pause_stops_registrations_reveals_and_deposits_but_never_refunds_or_s
     settle_all(market, buyer.address, 1)  # settling goes on
     refused(lambda: market.buy_item(buyer.address), "InfoMarketPaused")
     market.backend.advance_to(market.backend.block_number + 3)
-    assert len(market.refund_expired(buyer.address).of("RecordExpired")) == 1  # so does refunding
+    (closed,) = market.expire(buyer.address)[0].of("RoundTripExpired")  # so does an expiry
+    assert closed["transactions"] == 1
     market.set_paused(False)
     sell(market, seller, buyer, 10.0, age=4)
 
