@@ -56,7 +56,7 @@ def creatable_dir(path: str | Path, option: str = "--out") -> Path:
             raise UsageError(f"{option} {path}: {probe} is not a folder; choose another path")
         longest = os.pathconf(probe, "PC_NAME_MAX") if hasattr(os, "pathconf") else 255
         if any(len(os.fsencode(name)) > longest for name in missing):
-            raise OSError(errno.ENAMETOOLONG, os.strerror(errno.ENAMETOOLONG))
+            raise UsageError(f"{option} {path}: cannot write there ({os.strerror(errno.ENAMETOOLONG)})")
         with tempfile.TemporaryFile(dir=probe):
             pass
     except OSError as exc:  # a read-only or full folder, a name too long

@@ -3,7 +3,6 @@ from __future__ import annotations
 
 import time
 
-from ..analysis.study import out_dir, refuse_declared_seed
 from ..cliargs import UsageError, at_least, dask_client, seed_value, workers_count
 
 #: outer settings an option may make smaller than declared (the report is then marked reduced)
@@ -59,6 +58,7 @@ def _list_families(st) -> int:
 def cmd_defence_search(args) -> int:
     """Run ``infomarket defence-search``: the min-max search of defences per family (resumable), its frontier
     confirmed and reported; returns the exit code."""
+    from ..analysis.study import out_dir, refuse_declared_seed  # with the command: scipy.stats stays out of the parser
     # with the command: `infomarket --help` does not import the search, runner and store
     from ..config import load_experiment
     from ..runner.execute import default_workers, local_executor

@@ -8,7 +8,6 @@ import json
 import math
 import time
 
-from ..analysis.study import out_dir
 from ..cliargs import UsageError, at_least, seed_value, workers_count
 
 #: The policy's and the summaries' file names in ``--out``.
@@ -112,6 +111,8 @@ def cmd_adaptive_attack(args) -> int:
     from ..agents.runs import ACTIONS
     from .adaptive import resumed_generations, train
     from .adaptive_play import BATCH, check_memory
+
+    from ..analysis.study import out_dir  # with the command: scipy.stats stays out of the parser
 
     out = out_dir(args.out, holds="the checkpoint, the policy and the summary")
     if not args.defence.strip():

@@ -6,7 +6,6 @@ import functools
 import time
 from pathlib import Path
 
-from ..analysis.study import out_dir, questions_path, refuse_declared_seed
 from ..cliargs import UsageError, at_least, dask_client, seed_value, workers_count
 from .baselines import rotation_grid
 
@@ -78,6 +77,7 @@ def _list_baselines(st) -> int:
 def cmd_attack_search(args) -> int:
     """Run ``infomarket attack-search``: search each cell's worst attack into the store (resumable), then write the
     cells' frames and the summary; returns the exit code."""
+    from ..analysis.study import out_dir, questions_path, refuse_declared_seed
     # with the command: `infomarket --help` does not import the search, runner and store
     from ..config import load_experiment
     from ..runner.execute import default_workers, local_executor
