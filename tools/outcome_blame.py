@@ -1,6 +1,7 @@
 """How much blame outcome-based trust puts on honest sellers, with and without liars in the swarm.
 
     .venv/bin/python tools/outcome_blame.py --seeds 4 --steps 15000
+    .venv/bin/python tools/outcome_blame.py --honest vote_k --params '{"k": 2, "horizon": 1000}'
 
 The ``outcome_trust`` buyer blames every seller whose vector it used when a trip fails.  An honest robot
 that bought a lie, averaged it in and sold the result is blamed for it, as are honest sellers whose old
@@ -14,6 +15,7 @@ beside it.  Under outlier penalisation without stake, as docs/defences.md's othe
 from __future__ import annotations
 
 import argparse
+import json
 
 import numpy as np
 
@@ -60,15 +62,17 @@ def main() -> None:
     ap.add_argument("--liars", type=int, default=3)
     ap.add_argument("--rotation", type=float, default=90.0)
     ap.add_argument("--honest", default="naive,outcome_trust", help="the honest behaviours, comma-separated")
+    ap.add_argument("--params", default="{}", help="the honest behaviours' parameters, as JSON")
     args = ap.parse_args()
-    params = {"prior": 1.0, "distrust": 0.3, "power": 1.0, "memory": 8}
+    params = json.loads(args.params)
     for honest in args.honest.split(","):
         for liars in (0, args.liars):
-            rows = [run(honest, liars, s, args.steps, args.rotation, params if honest == "outcome_trust" else {})
-                    for s in range(args.seeds)]
+            rows = [run(honest, liars, s, args.steps, args.rotation, params) for s in range(args.seeds)]
             cells = []
             for key in rows[0]:
                 v = np.array([r[key] for r in rows])
+                if np.isnan(v).all():
+                    continue  # no liars: nothing to say about them
                 cells.append(f"{key} {np.nanmean(v):.3f} ± {np.nanstd(v):.3f}")
             print(f"{honest:14s} liars {liars}: " + ", ".join(cells), flush=True)
 

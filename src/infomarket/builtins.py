@@ -140,10 +140,9 @@ register_payment("capped_outlier", consensus.capped_outlier_weights,
                              "later ones are void: stake back, no pay",
                  limits={"theta": _ANGLE, "cap": (">= 1", lambda v: v >= 1)})
 
-# Defences fed by outcomes, by vector ages and by votes (docs/defences.md, "Outcomes, ages and votes").
+# Defences fed by trip outcomes, by vector ages and by votes (docs/defences.md, "Outcome, age and vote defences").
 from .behaviours import fusion, outcome, vote  # noqa: E402 - here: rules register in this order
 
-_UNIT = ("in [0, 1]", lambda v: 0 <= v <= 1)
 register_behaviour("outcome_trust", buy=outcome.outcome_trust_buy, sell="naive", honest=True,
                    description="keeps a Beta record of each seller fed by its own trips (site reached or nothing "
                                "found); skips sellers whose Beta mean is below `distrust` and weighs the rest by "
