@@ -196,3 +196,29 @@ def test_bad_parameters_are_refused_by_name(name, params, text):
     with pytest.raises(ConfigError) as e:
         make_config(3, name, swarm={"robots": 3, "groups": [{"behaviour": name, "count": 3, "params": params}]})
     assert text in str(e.value) and list(params)[0] in str(e.value)
+
+
+def test_in_a_run_outcome_trust_blames_liars_more_than_honest_sellers():
+    """A run on the shared kernel: every record is of a seller the robot bought from, and the 90-degree
+    saboteurs' judged trips fail more often than the honest sellers' (docs/defences.md measures how much)."""
+    from infomarket import Experiment
+
+    from ..shared_kernel import simulation
+
+    groups = [{"behaviour": "outcome_trust", "count": 22}, {"behaviour": "saboteur", "count": 3}]
+    cfg = Experiment.model_validate({"steps": 6000, "swarm": {"robots": 25, "groups": groups},
+                                     "payment": {"scheme": "outlier"}})
+    sim = simulation(cfg, 0, record_events=True)
+    sim.run()
+    w = sim.world
+    bought = set(zip(w.ev_buyer[:w.ev_count[0]], w.ev_seller[:w.ev_count[0]]))
+    tally = {True: [0.0, 0.0], False: [0.0, 0.0]}  # liar? -> good, bad
+    for buyer in range(22):
+        for j in range(TRUST_SLOTS):
+            s = int(w.trust_seller[buyer, j])
+            if s >= 0:
+                assert (buyer, s) in bought
+                tally[s >= 22][0] += w.trust_good[buyer, j]
+                tally[s >= 22][1] += w.trust_bad[buyer, j]
+    honest, liar = (t[1] / (t[0] + t[1]) for t in (tally[False], tally[True]))
+    assert sum(tally[True]) > 0 and liar > honest
