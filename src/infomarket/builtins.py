@@ -139,3 +139,25 @@ register_payment("capped_outlier", consensus.capped_outlier_weights,
                  description="outlier penalisation counting at most `cap` records per seller per round trip; "
                              "later ones are void: stake back, no pay",
                  limits={"theta": _ANGLE, "cap": (">= 1", lambda v: v >= 1)})
+
+# Defences fed by trip outcomes, by vector ages and by votes (docs/defences.md, "Outcome, age and vote defences").
+from .behaviours import fusion, outcome, vote  # noqa: E402 - here: rules register in this order
+
+register_behaviour("outcome_trust", buy=outcome.outcome_trust_buy, sell="naive", honest=True,
+                   description="keeps a Beta record of each seller fed by its own trips (site reached or nothing "
+                               "found); skips sellers whose Beta mean is below `distrust` and weighs the rest by "
+                               "it ** `power`",
+                   limits={"prior": ("> 0", lambda v: v > 0), "distrust": _UNIT, "power": (">= 0", lambda v: v >= 0),
+                           "memory": (">= 1", lambda v: v >= 1)})
+register_behaviour("gated_fusion", buy=fusion.gated_fusion_buy, sell="naive", honest=True, needs_neighbours=True,
+                   description="fuses a purchase Kalman-style with variances from the vectors' ages (`drift` "
+                               "degrees per step, `floor` units) and rejects it past a chi-square `gate`",
+                   limits={"drift": (">= 0", lambda v: v >= 0), "floor": ("> 0", lambda v: v > 0),
+                           "gate": ("> 0", lambda v: v > 0)})
+register_behaviour("vote_k", buy=vote.vote_k_buy, sell="naive", honest=True,
+                   description="with an invalid entry, buys from `k` distinct sellers and installs their "
+                               "geometric (or coordinate-wise) median; with a valid one, the sceptic",
+                   limits={"k": (">= 1 and <= 32", lambda v: 1 <= v <= 32),
+                           "geometric": ("0 or 1", lambda v: v in (0, 1)), "iterations": (">= 0", lambda v: v >= 0),
+                           "horizon": (">= 0", lambda v: v >= 0),
+                           "threshold": ("> 0", lambda v: v > 0)})

@@ -214,3 +214,41 @@ def confirm_or_wait(w, me, site, seller, x, y, age, threshold):
             return True
     pending_add(w, me, site, seller, x, y, age)
     return False
+
+
+@njit(forceinline=True, cache=True)
+def trust_get(w, me, seller):
+    """Robot ``me``'s outcome record of ``seller``: (good, bad), the trips its vectors led to the site and
+    those that found nothing there; (0, 0) for a seller it has not judged.  The record is the robot's own
+    (no other robot reads or writes it), so a seller cannot fake it as it can fake an offer."""
+    for j in range(w.trust_seller.shape[1]):
+        if w.trust_seller[me, j] == seller:
+            return w.trust_good[me, j], w.trust_bad[me, j]
+    return 0.0, 0.0
+
+
+@njit(forceinline=True, cache=True)
+def trust_add(w, me, seller, good, bad):
+    """Add ``good`` and ``bad`` outcomes to robot ``me``'s record of ``seller``.  A robot keeps records of at
+    most ``kt`` sellers (``engine.swarm.TRUST_SLOTS``): a new seller takes a free slot, else the slot with
+    the fewest outcomes (the lowest on a tie), so a long run forgets its least-known sellers first."""
+    slot = -1
+    for j in range(w.trust_seller.shape[1]):
+        if w.trust_seller[me, j] == seller:
+            slot = j
+            break
+    if slot < 0:
+        least = 0.0
+        for j in range(w.trust_seller.shape[1]):
+            seen = w.trust_good[me, j] + w.trust_bad[me, j]
+            if w.trust_seller[me, j] < 0:
+                slot = j
+                break
+            if slot < 0 or seen < least:
+                slot = j
+                least = seen
+        w.trust_seller[me, slot] = seller
+        w.trust_good[me, slot] = 0.0
+        w.trust_bad[me, slot] = 0.0
+    w.trust_good[me, slot] += good
+    w.trust_bad[me, slot] += bad

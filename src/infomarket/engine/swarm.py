@@ -1,9 +1,11 @@
 """The swarm's state: every robot's pose, odometry, navigation table, offers, pending purchases, spots,
-timers and neighbours; its builder (the initial draws of docs/model.md §1) and its growth.
+timers, neighbours and outcome records; its builder (the initial draws of docs/model.md §1) and its growth.
 
 Written by the engine's step; a buy rule writes only its own robot's ``new_*`` table and pending list,
 through ``behaviours.api``.  Nothing is [n, n]: ``kn`` neighbour and ``kp`` pending slots per robot, grown
-by the host between steps when the kernel asks for room (``grow_swarm``).
+by the host between steps when the kernel asks for room (``grow_swarm``), and ``kt`` = ``TRUST_SLOTS`` outcome
+records per robot (the sellers it has judged by its trips, ``api.trust_add``), a fixed number so that a
+large swarm pays ``n * kt``, not ``n * n``.
 """
 from __future__ import annotations
 
@@ -19,6 +21,8 @@ PATH_POINTS = 4
 #: First neighbour and pending capacities.
 NEIGHBOUR_CAPACITY = 8
 PENDING_CAPACITY = 4
+#: Sellers a robot keeps an outcome record for (``api.trust_add`` forgets the least-judged one beyond it).
+TRUST_SLOTS = 16
 
 # Robot states.
 EXPLORING = 0
@@ -64,6 +68,9 @@ SPEC = Spec("swarm", fields("engine", [
     ("path_count", "int64", "n,2", "further waypoints held (0: a plain vector)"),
     ("new_path_vec", "float64", "n,2,PATH_POINTS-1,2", "the path being bought into"),
     ("new_path_count", "int64", "n,2", "its waypoints"),
+    ("trust_seller", "int64", "n,kt", "sellers the robot keeps an outcome record for (-1: free slot)"),
+    ("trust_good", "float64", "n,kt", "their trips that reached the site (written by buy rules, ``api.trust_add``)"),
+    ("trust_bad", "float64", "n,kt", "their trips that found nothing there"),
 ]))
 
 
@@ -95,6 +102,8 @@ def build_swarm(cfg: Experiment, rng: np.random.Generator, kind: np.ndarray, cel
         "cell_start": z(cells + 1, np.int64), "cell_items": z(n, np.int64),
         "blocked": z((n, 2), np.bool_), "path_vec": z((n, 2, PATH_POINTS - 1, 2)), "path_count": z((n, 2), np.int64),
         "new_path_vec": z((n, 2, PATH_POINTS - 1, 2)), "new_path_count": z((n, 2), np.int64),
+        "trust_seller": np.full((n, TRUST_SLOTS), -1, np.int64), "trust_good": z((n, TRUST_SLOTS)),
+        "trust_bad": z((n, TRUST_SLOTS)),
     }
     SPEC.check(swarm)
     return swarm

@@ -14,9 +14,9 @@ the spec's ``writer`` decides how each field is typed there, and so who can writ
 ``log``     outputs (events, payments, history, error bits, the clock): read-only except inside the
             engine's and the ledger's log operations.
 
-Shapes are written with symbols: ``n`` robots, ``kn`` neighbour slots, ``kp`` pending slots, ``P`` the
-transaction pool, ``E`` the event log, ``S`` sites, ``K`` obstacles, ``m`` history rows; ``""`` is a scalar
-(the chain model's own symbols are listed in ``ledger.poa.spec``).
+Shapes are written with symbols: ``n`` robots, ``kn`` neighbour slots, ``kp`` pending slots, ``kt`` outcome
+records, ``P`` the transaction pool, ``E`` the event log, ``S`` sites, ``K`` obstacles, ``m`` history rows;
+``""`` is a scalar (the chain model's own symbols are listed in ``ledger.poa.spec``).
 """
 from __future__ import annotations
 
