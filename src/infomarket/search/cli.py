@@ -77,8 +77,8 @@ def _list_baselines(st) -> int:
 def cmd_attack_search(args) -> int:
     """Run ``infomarket attack-search``: search each cell's worst attack into the store (resumable), then write the
     cells' frames and the summary; returns the exit code."""
+    # with the command: `infomarket --help` imports neither scipy.stats nor the search, runner and store
     from ..analysis.study import out_dir, questions_path, refuse_declared_seed
-    # with the command: `infomarket --help` does not import the search, runner and store
     from ..config import load_experiment
     from ..runner.execute import default_workers, local_executor
     from ..runner.feed import Feed, dask_threads
