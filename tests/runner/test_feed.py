@@ -7,6 +7,7 @@ import pandas as pd
 import pytest
 
 import infomarket as im
+from infomarket.errors import InternalError
 from infomarket.runner.feed import Feed
 from infomarket.runner.sweep import plan, run_sweep
 from infomarket.store import Store
@@ -74,3 +75,31 @@ def test_a_jobs_error_is_raised_and_ends_the_others(conds, tmp_path):
         t.join(timeout=60)
         assert not t.is_alive()
     assert after == []
+
+
+def test_a_job_that_sweeps_after_the_map_ended_is_stopped_not_run_alone(conds, tmp_path):
+    """The interleaving the test above leaves to chance, forced: the other job asks its next sweep only
+    after ``map`` has raised (its thread lives on), and must be stopped rather than sweep by itself."""
+    feed = Feed(Store(tmp_path / "s", cache=True))
+    raised, outcome = threading.Event(), []
+
+    def late():
+        feed._turn(False)  # wait without holding the turn, as a job between two sweeps does
+        raised.wait(60)
+        feed._turn(True)
+        try:
+            feed.sweep(conds[1:2])
+            outcome.append("swept alone")
+        except InternalError as exc:
+            outcome.append(str(exc))
+
+    def fails():
+        raise ValueError("the optimiser's own error")
+
+    with pytest.raises(ValueError, match="the optimiser's own error"):
+        feed.map([late, fails])
+    raised.set()
+    for t in feed._jobs:
+        t.join(timeout=60)
+    assert outcome == ["stopped: ValueError: the optimiser's own error"]
+    assert not Store(tmp_path / "s").exists() or Store(tmp_path / "s").runs().empty

@@ -109,6 +109,8 @@ class Feed:
         self._wake = threading.Event()
         self._main: threading.Thread | None = None
         self._since = 0.0
+        self._jobs: set[threading.Thread] = set()
+        self._ended: BaseException | None = None
 
     # ------------------------------------------------------------------------------- a job's side
     def sweep(self, conds: list, store: Store | None = None, *, on_plan=None, on_part=None, **_) -> SweepReport:
@@ -116,6 +118,9 @@ class Feed:
         among the other jobs' (the job's turn given up meanwhile); in the main thread, ``run_sweep`` itself."""
         if store is not None and store is not self.store:
             raise InternalError("a feed sweeps into its own store only")
+        if self._ended is not None and threading.current_thread() in self._jobs:
+            # a job of a map that an error or a stop ended: its thread lives on, but it must not sweep alone
+            raise _stopped(self._ended)
         if self._main is None or threading.current_thread() is self._main:
             t0 = time.perf_counter()
             rep = run_sweep(conds, self.store, workers=CUT_FOR, executor=self.executor, on_done=self.on_done,
@@ -161,6 +166,7 @@ class Feed:
         self._baton.acquire()
         threads = [threading.Thread(target=body, args=(k,), daemon=True, name=f"infomarket-job-{k}")
                    for k in range(len(jobs))]
+        self._jobs, self._ended = set(threads), None
         try:
             for t in threads:
                 t.start()
@@ -180,6 +186,7 @@ class Feed:
                 self._collect()
                 interrupts.check()
         except BaseException as exc:  # noqa: BLE001 - any end, Ctrl-C included, stops every job, then goes on up
+            self._ended = exc
             self._stop(exc)
             interrupts.raise_stopped(exc)
         finally:
@@ -321,12 +328,17 @@ class Feed:
             fut.cancel()
         self._running.clear()
         self._queue.clear()
-        stop = InternalError(f"stopped: {type(exc).__name__}: {exc}")
+        stop = _stopped(exc)
         for s in self._asked + self._open:
             s.error = stop
             s.done.set()
         self._asked.clear()
         self._open.clear()
+
+
+def _stopped(exc: BaseException) -> InternalError:
+    """The error a job's sweep ends with once ``exc`` (another job's error, or a stop) ended the map."""
+    return InternalError(f"stopped: {type(exc).__name__}: {exc}")
 
 
 def dask_threads(client) -> int:
