@@ -29,14 +29,15 @@ from infomarket.engine.simulation import Simulation
 
 
 def run(honest: str, liars: int, seed: int, steps: int, rotation: float, params: dict, scheme: str = "outlier",
-        stake: float = 0.0) -> dict:
+        stake: float = 0.0, pparams: dict | None = None) -> dict:
     """One run: items per honest robot (and, with a stake, the stake lost per honest robot and per liar)
     and, for ``outcome_trust`` buyers, the pooled records."""
     groups = [{"behaviour": honest, "count": 25 - liars, "params": params}]
     if liars:
         groups.append({"behaviour": "saboteur", "count": liars, "params": {"rotation_angle": rotation}})
     cfg = im.Experiment.model_validate({"steps": steps, "swarm": {"robots": 25, "groups": groups},
-                                        "payment": {"scheme": scheme, "stake": stake}})
+                                        "payment": {"scheme": scheme, "stake": stake,
+                                                    "params": pparams or {}}})
     sim = Simulation(cfg, seed)
     result = sim.run()
     out = {"items": float(result.robots.items_collected[:25 - liars].mean())}
@@ -76,11 +77,13 @@ def main() -> None:
     ap.add_argument("--params", default="{}", help="the honest behaviours' parameters, as JSON")
     ap.add_argument("--scheme", default="outlier", help="the payment scheme")
     ap.add_argument("--stake", type=float, default=0.0, help="the stake per sale")
+    ap.add_argument("--payment-params", default="{}", help="the scheme's parameters, as JSON")
     args = ap.parse_args()
     params = json.loads(args.params)
     for honest in args.honest.split(","):
         for liars in (0, args.liars):
-            rows = [run(honest, liars, s, args.steps, args.rotation, params, args.scheme, args.stake)
+            rows = [run(honest, liars, s, args.steps, args.rotation, params, args.scheme, args.stake,
+                        json.loads(args.payment_params))
                     for s in range(args.seeds)]
             cells = []
             for key in rows[0]:
