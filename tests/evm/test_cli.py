@@ -153,6 +153,15 @@ def test_a_consensus_slash_experiment_is_refused_before_simulating(tmp_path, cap
     assert "simulated" not in captured.out
 
 
+def test_an_outcome_slash_experiment_is_refused_with_its_reason(tmp_path, capsys):
+    _simulator()
+    path = _experiment_file(tmp_path, "outcome_slash", "{ grace = 1.0 }")
+    assert main(["chain", "demo", "--experiment", path, "--scheme", "experiment"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("infomarket: error: outcome_slash is not on chain: it slashes by the depositing buyer's "
+                          "own outcome records") and len(err.strip().splitlines()) == 1
+
+
 def test_an_adaptive_outlier_experiment_is_refused_with_its_reason(tmp_path, capsys):
     _simulator()
     path = _experiment_file(tmp_path, "adaptive_outlier", "{ theta = 30.0 }")
