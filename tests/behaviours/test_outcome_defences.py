@@ -190,6 +190,7 @@ def test_vote_k_drops_votes_older_than_the_horizon():
 
 @pytest.mark.parametrize("name, params, text", [
     ("outcome_trust", {"distrust": 1.5}, "in [0, 1]"), ("outcome_trust", {"prior": 0}, "> 0"),
+    ("outcome_trust", {"provenance": 0.5}, "0 or 1"),
     ("gated_fusion", {"floor": 0}, "> 0"), ("gated_fusion", {"drift": -1}, ">= 0"),
     ("vote_k", {"k": 0}, ">= 1 and <= 32"), ("vote_k", {"geometric": 0.5}, "0 or 1")])
 def test_bad_parameters_are_refused_by_name(name, params, text):

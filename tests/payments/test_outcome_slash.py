@@ -66,3 +66,12 @@ def test_on_a_ledger_alone_every_seller_is_unjudged():
 
 def test_the_rule_passes_the_public_checker():
     checks.check_payment("outcome_slash")
+
+
+@pytest.mark.parametrize("params, text", [({"grace": 0.0}, "> 0"), ({"theta": 200.0}, "in [0, 180]")])
+def test_bad_parameters_are_refused_by_name(params, text):
+    from infomarket.errors import ConfigError
+
+    with pytest.raises(ConfigError) as e:
+        make_config(3, scheme="outcome_slash", payment={"params": params})
+    assert text in str(e.value) and list(params)[0] in str(e.value)
