@@ -170,3 +170,7 @@ register_payment("outcome_slash", outcomes.outcome_slash_weights,
                              "outcome record of it (outcome_trust buyers) and shares the rest by that times its "
                              "eq. 7 count",
                  limits={"theta": _ANGLE, "grace": ("> 0", lambda v: v > 0)})
+register_payment("trip_slash", outcomes.trip_slash_weights,
+                 description="each trip that failed on a seller's vector since the buyer's last settlement "
+                             "(outcome_trust buyers) voids one of its records' stakes; the rest shared by eq. 7",
+                 limits={"theta": _ANGLE})

@@ -14,23 +14,27 @@ from infomarket.registry import get_payment
 from ..conftest import Handle, make_config
 
 
-def _weights(records, directions, theta=30.0, grace=1.0):
-    """The rule's weights for buyer 0's trip of food records from sellers 1, 2, 3 at ``directions``, with
-    the buyer's outcome records ``{seller: (good, bad)}``."""
-    h = Handle(make_config(4, scheme="outcome_slash", payment={"stake": 0.04, "reward": 1.0,
-                                                               "information_share": 0.5}))
+def _paid(scheme, sales, records, *params):
+    """Scheme ``scheme``'s weights for buyer 0's round trip of food records ``sales`` = [(seller,
+    direction)], with the buyer's outcome records ``{seller: (good, bad)}`` (every failure still due)."""
+    h = Handle(make_config(5, scheme=scheme, payment={"stake": 0.04, "reward": 1.0, "information_share": 0.5}))
     w = h.world
-    a = w.tx_off[0]
-    for x, d in enumerate(directions):
-        w.tx_seller[a + x], w.tx_site[a + x], w.tx_dir[a + x], w.tx_stake[a + x] = x + 1, 0, d, 0.04
-    w.tx_count[0] = len(directions)
-    w.pot[0] = 0.04 * len(directions)
+    a, k = w.tx_off[0], len(sales)
+    for x, (s, d) in enumerate(sales):
+        w.tx_seller[a + x], w.tx_site[a + x], w.tx_dir[a + x], w.tx_stake[a + x] = s, 0, d, 0.04
+    w.tx_count[0] = k
+    w.pot[0] = 0.04 * k
     for s, (good, bad) in records.items():
         trust_add(h.view, 0, s, good, bad)
-    weights = np.zeros(len(directions))
-    get_payment("outcome_slash").weights.func(0, w.tx_seller[a:a + 3], w.tx_site[a:a + 3], w.tx_dir[a:a + 3],
-                                              weights, h.view, theta, grace)
+    weights = np.zeros(k)
+    get_payment(scheme).weights.func(0, w.tx_seller[a:a + k], w.tx_site[a:a + k], w.tx_dir[a:a + k], weights,
+                                     h.view, *params)
     return weights
+
+
+def _weights(records, directions, theta=30.0, grace=1.0):
+    """``outcome_slash``'s weights for sellers 1, 2, 3 selling once each at ``directions``."""
+    return _paid("outcome_slash", list(zip((1, 2, 3), directions)), records, theta, grace)
 
 
 def test_failed_trips_slash_the_stake_and_the_share():
@@ -57,6 +61,17 @@ def test_unjudged_sellers_get_their_stakes_back_and_share_by_agreement():
     assert list(out) == pytest.approx([0.04 + 0.2, 0.04 + 0.2, 0.04 + 0.1], abs=1e-12)
 
 
+def test_each_failed_trip_of_the_round_trip_voids_one_records_stake():
+    # seller 1 sells twice (10, 20) with 1 failure due: each record keeps 1/2; seller 2 once (25), none due:
+    # keeps all; seller 3 once (100) with 2 failures due (more than its records): keeps nothing.  Its good
+    # trips do not count.  A = 0.5 + 4 * 0.04 = 0.66; stakes back 0.02 + 0.02 + 0.04 = 0.08; the rest 0.58
+    # by keep x eq. 7 count: 1/2 * 3, 1/2 * 3, 1 * 3, 0 * 1 (of 6).
+    out = _paid("trip_slash", [(1, 10.0), (1, 20.0), (2, 25.0), (3, 100.0)],
+                {1: (5.0, 1.0), 3: (0.0, 2.0)}, 30.0)
+    assert list(out) == pytest.approx([0.02 + 0.145, 0.02 + 0.145, 0.04 + 0.29, 0.0], abs=1e-12)
+    assert out.sum() == pytest.approx(0.66, abs=1e-12)
+
+
 def test_on_a_ledger_alone_every_seller_is_unjudged():
     # replayed without a swarm (no outcome records): the same trip pays stakes back plus 0.2, 0.2, 0.1
     events = [LedgerEvent("purchase", 0, s, 0, d) for s, d in ((1, 10.0), (2, 20.0), (3, 100.0))]
@@ -64,8 +79,9 @@ def test_on_a_ledger_alone_every_seller_is_unjudged():
     assert list(out.balances) == pytest.approx([1 + 1 + 0.12 - 0.62, 1.2, 1.2, 1.1], abs=1e-12)
 
 
-def test_the_rule_passes_the_public_checker():
-    checks.check_payment("outcome_slash")
+@pytest.mark.parametrize("name", ["outcome_slash", "trip_slash"])
+def test_the_rules_pass_the_public_checker(name):
+    checks.check_payment(name)
 
 
 @pytest.mark.parametrize("params, text", [({"grace": 0.0}, "> 0"), ({"theta": 200.0}, "in [0, 180]")])

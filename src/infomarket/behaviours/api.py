@@ -254,17 +254,36 @@ def trust_add(w, me, seller, good, bad):
         w.trust_seller[me, slot] = seller
         w.trust_good[me, slot] = 0.0
         w.trust_bad[me, slot] = 0.0
+        w.trust_due[me, slot] = 0.0
     w.trust_good[me, slot] += good
     w.trust_bad[me, slot] += bad
+    w.trust_due[me, slot] += bad
+
+
+@njit(forceinline=True, cache=True)
+def trust_settled(w, me):
+    """Robot ``me``'s round trip has been settled (its open transactions are none): the failures on its
+    records are charged, none is due any more.  A buy rule calls it when ``w.tx_count[me]`` is 0."""
+    for j in range(w.trust_due.shape[1]):
+        w.trust_due[me, j] = 0.0
+
+
+@njit(forceinline=True, cache=True)
+def _trust_with_due(w, me, seller):
+    for j in range(w.trust_seller.shape[1]):
+        if w.trust_seller[me, j] == seller:
+            return w.trust_good[me, j], w.trust_bad[me, j], w.trust_due[me, j]
+    return 0.0, 0.0, 0.0
 
 
 def trust_record(w, me, seller):
-    """``trust_get`` for rules that may run on a world with no outcome records: a payment rule reading the
-    buyer's record through its ``market`` argument is also run on a ledger alone (``ledger.replay``, the
-    payment checker), where every seller is unjudged, (0, 0)."""
+    """Robot ``me``'s record of ``seller`` for a payment rule: (good, bad, due), ``due`` the failed trips
+    recorded since its round trip was last settled (``trust_settled``).  A payment rule reads the buyer's
+    record through its ``market`` argument, and is also run on a ledger alone (``ledger.replay``, the
+    payment checker), where every seller is unjudged: (0, 0, 0)."""
     if not _has_field(w, "trust_seller"):
-        return 0.0, 0.0
-    return trust_get(w, me, seller)
+        return 0.0, 0.0, 0.0
+    return _trust_with_due(w, me, seller)
 
 
 def _has_field(w, name):
@@ -276,8 +295,8 @@ def _has_field(w, name):
 @overload(trust_record, inline="always")
 def _trust_record(w, me, seller):
     if _has_field(w, "trust_seller"):
-        return lambda w, me, seller: trust_get(w, me, seller)
-    return lambda w, me, seller: (0.0, 0.0)
+        return lambda w, me, seller: _trust_with_due(w, me, seller)
+    return lambda w, me, seller: (0.0, 0.0, 0.0)
 
 
 @njit(forceinline=True, cache=True)

@@ -21,7 +21,7 @@ Registered as ``outcome_trust`` by ``infomarket.builtins``.
 from ..jit import njit
 
 from .api import buy, current, install, next_younger, origin_of, origin_set, own_entry, pending_add, pending_clear
-from .api import pending_count, pending_find, pending_get, pending_remove, trust_add, trust_get
+from .api import pending_count, pending_find, pending_get, pending_remove, trust_add, trust_get, trust_settled
 
 
 @njit(forceinline=True, cache=True)
@@ -78,6 +78,8 @@ def outcome_trust_buy(w, me, nbrs, prior=1.0, distrust=0.3, power=1.0, memory=8.
     record read, the user remembered) and the installed entry's origin is recorded: the offer's when its
     weight ``k`` is at least 1/2, else the own entry's.
     With ``distrust`` = 0 and ``power`` = 0 it buys and steers exactly as the naive robot."""
+    if w.tx_count[me] == 0:
+        trust_settled(w, me)  # its round trip was settled: the failures recorded before are charged
     for site in range(2):
         settle_outcome(w, me, site)
         mine = origin_of(w, me, site)  # the start-of-step entry's origin (the robot itself when unrecorded)

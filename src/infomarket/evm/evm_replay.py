@@ -271,6 +271,8 @@ OFF_CHAIN = {
     "outcome_slash": "outcome_slash is not on chain: it slashes by the depositing buyer's own outcome records of "
                      "its sellers, robot state that the contract does not hold (a buyer would have to report "
                      "them with its deposit)",
+    "trip_slash": "trip_slash is not on chain: it slashes by the depositing buyer's own outcome records of its "
+                  "sellers (the failures since its last settlement), robot state that the contract does not hold",
 }
 
 
