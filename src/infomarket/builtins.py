@@ -146,9 +146,9 @@ from .behaviours import fusion, outcome, vote  # noqa: E402 - here: rules regist
 register_behaviour("outcome_trust", buy=outcome.outcome_trust_buy, sell="naive", honest=True,
                    description="keeps a Beta record of each seller fed by its own trips (site reached or nothing "
                                "found); skips sellers whose Beta mean is below `distrust` and weighs the rest by "
-                               "it ** `power`",
+                               "it ** `power`; with `provenance` 1, of each vector's origin instead of its seller",
                    limits={"prior": ("> 0", lambda v: v > 0), "distrust": _UNIT, "power": (">= 0", lambda v: v >= 0),
-                           "memory": (">= 1", lambda v: v >= 1)})
+                           "memory": (">= 1", lambda v: v >= 1), "provenance": ("0 or 1", lambda v: v in (0, 1))})
 register_behaviour("gated_fusion", buy=fusion.gated_fusion_buy, sell="naive", honest=True, needs_neighbours=True,
                    description="fuses a purchase Kalman-style with variances from the vectors' ages (`drift` "
                                "degrees per step, `floor` units) and rejects it past a chi-square `gate`",
@@ -161,3 +161,16 @@ register_behaviour("vote_k", buy=vote.vote_k_buy, sell="naive", honest=True,
                            "geometric": ("0 or 1", lambda v: v in (0, 1)), "iterations": (">= 0", lambda v: v >= 0),
                            "horizon": (">= 0", lambda v: v >= 0),
                            "threshold": ("> 0", lambda v: v > 0)})
+
+# Slashing fed by trip outcomes: the buyer's outcome records decide the stakes (docs/defences.md).
+from .payments import outcomes  # noqa: E402 - here: rules register in this order
+
+register_payment("outcome_slash", outcomes.outcome_slash_weights,
+                 description="a seller keeps (good + grace) / (good + bad + grace) of its stake by the buyer's "
+                             "outcome record of it (outcome_trust buyers) and shares the rest by that times its "
+                             "eq. 7 count",
+                 limits={"theta": _ANGLE, "grace": ("> 0", lambda v: v > 0)})
+register_payment("trip_slash", outcomes.trip_slash_weights,
+                 description="each trip that failed on a seller's vector since the buyer's last settlement "
+                             "(outcome_trust buyers) voids one of its records' stakes; the rest shared by eq. 7",
+                 limits={"theta": _ANGLE})

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from infomarket.behaviours import fusion, outcome
-from infomarket.behaviours.api import pending_add, trust_add, trust_get
+from infomarket.behaviours.api import pending_add, trust_add, trust_get, trust_record
 from infomarket.engine.swarm import TRUST_SLOTS
 from infomarket.engine.world import FOOD, open_transactions
 from infomarket.errors import ConfigError
@@ -89,6 +89,27 @@ def test_a_purchase_weighs_its_age_weight_times_the_beta_mean(power, x):
     trust_add(h.view, 0, 1, 2.0, 0.0)
     vec, age, _, held = _buy(h, "outcome_trust", 1.0, 0.3, power, 8.0)
     assert vec == pytest.approx((x, 0.0), abs=1e-12) and age == 9 and held == [1]
+
+
+def test_failures_are_due_until_the_round_trip_is_settled():
+    # two failures and a success on seller 1: 2 due.  While robot 0 has an open transaction its buy rule
+    # keeps them due; once it has none (its round trip settled) it clears them, the record stays.
+    from infomarket.jit import njit
+
+    @njit
+    def record(w, me, seller):  # trust_record is for compiled rules: it reads a world's type
+        return trust_record(w, me, seller)
+
+    h = _market(2)
+    trust_add(h.view, 0, 1, 0.0, 2.0)
+    trust_add(h.view, 0, 1, 1.0, 0.0)
+    assert record(h.view, 0, 1) == (1.0, 2.0, 2.0) and record(h.view, 0, 5) == (0.0, 0.0, 0.0)
+    h.world.tx_count[0] = 1
+    _buy(h, "outcome_trust", 1.0, 0.3, 1.0, 8.0, 0.0)
+    assert record(h.view, 0, 1) == (1.0, 2.0, 2.0)
+    h.world.tx_count[0] = 0
+    _buy(h, "outcome_trust", 1.0, 0.3, 1.0, 8.0, 0.0)
+    assert record(h.view, 0, 1) == (1.0, 2.0, 0.0)
 
 
 def test_the_record_forgets_the_least_judged_seller_when_full():
@@ -190,6 +211,7 @@ def test_vote_k_drops_votes_older_than_the_horizon():
 
 @pytest.mark.parametrize("name, params, text", [
     ("outcome_trust", {"distrust": 1.5}, "in [0, 1]"), ("outcome_trust", {"prior": 0}, "> 0"),
+    ("outcome_trust", {"provenance": 0.5}, "0 or 1"),
     ("gated_fusion", {"floor": 0}, "> 0"), ("gated_fusion", {"drift": -1}, ">= 0"),
     ("vote_k", {"k": 0}, ">= 1 and <= 32"), ("vote_k", {"geometric": 0.5}, "0 or 1")])
 def test_bad_parameters_are_refused_by_name(name, params, text):

@@ -153,6 +153,16 @@ def test_a_consensus_slash_experiment_is_refused_before_simulating(tmp_path, cap
     assert "simulated" not in captured.out
 
 
+@pytest.mark.parametrize("scheme", ["outcome_slash", "trip_slash"])
+def test_an_outcome_slashing_experiment_is_refused_with_its_reason(tmp_path, capsys, scheme):
+    _simulator()
+    path = _experiment_file(tmp_path, scheme, "{ theta = 30.0 }")
+    assert main(["chain", "demo", "--experiment", path, "--scheme", "experiment"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"infomarket: error: {scheme} is not on chain: it slashes by the depositing buyer's "
+                          "own outcome records") and len(err.strip().splitlines()) == 1
+
+
 def test_an_adaptive_outlier_experiment_is_refused_with_its_reason(tmp_path, capsys):
     _simulator()
     path = _experiment_file(tmp_path, "adaptive_outlier", "{ theta = 30.0 }")

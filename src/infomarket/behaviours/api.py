@@ -8,6 +8,10 @@ Timing (docs/model.md §3): during the communication phase sellers sell from the
 of the step (``own_entry``), while a buyer's purchases go into its new table (``current`` / ``install``
 / ``combine``), which it starts using when it moves.  Stakes and the pending list change at once.
 """
+from typing import Any
+
+from numba.extending import overload
+
 from ..jit import njit
 
 from ..engine.geometry import direction, norm
@@ -250,5 +254,72 @@ def trust_add(w, me, seller, good, bad):
         w.trust_seller[me, slot] = seller
         w.trust_good[me, slot] = 0.0
         w.trust_bad[me, slot] = 0.0
+        w.trust_due[me, slot] = 0.0
     w.trust_good[me, slot] += good
     w.trust_bad[me, slot] += bad
+    w.trust_due[me, slot] += bad
+
+
+@njit(forceinline=True, cache=True)
+def trust_settled(w, me):
+    """Robot ``me``'s round trip has been settled (its open transactions are none): the failures on its
+    records are charged, none is due any more.  A buy rule calls it when ``w.tx_count[me]`` is 0."""
+    for j in range(w.trust_due.shape[1]):
+        w.trust_due[me, j] = 0.0
+
+
+@njit(forceinline=True, cache=True)
+def _trust_with_due(w, me, seller):
+    for j in range(w.trust_seller.shape[1]):
+        if w.trust_seller[me, j] == seller:
+            return w.trust_good[me, j], w.trust_bad[me, j], w.trust_due[me, j]
+    return 0.0, 0.0, 0.0
+
+
+def trust_record(w, me, seller):
+    """Robot ``me``'s record of ``seller`` for a payment rule: (good, bad, due), ``due`` the failed trips
+    recorded since its round trip was last settled (``trust_settled``).  A payment rule reads the buyer's
+    record through its ``market`` argument, and is also run on a ledger alone (``ledger.replay``, the
+    payment checker), where every seller is unjudged: (0, 0, 0)."""
+    if not _has_field(w, "trust_seller"):
+        return 0.0, 0.0, 0.0
+    return _trust_with_due(w, me, seller)
+
+
+def _has_field(w, name):
+    """Does the world (or, compiling, its numba type) hold field ``name``?"""
+    names: Any = getattr(w, "field_dict", None) or getattr(w, "_fields", ())
+    return name in names
+
+
+@overload(trust_record, inline="always")
+def _trust_record(w, me, seller):
+    if _has_field(w, "trust_seller"):
+        return lambda w, me, seller: _trust_with_due(w, me, seller)
+    return lambda w, me, seller: (0.0, 0.0, 0.0)
+
+
+@njit(forceinline=True, cache=True)
+def origin_set(w, me, site, origin, age):
+    """Record that robot ``me``'s entry for ``site``, just installed with ``age``, carries the information of
+    robot ``origin`` (provenance: who first sensed it, as far as the robot knows).  Buyers read it as the
+    origin of the robot's offers (``origin_of``); only the robot's own buy rule writes it."""
+    w.origin[me, site, 0] = origin
+    w.origin[me, site, 1] = age
+    w.origin[me, site, 2] = w.clock[0]
+
+
+@njit(forceinline=True, cache=True)
+def origin_of(w, seller, site):
+    """The robot a seller's offer for ``site`` came from: its recorded origin (``origin_set``) while the
+    offer is that record's entry, else the seller itself.  The offer is the start-of-step entry, so a record
+    made this step (after it) does not describe it; and an offer younger by two steps or more than the
+    recorded age plus the steps since (ages only grow, ±1 for when in the step they do) was sensed since,
+    by the seller.  A seller whose rule records nothing (a naive robot, a liar) is its offers' origin."""
+    o = w.origin[seller, site, 0]
+    if o < 0:
+        return seller
+    since = w.clock[0] - w.origin[seller, site, 2]
+    if since <= 0 or w.off_age[seller, site] + 1 < w.origin[seller, site, 1] + since:
+        return seller
+    return o

@@ -8,14 +8,20 @@ holding the seller's vector) and ``bad`` ones (its entry failed: it reached the 
 or ran into the arena's wall).  It buys only from sellers whose Beta mean is at least ``distrust`` and
 averages a purchase in with its age weight times that mean ** ``power`` (docs/defences.md).
 
-Written through the public API alone: the sellers whose vectors the robot used since its last outcome
-are its pending list (``behaviours.api``), the records are ``api.trust_get`` / ``api.trust_add``.
+With ``provenance`` = 1 it judges and weighs the *origin* of each vector instead of its seller: a lie
+resold by an honest robot is blamed on the liar that first sold it, not on the reseller.  The robot
+records the origin of each entry it installs (``api.origin_set``: the bought vector's origin when the
+purchase dominates the average, else its own entry's), and reads a seller's offer's origin with
+``api.origin_of``.
+
+Written through the public API alone: the sellers (or origins) whose vectors the robot used since its last
+outcome are its pending list (``behaviours.api``), the records are ``api.trust_get`` / ``api.trust_add``.
 Registered as ``outcome_trust`` by ``infomarket.builtins``.
 """
 from ..jit import njit
 
-from .api import buy, current, install, next_younger, own_entry, pending_add, pending_clear, pending_count
-from .api import pending_find, pending_get, pending_remove, trust_add, trust_get
+from .api import buy, current, install, next_younger, origin_of, origin_set, own_entry, pending_add, pending_clear
+from .api import pending_count, pending_find, pending_get, pending_remove, trust_add, trust_get, trust_settled
 
 
 @njit(forceinline=True, cache=True)
@@ -63,20 +69,27 @@ def remember_user(w, me, site, seller, x, y, age, memory):
     pending_add(w, me, site, seller, x, y, age)
 
 
-def outcome_trust_buy(w, me, nbrs, prior=1.0, distrust=0.3, power=1.0, memory=8.0):
+def outcome_trust_buy(w, me, nbrs, prior=1.0, distrust=0.3, power=1.0, memory=8.0, provenance=0.0):
     """Per site: first settle the last trip's outcome (``settle_outcome``); then, as the naive robot, buy
     the freshest offer younger than the current entry, skipping sellers whose Beta mean is below
     ``distrust``, and average it in by eqs. (4)-(5) with the bought vector's age weight multiplied by the
     Beta mean ** ``power`` (an invalid entry takes the purchase).  The seller joins the users of that site.
+    With ``provenance`` = 1 the offer's origin (``api.origin_of``) takes the seller's place in all three (the
+    record read, the user remembered) and the installed entry's origin is recorded: the offer's when its
+    weight ``k`` is at least 1/2, else the own entry's.
     With ``distrust`` = 0 and ``power`` = 0 it buys and steers exactly as the naive robot."""
+    if w.tx_count[me] == 0:
+        trust_settled(w, me)  # its round trip was settled: the failures recorded before are charged
     for site in range(2):
         settle_outcome(w, me, site)
+        mine = origin_of(w, me, site)  # the start-of-step entry's origin (the robot itself when unrecorded)
         s = -1
         while True:
             s = next_younger(w, me, nbrs, site, s)
             if s < 0:
                 break
-            good, bad = trust_get(w, me, s)
+            judged = origin_of(w, s, site) if provenance > 0.0 else s
+            good, bad = trust_get(w, me, judged)
             t = beta_mean(good, bad, prior)
             if t < distrust:
                 continue
@@ -86,11 +99,14 @@ def outcome_trust_buy(w, me, nbrs, prior=1.0, distrust=0.3, power=1.0, memory=8.
                 continue
             total = oage + age
             nx, ny = x, y  # an invalid entry takes the purchase, the two ages still averaged (``api.combine``)
+            k = 1.0
             if valid:
                 wb = (0.5 if total == 0 else oage / total) * t ** power
                 wo = 0.5 if total == 0 else age / total
                 k = wb / (wb + wo) if wb + wo > 0.0 else 0.0
                 nx, ny = ox + k * (x - ox), oy + k * (y - oy)
             install(w, me, site, nx, ny, total // 2)
-            remember_user(w, me, site, s, nx, ny, total // 2, int(memory))
+            remember_user(w, me, site, judged, nx, ny, total // 2, int(memory))
+            if provenance > 0.0:
+                origin_set(w, me, site, judged if k >= 0.5 else mine, total // 2)
             break

@@ -1,11 +1,12 @@
 """The swarm's state: every robot's pose, odometry, navigation table, offers, pending purchases, spots,
-timers, neighbours and outcome records; its builder (the initial draws of docs/model.md §1) and its growth.
+timers, neighbours, outcome records and provenance; its builder (the initial draws of docs/model.md §1) and its growth.
 
 Written by the engine's step; a buy rule writes only its own robot's ``new_*`` table and pending list,
 through ``behaviours.api``.  Nothing is [n, n]: ``kn`` neighbour and ``kp`` pending slots per robot, grown
 by the host between steps when the kernel asks for room (``grow_swarm``), and ``kt`` = ``TRUST_SLOTS`` outcome
 records per robot (the sellers it has judged by its trips, ``api.trust_add``), a fixed number so that a
-large swarm pays ``n * kt``, not ``n * n``.
+large swarm pays ``n * kt``, not ``n * n``.  ``origin`` is the provenance a buy rule may record of its own
+entries (``api.origin_set``), which buyers read as the origin of that robot's offers (``api.origin_of``).
 """
 from __future__ import annotations
 
@@ -71,6 +72,10 @@ SPEC = Spec("swarm", fields("engine", [
     ("trust_seller", "int64", "n,kt", "sellers the robot keeps an outcome record for (-1: free slot)"),
     ("trust_good", "float64", "n,kt", "their trips that reached the site (written by buy rules, ``api.trust_add``)"),
     ("trust_bad", "float64", "n,kt", "their trips that found nothing there"),
+    ("trust_due", "float64", "n,kt", "of those, the ones since the robot's round trip was last settled (a "
+                                     "payment rule may charge them, ``api.trust_record``)"),
+    ("origin", "int64", "n,2,3", "per site: the robot its entry's information came from, the entry's age and the "
+                                 "step when its buy rule recorded them (-1: none; ``api.origin_set``)"),
 ]))
 
 
@@ -103,7 +108,7 @@ def build_swarm(cfg: Experiment, rng: np.random.Generator, kind: np.ndarray, cel
         "blocked": z((n, 2), np.bool_), "path_vec": z((n, 2, PATH_POINTS - 1, 2)), "path_count": z((n, 2), np.int64),
         "new_path_vec": z((n, 2, PATH_POINTS - 1, 2)), "new_path_count": z((n, 2), np.int64),
         "trust_seller": np.full((n, TRUST_SLOTS), -1, np.int64), "trust_good": z((n, TRUST_SLOTS)),
-        "trust_bad": z((n, TRUST_SLOTS)),
+        "trust_bad": z((n, TRUST_SLOTS)), "trust_due": z((n, TRUST_SLOTS)), "origin": np.full((n, 2, 3), -1, np.int64),
     }
     SPEC.check(swarm)
     return swarm

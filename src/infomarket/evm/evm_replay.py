@@ -268,6 +268,11 @@ OFF_CHAIN = {
                        "(docs/chain.md, \"Which rules run where\")",
     "adaptive_outlier": "adaptive_outlier is not on chain: each seller's Theta follows its reputation, which the "
                         "simulated ledger keeps and the contract does not",
+    "outcome_slash": "outcome_slash is not on chain: it slashes by the depositing buyer's own outcome records of "
+                     "its sellers, robot state that the contract does not hold (a buyer would have to report "
+                     "them with its deposit)",
+    "trip_slash": "trip_slash is not on chain: it slashes by the depositing buyer's own outcome records of its "
+                  "sellers (the failures since its last settlement), robot state that the contract does not hold",
 }
 
 

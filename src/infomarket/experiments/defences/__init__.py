@@ -1,0 +1,2 @@
+"""Defence combinations, one runnable experiment each: a buy rule with a payment rule that slashes stakes
+(docs/defences.md, "Combinations")."""
