@@ -4,6 +4,7 @@ from __future__ import annotations
 import argparse
 import functools
 import time
+from dataclasses import replace
 from pathlib import Path
 
 from ..cliargs import UsageError, at_least, dask_client, seed_value, workers_count
@@ -78,7 +79,7 @@ def cmd_attack_search(args) -> int:
     """Run ``infomarket attack-search``: search each cell's worst attack into the store (resumable), then write the
     cells' frames and the summary; returns the exit code."""
     # with the command: `infomarket --help` imports neither scipy.stats nor the search, runner and store
-    from ..analysis.study import out_dir, questions_path, refuse_declared_seed
+    from ..analysis.study import out_dir, refuse_declared_seed
     from ..config import load_experiment
     from ..runner.execute import default_workers, local_executor
     from ..runner.feed import Feed, dask_threads
@@ -91,10 +92,8 @@ def cmd_attack_search(args) -> int:
     from . import adaptive, provenance, report
 
     exp = load_experiment(args.experiment)
-    path = questions_path(args.questions, study_mod.QUESTIONS)
-    decl = study_mod.Declaration.read(path, path.name)
-    # the package's file is read as the study reads it
-    data = decl.data if args.questions is not None else study_mod.load_declarations()
+    decl = study_mod.read(args.questions)  # the shipped file as the package read it, or the one given
+    path, data = decl.path, decl.data
     st = study_mod.load(exp, data, path=path, budget=args.budget, popsize=args.popsize, restarts=args.restarts,
                         runs=args.runs,
                         finalists=args.finalists, race=_race(args.race) if args.race is not None else None,
@@ -163,9 +162,9 @@ def cmd_attack_search(args) -> int:
     first_run = store.meta().get("attack_search")
     header = {**provenance.report_header(first_run, path), "validation": validation}
     written += report.write(out, analysis, reduced=reduced, wall_seconds=wall, provenance=first_run,
-                            header=header, records=decl.record_markdown(), busy=busy, **length)
+                            header=header, records=_records(decl), busy=busy, **length)
     text = report.markdown(analysis, reduced=reduced, wall_seconds=wall, header=header,
-                           records=decl.record_markdown(), busy=busy, **length)
+                           records=_records(decl), busy=busy, **length)
     if not args.quiet:
         print(text)
         made = sum(r.done for r in results)
@@ -173,6 +172,11 @@ def cmd_attack_search(args) -> int:
         print(f"attack-search: {made} runs made now, {kept} found in the store; {wall:.1f} s wall; "
               f"wrote {', '.join(str(p) for p in written)}")
     return 0
+
+
+def _records(decl) -> list[str]:
+    """The report's record section, naming the questions file by its file name (as the study's reports do)."""
+    return replace(decl, name=decl.path.name).record_markdown()
 
 
 def _validate(st, args) -> int:
