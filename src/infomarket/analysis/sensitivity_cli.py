@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import argparse
 
-from ..cliargs import writable_dir
+from ..cliargs import study_options, writable_dir
 
 
 def add_subcommand(subparsers) -> None:
@@ -17,7 +17,7 @@ def add_subcommand(subparsers) -> None:
                     "of a Sobol' design) and write STEM.md in DIR (STEM: the experiment's name, prefixed with "
                     "'sensitivity-' unless it starts with it).")
     p.add_argument("store", metavar="STORE", help="a results store swept from an experiment with [sweep.sample]")
-    p.add_argument("--out", required=True, metavar="DIR", help="folder for the table, figures and report")
+    study_options(p, "folder for the table, figures and report", required=True, metavar="DIR")
     p.add_argument("--experiment", help="which design, when the store holds several")
     p.add_argument("--vector", choices=("svg", "pdf"), default="svg", help="vector format besides PNG")
     p.add_argument("--local", metavar="LOCAL_STORE",

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import html
 import tomllib
+from abc import ABC, abstractmethod
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -31,7 +32,7 @@ from typing import Any, TypeVar
 import pandas as pd
 
 from ..cliargs import UsageError, writable_dir
-from ..errors import ConfigError
+from ..errors import ArgumentError, ConfigError
 from ..store.files import write_atomic, write_parquet_atomic, write_text_atomic
 from . import declared
 from . import stats as st
@@ -399,6 +400,17 @@ class Report:
         parts += [(f"{stem}.png", figure)] if figure is not None else []
         return cls(parts)
 
+    def text(self, name: str) -> str:
+        """The text part called ``name`` (a command prints its report's markdown as it writes it).
+
+        Raises:
+            ArgumentError: the report has no text part of that name.
+        """
+        for part_name, part in self.parts:
+            if part_name == name and isinstance(part, str):
+                return part
+        raise ArgumentError(f"the report has no text part {name!r}")
+
     def write(self, out: str | Path) -> list[Path]:
         """Write every part into ``out`` (created when missing); returns the files, in the parts' order."""
         folder = writable_dir(Path(out))
@@ -412,6 +424,30 @@ class Report:
             else:
                 files.append(write_atomic(path, part, keep_suffix=True))
         return files
+
+
+class Study(ABC):
+    """A declared study, the shape every study's command takes: its declaration file, and ``answer``, its
+    answers from the stores it reads as a ``Report`` (the files it writes, in order), written by ``write``
+    through ``Report.write`` (the store's atomic writers).  A study keeps only what is its own: its
+    settings, the rule of each question, its tables and figure.
+    """
+
+    #: the study's declaration file, read once (None: a study that reads its questions elsewhere)
+    declaration: Declaration | None = None
+
+    @abstractmethod
+    def answer(self, store) -> Report:
+        """The study's answers from ``store`` (a store, or the stores or folder of stores it is answered
+        from) as the files it writes; nothing is written here.
+
+        Raises:
+            UsageError: the store holds nothing the study can answer from.
+        """
+
+    def write(self, store, out: str | Path) -> list[Path]:
+        """``answer(store)`` written into ``out`` (created when missing); returns the files, in order."""
+        return self.answer(store).write(out)
 
 
 def drawn(make: Callable[[], object], **options) -> Callable[[Path], None]:

@@ -7,7 +7,7 @@ import time
 from dataclasses import replace
 from pathlib import Path
 
-from ..cliargs import UsageError, at_least, dask_client, seed_value, workers_count
+from ..cliargs import UsageError, at_least, dask_client, study_options, workers_count
 from .baselines import rotation_grid
 
 
@@ -157,13 +157,12 @@ def cmd_attack_search(args) -> int:
     busy = feed.busy.as_dict()
     written, text = write(out, st, results, reduced=reduced, wall_seconds=wall, steps=first.steps,
                           transitory=first.transitory)
-    analysis = report.analyse(st, results)
     length = {"steps": first.steps, "transitory": first.transitory}
-    first_run = store.meta().get("attack_search")
-    header = {**provenance.report_header(first_run, path), "validation": validation}
-    written += report.write(out, analysis, reduced=reduced, wall_seconds=wall, provenance=first_run,
-                            header=header, records=_records(decl), busy=busy, **length)
-    text = report.markdown(analysis, reduced=reduced, wall_seconds=wall, header=header,
+    header = {**provenance.report_header(store.meta().get(report.PROVENANCE), path), "validation": validation}
+    answers = report.AttackSearch(st, results, reduced=reduced, wall_seconds=wall, header=header,
+                                  records=_records(decl), busy=busy, **length)
+    written += answers.write(store, out)
+    text = report.markdown(answers.analysis, reduced=reduced, wall_seconds=wall, header=header,
                            records=_records(decl), busy=busy, **length)
     if not args.quiet:
         print(text)
@@ -258,9 +257,6 @@ def add_subcommand(sub) -> None:
                                              "restarts and a random search, raced, confirmed on fresh seeds; resumable")
     p.add_argument("experiment", nargs="?", default="attack_search",
                    help="a study experiment (default: the shipped attack_search, or a file like it)")
-    p.add_argument("--questions", metavar="FILE",
-                   help="the study's questions file: settings, baselines, questions (default: the package's "
-                        "questions.toml)")
     p.add_argument("--defence", help="defence(s) to search, comma-separated (default: every one of the study)")
     p.add_argument("--byzantines", metavar="K", help="Byzantine count(s), comma-separated (default: the study's)")
     p.add_argument("--budget", type=at_least(1), metavar="N",
@@ -294,7 +290,6 @@ def add_subcommand(sub) -> None:
     p.add_argument("--leader-runs", type=at_least(1), metavar="N",
                    help="runs of a re-evaluated leader (default: declared)")
     p.add_argument("--objective", choices=["items", "liar_wealth"], help="what the attack optimises (default: items)")
-    p.add_argument("--seed", type=seed_value, help="the search's seed: optimisers and seed sets (default: declared)")
     p.add_argument("--adaptive-budget", type=at_least(0), metavar="N",
                    help="evaluations per cell of the adaptive attacker, the second searcher "
                         "(0: none; default: declared)")
@@ -310,7 +305,10 @@ def add_subcommand(sub) -> None:
                                                                  "and exit")
     p.add_argument("--steps", type=at_least(1), help="steps per run (default: the experiment's), for a reduced search")
     p.add_argument("--transitory", type=at_least(0), help="steps not counted (default: the experiment's)")
-    p.add_argument("--out", help="folder: the results store (OUT/store) and the report")
+    study_options(p, "folder: the results store (OUT/store) and the report",
+                  questions="the study's questions file: settings, baselines, questions (default: the package's "
+                            "questions.toml)",
+                  seed="the search's seed: optimisers and seed sets (default: declared)")
     p.add_argument("--workers", type=workers_count, help="local processes (default: one per core)")
     p.add_argument("--dask", metavar="ADDRESS", help="run on a Dask scheduler, e.g. tcp://host:8786")
     p.add_argument("--reduced", metavar="TEXT", help="label the report as a reduced run (what was reduced)")
