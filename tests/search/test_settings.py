@@ -3,7 +3,7 @@ an experiment file's is (the source, then one line per key naming what is expect
 import pytest
 
 from infomarket.errors import UsageError
-from infomarket.search.study import Settings, settings
+from infomarket.search.study import Learner, Settings, learner, settings
 
 SOURCE = "search settings (questions.toml [search] or an option)"
 
@@ -36,3 +36,21 @@ def test_every_bad_setting_is_named_in_the_fields_order():
 def test_an_option_overrides_the_table_and_a_small_budget_makes_one_smaller_generation():
     s = settings({"budget": 64, "race": [2, 4]}, {"budget": 3, "runs": None})
     assert s == Settings(budget=3, popsize=3, race=(2, 4)) and s.generations == 1
+
+
+@pytest.mark.parametrize("table, line", [
+    ({"budget": -1}, "budget: a whole number of at least 0 is expected (got -1)"),
+    ({"pairs": 2.5}, "pairs: a whole number of at least 1 is expected (got 2.5)"),
+    ({"sigma": float("inf")}, "sigma: a finite number above 0 is expected (got inf)"),
+    ({"lr": 0}, "lr: a finite number above 0 is expected (got 0)"),
+    ({"rate": 0.1}, "rate: unknown key; allowed keys here: budget, pairs, runs, sigma, lr"),
+])
+def test_the_adaptive_attackers_training_is_read_by_the_same_parser(table, line):
+    with pytest.raises(UsageError) as err:
+        learner(table)
+    assert str(err.value) == f"questions.toml [adaptive] or an option: invalid settings\n  {line}"
+
+
+def test_the_adaptive_budget_option_overrides_the_declared_one():
+    assert learner({"budget": 48, "sigma": 0.1}, {"budget": None}) == Learner(48, sigma=0.1)
+    assert learner({"budget": 48}, {"budget": 0}).budget == 0

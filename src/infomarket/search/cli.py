@@ -124,10 +124,8 @@ def cmd_attack_search(args) -> int:
     total = planned_runs(st) * len(chosen)
     client = dask_client(args.dask) if args.dask else None
     workers = args.workers or default_workers()
-    learner = {**ADAPTIVE, **data.get("adaptive", {})}
-    if args.adaptive_budget is not None:
-        learner["budget"] = args.adaptive_budget
-    _check_learner(learner)  # before any run: a bad value must not surface after a cell's search
+    # before any run: a bad value must not surface after a cell's search
+    learner = study_mod.learner(data.get("adaptive", {}), {"budget": args.adaptive_budget}, path.name)
     validation = _study_validation(st, out, args.quiet)
     need = data.get("validation", {}).get("min_recovery")
     if need is not None and not reduced and validation.get("search", 0.0) < need:
@@ -146,7 +144,7 @@ def cmd_attack_search(args) -> int:
             run = store_runner(store, on_skip=lambda k: k and bar.skip(k), feed=feed)
             results = run.map([functools.partial(search_cell, st, c, store, run=run, steps=args.steps,
                                                  transitory=args.transitory) for c in chosen])
-            for c, r in zip(chosen, results) if learner["budget"] else ():  # after every cell: its own pool
+            for c, r in zip(chosen, results) if learner.budget else ():  # after every cell: its own pool
                 r.extra["adaptive"] = _adaptive(adaptive, st, c, r, learner, out, args,
                                                 1 if client is not None else workers)
     finally:
@@ -220,32 +218,14 @@ def _study_validation(st, out: Path, quiet: bool) -> dict:
     return result["rates"]
 
 
-#: the adaptive attacker's training when questions.toml declares no ``[adaptive]`` table (budget 0: not run)
-ADAPTIVE = {"budget": 0, "pairs": 8, "runs": 4, "sigma": 0.05, "lr": 0.02}
-
-
-def _check_learner(learner: dict) -> None:
-    unknown = sorted(set(learner) - set(ADAPTIVE))
-    if unknown:
-        raise UsageError(f"questions.toml [adaptive]: unknown key {unknown[0]!r}; allowed: {', '.join(ADAPTIVE)}")
-    for k, v in learner.items():
-        whole = k in ("budget", "pairs", "runs")
-        ok = (isinstance(v, int) and not isinstance(v, bool) and v >= (0 if k == "budget" else 1)) if whole else \
-            (isinstance(v, (int, float)) and not isinstance(v, bool) and 0 < v < float("inf"))
-        if not ok:
-            raise UsageError(f"questions.toml [adaptive] {k} = {v!r}: must be "
-                             + ("a whole number >= " + ("0" if k == "budget" else "1") if whole
-                                else "a finite number > 0"))
-
-
-def _adaptive(adaptive, st, cell, r, learner: dict, out: Path, args, workers: int):
+def _adaptive(adaptive, st, cell, r, learner, out: Path, args, workers: int):
     """The second searcher of a cell: the adaptive attacker trained on search seeds of its own (checkpointed
     under OUT/adaptive/EXPERIMENT, so a search started again resumes it), then played on the cell's
     confirmation seeds, where the report compares it with the parametric search's attack."""
     folder = out / "adaptive" / cell.experiment
     length = {"steps": args.steps, "transitory": args.transitory}
-    policy = adaptive.train(cell, int(learner["budget"]), pairs=int(learner["pairs"]), runs=int(learner["runs"]),
-                            sigma=float(learner["sigma"]), lr=float(learner["lr"]), seed=st.settings.seed,
+    policy = adaptive.train(cell, learner.budget, pairs=learner.pairs, runs=learner.runs,
+                            sigma=float(learner.sigma), lr=float(learner.lr), seed=st.settings.seed,
                             objective=st.settings.objective, checkpoint=folder, workers=workers, **length)
     policy.save(folder / "policy.npz")
     return adaptive.confirm(cell, policy, r.confirmation_seeds, workers=workers, **length)

@@ -104,6 +104,30 @@ def settings(table: dict, overrides: dict | None = None,
 
 
 @dataclass(frozen=True)
+class Learner:
+    """The adaptive attacker's training (``questions.toml`` ``[adaptive]``; budget 0: not run)."""
+
+    budget: int = 0        # evaluations per cell
+    pairs: int = 8         # antithetic pairs per generation
+    runs: int = 4          # runs per evaluation
+    sigma: float = 0.05    # the perturbations' step
+    lr: float = 0.02       # the learning rate
+
+
+def _finite(v) -> bool:
+    return not isinstance(v, bool) and isinstance(v, (int, float)) and 0 < v < float("inf")
+
+
+def learner(table: dict, overrides: dict | None = None, source: str = "questions.toml") -> Learner:
+    """The ``Learner`` of an ``[adaptive]`` table with ``overrides`` (None ignored) over it, read by the
+    studies' one parser: a bad key or value is a UsageError naming it."""
+    return study_settings(Learner, table, overrides, f"{source} [adaptive] or an option",
+                          whole={"budget": 0, "pairs": 1, "runs": 1},
+                          checks=[(k, lambda s, k=k: _finite(getattr(s, k)), "a finite number above 0 is expected")
+                                  for k in ("sigma", "lr")])
+
+
+@dataclass(frozen=True)
 class Cell:
     """One defence against one Byzantine count: the configuration the attackers' parameters go into."""
 
