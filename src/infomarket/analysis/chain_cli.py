@@ -1,5 +1,5 @@
 """``infomarket chain-study STORE [STORE ...] --out DIR``: the chain study's answers from its stores
-(``analysis.chain_study``), written as chain-study.md, chain-study.csv and chain-study.png."""
+(``analysis.chain_report``), written as chain-study.md, chain-study.csv and chain-study.png."""
 from __future__ import annotations
 
 import argparse
@@ -33,7 +33,7 @@ def cmd_chain_study(args: argparse.Namespace) -> int:
     """
     # the analysis and matplotlib load when the command runs, not when the CLI starts
     from . import study
-    from .chain_study import ChainStudy
+    from .chain_report import ChainStudy
 
     out = study.out_dir(args.out)
     chain = ChainStudy(args.wall)
