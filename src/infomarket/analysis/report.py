@@ -73,12 +73,12 @@ def build_report(source, out: str | Path, *, vector: str = "svg", label: str | N
     out = Path(out)
     created = not out.exists()
     out.mkdir(parents=True, exist_ok=True)
-    headline = HeadlineStudy(vector, label, echo, store)
     # drawn into a staging folder inside ``out`` and moved in once every file is written: a full disk or a
     # stop half-way leaves ``out`` as it was (an older report whole), never a part of a new set beside it
     staging = Path(tempfile.mkdtemp(prefix=".report-", suffix=".part", dir=out))
     try:
-        headline.write(source, staging)
+        report, parts = _draw(source, vector, label or _label(source), echo, store)  # HeadlineStudy's answer
+        study.Report(parts).write(staging)
         for path in sorted(staging.iterdir()):
             os.replace(path, out / path.name)
     except BaseException:
@@ -88,7 +88,6 @@ def build_report(source, out: str | Path, *, vector: str = "svg", label: str | N
                 out.rmdir()
         raise
     staging.rmdir()
-    report = headline.report
     report.files = [out / p.name for p in report.files]
     for r in report.figures:
         r.files = [out / p.name for p in r.files]

@@ -199,10 +199,10 @@ def settings(cls: type[S], table: dict, overrides: dict | None = None, source: s
                                            for k in unknown]))
     s = cls(**given)
     problems: list[tuple[str, str]] = []
-    for k, lo in (whole or {}).items():
+    for k, least in (whole or {}).items():
         v = getattr(s, k)
-        if isinstance(v, bool) or not isinstance(v, int) or v < lo:
-            problems.append((k, f"a whole number of at least {lo} is expected"))
+        if isinstance(v, bool) or not isinstance(v, int) or v < least:
+            problems.append((k, f"a whole number of at least {least} is expected"))
     problems += [(k, "true or false is expected") for k in flags if not isinstance(getattr(s, k), bool)]
     for k, lo, hi in numbers:
         v = getattr(s, k)

@@ -123,8 +123,8 @@ def learner(table: dict, overrides: dict | None = None, source: str = "questions
     studies' one parser: a bad key or value is a UsageError naming it."""
     return study_settings(Learner, table, overrides, f"{source} [adaptive] or an option",
                           whole={"budget": 0, "pairs": 1, "runs": 1},
-                          checks=[(k, lambda s, k=k: _finite(getattr(s, k)), "a finite number above 0 is expected")
-                                  for k in ("sigma", "lr")])
+                          checks=[("sigma", lambda s: _finite(s.sigma), "a finite number above 0 is expected"),
+                                  ("lr", lambda s: _finite(s.lr), "a finite number above 0 is expected")])
 
 
 @dataclass(frozen=True)
