@@ -361,10 +361,12 @@ def figure_parts(fig: Figure, name: str, vector: str = "svg") -> list[tuple[str,
     vector_meta = {"svg": {"Date": None}, "pdf": {"CreationDate": None}}[vector]
 
     def png(path: Path) -> None:
+        """The raster, at the reports' resolution, without the software's name (which changes with versions)."""
         with matplotlib.rc_context({"svg.hashsalt": "infomarket"}):
             fig.savefig(path, dpi=150, metadata={"Software": None})
 
     def drawing(path: Path) -> None:
+        """The vector drawing, without its creation date."""
         with matplotlib.rc_context({"svg.hashsalt": "infomarket"}):
             fig.savefig(path, metadata=vector_meta)
     return [(f"{name}.png", png), (f"{name}.{vector}", drawing)]

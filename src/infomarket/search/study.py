@@ -65,6 +65,7 @@ class Settings:
 
 
 def _whole(v) -> bool:
+    """A whole number, not a flag (``True`` is an int to Python, never a count to a study)."""
     return isinstance(v, int) and not isinstance(v, bool)
 
 
@@ -115,6 +116,7 @@ class Learner:
 
 
 def _finite(v) -> bool:
+    """A finite number above 0, not a flag: a step or a rate the training can take."""
     return not isinstance(v, bool) and isinstance(v, (int, float)) and 0 < v < float("inf")
 
 
