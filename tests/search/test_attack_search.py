@@ -163,8 +163,8 @@ def test_the_same_search_on_dask_gives_identical_results(inline, tmp_path):
     (["--byzantines", "5"], ["--byzantines 5", "allowed: 1, 3, 8"]),
     (["--race", "8,4"], ["race: cumulative runs per stage", "each above the one before", "(got [8, 4])"]),
     (["--race", "8,x"], ["--race '8,x'"]),
-    (["--keep", "0"], ["keep = 0"]),
-    (["--grid-step", "-5"], ["grid_step = -5"]),
+    (["--keep", "0"], ["keep: a number in (0, 1] is expected (got 0.0)"]),
+    (["--grid-step", "-5"], ["grid_step: a number in (0, 180] is expected (got -5.0)"]),
 ])
 def test_bad_input_is_refused_before_anything_is_written(tmp_path, capsys, option, words):
     out = tmp_path / "never"
