@@ -12,7 +12,7 @@ from pathlib import Path
 from .errors import UsageError, printable, report
 
 __all__ = ["Parser", "UsageError", "at_least", "creatable_dir", "fraction", "scheduler_address", "seed_value",
-           "workers_count", "writable_dir", "writable_file"]
+           "study_options", "workers_count", "writable_dir", "writable_file"]
 
 
 class Parser(argparse.ArgumentParser):
@@ -188,3 +188,26 @@ def dask_client(address: str, option: str = "--dask"):
     except (OSError, TimeoutError, ValueError, TypeError) as exc:  # a scheme Dask lacks, an address it cannot parse
         raise UsageError(f"{option} {address}: no Dask scheduler answers there ({type(exc).__name__}: "
                          f"{printable(str(exc))[:300]})") from None
+
+
+def study_options(p: argparse.ArgumentParser, out: str, *, required: bool = False, metavar: str | None = None,
+                  questions: str | None = None, seed: str | None = None, seed_default: int | None = None) -> None:
+    """The options a study's command shares with every other study's, added alike: ``--out`` (the folder
+    its files go to; checked by ``analysis.study.out_dir`` before anything runs), ``--questions FILE``
+    (its declaration file, read by ``analysis.study.questions_path``) and ``--seed`` (checked by
+    ``analysis.study.refuse_declared_seed`` against the declared one), each added when its help is given.
+
+    Args:
+        p: the command's parser.
+        out: ``--out``'s help: what the folder holds.
+        required: ``--out`` must be given (argparse refuses the command without it).
+        metavar: ``--out``'s metavar.
+        questions: ``--questions``' help (None: the command takes no questions file).
+        seed: ``--seed``'s help (None: the command takes no seed).
+        seed_default: ``--seed``'s value when it is not given (None: the declared one).
+    """
+    if questions is not None:
+        p.add_argument("--questions", metavar="FILE", help=questions)
+    if seed is not None:
+        p.add_argument("--seed", type=seed_value, default=seed_default, help=seed)
+    p.add_argument("--out", required=required, metavar=metavar, help=out)

@@ -8,6 +8,14 @@ STORES (default /tmp/infomarket-report-stores) keeps the stores between calls: t
 ones run short sweeps, the others are written directly.  The attack and defence searches' reports are
 written from their tests' hand-built results (tests/search/test_report.py, tests/defence/test_report.py).
 Run it on both trees and ``diff -r`` the OUTs.
+
+``search-run`` and ``defence-run`` run the attack and defence searches' tiny studies (their tests' TINY
+commands, one worker) into STORES once, then answer them again from a copy of that store (every run found,
+none made) into OUT, so the two trees' reports come from the same store; what a call measures of itself
+(wall seconds, how busy it kept the workers) is set to null in the JSON and dropped from the markdown
+before the diff.  Give the run modes by name (they are not in the default list):
+
+    PYTHONPATH=src python tests/analysis/generate_reports.py OUT STORES search-run defence-run
 """
 import shutil
 import sys
@@ -24,6 +32,18 @@ OUT = Path(sys.argv[1]) if __name__ == "__main__" else None
 STORES = Path(sys.argv[2]) if len(sys.argv) > 2 and "/" in sys.argv[2] else Path("/tmp/infomarket-report-stores")
 what = [w for w in sys.argv[2:] if "/" not in w] or ["headline", "future", "chain", "terrain", "sens", "search",
                                                      "defence"]
+
+#: the tiny studies of the searches' tests (tests/search/test_attack_search.py, tests/defence/test_cli.py)
+SEARCH_RUN = ["attack-search", "attack_search", "--defence", "staking", "--byzantines", "3", "--budget", "4",
+              "--popsize", "2", "--restarts", "2", "--runs", "2", "--finalists", "2", "--race", "2,3",
+              "--confirmation-runs", "3", "--grid-step", "90", "--steps", "400", "--transitory", "100", "--seed", "7",
+              "--adaptive-budget", "0", "--workers", "1", "--quiet"]
+DEFENCE_RUN = ["defence-search", "attack_search", "--questions",
+               str(Path(__file__).resolve().parents[1] / "defence" / "tiny.toml"), "--family", "theta",
+               "--byzantines", "3", "--steps", "1500", "--transitory", "500", "--seed", "6", "--workers", "1",
+               "--quiet"]
+#: what a call measures of itself: nulled in the JSON reports, its lines dropped from the markdown
+OWN = ("wall_seconds", "busy")
 
 #: how busy a study kept the machine, as the search and defence reports print it
 BUSY = {"wall_seconds": 10.0, "workers": 2, "runs": 40, "run_seconds": 15.0, "compile_seconds": 1.5,
@@ -123,7 +143,30 @@ def run():
         dr.write_frames(out, result)
         dr.write(out, a, reduced="tiny", wall_seconds=12.5, provenance={"questions commit": "abc123"},
                  records=["## Amendments", "", "- one", ""], busy=BUSY)
+    for mode, args, files in (("search-run", SEARCH_RUN, ("report.json", "report.md", "search.json")),
+                               ("defence-run", DEFENCE_RUN, ("defence.json", "defence.md"))):
+        if mode in what:
+            made = STORES / mode
+            if not made.exists():
+                assert main(args + ["--out", str(made)]) == 0
+            out = fresh(OUT / mode)
+            shutil.copytree(made / "store", out / "store")
+            assert main(args + ["--out", str(out)]) == 0
+            for name in files:
+                own(out / name)
     print("done", what)
+
+
+def own(path: Path) -> None:
+    """``path`` without what the call measured of itself (``OWN``): nulled in JSON, dropped from markdown."""
+    import json
+
+    if path.suffix == ".json":
+        data = json.loads(path.read_text())
+        path.write_text(json.dumps({k: (None if k in OWN else v) for k, v in data.items()}, indent=2) + "\n")
+    else:
+        path.write_text("".join(line for line in path.read_text().splitlines(keepends=True)
+                                if not any(w in line.lower() for w in ("wall", "busy", "worker", "seconds"))))
 
 
 if __name__ == "__main__":

@@ -160,14 +160,17 @@ def test_the_settings_parser_names_the_key_and_what_it_expects():
 
     rules = {"whole": {"runs": 2}, "flags": ("paired",), "numbers": (("share", 0.0, 1.0),)}
     assert study.settings(Plan, {"runs": 4}, {"runs": 16, "share": None}, "q.toml [plan]", **rules) == Plan(16)
-    for table, message in (({"run": 4}, "q.toml [plan]: unknown key 'run'; allowed: runs, share, paired"),
-                           ({"runs": 1}, "q.toml [plan]: runs = 1: a whole number of at least 2 is expected"),
-                           ({"runs": True}, "q.toml [plan]: runs = True: a whole number of at least 2 is expected"),
-                           ({"paired": 1}, "q.toml [plan]: paired = 1: true or false is expected"),
-                           ({"share": 0.0}, "q.toml [plan]: share = 0.0: a number in (0, 1] is expected")):
+    head = "q.toml [plan]: invalid settings\n  "
+    for table, message in (({"run": 4}, "run: unknown key; allowed keys here: runs, share, paired"),
+                           ({"runs": 1}, "runs: a whole number of at least 2 is expected (got 1)"),
+                           ({"runs": True}, "runs: a whole number of at least 2 is expected (got True)"),
+                           ({"paired": 1}, "paired: true or false is expected (got 1)"),
+                           ({"share": 0.0}, "share: a number in (0, 1] is expected (got 0.0)"),
+                           ({"share": 2, "runs": 0}, "runs: a whole number of at least 2 is expected (got 0)\n  "
+                                                     "share: a number in (0, 1] is expected (got 2)")):
         with pytest.raises(study.UsageError) as err:
             study.settings(Plan, table, None, "q.toml [plan]", **rules)
-        assert str(err.value) == message
+        assert str(err.value) == head + message
 
 
 # ------------------------------------------------------------------------------------------ verdicts

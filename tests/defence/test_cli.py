@@ -165,7 +165,7 @@ set = { "payment.stake" = 0.0 }
     (["--family", " "], ["--family ' '"]),
     (["--byzantines", "5"], ["--byzantines 5", "allowed: 1, 3, 8"]),
     (["--transitory", "1500"], ["--transitory 1500", "below --steps 1500"]),
-    (["--inner-race", "4,2"], ["race = [4, 2]"]),
+    (["--inner-race", "4,2"], ["race: cumulative runs per stage", "(got [4, 2])"]),
     (["--questions", "/nonexistent/q.toml"], ["--questions /nonexistent/q.toml", "no such file"]),
     (["--out", " "], ["--out ' '"]),
 ])

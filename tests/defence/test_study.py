@@ -7,7 +7,7 @@ from infomarket.errors import UsageError
 
 @pytest.mark.parametrize("value", ["no", 0, 1, None])
 def test_every_count_must_be_true_or_false(value):
-    with pytest.raises(UsageError, match=r"every_count = .*true or false"):
+    with pytest.raises(UsageError, match=r"every_count: true or false is expected"):
         settings({"every_count": value})
 
 

@@ -7,6 +7,7 @@ import json
 import signal
 import subprocess
 import time
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -160,10 +161,10 @@ def test_the_same_search_on_dask_gives_identical_results(inline, tmp_path):
 @pytest.mark.parametrize("option, words", [
     (["--defence", "nope"], ["--defence nope", "allowed: outlier, staking"]),
     (["--byzantines", "5"], ["--byzantines 5", "allowed: 1, 3, 8"]),
-    (["--race", "8,4"], ["race = [8, 4]", "each above the one before"]),
+    (["--race", "8,4"], ["race: cumulative runs per stage", "each above the one before", "(got [8, 4])"]),
     (["--race", "8,x"], ["--race '8,x'"]),
-    (["--keep", "0"], ["keep = 0"]),
-    (["--grid-step", "-5"], ["grid_step = -5"]),
+    (["--keep", "0"], ["keep: a number in (0, 1] is expected (got 0.0)"]),
+    (["--grid-step", "-5"], ["grid_step: a number in (0, 180] is expected (got -5.0)"]),
 ])
 def test_bad_input_is_refused_before_anything_is_written(tmp_path, capsys, option, words):
     out = tmp_path / "never"
@@ -175,12 +176,12 @@ def test_bad_input_is_refused_before_anything_is_written(tmp_path, capsys, optio
 
 
 def test_an_unknown_search_setting_is_refused(tmp_path, capsys, monkeypatch):
-    declared = study.load_declarations()
-    monkeypatch.setattr(study, "load_declarations", lambda: {**declared, "search": {"budegt": 3}})
+    shipped = study.DECLARATION
+    monkeypatch.setattr(study, "DECLARATION", replace(shipped, data={**shipped.data, "search": {"budegt": 3}}))
     out = tmp_path / "never"
     assert main(["attack-search", "attack_search", "--out", str(out)]) == 2
     err = capsys.readouterr().err
-    assert "unknown key 'budegt'" in err and "budget" in err and "Traceback" not in err
+    assert "budegt: unknown key; allowed keys here: budget" in err and "Traceback" not in err
     assert not out.exists()
 
 

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import argparse
 
-from ..cliargs import creatable_dir
+from ..cliargs import creatable_dir, study_options
 
 
 def add_subcommand(subparsers) -> None:
@@ -14,7 +14,7 @@ def add_subcommand(subparsers) -> None:
         description="Draw every figure of the paper that the store has data for (PNG and SVG/PDF), compare "
                     "the headline numbers with the paper, and write report.md and report.html in DIR.")
     p.add_argument("store", metavar="STORE", help="a results store (folder with store.json)")
-    p.add_argument("--out", required=True, metavar="DIR", help="folder for the figures and the report")
+    study_options(p, "folder for the figures and the report", required=True, metavar="DIR")
     p.add_argument("--vector", choices=("svg", "pdf"), default="svg", help="vector format besides PNG")
     p.add_argument("--quiet", action="store_true", help="print nothing but errors")
     p.set_defaults(func=cmd_figures)

@@ -350,11 +350,23 @@ FIGURES: tuple[FigureSpec, ...] = (
 
 
 def save(fig: Figure, out: Path, name: str, vector: str = "svg") -> list[Path]:
-    """Write ``name.png`` and ``name.svg`` (or ``.pdf``) under ``out``, without timestamps or random ids,
-    so the same data give the same files; each whole or not at all (the store's atomic writer)."""
-    paths = [out / f"{name}.png", out / f"{name}.{vector}"]
+    """Write ``name.png`` and ``name.svg`` (or ``.pdf``) under ``out`` (``figure_parts``); each whole or not
+    at all (the store's atomic writer)."""
+    return [write_atomic(out / file, part, keep_suffix=True) for file, part in figure_parts(fig, name, vector)]
+
+
+def figure_parts(fig: Figure, name: str, vector: str = "svg") -> list[tuple[str, Callable[[Path], None]]]:
+    """``fig`` as two parts of a study's ``Report``: ``name.png`` and ``name.svg`` (or ``.pdf``), saved
+    without timestamps or random ids, so the same data give the same files."""
     vector_meta = {"svg": {"Date": None}, "pdf": {"CreationDate": None}}[vector]
-    with matplotlib.rc_context({"svg.hashsalt": "infomarket"}):
-        write_atomic(paths[0], lambda tmp: fig.savefig(tmp, dpi=150, metadata={"Software": None}), keep_suffix=True)
-        write_atomic(paths[1], lambda tmp: fig.savefig(tmp, metadata=vector_meta), keep_suffix=True)
-    return paths
+
+    def png(path: Path) -> None:
+        """The raster, at the reports' resolution, without the software's name (which changes with versions)."""
+        with matplotlib.rc_context({"svg.hashsalt": "infomarket"}):
+            fig.savefig(path, dpi=150, metadata={"Software": None})
+
+    def drawing(path: Path) -> None:
+        """The vector drawing, without its creation date."""
+        with matplotlib.rc_context({"svg.hashsalt": "infomarket"}):
+            fig.savefig(path, metadata=vector_meta)
+    return [(f"{name}.png", png), (f"{name}.{vector}", drawing)]

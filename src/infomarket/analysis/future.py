@@ -25,7 +25,7 @@ from scipy import stats as sps
 from . import stats as st
 from .boxplots import draw_boxes, legend_handles
 from .declared import size_note, status_of
-from .figures import _runs_text, save
+from .figures import _runs_text, figure_parts
 from .frames import Frames, MissingDataError
 from .headline import DECLARATION
 from .study import NO_DATA, Declaration, Verdict, html_table, md_table
@@ -369,15 +369,17 @@ class Section:
     lock: str = ""  # whether the questions were declared before the store's first run
 
 
-def section(frames: Frames, out: Path, vector: str, echo: Callable[[str], None]) -> Section | None:
-    """Draw each attack's figure and answer the declared questions; None when the store has no
-    future-sweep runs (a paper-only store's report is unchanged)."""
+def section(frames: Frames, parts: list, vector: str, echo: Callable[[str], None]) -> Section | None:
+    """Draw each attack's figure (its files added to ``parts``, a study ``Report``'s) and answer the declared
+    questions; None when the store has no future-sweep runs (a paper-only store's report is unchanged)."""
     if not has_data(frames):
         return None
     figs = []
     for name, caption, draw in figure_specs():
         try:
-            files = save(draw(frames), out, name, vector)
+            drawn = figure_parts(draw(frames), name, vector)
+            parts += drawn
+            files = [Path(file) for file, _ in drawn]
             figs.append((name, caption, files, ""))
             echo(f"{name}: wrote {', '.join(p.name for p in files)}")
         except MissingDataError as exc:

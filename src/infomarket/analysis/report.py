@@ -18,10 +18,10 @@ from pathlib import Path
 import pandas as pd
 
 from ..store import Store
-from ..store.files import write_text_atomic
 from . import future
 from .completeness import gaps
-from .figures import FIGURES, save
+from . import study
+from .figures import FIGURES, figure_parts
 from .frames import Frames, MissingDataError
 from .headline import DECLARATION as TOLERANCES, FAIL, INCOMPLETE, INCONCLUSIVE, NO_DATA, PASS, headline_table
 from .stats import N_TOO_SMALL, shown
@@ -77,7 +77,8 @@ def build_report(source, out: str | Path, *, vector: str = "svg", label: str | N
     # stop half-way leaves ``out`` as it was (an older report whole), never a part of a new set beside it
     staging = Path(tempfile.mkdtemp(prefix=".report-", suffix=".part", dir=out))
     try:
-        report = _draw(source, staging, vector, label or _label(source), echo, store)
+        report, parts = _draw(source, vector, label or _label(source), echo, store)  # HeadlineStudy's answer
+        study.Report(parts).write(staging)
         for path in sorted(staging.iterdir()):
             os.replace(path, out / path.name)
     except BaseException:
@@ -97,13 +98,35 @@ def build_report(source, out: str | Path, *, vector: str = "svg", label: str | N
     return report
 
 
-def _draw(source, out: Path, vector: str, label: str, echo: Callable[[str], None], store: Store | None) -> Report:
-    """``build_report``'s work, every file written into ``out`` (its staging folder)."""
+class HeadlineStudy(study.Study):
+    """The paper's headline rows and open questions (``tolerances.toml``) answered from a store (or anything
+    ``Frames.of`` reads): every figure, ``report.md`` and ``report.html``, with a sensitivity section for
+    each sampled design of ``store`` (or of the source, when it is a store).  ``report`` keeps what it
+    judged once ``answer`` has run."""
+
+    declaration = TOLERANCES
+
+    def __init__(self, vector: str = "svg", label: str | None = None,
+                 echo: Callable[[str], None] = lambda line: None, store: Store | None = None) -> None:
+        self.vector, self.label, self.echo, self.store = vector, label, echo, store
+        self.report: Report | None = None
+
+    def answer(self, store) -> study.Report:
+        """Every figure drawn, the headline table, the open questions and ``report.md`` / ``report.html`` of
+        ``store``, as the files they are written to."""
+        self.report, parts = _draw(store, self.vector, self.label or _label(store), self.echo, self.store)
+        return study.Report(parts)
+
+
+def _draw(source, vector: str, label: str, echo: Callable[[str], None], store: Store | None
+          ) -> tuple[Report, list]:
+    """``HeadlineStudy.answer``'s work: what it judged, and its files as a study ``Report``'s parts."""
     frames = Frames.of(source)
     incomplete = gaps(frames.runs)
     for gap in incomplete.values():
         echo(f"WARNING: {gap.describe()}")
-    results = []
+    results: list[FigureResult] = []
+    parts: list = []
     for spec in FIGURES:
         try:
             fig = spec.draw(frames)
@@ -111,7 +134,9 @@ def _draw(source, out: Path, vector: str, label: str, echo: Callable[[str], None
             results.append(FigureResult(spec.name, spec.caption, note=str(exc)))
             echo(f"{spec.name}: skipped ({exc})")
             continue
-        files = save(fig, out, spec.name, vector)
+        drawn = figure_parts(fig, spec.name, vector)
+        parts += drawn
+        files = [Path(name) for name, _ in drawn]
         warning = " ".join(g.describe() for name, g in incomplete.items() if name.startswith(spec.name))
         results.append(FigureResult(spec.name, spec.caption, files, warning=warning))
         echo(f"{spec.name}: wrote {', '.join(p.name for p in files)}" + (" (INCOMPLETE design)" if warning else ""))
@@ -122,15 +147,16 @@ def _draw(source, out: Path, vector: str, label: str, echo: Callable[[str], None
     for note in report.lengths:
         echo(f"WARNING: {note}")
     report.lock = TOLERANCES.lock_summary(frames.meta.get("declarations") if frames.meta else None, "rows.")
-    report.future = future.section(frames, out, vector, echo)
+    report.future = future.section(frames, parts, vector, echo)
     store = store if store is not None else (Store(source) if isinstance(source, (str, Path)) else
                                              source if isinstance(source, Store) else None)
     if store is not None:
-        report.sections = report_section(store, out, vector, echo)
+        report.sections = report_section(store, parts, vector, echo)
     echo(f"paper vs this store: {_counts_text(report)}")
     for name, text in (("report.md", to_markdown(report)), ("report.html", to_html(report))):
-        report.files.append(write_text_atomic(text, out / name, "utf-8"))
-    return report
+        parts.append((name, text))
+        report.files.append(Path(name))
+    return report, parts
 
 
 def length_notes(runs: pd.DataFrame) -> list[str]:

@@ -10,13 +10,14 @@ import numpy as np
 import pandas as pd
 
 from ..runner import design as designs
-from ..store.files import write_parquet_atomic, write_text_atomic
+from ..cliargs import UsageError
+from ..store import Store
 from .declared import status_of
-from .figures import save
+from .figures import figure_parts
 from .frames import MissingDataError
 from . import sensitivity as sens  # module-level knobs (PAWN_PERMUTATIONS) read when drawing
-from .sensitivity import TITLES, Sensitivity, floor_of, from_store, morris_noise
-from .study import INCONCLUSIVE, NO, YES, Declaration, html_table, md_table, packaged, write_csv
+from .sensitivity import TITLES, Sensitivity, floor_of, from_store, local_robustness, morris_noise
+from .study import INCONCLUSIVE, NO, YES, Declaration, Report, Study, html_table, md_table, packaged
 
 DECLARATION = packaged("sensitivity_questions.toml")
 QUESTIONS = DECLARATION.path
@@ -286,30 +287,75 @@ def stem(experiment: str) -> str:
     return experiment if experiment.startswith("sensitivity") else f"sensitivity-{experiment}"
 
 
-def write(s: Sensitivity, out: str | Path, *, vector: str = "svg",
-          answers_table: pd.DataFrame | None = None) -> list[Path]:
+def report(s: Sensitivity, *, vector: str = "svg", answers_table: pd.DataFrame | None = None) -> Report:
     """``STEM.csv`` / ``.parquet`` (the long table, the noise floor and PAWN included), the bar chart
     (and the S2 heat map of a second-order Sobol' design) as PNG and ``vector``, and ``STEM.md``
-    (``stem``: ``sensitivity-NAME``, or NAME when it starts with "sensitivity"); returns the files."""
-
-    out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
+    (``stem``: ``sensitivity-NAME``, or NAME when it starts with "sensitivity"), as a ``Report``."""
     name = stem(s.design.experiment)
-    files = [out / f"{name}.csv", out / f"{name}.parquet"]
-    write_csv(s.table, files[0])
-    write_parquet_atomic(s.table, files[1])
-    figs = save(_bars(s), out, f"{name}-indices", vector)
+    figs = figure_parts(_bars(s), f"{name}-indices", vector)
     if s.design.method == "sobol" and s.design.second_order:
-        figs += save(_heatmap(s), out, f"{name}-S2", vector)
-    md = out / f"{name}.md"
-    write_text_atomic(markdown(s, [p.name for p in figs], answers_table), md, "utf-8")
-    s.files = files + figs + [md]
+        figs += figure_parts(_heatmap(s), f"{name}-S2", vector)
+    return Report([(f"{name}.csv", s.table), (f"{name}.parquet", s.table), *figs,
+                   (f"{name}.md", markdown(s, [f for f, _ in figs], answers_table))])
+
+
+def write(s: Sensitivity, out: str | Path, *, vector: str = "svg",
+          answers_table: pd.DataFrame | None = None) -> list[Path]:
+    """``report(s, ...)`` written into ``out`` (created when missing); returns the files (kept in
+    ``s.files``)."""
+    s.files = report(s, vector=vector, answers_table=answers_table).write(out)
     return s.files
 
 
-def report_section(store, out: Path, vector: str = "svg", echo=lambda line: None) -> list[tuple[str, str]]:
-    """(markdown, html) of every design in ``store``, figures written into ``out``; [] when it has none
-    or when a design is not complete yet (with a note through ``echo``)."""
+class SensitivityStudy(Study):
+    """The sensitivity study: the indices of a store's sampled design (``experiment``: which, when the store
+    holds several), its declared questions answered (``sensitivity_questions.toml``), and with ``local``,
+    a store of a replicated local design, whether that point is robust (``STEM-robustness.csv``)."""
+
+    declaration = DECLARATION
+
+    def __init__(self, experiment: str | None = None, vector: str = "svg", local: str | None = None) -> None:
+        self.experiment, self.vector, self.local = experiment, vector, local
+        self.indices: Sensitivity | None = None
+        self.robustness: tuple[pd.DataFrame, pd.DataFrame] | None = None
+        self.answers: pd.DataFrame | None = None
+
+    def answer(self, store) -> Report:
+        """The indices, tables, figures and ``STEM.md`` of the design in ``store`` (a store's folder).
+
+        Raises:
+            UsageError: a store holds no complete sampled design (the store named).
+        """
+        try:
+            s = from_store(store, self.experiment)
+        except MissingDataError as exc:
+            raise UsageError(_named(store, exc)) from None
+        local = None
+        if self.local:
+            try:
+                local = local_robustness(from_store(self.local), s.points)
+            except MissingDataError as exc:
+                raise UsageError(f"--local {_named(self.local, exc)}") from None
+        table = declared_answers(s, Store(store), local)
+        parts = report(s, vector=self.vector, answers_table=table).parts
+        if local is not None:
+            parts.append((f"{stem(s.design.experiment)}-robustness.csv", local[0]))
+            if len(local[1]):
+                parts.append((f"{stem(s.design.experiment)}-local-mu-star.csv", local[1]))
+        self.indices, self.robustness, self.answers = s, local, table
+        return Report(parts)
+
+
+def _named(path: str, exc: Exception) -> str:
+    """``PATH: message``, with the path once: a message that already starts with it is left as it is."""
+    text = str(exc)
+    bare = str(path).rstrip("/")
+    return text if bare and text.startswith(bare) else f"{path}: {text}"
+
+
+def report_section(store, parts: list, vector: str = "svg", echo=lambda line: None) -> list[tuple[str, str]]:
+    """(markdown, html) of every design in ``store``, its files added to ``parts`` (a study ``Report``'s);
+    [] when it has none or when a design is not complete yet (with a note through ``echo``)."""
 
     sections = []
     for name in designs.designs(store.root):
@@ -319,10 +365,9 @@ def report_section(store, out: Path, vector: str = "svg", echo=lambda line: None
             echo(f"sensitivity of {name}: skipped ({exc})")
             continue
         table = declared_answers(s, store)
-        files = write(s, out, vector=vector, answers_table=table)
-        names = [p.name for p in files if p.suffix in (".png", f".{vector}")]
+        files = report(s, vector=vector, answers_table=table).parts
+        parts += files
+        names = [f for f, _ in files if f.endswith((".png", f".{vector}"))]
         sections.append((markdown(s, names, table), html_section(s, names, table)))
-        echo(f"sensitivity of {name}: wrote {', '.join(p.name for p in files)}")
+        echo(f"sensitivity of {name}: wrote {', '.join(f for f, _ in files)}")
     return sections
-
-

@@ -23,15 +23,16 @@ from __future__ import annotations
 
 import html
 import tomllib
+from abc import ABC, abstractmethod
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import TypeVar
+from typing import Any, TypeVar
 
 import pandas as pd
 
 from ..cliargs import UsageError, writable_dir
-from ..errors import ConfigError
+from ..errors import ArgumentError, ConfigError
 from ..store.files import write_atomic, write_parquet_atomic, write_text_atomic
 from . import declared
 from . import stats as st
@@ -148,12 +149,18 @@ class Declaration:
 
 
 # ------------------------------------------------------------------------------------------ settings
+#: a rule of ``settings``' ``checks``: the key it is reported under, whether the settings keep it, what is expected
+Check = tuple[str, Callable[[Any], bool], str]
+
+
 def settings(cls: type[S], table: dict, overrides: dict | None = None, source: str = "settings", *,
              whole: dict[str, int] | None = None, flags: Iterable[str] = (),
-             numbers: Iterable[tuple[str, float, float]] = ()) -> S:
+             numbers: Iterable[tuple[str, float, float]] = (), checks: Iterable[Check] = ()) -> S:
     """A study's settings: the dataclass ``cls`` from its declaration's ``table`` with ``overrides`` (the
-    command line's options; None values ignored) over it, each value checked, so that every study refuses
-    a bad setting with the same words whether it came from the file or an option.
+    command line's options; None values ignored) over it, each value checked.  Every study's settings are
+    read here, and a bad one is refused as an experiment file's bad key is (``config.messages``): one
+    message from ``source``, one line per problem naming the key, what is expected and the value given,
+    whether it came from the file or an option.
 
     Args:
         cls: the study's settings dataclass (its fields are the keys allowed).
@@ -163,9 +170,12 @@ def settings(cls: type[S], table: dict, overrides: dict | None = None, source: s
         whole: key -> the least whole number allowed.
         flags: keys that take true or false.
         numbers: (key, low, high): a number in (low, high].
+        checks: (key, ok, expected): a rule of the study's own (``ok(settings)`` false: ``key`` is refused
+            with ``expected``), for what the kinds above cannot say (a list's shape, one key bounded by another).
 
     Raises:
-        UsageError: an unknown key (the allowed ones named), or a value of the wrong kind or out of range.
+        UsageError: an unknown key (the allowed ones named), or values of the wrong kind or out of range
+            (every one of them named).
 
     Example:
         >>> from dataclasses import dataclass
@@ -178,26 +188,43 @@ def settings(cls: type[S], table: dict, overrides: dict | None = None, source: s
         >>> settings(Plan, {"run": 16})
         Traceback (most recent call last):
         ...
-        infomarket.errors.UsageError: settings: unknown key 'run'; allowed: runs
+        infomarket.errors.UsageError: settings: invalid settings
+          run: unknown key; allowed keys here: runs
     """
-    known = cls.__dataclass_fields__  # type: ignore[attr-defined]
+    known = list(cls.__dataclass_fields__)  # type: ignore[attr-defined]
     given = {**table, **{k: v for k, v in (overrides or {}).items() if v is not None}}
-    for k in given:
-        if k not in known:
-            raise UsageError(f"{source}: unknown key {k!r}; allowed: {', '.join(known)}")
+    unknown = [k for k in given if k not in known]
+    if unknown:
+        raise UsageError(_invalid(source, [f"{k}: unknown key; allowed keys here: {', '.join(known)}"
+                                           for k in unknown]))
     s = cls(**given)
-    for k, lo in (whole or {}).items():
+    problems: list[tuple[str, str]] = []
+    for k, least in (whole or {}).items():
         v = getattr(s, k)
-        if isinstance(v, bool) or not isinstance(v, int) or v < lo:
-            raise UsageError(f"{source}: {k} = {v!r}: a whole number of at least {lo} is expected")
-    for k in flags:
-        if not isinstance(getattr(s, k), bool):
-            raise UsageError(f"{source}: {k} = {getattr(s, k)!r}: true or false is expected")
+        if isinstance(v, bool) or not isinstance(v, int) or v < least:
+            problems.append((k, f"a whole number of at least {least} is expected"))
+    problems += [(k, "true or false is expected") for k in flags if not isinstance(getattr(s, k), bool)]
     for k, lo, hi in numbers:
         v = getattr(s, k)
         if isinstance(v, bool) or not isinstance(v, (int, float)) or not lo < v <= hi:
-            raise UsageError(f"{source}: {k} = {v!r}: a number in ({lo:g}, {hi:g}] is expected")
+            problems.append((k, f"a number in ({lo:g}, {hi:g}] is expected"))
+    problems += [(k, expected) for k, ok, expected in checks if not ok(s)]
+    if problems:  # in the fields' order, each key once (its first rule)
+        first = {k: what for k, what in reversed(problems)}
+        raise UsageError(_invalid(source, [f"{k}: {first[k]} (got {_shown(getattr(s, k))})"
+                                           for k in known if k in first]))
     return s
+
+
+def _invalid(source: str, lines: list[str]) -> str:
+    """A settings error as ``config.messages`` writes an experiment's: the source, then a line per problem."""
+    return f"{source}: invalid settings\n  " + "\n  ".join(lines)
+
+
+def _shown(value: object, limit: int = 80) -> str:
+    """A value as an error message quotes it: its repr, cut to ``limit`` characters."""
+    text = repr(list(value) if isinstance(value, tuple) else value)
+    return text if len(text) <= limit else f"{text[:limit]}... ({len(text)} characters)"
 
 
 def packaged(name: str) -> Declaration:
@@ -373,6 +400,17 @@ class Report:
         parts += [(f"{stem}.png", figure)] if figure is not None else []
         return cls(parts)
 
+    def text(self, name: str) -> str:
+        """The text part called ``name`` (a command prints its report's markdown as it writes it).
+
+        Raises:
+            ArgumentError: the report has no text part of that name.
+        """
+        for part_name, part in self.parts:
+            if part_name == name and isinstance(part, str):
+                return part
+        raise ArgumentError(f"the report has no text part {name!r}")
+
     def write(self, out: str | Path) -> list[Path]:
         """Write every part into ``out`` (created when missing); returns the files, in the parts' order."""
         folder = writable_dir(Path(out))
@@ -386,6 +424,30 @@ class Report:
             else:
                 files.append(write_atomic(path, part, keep_suffix=True))
         return files
+
+
+class Study(ABC):
+    """A declared study, the shape every study's command takes: its declaration file, and ``answer``, its
+    answers from the stores it reads as a ``Report`` (the files it writes, in order), written by ``write``
+    through ``Report.write`` (the store's atomic writers).  A study keeps only what is its own: its
+    settings, the rule of each question, its tables and figure.
+    """
+
+    #: the study's declaration file, read once (None: a study that reads its questions elsewhere)
+    declaration: Declaration | None = None
+
+    @abstractmethod
+    def answer(self, store) -> Report:
+        """The study's answers from ``store`` (a store, or the stores or folder of stores it is answered
+        from) as the files it writes; nothing is written here.
+
+        Raises:
+            UsageError: the store holds nothing the study can answer from.
+        """
+
+    def write(self, store, out: str | Path) -> list[Path]:
+        """``answer(store)`` written into ``out`` (created when missing); returns the files, in order."""
+        return self.answer(store).write(out)
 
 
 def drawn(make: Callable[[], object], **options) -> Callable[[Path], None]:

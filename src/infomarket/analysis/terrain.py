@@ -14,6 +14,7 @@ p-value reported beside it; the crowd's ratio is read from its bootstrap interva
 """
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -402,3 +403,16 @@ def jsonable(a):
     if isinstance(a, (np.floating, np.integer)):
         return a.item()
     return a
+
+
+class TerrainStudy(study.Study):
+    """The terrain study: its questions (``terrain_questions.toml``) answered from a folder holding its
+    stores, as ``terrain.md``, ``terrain.json`` and ``terrain.png``."""
+
+    declaration = DECLARATION
+
+    def answer(self, store) -> study.Report:
+        """The answers from the folder ``store`` (its stores corridor/, two_food/, crowd/, ...)."""
+        a = answer(Path(store))
+        return study.Report.of("terrain", markdown(a), extra=[("terrain.json", json.dumps(jsonable(a), indent=1))],
+                               figure=lambda p: figure(a, p))

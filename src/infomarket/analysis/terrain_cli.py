@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
+
+from ..cliargs import study_options
 
 
 def add_subcommand(subparsers) -> None:
@@ -13,7 +14,7 @@ def add_subcommand(subparsers) -> None:
                               "from their stores, with a figure")
     p.add_argument("results", help="folder holding the stores corridor/, two_food/, crowd/ "
                                    "(optionally corridor_waypoints/, crowd_sensing/)")
-    p.add_argument("--out", required=True, help="folder for terrain.md, terrain.json, terrain.png")
+    study_options(p, "folder for terrain.md, terrain.json, terrain.png", required=True)
     p.set_defaults(func=cmd_terrain_report)
 
 
@@ -22,13 +23,11 @@ def cmd_terrain_report(args: argparse.Namespace) -> int:
     exit code."""
     # the analysis (scipy.stats, pandas) loads when the command runs, not when the CLI starts
     from . import study
-    from .terrain import answer, figure, jsonable, markdown
+    from .terrain import TerrainStudy
 
     out = study.out_dir(args.out)
-    a = answer(Path(args.results))
-    text = markdown(a)
-    files = study.Report.of("terrain", text, extra=[("terrain.json", json.dumps(jsonable(a), indent=1))],
-                            figure=lambda p: figure(a, p)).write(out)
-    print(text)
+    report = TerrainStudy().answer(Path(args.results))
+    files = report.write(out)
+    print(report.text("terrain.md"))
     print(f"wrote {', '.join(str(f) for f in files)}")
     return 0

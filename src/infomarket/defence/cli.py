@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import time
 
-from ..cliargs import UsageError, at_least, dask_client, seed_value, workers_count
+from ..cliargs import UsageError, at_least, dask_client, study_options, workers_count
 
 #: outer settings an option may make smaller than declared (the report is then marked reduced)
 SIZES = ("candidates", "refine", "cost_runs", "frontier", "confirmation_runs")
@@ -115,13 +115,12 @@ def cmd_defence_search(args) -> int:
     wall = time.perf_counter() - t0
     feed.busy.wall_seconds = wall
     busy = feed.busy.as_dict()
-    analysis = report.analyse(st, result)
-    prov = store.meta().get(driver.NAME)
-    written = report.write_frames(out, result)
-    written += report.write(out, analysis, reduced=reduced, wall_seconds=wall, provenance=prov,
-                            records=declaration.record_markdown(), busy=busy)
+    answers = report.DefenceSearch(st, result, reduced=reduced, wall_seconds=wall,
+                                   records=declaration.record_markdown(), busy=busy)
+    written = answers.write(store, out)
     if not args.quiet:
-        print(report.markdown(analysis, reduced=reduced, wall_seconds=wall, provenance=prov, busy=busy))
+        print(report.markdown(answers.analysis, reduced=reduced, wall_seconds=wall,
+                              provenance=store.meta().get(driver.NAME), busy=busy))
         print(f"defence-search: {sum(j.runs for j in judged)} search-phase runs, "
               f"{result.made + result.found} confirmation runs; {wall:.1f} s wall; "
               f"wrote {', '.join(str(p) for p in written)}")
@@ -133,8 +132,6 @@ def add_subcommand(sub) -> None:
     p = sub.add_parser("defence-search", help="defences searched against the worst attack an inner attack search "
                                               "finds (min-max), the frontier confirmed on fresh seeds; resumable")
     p.add_argument("experiment", help="a study experiment (the shipped attack_search, or a file like it)")
-    p.add_argument("--questions", metavar="FILE", help="the study's questions file: families, settings and rules "
-                                                        "(default: the shipped defence/questions.toml)")
     p.add_argument("--family", help="famil(ies) to search, comma-separated; `existing`: the experiment's own "
                                     "defences (default: every one)")
     p.add_argument("--byzantines", metavar="K", help="Byzantine count(s), comma-separated; the target count is "
@@ -155,11 +152,13 @@ def add_subcommand(sub) -> None:
                    help="the inner search's rotation grid step (default: declared)")
     p.add_argument("--inner-race", metavar="N,N,...", help="the inner search's cumulative runs per raced attack "
                                                            "(default: declared)")
-    p.add_argument("--seed", type=seed_value, help="the study's seed: designs and seed sets (default: declared)")
     p.add_argument("--list-families", action="store_true", help="list the families and their parameters and exit")
     p.add_argument("--steps", type=at_least(1), help="steps per run (default: the experiment's), for a reduced study")
     p.add_argument("--transitory", type=at_least(0), help="steps not counted (default: the experiment's)")
-    p.add_argument("--out", help="folder: the results store (OUT/store) and the report")
+    study_options(p, "folder: the results store (OUT/store) and the report",
+                  questions="the study's questions file: families, settings and rules (default: the shipped "
+                            "defence/questions.toml)",
+                  seed="the study's seed: designs and seed sets (default: declared)")
     p.add_argument("--workers", type=workers_count, help="local processes (default: one per core)")
     p.add_argument("--dask", metavar="ADDRESS", help="run on a Dask scheduler, e.g. tcp://host:8786")
     p.add_argument("--reduced", metavar="TEXT", help="label the report as a reduced run (what was reduced)")

@@ -18,9 +18,10 @@ from ..analysis import paired_runs as pr
 from ..analysis import stats
 from ..analysis.formats import interval_text, json_ready
 from ..analysis.study import Report, drawn
+from ..analysis.study import Study as DeclaredStudy
 from ..runner.progress import busy_markdown
-from .driver import Judged, Result, pareto
-from .study import Study, floor
+from .driver import NAME, Judged, Result, pareto
+from .study import DECLARATION, Study, floor
 
 DEFAULTS = {"alpha": stats.ALPHA, "confidence": stats.CONFIDENCE}
 
@@ -304,21 +305,49 @@ def _kappa(v) -> str:
     return "none (half or more lie)" if v is None or not math.isfinite(v) else f"{v:.3f}"
 
 
-def write_frames(out: Path, result: Result) -> list[Path]:
+def frames(result: Result) -> Report:
     """The confirmation runs as Parquet frames (``defence_cost.parquet``: label, run, items, undefended;
     ``defence_attacks.parquet``: label, byzantines, run, worst, reference), for DuckDB or pandas."""
-    return Report([("defence_cost.parquet", result.cost_runs),
-                   ("defence_attacks.parquet", result.attack_runs)]).write(out)
+    return Report([("defence_cost.parquet", result.cost_runs), ("defence_attacks.parquet", result.attack_runs)])
 
 
-def write(out: Path, a: dict, *, reduced: str = "", wall_seconds: float | None = None,
-          provenance: dict | None = None, records: list[str] | None = None, busy: dict | None = None) -> list[Path]:
-    """``defence.json``, ``defence.md`` and ``frontier.png`` into ``out``, each written whole or not at all;
-    ``busy``: how busy the study kept its workers (``runner.feed.Busy.as_dict``)."""
+def write_frames(out: Path, result: Result) -> list[Path]:
+    """``frames(result)`` written into ``out``; returns the files."""
+    return frames(result).write(out)
+
+
+def write(out: Path, a: dict, **meta) -> list[Path]:
+    """``report(a, **meta)`` written into ``out``, each file whole or not at all; returns the files."""
+    return report(a, **meta).write(out)
+
+
+def report(a: dict, *, reduced: str = "", wall_seconds: float | None = None, provenance: dict | None = None,
+           records: list[str] | None = None, busy: dict | None = None) -> Report:
+    """``defence.json``, ``defence.md`` and ``frontier.png`` as a ``Report``; ``busy``: how busy the study
+    kept its workers (``runner.feed.Busy.as_dict``)."""
     meta = {"reduced": reduced, "wall_seconds": wall_seconds, "provenance": provenance or {}, "busy": busy or {}}
     parts: list = [("defence.json", json.dumps(json_ready({**meta, **a}), indent=2) + "\n"),
                    ("defence.md", markdown(a, reduced=reduced, wall_seconds=wall_seconds, provenance=provenance,
                                            records=records, busy=busy))]
     if a["confirmed"]:
         parts.append(("frontier.png", drawn(lambda: figure(a), dpi=120)))
-    return Report(parts).write(out)
+    return Report(parts)
+
+
+class DefenceSearch(DeclaredStudy):
+    """The defence search as a declared study: the search's ``result`` (the driver's, read from and made
+    into the store) answered as its frames, ``defence.json``, ``defence.md`` and ``frontier.png``, with the
+    store's record of the study's first run as its provenance; ``meta``: ``report``'s other arguments."""
+
+    declaration = DECLARATION
+
+    def __init__(self, study: Study, result: Result, **meta) -> None:
+        self.study, self.result, self.meta = study, result, meta
+        self.declaration = study.declaration  # the questions file the study was read from
+        self.analysis: dict = {}
+
+    def answer(self, store) -> Report:
+        """The frames and the report of the result, ``store``'s record of the first run as provenance."""
+        self.analysis = analyse(self.study, self.result)
+        written = report(self.analysis, provenance=store.meta().get(NAME), **self.meta)
+        return Report(frames(self.result).parts + written.parts)

@@ -8,7 +8,7 @@ import json
 import math
 import time
 
-from ..cliargs import UsageError, at_least, seed_value, workers_count
+from ..cliargs import UsageError, at_least, study_options, workers_count
 
 #: The policy's and the summaries' file names in ``--out``.
 POLICY_FILE, SUMMARY_JSON, SUMMARY_MD = "policy.npz", "summary.json", "summary.md"
@@ -38,7 +38,6 @@ def add_subcommand(sub) -> None:
     p.add_argument("--byzantines", required=True, type=at_least(1), metavar="K", help="the cell's Byzantine count")
     p.add_argument("--budget", required=True, type=at_least(1), metavar="N",
                    help="candidate evaluations (each generation: its centre and 2 x --pairs perturbations)")
-    p.add_argument("--out", required=True, help="folder: checkpoint, policy.npz, summary.json and summary.md")
     p.add_argument("--pairs", type=at_least(1), default=8, help="antithetic pairs per generation (default 8)")
     p.add_argument("--runs", type=at_least(1), default=4,
                    help="runs per candidate, the same seeds for the whole generation (default 4)")
@@ -50,7 +49,8 @@ def add_subcommand(sub) -> None:
                    help="what the attack optimises (default items: the honest robots' items, minimised)")
     p.add_argument("--steps", type=at_least(2), help="steps per run (default: the experiment's)")
     p.add_argument("--transitory", type=at_least(0), help="steps not counted (default: the experiment's)")
-    p.add_argument("--seed", type=seed_value, default=0, help="the training's seed (default 0)")
+    study_options(p, "folder: checkpoint, policy.npz, summary.json and summary.md", required=True,
+                  seed="the training's seed (default 0)", seed_default=0)
     p.add_argument("--eval-runs", type=at_least(0), default=16,
                    help="runs on fresh seeds comparing the learned policy with its start, paired (default 16; 0: none)")
     p.add_argument("--workers", type=workers_count, default=1, help="local processes (default 1)")

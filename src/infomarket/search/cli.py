@@ -4,9 +4,10 @@ from __future__ import annotations
 import argparse
 import functools
 import time
+from dataclasses import replace
 from pathlib import Path
 
-from ..cliargs import UsageError, at_least, dask_client, seed_value, workers_count
+from ..cliargs import UsageError, at_least, dask_client, study_options, workers_count
 from .baselines import rotation_grid
 
 
@@ -78,7 +79,7 @@ def cmd_attack_search(args) -> int:
     """Run ``infomarket attack-search``: search each cell's worst attack into the store (resumable), then write the
     cells' frames and the summary; returns the exit code."""
     # with the command: `infomarket --help` imports neither scipy.stats nor the search, runner and store
-    from ..analysis.study import out_dir, questions_path, refuse_declared_seed
+    from ..analysis.study import out_dir, refuse_declared_seed
     from ..config import load_experiment
     from ..runner.execute import default_workers, local_executor
     from ..runner.feed import Feed, dask_threads
@@ -91,10 +92,8 @@ def cmd_attack_search(args) -> int:
     from . import adaptive, provenance, report
 
     exp = load_experiment(args.experiment)
-    path = questions_path(args.questions, study_mod.QUESTIONS)
-    decl = study_mod.Declaration.read(path, path.name)
-    # the package's file is read as the study reads it
-    data = decl.data if args.questions is not None else study_mod.load_declarations()
+    decl = study_mod.read(args.questions)  # the shipped file as the package read it, or the one given
+    path, data = decl.path, decl.data
     st = study_mod.load(exp, data, path=path, budget=args.budget, popsize=args.popsize, restarts=args.restarts,
                         runs=args.runs,
                         finalists=args.finalists, race=_race(args.race) if args.race is not None else None,
@@ -125,10 +124,8 @@ def cmd_attack_search(args) -> int:
     total = planned_runs(st) * len(chosen)
     client = dask_client(args.dask) if args.dask else None
     workers = args.workers or default_workers()
-    learner = {**ADAPTIVE, **data.get("adaptive", {})}
-    if args.adaptive_budget is not None:
-        learner["budget"] = args.adaptive_budget
-    _check_learner(learner)  # before any run: a bad value must not surface after a cell's search
+    # before any run: a bad value must not surface after a cell's search
+    learner = study_mod.learner(data.get("adaptive", {}), {"budget": args.adaptive_budget}, path.name)
     validation = _study_validation(st, out, args.quiet)
     need = data.get("validation", {}).get("min_recovery")
     if need is not None and not reduced and validation.get("search", 0.0) < need:
@@ -147,7 +144,7 @@ def cmd_attack_search(args) -> int:
             run = store_runner(store, on_skip=lambda k: k and bar.skip(k), feed=feed)
             results = run.map([functools.partial(search_cell, st, c, store, run=run, steps=args.steps,
                                                  transitory=args.transitory) for c in chosen])
-            for c, r in zip(chosen, results) if learner["budget"] else ():  # after every cell: its own pool
+            for c, r in zip(chosen, results) if learner.budget else ():  # after every cell: its own pool
                 r.extra["adaptive"] = _adaptive(adaptive, st, c, r, learner, out, args,
                                                 1 if client is not None else workers)
     finally:
@@ -158,14 +155,13 @@ def cmd_attack_search(args) -> int:
     busy = feed.busy.as_dict()
     written, text = write(out, st, results, reduced=reduced, wall_seconds=wall, steps=first.steps,
                           transitory=first.transitory)
-    analysis = report.analyse(st, results)
     length = {"steps": first.steps, "transitory": first.transitory}
-    first_run = store.meta().get("attack_search")
-    header = {**provenance.report_header(first_run, path), "validation": validation}
-    written += report.write(out, analysis, reduced=reduced, wall_seconds=wall, provenance=first_run,
-                            header=header, records=decl.record_markdown(), busy=busy, **length)
-    text = report.markdown(analysis, reduced=reduced, wall_seconds=wall, header=header,
-                           records=decl.record_markdown(), busy=busy, **length)
+    header = {**provenance.report_header(store.meta().get(report.PROVENANCE), path), "validation": validation}
+    answers = report.AttackSearch(st, results, reduced=reduced, wall_seconds=wall, header=header,
+                                  records=_records(decl), busy=busy, **length)
+    written += answers.write(store, out)
+    text = report.markdown(answers.analysis, reduced=reduced, wall_seconds=wall, header=header,
+                           records=_records(decl), busy=busy, **length)
     if not args.quiet:
         print(text)
         made = sum(r.done for r in results)
@@ -173,6 +169,11 @@ def cmd_attack_search(args) -> int:
         print(f"attack-search: {made} runs made now, {kept} found in the store; {wall:.1f} s wall; "
               f"wrote {', '.join(str(p) for p in written)}")
     return 0
+
+
+def _records(decl) -> list[str]:
+    """The report's record section, naming the questions file by its file name (as the study's reports do)."""
+    return replace(decl, name=decl.path.name).record_markdown()
 
 
 def _validate(st, args) -> int:
@@ -217,32 +218,14 @@ def _study_validation(st, out: Path, quiet: bool) -> dict:
     return result["rates"]
 
 
-#: the adaptive attacker's training when questions.toml declares no ``[adaptive]`` table (budget 0: not run)
-ADAPTIVE = {"budget": 0, "pairs": 8, "runs": 4, "sigma": 0.05, "lr": 0.02}
-
-
-def _check_learner(learner: dict) -> None:
-    unknown = sorted(set(learner) - set(ADAPTIVE))
-    if unknown:
-        raise UsageError(f"questions.toml [adaptive]: unknown key {unknown[0]!r}; allowed: {', '.join(ADAPTIVE)}")
-    for k, v in learner.items():
-        whole = k in ("budget", "pairs", "runs")
-        ok = (isinstance(v, int) and not isinstance(v, bool) and v >= (0 if k == "budget" else 1)) if whole else \
-            (isinstance(v, (int, float)) and not isinstance(v, bool) and 0 < v < float("inf"))
-        if not ok:
-            raise UsageError(f"questions.toml [adaptive] {k} = {v!r}: must be "
-                             + ("a whole number >= " + ("0" if k == "budget" else "1") if whole
-                                else "a finite number > 0"))
-
-
-def _adaptive(adaptive, st, cell, r, learner: dict, out: Path, args, workers: int):
+def _adaptive(adaptive, st, cell, r, learner, out: Path, args, workers: int):
     """The second searcher of a cell: the adaptive attacker trained on search seeds of its own (checkpointed
     under OUT/adaptive/EXPERIMENT, so a search started again resumes it), then played on the cell's
     confirmation seeds, where the report compares it with the parametric search's attack."""
     folder = out / "adaptive" / cell.experiment
     length = {"steps": args.steps, "transitory": args.transitory}
-    policy = adaptive.train(cell, int(learner["budget"]), pairs=int(learner["pairs"]), runs=int(learner["runs"]),
-                            sigma=float(learner["sigma"]), lr=float(learner["lr"]), seed=st.settings.seed,
+    policy = adaptive.train(cell, learner.budget, pairs=learner.pairs, runs=learner.runs,
+                            sigma=float(learner.sigma), lr=float(learner.lr), seed=st.settings.seed,
                             objective=st.settings.objective, checkpoint=folder, workers=workers, **length)
     policy.save(folder / "policy.npz")
     return adaptive.confirm(cell, policy, r.confirmation_seeds, workers=workers, **length)
@@ -254,9 +237,6 @@ def add_subcommand(sub) -> None:
                                              "restarts and a random search, raced, confirmed on fresh seeds; resumable")
     p.add_argument("experiment", nargs="?", default="attack_search",
                    help="a study experiment (default: the shipped attack_search, or a file like it)")
-    p.add_argument("--questions", metavar="FILE",
-                   help="the study's questions file: settings, baselines, questions (default: the package's "
-                        "questions.toml)")
     p.add_argument("--defence", help="defence(s) to search, comma-separated (default: every one of the study)")
     p.add_argument("--byzantines", metavar="K", help="Byzantine count(s), comma-separated (default: the study's)")
     p.add_argument("--budget", type=at_least(1), metavar="N",
@@ -290,7 +270,6 @@ def add_subcommand(sub) -> None:
     p.add_argument("--leader-runs", type=at_least(1), metavar="N",
                    help="runs of a re-evaluated leader (default: declared)")
     p.add_argument("--objective", choices=["items", "liar_wealth"], help="what the attack optimises (default: items)")
-    p.add_argument("--seed", type=seed_value, help="the search's seed: optimisers and seed sets (default: declared)")
     p.add_argument("--adaptive-budget", type=at_least(0), metavar="N",
                    help="evaluations per cell of the adaptive attacker, the second searcher "
                         "(0: none; default: declared)")
@@ -306,7 +285,10 @@ def add_subcommand(sub) -> None:
                                                                  "and exit")
     p.add_argument("--steps", type=at_least(1), help="steps per run (default: the experiment's), for a reduced search")
     p.add_argument("--transitory", type=at_least(0), help="steps not counted (default: the experiment's)")
-    p.add_argument("--out", help="folder: the results store (OUT/store) and the report")
+    study_options(p, "folder: the results store (OUT/store) and the report",
+                  questions="the study's questions file: settings, baselines, questions (default: the package's "
+                            "questions.toml)",
+                  seed="the search's seed: optimisers and seed sets (default: declared)")
     p.add_argument("--workers", type=workers_count, help="local processes (default: one per core)")
     p.add_argument("--dask", metavar="ADDRESS", help="run on a Dask scheduler, e.g. tcp://host:8786")
     p.add_argument("--reduced", metavar="TEXT", help="label the report as a reduced run (what was reduced)")

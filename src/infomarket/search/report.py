@@ -27,11 +27,15 @@ from ..analysis import stats
 from ..analysis.declared import size_note
 from ..analysis.formats import interval_text, json_ready
 from ..analysis.study import Report, drawn
+from ..analysis.study import Study as DeclaredStudy
 from ..errors import ArgumentError
 from ..runner.progress import busy_markdown
 from . import decision
 from .objective import loss
 from .study import DECLARATION, Study
+
+#: the key of the store's record of the study's first run (``driver.record_provenance``)
+PROVENANCE = "attack_search"
 
 #: the comparisons of the "does one searcher beat another" questions: (question, x role, y role)
 DUELS = (("search_beats_baseline", "search", "baseline"), ("search_beats_random", "search", "random"))
@@ -284,10 +288,15 @@ def figure(analysis: dict):
     return fig
 
 
-def write(out: Path, analysis: dict, *, reduced: str = "", wall_seconds: float | None = None,
-          steps: int | None = None, transitory: int | None = None, provenance: dict | None = None,
-          busy: dict | None = None, header: dict | None = None, records: list[str] | None = None) -> list[Path]:
-    """``report.json``, ``report.md`` and ``loss.png`` into ``out``; ``steps`` and ``transitory``: the runs'
+def write(out: Path, analysis: dict, **meta) -> list[Path]:
+    """``report(analysis, **meta)`` written into ``out``; returns the files."""
+    return report(analysis, **meta).write(out)
+
+
+def report(analysis: dict, *, reduced: str = "", wall_seconds: float | None = None,
+           steps: int | None = None, transitory: int | None = None, provenance: dict | None = None,
+           busy: dict | None = None, header: dict | None = None, records: list[str] | None = None) -> Report:
+    """``report.json``, ``report.md`` and ``loss.png``, as a ``Report``; ``steps`` and ``transitory``: the runs'
     length, recorded so a shortened search reads as one; ``provenance``: e.g. the questions file's commit
     and the first run's time, printed as they are; ``header``: ``commit``, ``tree_clean``,
     ``questions_commit`` and ``validation`` (the planted suite's recovery rate per searcher), the first
@@ -301,7 +310,24 @@ def write(out: Path, analysis: dict, *, reduced: str = "", wall_seconds: float |
                                           busy=busy))]
     if analysis["cells"]:
         parts.append(("loss.png", drawn(lambda: figure(analysis), dpi=120)))
-    return Report(parts).write(out)
+    return Report(parts)
+
+
+class AttackSearch(DeclaredStudy):
+    """The attack search as a declared study: the searched cells' ``results`` (the driver's, read from and
+    made into the store) answered as ``report.json``, ``report.md`` and ``loss.png``, with the store's
+    record of the study's first run as its provenance; ``meta``: ``report``'s other arguments."""
+
+    declaration = DECLARATION
+
+    def __init__(self, study: Study, results: list, **meta) -> None:
+        self.study, self.results, self.meta = study, results, meta
+        self.analysis: dict = {}
+
+    def answer(self, store) -> Report:
+        """The report of the results, ``store``'s record of the study's first run as its provenance."""
+        self.analysis = analyse(self.study, self.results)
+        return report(self.analysis, provenance=store.meta().get(PROVENANCE), **self.meta)
 
 
 def _role_table(cells: list[dict]) -> list[str]:

@@ -10,13 +10,13 @@ options override the settings.
 from __future__ import annotations
 
 import copy
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..config.load import validate
 from ..config.schema import Experiment
-from ..analysis.study import Declaration
+from ..analysis.study import Check, Declaration, questions_path
+from ..analysis.study import settings as study_settings
 from ..errors import ConfigError, UsageError
 from ..registry import payments
 from ..runner.plan import conditions
@@ -64,52 +64,69 @@ class Settings:
         return -(-self.budget // self.popsize)
 
 
+def _whole(v) -> bool:
+    """A whole number, not a flag (``True`` is an int to Python, never a count to a study)."""
+    return isinstance(v, int) and not isinstance(v, bool)
+
+
+def _race(s: Settings) -> bool:
+    """Cumulative runs per stage: whole numbers from 2 up, each above the one before."""
+    r = s.race
+    return (isinstance(r, tuple) and bool(r) and all(_whole(x) for x in r) and r[0] >= 2
+            and all(b > a for a, b in zip(r, r[1:])))
+
+
+#: the rules of every setting (``analysis.study.settings``), as the parser of every study takes them
+WHOLE = {"budget": 1, "popsize": 2, "restarts": 1, "runs": 1, "finalists": 1, "confirmation_runs": 2, "seed": 0,
+         "gate_rounds": 0, "local": 0, "leaders": 0, "leader_runs": 1, "validation": 0, "confirm_top": 1, "refine": 0}
+NUMBERS = (("sigma0", 0.0, 1.0), ("keep", 0.0, 1.0), ("grid_step", 0.0, 180.0), ("local_sigma", 0.0, 1.0),
+           ("refine_step", 0.0, 0.5))
+CHECKS: tuple[Check, ...] = (
+    ("race", _race, "cumulative runs per stage, whole numbers from 2 up, each above the one before (e.g. [8, 16, 32])"),
+    ("spread", lambda s: not isinstance(s.spread, bool) and isinstance(s.spread, (int, float))
+     and 0.0 <= s.spread < 1.0, "a share of the budget in [0, 1) is expected"),
+    ("local", lambda s: not (_whole(s.local) and _whole(s.restarts)) or s.local <= s.restarts,
+     "at most as many local restarts as restarts is expected"),
+    ("objective", lambda s: s.objective in OBJECTIVES, f"one of {', '.join(OBJECTIVES)} is expected"))
+
+
 def settings(table: dict, overrides: dict | None = None,
              source: str = "search settings (questions.toml [search] or an option)") -> Settings:
-    """The ``Settings`` of a ``[search]`` table with ``overrides`` (None values ignored) over it; an unknown
-    key or a value out of range is a UsageError naming it."""
-    known = Settings.__dataclass_fields__
-    base = {}
-    for k, v in table.items():
-        if k not in known:
-            raise UsageError(f"{source}: unknown key {k!r}; allowed: {', '.join(known)}")
-        base[k] = v
-    base.update({k: v for k, v in (overrides or {}).items() if v is not None})
-    if isinstance(base.get("budget"), int) and base["budget"] < base.get("popsize", Settings.popsize):
-        base["popsize"] = max(2, base["budget"])  # a budget below one population: one smaller generation
-    if "race" in base:
-        base["race"] = tuple(base["race"]) if isinstance(base["race"], (list, tuple)) else base["race"]
-    s = Settings(**base)
-    ints = ("budget", "popsize", "restarts", "runs", "finalists", "confirmation_runs", "seed", "gate_rounds", "local",
-            "leaders", "leader_runs", "validation", "confirm_top", "refine")
-    for k in ints:
-        v = getattr(s, k)
-        if isinstance(v, bool) or not isinstance(v, int):
-            raise UsageError(f"{source}: {k} = {v!r}: a whole number is expected")
-    for k, v in (("budget", 1), ("popsize", 2), ("restarts", 1), ("runs", 1), ("finalists", 1),
-                 ("confirmation_runs", 2), ("seed", 0), ("gate_rounds", 0), ("local", 0), ("leaders", 0),
-                 ("leader_runs", 1), ("validation", 0), ("confirm_top", 1), ("refine", 0)):
-        if getattr(s, k) < v:
-            raise UsageError(f"{source}: {k} = {getattr(s, k)}: must be at least {v}")
-    race = s.race
-    if (not isinstance(race, tuple) or not race or any(isinstance(r, bool) or not isinstance(r, int) for r in race)
-            or race[0] < 2 or any(b <= a for a, b in zip(race, race[1:]))):
-        raise UsageError(f"{source}: race = {list(race) if isinstance(race, tuple) else race!r}: cumulative runs per "
-                         f"stage, whole numbers from 2 up, each above the one before (e.g. [8, 16, 32])")
-    if isinstance(s.spread, bool) or not isinstance(s.spread, (int, float)) or not 0.0 <= s.spread < 1.0:
-        raise UsageError(f"{source}: spread = {s.spread!r}: a share of the budget in [0, 1) is expected")
-    if not isinstance(s.pool_baselines, bool):
-        raise UsageError(f"{source}: pool_baselines = {s.pool_baselines!r}: true or false is expected")
-    if s.local > s.restarts:
-        raise UsageError(f"{source}: local = {s.local}: at most restarts ({s.restarts}) restarts can be local")
-    for k, lo, hi in (("keep", 0.0, 1.0), ("sigma0", 0.0, 1.0), ("grid_step", 0.0, 180.0), ("local_sigma", 0.0, 1.0),
-                      ("refine_step", 0.0, 0.5)):
-        v = getattr(s, k)
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not lo < v <= hi:
-            raise UsageError(f"{source}: {k} = {v!r}: a number in ({lo:g}, {hi:g}] is expected")
-    if s.objective not in OBJECTIVES:
-        raise UsageError(f"--objective {s.objective}: unknown; allowed: {', '.join(OBJECTIVES)}")
-    return s
+    """The ``Settings`` of a ``[search]`` table with ``overrides`` (None values ignored) over it, read by the
+    studies' one parser (``analysis.study.settings``): an unknown key or a value out of range is a
+    UsageError naming it.  A budget below one population makes one smaller generation."""
+    given = {**table, **{k: v for k, v in (overrides or {}).items() if v is not None}}
+    if _whole(given.get("budget")) and given["budget"] < given.get("popsize", Settings.popsize):
+        given["popsize"] = max(2, given["budget"])  # a budget below one population: one smaller generation
+    if isinstance(given.get("race"), list):
+        given["race"] = tuple(given["race"])
+    return study_settings(Settings, given, None, source, whole=WHOLE, flags=("pool_baselines",), numbers=NUMBERS,
+                          checks=CHECKS)
+
+
+@dataclass(frozen=True)
+class Learner:
+    """The adaptive attacker's training (``questions.toml`` ``[adaptive]``; budget 0: not run)."""
+
+    budget: int = 0        # evaluations per cell
+    pairs: int = 8         # antithetic pairs per generation
+    runs: int = 4          # runs per evaluation
+    sigma: float = 0.05    # the perturbations' step
+    lr: float = 0.02       # the learning rate
+
+
+def _finite(v) -> bool:
+    """A finite number above 0, not a flag: a step or a rate the training can take."""
+    return not isinstance(v, bool) and isinstance(v, (int, float)) and 0 < v < float("inf")
+
+
+def learner(table: dict, overrides: dict | None = None, source: str = "questions.toml") -> Learner:
+    """The ``Learner`` of an ``[adaptive]`` table with ``overrides`` (None ignored) over it, read by the
+    studies' one parser: a bad key or value is a UsageError naming it."""
+    return study_settings(Learner, table, overrides, f"{source} [adaptive] or an option",
+                          whole={"budget": 0, "pairs": 1, "runs": 1},
+                          checks=[("sigma", lambda s: _finite(s.sigma), "a finite number above 0 is expected"),
+                                  ("lr", lambda s: _finite(s.lr), "a finite number above 0 is expected")])
 
 
 @dataclass(frozen=True)
@@ -153,15 +170,23 @@ class Study:
     declaration_path: Path = QUESTIONS  # the questions file declaring it (its commit goes into the report)
 
 
+def read(path: str | Path | None = None) -> Declaration:
+    """The study's questions file: the shipped one (read once, with the package), or a file like it."""
+    if path is None:
+        return DECLARATION
+    return Declaration.read(questions_path(path, QUESTIONS), Path(path).name)
+
+
 def load_declarations(path: Path = QUESTIONS) -> dict:
-    """The attack-search study's declarations (its questions file, or ``path``) as parsed TOML."""
-    return tomllib.loads(Path(path).read_text())
+    """The attack-search study's declarations (its questions file, or ``path``) as parsed TOML, each file
+    read once (``read``)."""
+    return read(None if Path(path) == QUESTIONS else path).data
 
 
 def load(experiment: Experiment, declarations: dict | None = None, *, path: Path = QUESTIONS, **overrides) -> Study:
     """The study of ``experiment`` with the declared settings, ``overrides`` (None values ignored) applied;
     ``path``: the questions file the declarations were read from."""
-    d = load_declarations() if declarations is None else declarations
+    d = DECLARATION.data if declarations is None else declarations
     settings_ = settings(d.get("search", {}), overrides)
     baselines, reference = {}, None
     for name, b in d.get("baselines", {}).items():
