@@ -141,6 +141,25 @@ def test_search_vs_best_baseline_and_random_search(analysis):
     assert b["search_beats_random"]["answer"] == "yes"
 
 
+def test_a_duels_bound_is_one_sided_at_the_level_its_holm_test_used(analysis):
+    a, b = analysis["cells"]
+    # search - baseline, Holm over the 2 cells: A's p = 1/256 is judged first, at 0.05 / 2, and rejected;
+    # B's (+-3 noise) next, at 0.05.  One-sided upper bound at 0.025 for n = 8: P(T+ <= 3) = 5/256 <= 0.025
+    # < 7/256, so the 4th largest Walsh average of d_i = -(1.0 + 0.1 i): -1 - 0.05 (i + j) at i + j = 4
+    beats = a["search_beats_baseline"]
+    assert beats["level"] == 0.05 / 2 and b["search_beats_baseline"]["level"] == 0.05
+    assert beats["upper"] == pytest.approx(-1.2) and beats["percent_upper"] == pytest.approx(1.2 / 11.0)
+    # the adaptive duel is a family of one, judged at 0.05: P(T+ <= 5) = 10/256 <= 0.05 < 14/256, the 6th
+    # largest Walsh average of d_i = -(0.5 + 0.05 i): -0.5 - 0.025 (i + j), the 6th at i + j = 5
+    ad = a["adaptive_beats_parametric"]["adaptive"]
+    assert ad["level"] == 0.05 and ad["upper"] == pytest.approx(-0.625)
+    # shown exactly when the bound is below 0, in every duel
+    duels = [c[q] for c in (a, b) for q in ("search_beats_baseline", "search_beats_random")] + [ad]
+    assert all((d["upper"] < 0) == d["significant"] for d in duels)
+    text = report.markdown(analysis)
+    assert "-1.45 (≤ -1.20 at 0.025; +13.2%, at least +10.9%)" in text
+
+
 def test_an_extra_searcher_is_compared_with_the_search(analysis):
     a, b = analysis["cells"]
     ad = a["adaptive_beats_parametric"]["adaptive"]
@@ -222,7 +241,8 @@ def test_a_reference_with_no_items_leaves_the_loss_undefined():
     md = report.markdown(a)
     assert "| outlier | 1 | 8 | 0.50 | – | undefined | inconclusive |" in md
     assert "- outlier, 1: the truthful reference collected no items on 4 of 8 seeds" in md
-    assert "| +0.00 unbounded (share undefined) | inconclusive (power 0.00) |" in md  # d = 0, medians 0
+    # d = 0 on every seed: no bound; medians 0: no share
+    assert "| +0.00 (unbounded at 0.05; share undefined) | inconclusive (power 0.00) |" in md
     assert report.figure(a) is not None
 
 

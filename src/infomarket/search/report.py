@@ -92,11 +92,16 @@ def _duel(xs, ys, cells, rule: dict, label: str) -> list[dict]:
                         alpha=rule["alpha"], family=sizes[i], confidence=rule["confidence"],
                         label=f"{c['experiment']}: {label}")
              for i, (x, y, c) in enumerate(zip(xs, ys, cells))]
+    level = {}
+    for g in _groups(cells, rule["family"]):  # the threshold each comparison's one-sided test was judged at
+        level.update(zip(g, decision.holm_levels([comps[i].p for i in g], rule["alpha"])[1]))
     out = []
-    for c, y in zip(_holm(comps, cells, rule["family"]), ys):
+    for i, (c, x, y) in enumerate(zip(_holm(comps, cells, rule["family"]), xs, ys)):
         no = (not c.significant) and c.power >= rule["power"]
         med = float(np.median(y))
+        upper = decision.bound(np.asarray(x, float) - np.asarray(y, float), level[i], "upper")
         out.append({"answer": stats.answer(c.significant, no), **_row(c),
+                    "level": level[i], "upper": upper, "percent_upper": _pct(upper, med),
                     "percent": _pct(c.hl, med), "percent_low": _pct(c.high, med), "percent_high": _pct(c.low, med)})
     return out
 
@@ -373,11 +378,20 @@ def _answer(a: dict | None) -> str:
 
 
 def _duel_cell(a: dict | None) -> str:
+    """A duel as its decision reads it: the estimate and its one-sided upper bound at the level the Holm
+    test was judged at (below 0 exactly when "beats" is shown), and the same as a share of the other's median.
+    A duel written before those bounds were kept shows its two-sided interval, as it was reported."""
     if not a:
         return "–"
-    share = ("share undefined" if math.isnan(a["percent"]) else
-             f"{a['percent']:+.1%} {interval_text(a['percent_low'], a['percent_high'], '+.1%')}")
-    return f"{a['hl']:+.2f} {interval_text(a['low'], a['high'], '.2f')} ({share})"
+    if "upper" not in a:
+        share = ("share undefined" if math.isnan(a["percent"]) else
+                 f"{a['percent']:+.1%} {interval_text(a['percent_low'], a['percent_high'], '+.1%')}")
+        return f"{a['hl']:+.2f} {interval_text(a['low'], a['high'], '.2f')} ({share})"
+    up = a["upper"]
+    bound = f"≤ {up:+.2f}" if math.isfinite(up) else ("undefined" if math.isnan(up) else "unbounded")
+    share = ("share undefined" if math.isnan(a["percent"]) else f"{a['percent']:+.1%}"
+             + (f", at least {a['percent_upper']:+.1%}" if math.isfinite(a["percent_upper"]) else ""))
+    return f"{a['hl']:+.2f} ({bound} at {a['level']:.2g}; {share})"
 
 
 def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, steps: int | None = None,
@@ -408,8 +422,10 @@ def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, s
               "interval is one-sided bound to one-sided bound at the level its test was judged at (the "
               "per-attack table below). Search − baseline, search − random: Hodges-Lehmann "
               "of the per-seed differences of the objective's damage value (negative: the search's attack "
-              "does more damage), with the interval, and as a share of the other's median (positive: more "
-              "damage). A \"no\" to a \"beats\" question needs the power shown.", "",
+              "does more damage) with its one-sided upper bound at the level its Holm test was judged at (the "
+              "search is shown to beat the other exactly when the bound is below 0), and as a share of the "
+              "other's median (positive: more damage; \"at least\": the same bound). A \"no\" to a \"beats\" "
+              "question needs the power shown.", "",
               "| defence | Byz. | runs | truthful | worst confirmed (role: attack) | loss [decision-level bounds] "
               "| within 10 %? | "
               "search − best baseline | beats baseline? | search − random | beats random? | runs / CPU s |",
@@ -435,7 +451,8 @@ def markdown(a: dict, *, reduced: str = "", wall_seconds: float | None = None, s
     extra = sorted({n for c in a["cells"] for n in c.get(EXTRA_QUESTION, {})})
     for n in extra:
         lines += ["", f"**{n} vs the parametric search** (per-seed {n} − search; negative: {n} does more damage):",
-                  "", "| defence | Byz. | attack | difference [95 % CI] | beats the parametric search? |",
+                  "", "| defence | Byz. | attack | difference (one-sided bound at its level) "
+                  "| beats the parametric search? |",
                   "|---|---|---|---|---|"]
         for c in a["cells"]:
             e = c.get(EXTRA_QUESTION, {}).get(n)
