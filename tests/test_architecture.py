@@ -323,24 +323,55 @@ def test_compiled_helpers_are_inlined_by_llvm_not_by_numba():
     assert not offenders, offenders
 
 
-#: Most lines a Python file of the project may hold: a longer one mixes jobs that want modules of their own.
+#: Most lines a source file of the project may hold, in any language: a longer one mixes jobs that want
+#: modules of their own.
 MAX_LINES = 500
 
+#: The languages people write here (Python, Solidity, JavaScript, the viewer's HTML and CSS, TOML
+#: declarations): every such file under src/, contracts/, tests/ and tools/ is held to MAX_LINES.
+SOURCE_SUFFIXES = frozenset({".py", ".sol", ".js", ".mjs", ".css", ".html", ".toml"})
 
-def _python_files() -> list[Path]:
-    """The project's Python files, never walking into installed packages (``make node`` and the artifact
-    test write ``node_modules`` under tools/ while the suite runs)."""
+#: Files that are not held to it, by suffix, and why: no person writes them line by line. A file under
+#: src/ or contracts/ with a suffix in neither set fails the test, so a new language cannot slip past it.
+NOT_SOURCE = {
+    ".json": "written by programs: the compiled contract (tools/solc/compile.js), npm's lockfiles, "
+             "the conformance vectors the payment tests generate",
+    ".typed": "py.typed, the empty PEP 561 marker",
+}
+
+#: Folders never walked into: installed packages (``make node`` and the artifact test write
+#: ``node_modules`` under tools/ while the suite runs) and Python's byte code.
+NOT_WALKED = frozenset({"node_modules", "__pycache__"})
+
+
+def _project_files() -> list[Path]:
+    """Every file under src/, contracts/, tests/ and tools/, never walking into ``NOT_WALKED``."""
     repo, found = PACKAGE.parent.parent, []
-    for folder in ("src", "tests", "tools"):
+    for folder in ("src", "contracts", "tests", "tools"):
         for top, dirs, files in os.walk(repo / folder):
-            dirs[:] = [d for d in dirs if d not in ("node_modules", "__pycache__")]
-            found += [Path(top) / f for f in files if f.endswith(".py")]
+            dirs[:] = [d for d in dirs if d not in NOT_WALKED]
+            found += [Path(top) / f for f in files]
     return found
 
 
+def _source_files() -> list[Path]:
+    return [p for p in _project_files() if p.suffix in SOURCE_SUFFIXES]
+
+
+def test_every_file_of_the_package_and_the_contract_is_of_a_known_kind():
+    repo = PACKAGE.parent.parent
+    unknown = [str(p) for p in _project_files()
+               if p.is_relative_to(repo / "src") or p.is_relative_to(repo / "contracts")
+               if p.suffix not in SOURCE_SUFFIXES and p.suffix not in NOT_SOURCE]
+    assert unknown == [], f"add these files' suffix to SOURCE_SUFFIXES (or NOT_SOURCE, with the reason): {unknown}"
+
+
 def test_no_file_is_over_500_lines():
-    files = _python_files()
-    assert PACKAGE / "evm" / "market.py" in files and Path(__file__) in files  # the files are really found
+    files = _source_files()
+    found = {p.suffix for p in files}
+    # The files are really found, in every language the project is written in.
+    assert PACKAGE / "evm" / "market.py" in files and Path(__file__) in files
+    assert {".py", ".sol", ".js", ".css", ".html", ".toml"} <= found, found
     long = {str(p): n for p in files if (n := len(p.read_text().splitlines())) > MAX_LINES}
     assert long == {}, f"split these files (most {MAX_LINES} lines each): {long}"
 

@@ -1,10 +1,11 @@
 """Mutation check for the attack tests: remove each of the contract's checks in turn and show that the
 test guarding it fails.
 
-Each mutant is a copy of contracts/InformationMarket.sol with one check removed: an
-``if (<check>) revert ...`` turned into ``if (false) revert ...``, or one rule replaced by a wrong one
-(``REWRITES``: the similarity computed from something else, expiry ignored), compiled by the pinned
-solc-js into a temporary artifact, against which the tests guarding it run (through
+Each mutant is a copy of contracts/ (the contract and the modules it imports) with one check removed
+from the one file that holds it: an ``if (<check>) revert ...`` turned into ``if (false) revert ...``,
+or one rule replaced by a wrong one (``REWRITES``: the similarity computed from something else, expiry
+ignored); a text found in no file or more than once across the files is reported, not guessed. Each is
+compiled by the pinned solc-js into a temporary artifact, against which the tests guarding it run (through
 ``INFOMARKET_CHAIN_ARTIFACT``, see conftest.py; on revm only). It needs Node and takes a few minutes,
 so it is a script, not part of the test suite:
 
@@ -16,6 +17,7 @@ Exit status 0 when every mutant is caught (a test guarding it fails) and the unp
 from __future__ import annotations
 
 import re
+import shutil
 import sys
 import tempfile
 from pathlib import Path
@@ -24,7 +26,7 @@ ROOT = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT))  # a script: the checkout's tests package, for its one way to start a process
 from tests.procs import Procs  # noqa: E402 - after the checkout is on the path
 
-SOURCE = ROOT / "contracts" / "InformationMarket.sol"
+CONTRACTS = ROOT / "contracts"
 COMPILER = ROOT / "tools" / "solc" / "compile.js"
 TESTS = ROOT / "tests" / "evm"
 
@@ -218,17 +220,36 @@ REWRITES = [
      ["test_a_revocation_stands_after"]),
     ("a pause that changes nothing emits nothing", "if (_paused == paused_) return;", "",
      ["test_a_pause_stops_registrations"]),
-    ("batch bound 48", "uint256 private constant _MAX_SETTLE_BATCH = 48;",
-     "uint256 private constant _MAX_SETTLE_BATCH = 64;", ["test_the_trip_bound_and_the_batch_bound"]),
+    ("batch bound 48", "uint256 internal constant _MAX_SETTLE_BATCH = 48;",
+     "uint256 internal constant _MAX_SETTLE_BATCH = 64;", ["test_the_trip_bound_and_the_batch_bound"]),
 ]
 
 
-def compile_variant(source: str, workdir: Path, name: str) -> Path:
-    sol, out = workdir / f"{name}.sol", workdir / f"{name}.json"
-    sol.write_text(source)
+def read_sources() -> dict[str, str]:
+    """Every Solidity file of contracts/, by its path relative to that directory."""
+    return {p.relative_to(CONTRACTS).as_posix(): p.read_text() for p in sorted(CONTRACTS.rglob("*.sol"))}
+
+
+def compile_variant(sources: dict[str, str], workdir: Path, name: str) -> Path:
+    """Compile a copy of contracts/ holding ``sources`` (under the same source names) into an artifact."""
+    tree, out = workdir / name, workdir / f"{name}.json"
+    for rel, text in sources.items():
+        (tree / rel).parent.mkdir(parents=True, exist_ok=True)
+        (tree / rel).write_text(text)
     with Procs() as procs:
-        procs.run(["node", str(COMPILER), "--source", str(sol), "--out", str(out), "--allow-warnings"], check=True)
+        procs.run(["node", str(COMPILER), "--contracts", str(tree), "--out", str(out), "--allow-warnings"],
+                  check=True)
+    shutil.rmtree(tree)
     return out
+
+
+def patch(sources: dict[str, str], edit) -> tuple[dict[str, str], int]:
+    """Apply ``edit`` (text -> (new text, count)) to every file; (patched sources, total count)."""
+    patched, total = {}, 0
+    for rel, text in sources.items():
+        patched[rel], count = edit(text)
+        total += count
+    return patched, total
 
 
 def run_tests(artifact: Path, selected: list[str]) -> tuple[int, str]:
@@ -243,14 +264,16 @@ def run_tests(artifact: Path, selected: list[str]) -> tuple[int, str]:
 
 
 def main(words: list[str] | None = None) -> int:
-    original = SOURCE.read_text()
+    original = read_sources()
     variants = []
     for check, condition, tests in MUTANTS:
         pattern = re.compile(r"if \(" + re.escape(condition) + r"\)(\s*\{?\s*)revert")
-        variants.append(("without: " + check, *pattern.subn(r"if (false)\1revert", original), tests))
+        edit = lambda text, pattern=pattern: pattern.subn(r"if (false)\1revert", text)  # noqa: E731
+        variants.append(("without: " + check, *patch(original, edit), tests))
     for rule, old, new, tests in REWRITES:
         if tests:
-            variants.append(("broken: " + rule, original.replace(old, new), original.count(old), tests))
+            edit = lambda text, old=old, new=new: (text.replace(old, new), text.count(old))  # noqa: E731
+            variants.append(("broken: " + rule, *patch(original, edit), tests))
     if words:
         variants = [v for v in variants if any(w in v[0] for w in words)]
     all_tests = [t for *_, tests in variants for t in tests]

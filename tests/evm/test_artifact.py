@@ -12,15 +12,22 @@ import pytest
 from infomarket.evm.market import load_artifact
 
 ROOT = Path(__file__).resolve().parents[2]
-SOURCE = ROOT / "contracts" / "InformationMarket.sol"
+CONTRACTS = ROOT / "contracts"
 TOOLS = ROOT / "tools" / "solc"
 
 
-def test_artifact_records_the_source_it_was_built_from():
-    """Cheap staleness check that needs no compiler: the source's hash is stored in the artifact."""
-    artifact = load_artifact()
-    assert artifact["sourceSha256"] == hashlib.sha256(SOURCE.read_bytes()).hexdigest(), (
-        "contracts/InformationMarket.sol changed since the artifact was built: run `make contracts`")
+def test_artifact_records_the_sources_it_was_built_from():
+    """Cheap staleness check that needs no compiler: every source file's hash is stored in the artifact,
+    and every Solidity file under contracts/ is one the contract was built from (a module left out of
+    the composition would otherwise go unnoticed)."""
+    recorded = load_artifact()["sources"]
+    present = {f"contracts/{p.relative_to(CONTRACTS).as_posix()}": hashlib.sha256(p.read_bytes()).hexdigest()
+               for p in CONTRACTS.rglob("*.sol")}
+    assert set(recorded) == set(present), (
+        f"contracts/ and the artifact's sources differ ({sorted(set(recorded) ^ set(present))}): "
+        "run `make contracts`")
+    stale = sorted(name for name in present if recorded[name] != present[name])
+    assert not stale, f"{stale} changed since the artifact was built: run `make contracts`"
 
 
 def test_compiler_is_pinned_to_one_exact_version():

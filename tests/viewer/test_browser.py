@@ -230,7 +230,7 @@ def test_replay_opens_from_disk_and_plays(driver, fig2b, tmp_path):
 
 
 RING_PIXELS = """
-// Samples the circle where robot i's branch ring lies (CSS radius r + 3 to r + 4, viewer.js drawBranches):
+// Samples the circle where robot i's branch ring lies (CSS radius r + 3 to r + 4, viewer-draw.js drawBranches):
 // the fraction of its pixels that are not the arena's background, for each robot.
 const s = arguments[0], g = document.getElementById('arena').getContext('2d'), dpr = window.devicePixelRatio || 1;
 const scale = infomarketViewer.robotScreenPosition(0).x / s.x0;  // CSS pixels per world unit

@@ -72,8 +72,9 @@ def test_page_static_files_and_info(fig2b):
             page = await client.get("/")
             assert page.status == 200
             text = await page.text()
-            assert '<canvas id="arena"' in text and 'src="static/viewer.js"' in text
-            for name, kind in (("viewer.js", "javascript"), ("viewer.css", "css")):
+            assert '<canvas id="arena"' in text
+            assert text.index('src="static/viewer-draw.js"') < text.index('src="static/viewer.js"')
+            for name, kind in (("viewer-draw.js", "javascript"), ("viewer.js", "javascript"), ("viewer.css", "css")):
                 r = await client.get(f"/static/{name}")
                 assert r.status == 200 and kind in r.headers["Content-Type"]
             info = await (await client.get("/api/info")).json()

@@ -52,7 +52,7 @@ CHAIN_BYTE_COLUMNS = (("branch", "u1"),)
 CARRYING, FOOD_VALID, NEST_VALID, LAST_FOOD, LAST_NEST = 1, 2, 4, 8, 16
 
 #: A frame's size is a multiple of this (the widest column type, the float64 header), so that frame k of
-#: a replay, at k times the frame size, starts where a Float64Array may begin (viewer.js, ``makeLayout``).
+#: a replay, at k times the frame size, starts where a Float64Array may begin (viewer-draw.js, ``makeLayout``).
 ALIGN = 8
 
 #: How many of a robot's most recent events the side panel lists.

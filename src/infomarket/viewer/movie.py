@@ -26,7 +26,7 @@ HONEST, BYZANTINE = "#0072b2", "#e69f00"
 BYZANTINE_FRAME = "#000000"
 SITE_COLOURS = {"food": "#2ca02c", "nest": "#e8b100"}
 NO_SITE = "#666666"
-#: The chain model's branch colours, in turn for branches 1, 2, ...: the page's (viewer.js BRANCH) without
+#: The chain model's branch colours, in turn for branches 1, 2, ...: the page's (viewer-draw.js BRANCH) without
 #: its orange, which a ring around the movie's orange Byzantine discs would hide.
 BRANCH = ("#9467bd", "#17becf", "#8c564b", "#e377c2", "#bcbd22")
 #: Per format: frames per second and the most frames kept (a movie of ~15 s; GIFs grow fast).

@@ -82,6 +82,11 @@ def _pack(data: bytes) -> str:
     return base64.b64encode(gzip.compress(data, compresslevel=6, mtime=0)).decode("ascii")
 
 
+#: The viewer's scripts, in the order the page loads them (classic scripts: a page opened from disk may not
+#: load ES modules).
+SCRIPTS = ("viewer-draw.js", "viewer.js")
+
+
 def _inline(page: str, old: str, new: str) -> str:
     if page.count(old) != 1:
         raise InternalError(f"viewer page template changed: expected one {old!r}")  # a packaging defect
@@ -104,10 +109,13 @@ def html(rec: Recording) -> str:
     data = json.dumps(payload, separators=(",", ":")).replace("<", "\\u003c")  # nothing can close the tag
     page = (STATIC / "index.html").read_text(encoding="utf-8")
     css = (STATIC / "viewer.css").read_text(encoding="utf-8")
-    js = (STATIC / "viewer.js").read_text(encoding="utf-8").replace("</script", "<\\/script")
     page = _inline(page, '<link rel="stylesheet" href="static/viewer.css">', f"<style>\n{css}</style>")
-    page = _inline(page, '<script src="static/viewer.js"></script>',
-                   f'<script id="infomarket-replay" type="application/json">{data}</script>\n<script>\n{js}</script>')
+    for name in SCRIPTS:  # in the page's order: the drawing part first, the part that starts the viewer last
+        js = (STATIC / name).read_text(encoding="utf-8").replace("</script", "<\\/script")
+        tag = f"<script>\n{js}</script>"
+        if name == SCRIPTS[-1]:
+            tag = f'<script id="infomarket-replay" type="application/json">{data}</script>\n{tag}'
+        page = _inline(page, f'<script src="static/{name}"></script>', tag)
     return _inline(page, "<title>infomarket viewer</title>",
                    f"<title>infomarket replay: {escape(rec.scene['name'])}, seed {rec.scene['seed']}</title>")
 
