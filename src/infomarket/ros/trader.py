@@ -6,8 +6,9 @@ waiting on other processes (the two agents, the chain node); one after the other
 25-robot swarm would take hours while the world waits. So the trader keeps every unfinished event in
 a ``Schedule`` (``schedule.py`` says why the ledger stays the engine's) and, each time it is pumped,
 starts every sale that may run now, takes in the outcomes that have come, and sends again the tasks of
-sales that have waited ``retry`` seconds. A deposit runs alone, as before: the world waits for the
-robot's signature, co-signs as the nest and sends ``buyItem`` and ``settle``.
+sales that have waited ``retry`` seconds (then longer each time, ``BACKOFF``). A deposit runs alone, as
+before: the world waits for the robot's signature, co-signs as the nest and sends ``buyItem`` and
+``settle``.
 """
 from __future__ import annotations
 
@@ -20,16 +21,22 @@ from .world import RETRY, World
 
 #: Looks at the incoming messages per pump at most, while answers keep coming.
 LOOKS = 20
+#: A sale's tasks are sent again after ``retry`` seconds without its outcome, then after twice as long
+#: each time, up to this many times ``retry``: on a loaded machine a sale among several at once may take
+#: longer than ``retry`` with nothing lost, and resending at a fixed pace would only add work.
+BACKOFF = 4
 
 
 @dataclass
 class _Sale:
-    """A sale under way: its two tasks, when they were last sent, when it began."""
+    """A sale under way: its two tasks, when they were last sent and how long until they are sent again,
+    when it began."""
 
     ev: dict
     buy: dict
     sell: dict
     sent: float
+    wait: float
     began: float
 
 
@@ -94,10 +101,10 @@ class Trader:
                 break
         now = time.monotonic()
         for sale in self.live.values():
-            if now - sale.sent > self.retry:
+            if now - sale.sent > sale.wait:
                 self.world.tally.retries += 1
                 self._send(sale)
-                sale.sent = now
+                sale.sent, sale.wait = now, min(2 * sale.wait, BACKOFF * self.retry)
 
     def _look(self) -> None:
         """Take in the messages waiting for the world, without waiting for more."""
@@ -121,7 +128,7 @@ class Trader:
         sell = {**common, "kind": "sell", "x": float(ev["x"]), "y": float(ev["y"])}
         if self.world.hostile is not None:
             self.world.hostile(buyer, seller, task_id, common["site"], common["age"], common["step"])
-        sale = self.live[task_id] = _Sale(ev, buy, sell, time.monotonic(), time.perf_counter())
+        sale = self.live[task_id] = _Sale(ev, buy, sell, time.monotonic(), self.retry, time.perf_counter())
         self._send(sale)
 
     def _send(self, sale: _Sale) -> None:
