@@ -124,7 +124,8 @@ def add_subcommand(subparsers) -> None:
     s.add_argument("--controller-timeout", type=_seconds, metavar="S",
                    help="controlled agents take the behaviour's decision after S seconds without an answer")
     s.add_argument("--retry-after", type=_seconds, default=1.0, metavar="S",
-                   help="send a task again after S seconds without an answer (default 1)")
+                   help="send a sale's tasks again after S seconds without its outcome, then after twice as "
+                        "long each time up to 4 S (default 1)")
     s.add_argument("--parallel-trades", type=at_least(1), default=PARALLEL, metavar="N",
                    help=f"carry out up to N sales of disjoint robots at once (default {PARALLEL}; 1: one after "
                         "the other)")
