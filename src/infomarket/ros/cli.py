@@ -12,6 +12,7 @@ from pathlib import Path
 
 from ..cliargs import at_least, seed_value
 from ..errors import report as report_error
+from .schedule import PARALLEL, WINDOW
 
 
 def _rpc_url(text: str) -> str:
@@ -123,7 +124,14 @@ def add_subcommand(subparsers) -> None:
     s.add_argument("--controller-timeout", type=_seconds, metavar="S",
                    help="controlled agents take the behaviour's decision after S seconds without an answer")
     s.add_argument("--retry-after", type=_seconds, default=1.0, metavar="S",
-                   help="send a task again after S seconds without an answer (default 1)")
+                   help="send a sale's tasks again after S seconds without its outcome, then after twice as "
+                        "long each time up to 4 S (default 1)")
+    s.add_argument("--parallel-trades", type=at_least(1), default=PARALLEL, metavar="N",
+                   help=f"carry out up to N sales of disjoint robots at once (default {PARALLEL}; 1: one after "
+                        "the other)")
+    s.add_argument("--window", type=at_least(0), default=WINDOW, metavar="STEPS",
+                   help=f"step the world up to STEPS steps past its earliest unfinished trade (default {WINDOW}; "
+                        "0: every trade of a step done before the next step)")
     s.set_defaults(func=run_swarm)
 
 
@@ -186,7 +194,8 @@ def run_swarm(args) -> int:
         return report_error(f"--controlled: robots are 0..{args.robots - 1}", 2)
     try:
         swarm = Swarm(config, params, args.seed, args.out, args.rpc, faults, per_process=args.agents_per_process,
-                      controlled=controlled, controller_timeout=args.controller_timeout, retry=args.retry_after)
+                      controlled=controlled, controller_timeout=args.controller_timeout, retry=args.retry_after,
+                      parallel=args.parallel_trades, window=args.window)
     except ConfigError as exc:
         return report_error(exc, 2)
     try:

@@ -1,7 +1,8 @@
 """Hostile messages, sent by the world before each sale when ``--fault hostile`` is given: a malformed
-offer, a forged offer (signed by a key that is not the seller's) and a replayed acceptance (the
-previous sale's, sent to its seller again). Each agent must refuse and log every one and go on; the
-ledger must still equal the engine's.
+offer, a forged offer (signed by a key that is not the seller's) and a replayed acceptance (one of an
+earlier step's sale, sent to its seller again: sales of disjoint robots run at once, so "earlier" is
+by the step of the sale, not by the order the acceptances were heard). Each agent must refuse and
+log every one and go on; the ledger must still equal the engine's.
 """
 from __future__ import annotations
 
@@ -27,12 +28,21 @@ class Hostile:
         self.accepts = [node.create_publisher(UInt8MultiArray, wire.acceptances(i), q)
                         for i in range(len(addresses))]
         self.last: dict[int, tuple[int, bytes]] = {}  # seller -> (step, the last acceptance it was sent)
+        self.steps: dict[int, int] = {}  # task id -> the step of its sale
         self.sent = 0
         for i in range(len(addresses)):
-            node.create_subscription(UInt8MultiArray, wire.acceptances(i),
-                                     lambda m, i=i: self.last.__setitem__(i, (world.step, bytes(m.data))), q)
+            node.create_subscription(UInt8MultiArray, wire.acceptances(i), lambda m, i=i: self._heard(i, m), q)
 
-    def __call__(self, buyer: int, seller: int, task_id: int, site: int, age: int) -> None:
+    def _heard(self, seller: int, msg) -> None:
+        data = bytes(msg.data)
+        try:
+            task_id, _ = wire.decode_acceptance(data)
+        except wire.WireError:
+            return  # one of its own hostile messages, or another's
+        if task_id in self.steps:
+            self.last[seller] = (self.steps[task_id], data)
+
+    def __call__(self, buyer: int, seller: int, task_id: int, site: int, age: int, step: int) -> None:
         def send(pub, data) -> None:
             pub.publish(self._Bytes(data=list(data)))
             self.sent += 1
@@ -42,7 +52,8 @@ class Hostile:
         sig = keys.PrivateKey(secrets.token_bytes(32)).sign_msg_hash(offer_digest(self.domain, offer))
         forged = sig.r.to_bytes(32, "big") + sig.s.to_bytes(32, "big") + bytes([sig.v + 27])
         send(self.offers[buyer], wire.encode_offer(task_id, offer, forged))  # forged: another key signed it
-        for old_seller, (step, data) in list(self.last.items()):
-            if step < self.world.step:  # a sale of an earlier step: over for its seller
+        self.steps[task_id] = step
+        for old_seller, (old_step, data) in list(self.last.items()):
+            if old_step < step:  # a sale of an earlier step: over for its seller
                 send(self.accepts[old_seller], data)  # replayed
                 break

@@ -27,11 +27,13 @@ from ..evm.units import to_units
 from . import launch
 from .faults import Faults
 from .hostile import Hostile
-from .world import RETRY, Trader, World
+from .schedule import PARALLEL, WINDOW
+from .trader import Trader
+from .world import RETRY, World
 
 
-#: Steps between two looks at the world's incoming messages when no trade waits for them (a trade spins
-#: until it is done). A look costs about as much as publishing a step (rclpy rebuilds its wait set of
+#: Steps between two looks at the world's incoming messages when no trade is under way (while one is,
+#: every step looks). A look costs about as much as publishing a step (rclpy rebuilds its wait set of
 #: every topic); messages wait meanwhile in their queues (100 deep), and between trades only stragglers
 #: arrive (a duplicate offer or outcome, to be counted).
 DRAIN_EVERY = 10
@@ -59,7 +61,7 @@ class Swarm:
 
     def __init__(self, config, params, seed: int, out: Path, rpc: str | None, faults: Faults, *,
                  per_process: int = 1, controlled: list[int] = (), controller_timeout: float | None = None,
-                 retry: float = RETRY):
+                 retry: float = RETRY, parallel: int = PARALLEL, window: int = WINDOW):
         self.config, self.params, self.seed, self.out, self.rpc, self.faults = config, params, seed, out, rpc, faults
         self.n = config.swarm.robots
         #: the robots each agent process hosts (one each by default)
@@ -68,7 +70,7 @@ class Swarm:
         for robots in self.groups:
             if 0 < len(self.controlled.intersection(robots)) < len(robots):
                 raise ConfigError(f"robots {robots} share an agent process: --controlled names all of them or none")
-        self.retry = retry
+        self.retry, self.parallel, self.window = retry, parallel, window
         self.node = None
         self.agents: list = []  # one process per group
         self.world = None
@@ -123,7 +125,8 @@ class Swarm:
             market.grant_wealth(a, to_units(self.config.payment.initial_wealth))
         if self.faults.hostile:
             world.hostile = Hostile(world, market.domain, addresses)
-        trader = Trader(world, market, addresses, self.params, on_wait=self._check, retry=self.retry)
+        trader = Trader(world, market, addresses, self.params, on_wait=self._check, retry=self.retry,
+                        parallel=self.parallel, window=self.window)
         sim = Simulation(self.config, self.seed, record_events=True)
         say(f"agents registered ({', '.join(str(p.pid) for p in self.agents)}) after {time.perf_counter() - t0:.1f} s; "
             f"running {self.config.steps} steps")
@@ -135,11 +138,12 @@ class Swarm:
             sim.step(1)
             w = sim.world
             world.publish_step(step, w.pos, headings(w), comm)
-            if step % DRAIN_EVERY == 0:
+            if step % DRAIN_EVERY == 0 and not trader.live:
                 world.spin(0)
             t2 = time.perf_counter()
             self.seconds["world"] += t2 - t1
             if self.faults.kill and step == self.faults.kill[1]:
+                trader.drain()  # the kill lands between sales, or in the middle of this robot's own
                 self._arm_kill(step, [int(w.ev_seller[k]) for k in range(seen, int(w.ev_count[0]))
                                       if EVENT_NAMES[int(w.ev_kind[k])] == "purchase"], say)
             for k in range(seen, int(w.ev_count[0])):
@@ -150,7 +154,11 @@ class Swarm:
                 if ev["kind"] in ("purchase", "refused", "deposit"):
                     trader.event(k, ev)
             seen = int(w.ev_count[0])
+            trader.wait(lambda: not trader.behind(step))  # noqa: B023 - called before the loop moves on
             self.seconds["trading"] += time.perf_counter() - t2
+        t3 = time.perf_counter()
+        trader.drain()
+        self.seconds["trading"] += time.perf_counter() - t3
         return self._report(sim.result(), trader, addresses, time.perf_counter() - t0)
 
     def _arm_kill(self, step: int, sellers: list[int], say) -> None:
@@ -185,6 +193,7 @@ class Swarm:
         open_chain = [[c[0] for c in market.contributors(a)] for a in addresses]
         open_engine = [[addresses[s] for s in sellers] for sellers in trader.open_sellers]
         sales = trader.sales
+        stepping = self.seconds["world"] + self.seconds["trading"]
         gas_total = sum(tally.reveal_gas) + sum(tally.deposit_gas)
         protocol = sum(tally.messages[k] for k in ("offer", "acceptance", "deposit", "task", "done"))
 
@@ -204,6 +213,9 @@ class Swarm:
             "gas": {"reveal_mean": avg(tally.reveal_gas), "deposit_mean": avg(tally.deposit_gas), "total": gas_total,
                     "per_sale": gas_total / sales if sales else None},
             "seconds_per_sale": avg(tally.sale_seconds),
+            "trades": trader.trades, "trades_per_second": round(trader.trades / stepping, 3) if stepping else None,
+            "parallel": {"limit": self.parallel, "window_steps": self.window,
+                         "most_running": trader.schedule.most_running},
             "refused_messages": len(tally.refused_messages),
             "refused_examples": [r.get("what", "") + ": " + r.get("reason", "") for r in tally.refused_messages[:10]],
             "disagreements": tally.disagreements,

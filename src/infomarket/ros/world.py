@@ -1,5 +1,6 @@
 """The engine as the world: it steps the simulation, publishes what the robots sense, and has the agents
-carry out the trades its behaviours decided, one at a time, before it takes the next step (lock step).
+carry out the trades its behaviours decided (``trader.py``), those of disjoint robots at once, each
+robot's in the engine's order (lock step, within a window of steps).
 
 Design: the decisions (who sells to whom, what, when a robot deposits) come from the engine, which
 runs the experiment's registered behaviours exactly as ``simulate`` does; the agents carry them out as
@@ -9,21 +10,19 @@ own controller would receive the same task messages from that controller instead
 always uses the engine's behaviours.)
 
 Each step: advance the engine one step; publish ``/clock`` and every robot's odometry and sensed
-neighbours; then for each ledger event of the step, in the engine's order, a sale (buy task to the
-buyer, sell task to the seller, wait for the seller's outcome) or a deposit (deposit task, wait for
-the robot's signature, co-sign as the nest, ``buyItem`` and ``settle``). A task without an answer is
-sent again every ``RETRY`` seconds: a dropped message or a restarted agent costs time, not money.
+neighbours; then hand the step's ledger events to the trader: a sale (buy task to the buyer, sell task
+to the seller, wait for the seller's outcome) or a deposit (deposit task, wait for the robot's
+signature, co-sign as the nest, ``buyItem`` and ``settle``). A task without an answer is sent again
+every ``RETRY`` seconds: a dropped message or a restarted agent costs time, not money.
 """
 from __future__ import annotations
 
 import json
 import math
-import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..evm.protocol import checksum, deposit_digest, sign_deposit
 from . import wire
 
 #: Seconds of ROS time one simulated step stands for (the /clock the world publishes).
@@ -152,105 +151,3 @@ class World:
     def close(self) -> None:
         self.node.destroy_node()
         self.rclpy.try_shutdown()
-
-
-class Trader:
-    """Carries out the engine's ledger events through the agents and the contract."""
-
-    def __init__(self, world: World, market, addresses: list[str], params, on_wait=None, retry: float = RETRY):
-        self.world, self.market, self.addresses, self.params = world, market, addresses, params
-        self.retry = retry
-        self.on_wait = on_wait or (lambda: None)
-        self.open_sellers: list[list[int]] = [[] for _ in addresses]
-        self.bound = [0] * len(addresses)
-        self.sales = 0
-
-    def _until(self, done, resend) -> None:
-        """Spin until ``done()``; ``resend()`` every ``retry`` seconds meanwhile."""
-        resend()
-        last = time.monotonic()
-        while not done():
-            self.world.spin()
-            self.on_wait()
-            if time.monotonic() - last > self.retry:
-                self.world.tally.retries += 1
-                resend()
-                last = time.monotonic()
-
-    def event(self, task_id: int, ev: dict) -> None:
-        if ev["kind"] == "deposit":
-            return self.deposit(task_id, int(ev["buyer"]), int(ev["step"]))
-        return self.sale(task_id, ev)
-
-    def sale(self, task_id: int, ev: dict) -> None:
-        buyer, seller = int(ev["buyer"]), int(ev["seller"])
-        common = {"id": task_id, "step": int(ev["step"]), "site": int(ev["site"]), "age": int(ev["age"]),
-                  "buyer": buyer, "seller": seller, "buyer_address": self.addresses[buyer],
-                  "seller_address": self.addresses[seller]}
-        buy = {**common, "kind": "buy", "seller_x": float(ev["seller_x"]), "seller_y": float(ev["seller_y"])}
-        sell = {**common, "kind": "sell", "x": float(ev["x"]), "y": float(ev["y"])}
-        if self.world.hostile is not None:
-            self.world.hostile(buyer, seller, task_id, common["site"], common["age"])
-
-        def resend():
-            self.world.send_task(buyer, buy)
-            self.world.send_task(seller, sell)
-
-        t0 = time.perf_counter()
-        self._until(lambda: task_id in self.world.outcomes, resend)
-        out = self.world.outcomes[task_id]
-        if out.get("declined"):  # the robot's controller overruled the behaviour: the ledgers part here
-            self.world.tally.declined += 1
-            self.world.tally.disagreements.append(
-                f"step {ev['step']}: the {out['declined']}'s controller declined the sale of robot {seller} to "
-                f"robot {buyer} (the engine {'refused' if ev['kind'] == 'refused' else 'made'} it)")
-            return
-        expected_refusal = ev["kind"] == "refused"
-        if bool(out.get("refused")) != expected_refusal or out.get("error"):
-            self.world.tally.disagreements.append(
-                f"step {ev['step']}: the engine {'refused' if expected_refusal else 'made'} a sale of robot {seller} "
-                f"to robot {buyer}; on chain it was {'refused' if out.get('refused') else 'made'} "
-                f"{out.get('error', '')}")
-        if out.get("refused"):
-            self.world.tally.refusals_confirmed += expected_refusal
-            return
-        self.sales += 1
-        self.world.tally.sale_seconds.append(time.perf_counter() - t0)
-        if out.get("gas"):
-            self.world.tally.reveal_gas.append(int(out["gas"]))
-        self.open_sellers[buyer].append(seller)
-
-    def deposit(self, task_id: int, robot: int, step: int) -> None:
-        address = self.addresses[robot]
-        task = {"id": task_id, "step": step, "kind": "deposit", "robot": robot}
-        self._until(lambda: self._good_signature(task_id, address), lambda: self.world.send_task(robot, task))
-        _, trip, vrs = self.world.signed[task_id]
-        nest = self.market.nest
-        evidence = (*vrs, *sign_deposit(nest.key, self.market.domain, address, trip))
-        results = [self.market.buy_item(address, evidence=evidence)]
-        while self.market.pending_settlement(address)[0]:
-            results.append(self.market.settle(address))
-        self.world.tally.deposit_gas.append(sum(r.gas_used for r in results))
-        sellers = self.open_sellers[robot]
-        self.bound[robot] += len(sellers)  # each share floored: under a unit per share, either side
-        for s in sellers:
-            self.bound[s] += 1
-        self.open_sellers[robot] = []
-
-    def _good_signature(self, task_id: int, address: str) -> bool:
-        """The robot's deposit signature arrived and is its own (anything else is dropped and awaited again)."""
-        got = self.world.signed.get(task_id)
-        if got is None:
-            return False
-        robot, trip, (v, r, s) = got
-        from eth_account import Account
-
-        try:
-            signer = Account._recover_hash(deposit_digest(self.market.domain, robot, trip),
-                                           vrs=(v, int.from_bytes(r, "big"), int.from_bytes(s, "big")))
-        except Exception:  # noqa: BLE001 - any bad signature is one the robot did not make
-            signer = None
-        if robot != checksum(address) or signer != robot or trip != self.market.round_trip(address):
-            del self.world.signed[task_id]
-            return False
-        return True
