@@ -53,6 +53,12 @@ NOT_RUN = {
         "as above; tests/ros/test_swarm.py drops a fifth of the agents' messages",
     "infomarket ros swarm fig4C --robots 3 --steps 750 --seed 18 --out runs/declined --controlled all "
     "--agents-per-process 3": "needs the example controller running; tests/ros/test_controller.py runs it",
+    "infomarket ros swarm fig4C --robots 25 --steps 300 --seed 3 --agents-per-process 5 --out runs/at-once":
+        "25 agents in 5 processes and a chain node for minutes; tests/ros/test_schedule.py checks the rule",
+    "infomarket ros swarm fig4C --robots 25 --steps 300 --seed 3 --agents-per-process 5 --out runs/in-order "
+    "--parallel-trades 1 --window 0": "as above, trades one at a time (the lock step tests/ros/test_swarm.py runs)",
+    "infomarket ros swarm fig4C --robots 25 --steps 15000 --seed 3 --agents-per-process 5 --out runs/long":
+        "hours of trades (docs/ros.md estimates 3 to 5); not run anywhere yet",
     "infomarket bench --scaling": "96 timed runs; tests/bench runs the same code with 2 runs of 200 steps",
     "infomarket sweep future --out results/future --workers 1":
         "4 736 runs of 30 000 steps; tests/test_commands.py plans it and its --scale",

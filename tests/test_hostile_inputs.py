@@ -141,7 +141,7 @@ def test_rl_train_takes_every_defence_the_search_takes():
     (["--defence", ""], ["--defence ''", "at least one defence"]),
     (["--defence", " , "], ["--defence ' , '", "at least one defence"]),
     (["--byzantines", ""], ["--byzantines ''", "at least one count"]),
-    (["--race", "8,8"], ["race = [8, 8]", "each above the one before"]),
+    (["--race", "8,8"], ["race:", "each above the one before", "(got [8, 8])"]),
 ])
 def test_attack_search_refuses_before_writing(extra, words, tmp_path, monkeypatch, capsys):
     import infomarket.search.driver

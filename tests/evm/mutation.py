@@ -268,11 +268,11 @@ def main(words: list[str] | None = None) -> int:
     variants = []
     for check, condition, tests in MUTANTS:
         pattern = re.compile(r"if \(" + re.escape(condition) + r"\)(\s*\{?\s*)revert")
-        edit = lambda text, pattern=pattern: pattern.subn(r"if (false)\1revert", text)  # noqa: E731
+        edit = lambda text, pattern=pattern: pattern.subn(r"if (false)\1revert", text)  # noqa: E731 - binds the pattern
         variants.append(("without: " + check, *patch(original, edit), tests))
     for rule, old, new, tests in REWRITES:
         if tests:
-            edit = lambda text, old=old, new=new: (text.replace(old, new), text.count(old))  # noqa: E731
+            edit = lambda text, old=old, new=new: (text.replace(old, new), text.count(old))  # noqa: E731 - binds texts
             variants.append(("broken: " + rule, *patch(original, edit), tests))
     if words:
         variants = [v for v in variants if any(w in v[0] for w in words)]

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import pytest
 
+from infomarket.errors import InternalError
 from infomarket.ros.schedule import Job, Schedule
 from infomarket.ros.trader import Trader
 from infomarket.ros.world import Tally
@@ -62,14 +63,14 @@ def test_the_limit_bounds_the_sales_running_and_one_runs_them_in_order():
     one = schedule(1, (0, {0, 1}), (1, {2, 3}))
     assert keys(one.start()) == [0]
     assert one.start() == []
-    with pytest.raises(ValueError):
+    with pytest.raises(InternalError):
         Schedule(0)
 
 
 def test_jobs_come_in_the_engines_order_and_the_oldest_step_is_known():
     s = Schedule(4)
     s.add(Job(5, 3, frozenset({0, 1})))
-    with pytest.raises(ValueError):
+    with pytest.raises(InternalError):
         s.add(Job(4, 3, frozenset({2, 3})))
     s.add(Job(6, 4, frozenset({0, 2})))
     assert s.unfinished() == 2 and s.oldest_step() == 3

@@ -199,9 +199,10 @@ def test_a_pending_defence_waits_for_its_scheme(tmp_path, capsys, monkeypatch):
     unregistered it is refused, saying which scheme it waits for; registered, it is a cell."""
     import infomarket as im
 
-    declared = study.load_declarations()
+    declared = study.DECLARATION
     pending = {"later": {"requires": "outlier_distinct", "set": {"payment.scheme": "outlier_distinct"}}}
-    monkeypatch.setattr(study, "load_declarations", lambda: {**declared, "pending_defences": pending})
+    monkeypatch.setattr(study, "DECLARATION", replace(
+        declared, data={**declared.data, "pending_defences": pending}))
     registered = study.payments()
     monkeypatch.setattr(study, "payments", lambda: {k: v for k, v in registered.items() if k != "outlier_distinct"})
     out = tmp_path / "never"

@@ -19,6 +19,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..errors import InternalError
+
 #: Trades unfinished at once (waiting or running) at most: the world stops stepping until fewer are.
 QUEUE = 64
 #: Sales running at once at most (``--parallel-trades``); 1 runs them one after the other.
@@ -43,7 +45,7 @@ class Schedule:
 
     def __init__(self, limit: int):
         if limit < 1:
-            raise ValueError("at least one trade must be able to run")
+            raise InternalError("at least one trade must be able to run")
         self.limit = limit
         self.waiting: list[Job] = []  # in the engine's order
         self.running: dict[int, Job] = {}
@@ -51,7 +53,7 @@ class Schedule:
 
     def add(self, job: Job) -> None:
         if self.waiting and job.key <= self.waiting[-1].key:
-            raise ValueError(f"job {job.key} is not after job {self.waiting[-1].key} in the engine's order")
+            raise InternalError(f"job {job.key} is not after job {self.waiting[-1].key} in the engine's order")
         self.waiting.append(job)
 
     def start(self) -> list[Job]:
